@@ -1,0 +1,21 @@
+"""Errors a user can cause by what they give the simulator.
+
+Every error here ends start-up with exit code 2 and one line of text that
+names the file, field or parameter and what is wrong with it.
+"""
+
+
+class ConfigurationError(Exception):
+    """A user-supplied file or parameter is wrong; the message says how."""
+
+
+class DescriptionError(ConfigurationError):
+    """The robot description (URDF/xacro, meshes) cannot be used."""
+
+
+class ControllerConfigError(ConfigurationError):
+    """The controllers file cannot be used."""
+
+
+class ParameterError(ConfigurationError):
+    """A node parameter has a wrong type or value."""
