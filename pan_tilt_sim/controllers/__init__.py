@@ -1,0 +1,20 @@
+"""Pure-Python controllers, one type per module, built from controller YAML."""
+
+from pan_tilt_sim.controllers.base import (
+    CommandController,
+    CommandKind,
+    CommandResult,
+    Controller,
+    JointHandle,
+)
+from pan_tilt_sim.controllers.registry import create_controller, supported_types
+
+__all__ = [
+    'CommandController',
+    'CommandKind',
+    'CommandResult',
+    'Controller',
+    'JointHandle',
+    'create_controller',
+    'supported_types',
+]

@@ -1,0 +1,131 @@
+"""The small base every controller stands on (after ros2_control's ControllerInterface).
+
+A controller is pure Python: it is built from its YAML parameters, then
+:meth:`Controller.configure` hands it the :class:`JointHandle` objects of
+the joints it names, and :meth:`Controller.update` runs once per physics
+step.  Handles carry the measured state (written by the simulation before
+each update) and the effort command (written by the controller, read by the
+simulation after it).  Controllers never touch PyBullet or rclpy.
+"""
+
+from __future__ import annotations
+
+import abc
+import enum
+import math
+from collections.abc import Mapping
+from typing import Any, ClassVar
+
+from pan_tilt_sim.description import JointSpec
+from pan_tilt_sim.errors import ControllerConfigError
+
+
+class JointHandle:
+    """State and effort command of one joint, shared by simulation and controllers."""
+
+    __slots__ = ('spec', 'position', 'velocity', 'effort')
+
+    def __init__(self, spec: JointSpec) -> None:
+        self.spec = spec
+        self.position = spec.initial_position
+        self.velocity = 0.0
+        self.effort = 0.0
+
+    @property
+    def name(self) -> str:
+        """The joint's URDF name."""
+        return self.spec.name
+
+    def reset(self) -> None:
+        """Return to the joint's initial state (at rest, no effort)."""
+        self.position = self.spec.initial_position
+        self.velocity = 0.0
+        self.effort = 0.0
+
+
+class CommandKind(enum.Enum):
+    """What a command controller's topic carries (the node maps kinds to message types)."""
+
+    FLOAT64 = 'std_msgs/msg/Float64'
+
+
+class CommandResult(enum.Enum):
+    """What became of one command value."""
+
+    ACCEPTED = 'accepted'
+    CLAMPED = 'clamped'
+    REJECTED = 'rejected'
+
+
+class Controller(abc.ABC):
+    """Base of every controller type; subclasses list their YAML ``type`` strings."""
+
+    type_names: ClassVar[tuple[str, ...]] = ()
+
+    def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
+        self.name = name
+        self.params = params
+        self._source = source
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """The joints this controller claims (commands them exclusively)."""
+        return ()
+
+    @abc.abstractmethod
+    def configure(self, joints: Mapping[str, JointHandle]) -> None:
+        """Take the handles of the joints this controller uses."""
+
+    @abc.abstractmethod
+    def update(self, time: float, period: float) -> None:
+        """Run one control step at sim ``time`` (s), ``period`` s after the previous one."""
+
+    def reset(self) -> None:  # noqa: B027 -- stateless controllers need no reset
+        """Forget commands and internal state, as after a fresh start."""
+
+    def error(self, field: str, problem: str) -> ControllerConfigError:
+        """Return an error naming this controller's field in the controllers file."""
+        where = f'{self._source}: ' if self._source else ''
+        return ControllerConfigError(f'{where}{self.name}.{field}: {problem}')
+
+    def handle(self, joints: Mapping[str, JointHandle], joint: str, field: str) -> JointHandle:
+        """Look up ``joint``; the error lists the joints that exist."""
+        try:
+            return joints[joint]
+        except KeyError:
+            existing = ', '.join(sorted(joints)) or 'none'
+            raise self.error(
+                field, f"joint '{joint}' is not a movable joint of the robot "
+                f'(movable joints: {existing})') from None
+
+    def required_joint(self) -> str:
+        """Return the ``joint`` parameter, which must be a non-empty string."""
+        joint = self.params.get('joint')
+        if not isinstance(joint, str) or not joint:
+            raise self.error('joint', 'missing: name the joint this controller drives')
+        return joint
+
+
+class CommandController(Controller):
+    """A controller that takes commands from a topic ``<controller>/<command_topic>``."""
+
+    command_topic: ClassVar[str] = 'command'
+    command_kind: ClassVar[CommandKind] = CommandKind.FLOAT64
+
+    @abc.abstractmethod
+    def set_command(self, value: Any) -> CommandResult:
+        """Store the latest command (called from subscriptions; must be cheap)."""
+
+
+def clamp(value: float, lower: float, upper: float) -> float:
+    """Limit ``value`` to [lower, upper]."""
+    return lower if value < lower else upper if value > upper else value
+
+
+def bounded_command(value: float, lower: float, upper: float) -> tuple[float, CommandResult]:
+    """Check a scalar command: non-finite is rejected, out-of-range is clamped."""
+    if not math.isfinite(value):
+        return value, CommandResult.REJECTED
+    if value < lower or value > upper:
+        return clamp(value, lower, upper), CommandResult.CLAMPED
+    return value, CommandResult.ACCEPTED

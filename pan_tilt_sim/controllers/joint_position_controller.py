@@ -1,0 +1,81 @@
+"""``position_controllers/`` and ``effort_controllers/JointPositionController``.
+
+The command (rad or m) becomes a setpoint that is clamped to the joint's
+position limits and ramps toward the command no faster than the velocity
+limit; a PID on the position error, with the derivative on the measured
+velocity, gives the joint effort, clamped to the effort limit.  Until the
+first command arrives the setpoint is the joint's position at start, so the
+joint holds still.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from pan_tilt_sim.controllers.base import CommandController, CommandResult, JointHandle
+from pan_tilt_sim.controllers.gains import gains_from_params
+from pan_tilt_sim.controllers.limits import PositionLimits, clamp_effort
+from pan_tilt_sim.controllers.pid import Pid, PidGains
+
+# The seed's gains, used when the YAML gives none: with the seed's damping
+# they track critically damped or slower for link inertias up to ~10 kg m^2.
+DEFAULT_POSITION_GAINS = PidGains(p=100.0, i=0.01, d=10.0)
+
+
+class JointPositionController(CommandController):
+    """Position setpoint -> effort, through a PID."""
+
+    type_names = ('position_controllers/JointPositionController',
+                  'effort_controllers/JointPositionController')
+
+    def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
+        super().__init__(name, params, source)
+        self._joint_name = self.required_joint()
+        self._gains = gains_from_params(self, DEFAULT_POSITION_GAINS)
+        self._handle: JointHandle | None = None
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """The one joint this controller drives."""
+        return (self._joint_name,)
+
+    @property
+    def pid(self) -> Pid:
+        """The PID (its gains may be changed live)."""
+        return self._pid
+
+    @property
+    def setpoint(self) -> float:
+        """The rate-limited position setpoint the PID tracks now."""
+        return self._setpoint
+
+    def configure(self, joints: Mapping[str, JointHandle]) -> None:
+        """Bind the joint, its limits and a PID whose integral is bounded by the effort limit."""
+        handle = self.handle(joints, self._joint_name, 'joint')
+        self._handle = handle
+        self._limits = PositionLimits(handle.spec)
+        self._effort_limit = handle.spec.effort_limit
+        self._pid = Pid(self._gains.with_default_clamp(self._effort_limit))
+        self.reset()
+
+    def reset(self) -> None:
+        """Hold the joint where it is; forget commands and the integral."""
+        self._setpoint = self._handle.position
+        self._command = self._setpoint
+        self._pid.reset()
+
+    def set_command(self, value: float) -> CommandResult:
+        """Store a position command (clamped to the limits; NaN/Inf rejected)."""
+        value, result = self._limits.check(value)
+        if result is not CommandResult.REJECTED:
+            self._command = value
+        return result
+
+    def update(self, time: float, period: float) -> None:
+        """Ramp the setpoint, then compute and clamp the effort."""
+        handle = self._handle
+        setpoint = self._limits.ramp(self._setpoint, self._command, period)
+        self._setpoint = setpoint
+        effort = self._pid.compute(setpoint, handle.position, period, handle.velocity)
+        handle.effort = clamp_effort(effort, self._effort_limit)

@@ -1,0 +1,86 @@
+"""``joint_state_controller/JointStateController`` (ROS 2: joint_state_broadcaster).
+
+Every ``1 / publish_rate`` seconds of sim time it hands a sample of every
+movable joint -- name, position, velocity, effort -- to its sink (the node
+turns that into a ``sensor_msgs/msg/JointState`` stamped with sim time).
+The sample's lists are reused from call to call; a sink must copy them.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+from pan_tilt_sim.controllers.base import Controller, JointHandle
+
+DEFAULT_PUBLISH_RATE = 50.0  # Hz, as in the seeds' YAML
+# Tolerance on "publication due" so float sim times do not skip a sample.
+DUE_EPSILON = 1e-9
+
+JointStateSink = Callable[[float, Sequence[str], Sequence[float], Sequence[float],
+                           Sequence[float]], None]
+
+
+class JointStateController(Controller):
+    """Periodic snapshots of all movable joints."""
+
+    type_names = ('joint_state_controller/JointStateController',
+                  'joint_state_broadcaster/JointStateBroadcaster')
+
+    def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
+        super().__init__(name, params, source)
+        rate = params.get('publish_rate', DEFAULT_PUBLISH_RATE)
+        if isinstance(rate, bool) or not isinstance(rate, int | float) or not (
+                math.isfinite(rate) and rate > 0.0):
+            raise self.error('publish_rate', f'{rate!r} must be a number of Hz > 0')
+        self.publish_period = 1.0 / float(rate)
+        self._sink: JointStateSink | None = None
+        self._handles: list[JointHandle] = []
+
+    @property
+    def publish_rate(self) -> float:
+        """Samples per second of sim time."""
+        return 1.0 / self.publish_period
+
+    def set_sink(self, sink: JointStateSink | None) -> None:
+        """Where samples go: ``sink(time, names, positions, velocities, efforts)``."""
+        self._sink = sink
+
+    def configure(self, joints: Mapping[str, JointHandle]) -> None:
+        """Take every movable joint, in the description's order."""
+        self._handles = list(joints.values())
+        self.names = [handle.name for handle in self._handles]
+        count = len(self._handles)
+        self.positions = [0.0] * count
+        self.velocities = [0.0] * count
+        self.efforts = [0.0] * count
+        self.reset()
+
+    def reset(self) -> None:
+        """Publish at the next update, then every period."""
+        self._published = 0
+        self._next_due = 0.0
+
+    def time_of_next_sample(self) -> float:
+        """Sim time (s) at which the next sample is due."""
+        return self._next_due
+
+    def update(self, time: float, period: float) -> None:
+        """Hand a sample to the sink when one is due."""
+        if time + DUE_EPSILON < self._next_due:
+            return
+        self._published += 1
+        # Count periods from zero, so no rounding error accumulates.
+        self._next_due = self._published * self.publish_period
+        while self._next_due <= time + DUE_EPSILON:
+            self._published += 1
+            self._next_due = self._published * self.publish_period
+        if self._sink is None:
+            return
+        positions, velocities, efforts = self.positions, self.velocities, self.efforts
+        for index, handle in enumerate(self._handles):
+            positions[index] = handle.position
+            velocities[index] = handle.velocity
+            efforts[index] = handle.effort
+        self._sink(time, self.names, positions, velocities, efforts)

@@ -1,0 +1,40 @@
+"""Maps the YAML ``type`` strings to controller classes."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from pan_tilt_sim.controllers.base import Controller
+from pan_tilt_sim.controllers.joint_effort_controller import JointEffortController
+from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
+from pan_tilt_sim.controllers.joint_state_controller import JointStateController
+from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
+from pan_tilt_sim.errors import ControllerConfigError
+
+CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
+    JointStateController,
+    JointPositionController,
+    JointVelocityController,
+    JointEffortController,
+)
+
+CONTROLLER_TYPES: dict[str, type[Controller]] = {
+    type_name: cls for cls in CONTROLLER_CLASSES for type_name in cls.type_names}
+
+
+def supported_types() -> list[str]:
+    """Return every YAML ``type`` string the simulator understands, sorted."""
+    return sorted(CONTROLLER_TYPES)
+
+
+def create_controller(name: str, type_name: Any, params: Mapping[str, Any],
+                      source: str = '') -> Controller:
+    """Build the controller ``name`` of ``type_name``; unknown types list the supported ones."""
+    cls = CONTROLLER_TYPES.get(type_name) if isinstance(type_name, str) else None
+    if cls is None:
+        where = f'{source}: ' if source else ''
+        raise ControllerConfigError(
+            f"{where}{name}.type: unknown controller type '{type_name}' "
+            f"(supported: {', '.join(supported_types())})")
+    return cls(name, params, source)

@@ -1,0 +1,168 @@
+"""sim_node's parameters: declared with descriptions, read, type-coerced and validated.
+
+Users type ``-p real_time_factor:=0`` and ``-p time_step:=1e-3`` without
+thinking about types, so a double parameter also takes an integer (rclpy
+would otherwise raise InvalidParameterTypeException): those parameters are
+declared with dynamic typing, and this module checks and converts the type
+itself, naming the parameter and the type it wants when it is wrong.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import pathlib
+import sys
+from typing import Any
+
+from rcl_interfaces.msg import ParameterDescriptor, ParameterType
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+from pan_tilt_sim.errors import ParameterError
+from pan_tilt_sim.naming import check_namespace
+
+PACKAGE_NAME = 'pan_tilt_sim'
+DEFAULT_DESCRIPTION = pathlib.Path('urdf', 'pan_tilt.xacro')
+DEFAULT_CONTROLLERS = pathlib.Path('config', 'pan_tilt_control.yaml')
+DEFAULT_TIME_STEP = 0.001  # s, PyBullet's recommended range is 1/1000 .. 1/240
+MAX_TIME_STEP = 0.1  # s; beyond this the PID loop is meaningless
+DEFAULT_REAL_TIME_FACTOR = 1.0
+
+
+def package_share() -> pathlib.Path:
+    """Locate ``share/pan_tilt_sim`` (ament index, this prefix, or the source tree)."""
+    try:
+        from ament_index_python.packages import get_package_share_directory
+
+        return pathlib.Path(get_package_share_directory(PACKAGE_NAME))
+    except (ImportError, LookupError, OSError):
+        # Not indexed (AMENT_PREFIX_PATH unset or without us): try where pip
+        # puts data files, then the source checkout this module lives in.
+        installed = pathlib.Path(sys.prefix, 'share', PACKAGE_NAME)
+        if installed.is_dir():
+            return installed
+        return pathlib.Path(__file__).resolve().parents[1]
+
+
+@dataclasses.dataclass(frozen=True)
+class _Spec:
+    name: str
+    type: int
+    default: Any
+    description: str
+    read_only: bool = True
+
+
+_TYPE_NAMES = {
+    ParameterType.PARAMETER_BOOL: 'bool',
+    ParameterType.PARAMETER_INTEGER: 'integer',
+    ParameterType.PARAMETER_DOUBLE: 'double',
+    ParameterType.PARAMETER_STRING: 'string',
+    ParameterType.PARAMETER_STRING_ARRAY: 'string array',
+}
+
+
+def _specs() -> tuple[_Spec, ...]:
+    share = package_share()
+    return (
+        _Spec('robot_description_file', ParameterType.PARAMETER_STRING,
+              str(share / DEFAULT_DESCRIPTION), 'A .urdf or .xacro file describing the robot.'),
+        _Spec('xacro_args', ParameterType.PARAMETER_STRING_ARRAY, [''],
+              "xacro mappings for a .xacro description, each 'name:=value'."),
+        _Spec('controllers_file', ParameterType.PARAMETER_STRING,
+              str(share / DEFAULT_CONTROLLERS),
+              'Controller YAML (ROS 1 rosparam style or ros2_control style).'),
+        _Spec('time_step', ParameterType.PARAMETER_DOUBLE, DEFAULT_TIME_STEP,
+              'Physics step in seconds of sim time (0 < time_step <= 0.1).'),
+        _Spec('real_time_factor', ParameterType.PARAMETER_DOUBLE, DEFAULT_REAL_TIME_FACTOR,
+              'Sim seconds per wall second; 0 runs as fast as the machine allows.',
+              read_only=False),
+        _Spec('paused', ParameterType.PARAMETER_BOOL, False,
+              'Hold the physics (topics stay alive).', read_only=False),
+        _Spec('gui', ParameterType.PARAMETER_BOOL, False,
+              'Open a PyBullet window (needs a display); false is headless DIRECT mode.'),
+        _Spec('robot_namespace', ParameterType.PARAMETER_STRING, '',
+              "Namespace of the robot's topics; empty = derived from the node namespace, "
+              'the controllers file or the gazebo_ros_control plugin.'),
+    )
+
+
+@dataclasses.dataclass(frozen=True)
+class SimParameters:
+    """sim_node's parameters, checked."""
+
+    robot_description_file: str
+    xacro_args: tuple[str, ...]
+    controllers_file: str
+    time_step: float
+    real_time_factor: float
+    paused: bool
+    gui: bool
+    robot_namespace: str
+
+
+def declare_parameters(node: Node) -> SimParameters:
+    """Declare every parameter on ``node`` and return their checked values."""
+    values = {}
+    for spec in _specs():
+        descriptor = ParameterDescriptor(
+            name=spec.name, type=spec.type, description=spec.description,
+            read_only=spec.read_only,
+            # Doubles accept integers; the type is checked by coerce() instead.
+            dynamic_typing=spec.type == ParameterType.PARAMETER_DOUBLE)
+        parameter = node.declare_parameter(spec.name, spec.default, descriptor)
+        values[spec.name] = coerce(spec.name, spec.type, parameter.value)
+    values['xacro_args'] = tuple(arg for arg in values['xacro_args'] if arg)
+    checked = SimParameters(**values)
+    check_time_step(checked.time_step)
+    check_real_time_factor(checked.real_time_factor)
+    check_namespace('robot_namespace', checked.robot_namespace)
+    return checked
+
+
+def coerce(name: str, wanted: int, value: Any) -> Any:
+    """Return ``value`` as parameter type ``wanted``.
+
+    Integers pass for doubles; otherwise the type must match.
+    """
+    if wanted == ParameterType.PARAMETER_DOUBLE and isinstance(value, int) and not isinstance(
+            value, bool):
+        return float(value)
+    ok = {
+        ParameterType.PARAMETER_BOOL: lambda v: isinstance(v, bool),
+        ParameterType.PARAMETER_DOUBLE: lambda v: isinstance(v, float),
+        ParameterType.PARAMETER_STRING: lambda v: isinstance(v, str),
+        ParameterType.PARAMETER_STRING_ARRAY: lambda v: isinstance(v, list | tuple) and all(
+            isinstance(item, str) for item in v),
+    }[wanted](value)
+    if not ok:
+        raise ParameterError(
+            f"parameter '{name}' must be a {_TYPE_NAMES[wanted]}, got {_describe(value)}")
+    return list(value) if wanted == ParameterType.PARAMETER_STRING_ARRAY else value
+
+
+def check_time_step(value: float) -> None:
+    """``time_step`` must lie in (0, MAX_TIME_STEP]."""
+    if not (math.isfinite(value) and 0.0 < value <= MAX_TIME_STEP):
+        raise ParameterError(
+            f"parameter 'time_step' must be > 0 and <= {MAX_TIME_STEP} s, got {value}")
+
+
+def check_real_time_factor(value: float) -> None:
+    """``real_time_factor`` must be finite and >= 0."""
+    if not (math.isfinite(value) and value >= 0.0):
+        raise ParameterError(
+            f"parameter 'real_time_factor' must be a finite number >= 0, got {value}")
+
+
+def runtime_value(parameter: Parameter) -> Any:
+    """Return a parameter set at run time, coerced to the type it was declared with."""
+    spec = {spec.name: spec for spec in _specs()}[parameter.name]
+    return coerce(parameter.name, spec.type, parameter.value)
+
+
+def _describe(value: Any) -> str:
+    kind = {bool: 'bool', int: 'integer', float: 'double', str: 'string'}.get(
+        type(value), type(value).__name__)
+    return f'{kind} {value!r}'

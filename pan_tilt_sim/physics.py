@@ -1,0 +1,165 @@
+"""The physics layer: one PyBullet client, one robot, joints driven by torque.
+
+:class:`Physics` owns its own PyBullet client id (never the global default
+client), so several simulations can live in one process.  The robot is
+loaded with a fixed base and the URDF's inertia; PyBullet's default velocity
+motors are switched off, so every actuated joint moves only by the torque
+the controllers ask for.  URDF ``damping`` is applied by PyBullet itself as
+viscous torque; URDF ``friction`` is modelled as Coulomb friction by a
+velocity motor held at zero speed whose force is capped at the friction
+value, which also gives the static friction Gazebo users know.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import pathlib
+import tempfile
+from collections.abc import Iterator, Sequence
+
+from pan_tilt_sim.description import JointSpec, RobotDescription
+from pan_tilt_sim.errors import DescriptionError
+
+STANDARD_GRAVITY = 9.81  # m/s^2, along -z as in Gazebo's default world
+URDF_FILE_NAME = 'robot.urdf'
+# Index of the position and velocity in one entry of pybullet.getJointStates.
+STATE_POSITION = 0
+STATE_VELOCITY = 1
+
+
+@contextlib.contextmanager
+def quiet_native_output() -> Iterator[None]:
+    """Silence C-level stdout/stderr (PyBullet's build banner and loader chatter)."""
+    saved = []
+    try:
+        with open(os.devnull, 'wb') as devnull:
+            for fd in (1, 2):
+                saved.append((fd, os.dup(fd)))
+                os.dup2(devnull.fileno(), fd)
+            yield
+    finally:
+        for fd, copy in saved:
+            os.dup2(copy, fd)
+            os.close(copy)
+
+
+# PyBullet prints its build banner on stderr when imported; users see one line.
+with quiet_native_output():
+    import pybullet  # noqa: E402
+
+
+class Physics:
+    """A PyBullet world holding one fixed-base robot."""
+
+    def __init__(self, description: RobotDescription, time_step: float, *,
+                 gui: bool = False) -> None:
+        self._description = description
+        self._time_step = time_step
+        self._workdir = tempfile.TemporaryDirectory(prefix='pan_tilt_sim_')
+        mode = pybullet.GUI if gui else pybullet.DIRECT
+        with quiet_native_output():
+            self._client = pybullet.connect(mode)
+        if self._client < 0:
+            self._workdir.cleanup()
+            raise DescriptionError('PyBullet: cannot connect a physics client')
+        try:
+            self._body = self._load(description)
+        except BaseException:
+            self.close()
+            raise
+        self._joints = description.actuated_joints
+        index_of = self._joint_indices()
+        self._indices = [index_of[joint.name] for joint in self._joints]
+        self._torque_mode = pybullet.TORQUE_CONTROL
+        self._configure_motors()
+        self.reset_joints([joint.initial_position for joint in self._joints])
+
+    @property
+    def client_id(self) -> int:
+        """The PyBullet client id this object owns."""
+        return self._client
+
+    @property
+    def body_id(self) -> int:
+        """The PyBullet body id of the robot."""
+        return self._body
+
+    @property
+    def time_step(self) -> float:
+        """Seconds of simulated time per :meth:`step`."""
+        return self._time_step
+
+    @property
+    def joints(self) -> tuple[JointSpec, ...]:
+        """The actuated joints, in the order of every array this class takes or gives."""
+        return self._joints
+
+    def joint_index(self, name: str) -> int:
+        """PyBullet's index of the joint called ``name``."""
+        return self._indices[[joint.name for joint in self._joints].index(name)]
+
+    def read_states(self) -> list:
+        """``pybullet.getJointStates`` for the actuated joints: (position, velocity, ...)."""
+        return pybullet.getJointStates(self._body, self._indices, physicsClientId=self._client)
+
+    def step(self, efforts: Sequence[float]) -> list:
+        """Apply ``efforts`` (N*m or N), advance one time step, return the new states."""
+        client = self._client
+        pybullet.setJointMotorControlArray(
+            self._body, self._indices, self._torque_mode, forces=efforts,
+            physicsClientId=client)
+        pybullet.stepSimulation(physicsClientId=client)
+        return pybullet.getJointStates(self._body, self._indices, physicsClientId=client)
+
+    def reset_joints(self, positions: Sequence[float]) -> None:
+        """Put every actuated joint at ``positions`` with zero velocity."""
+        for index, position in zip(self._indices, positions, strict=True):
+            pybullet.resetJointState(
+                self._body, index, position, targetVelocity=0.0, physicsClientId=self._client)
+
+    def close(self) -> None:
+        """Disconnect the PyBullet client and remove temporary files (idempotent)."""
+        if self._client >= 0:
+            with contextlib.suppress(pybullet.error):
+                pybullet.disconnect(physicsClientId=self._client)
+            self._client = -1
+        self._workdir.cleanup()
+
+    def __enter__(self) -> Physics:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
+
+    def _load(self, description: RobotDescription) -> int:
+        client = self._client
+        pybullet.setGravity(0.0, 0.0, -STANDARD_GRAVITY, physicsClientId=client)
+        pybullet.setTimeStep(self._time_step, physicsClientId=client)
+        urdf_path = pathlib.Path(self._workdir.name) / URDF_FILE_NAME
+        urdf_path.write_text(description.urdf_xml, encoding='utf-8')
+        try:
+            with quiet_native_output():
+                return pybullet.loadURDF(
+                    str(urdf_path), useFixedBase=True,
+                    flags=pybullet.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client)
+        except pybullet.error as err:
+            raise DescriptionError(
+                f'{description.source}: PyBullet cannot load the robot: {err}') from None
+
+    def _joint_indices(self) -> dict[str, int]:
+        count = pybullet.getNumJoints(self._body, physicsClientId=self._client)
+        names = {}
+        for index in range(count):
+            info = pybullet.getJointInfo(self._body, index, physicsClientId=self._client)
+            names[info[1].decode('utf-8')] = index
+        return names
+
+    def _configure_motors(self) -> None:
+        # Velocity motors at zero speed: force 0 switches PyBullet's default motors
+        # off; a force equal to the URDF friction makes them Coulomb friction.
+        pybullet.setJointMotorControlArray(
+            self._body, self._indices, pybullet.VELOCITY_CONTROL,
+            targetVelocities=[0.0] * len(self._indices),
+            forces=[joint.friction for joint in self._joints],
+            physicsClientId=self._client)

@@ -1,0 +1,48 @@
+"""Conversions between ROS messages and the simulator's plain values."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from builtin_interfaces.msg import Time
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64
+
+from pan_tilt_sim.controllers import CommandKind
+
+NANOSECONDS_PER_SECOND = 1_000_000_000
+
+# Message type of each command kind, and how to get the command value out of it.
+COMMAND_MESSAGES: dict[CommandKind, tuple[type, Callable[[Any], Any]]] = {
+    CommandKind.FLOAT64: (Float64, lambda msg: msg.data),
+}
+
+
+def stamp(seconds: float, into: Time | None = None) -> Time:
+    """Return sim time in seconds as a ``builtin_interfaces/Time`` (filled in place if given)."""
+    nanoseconds = round(seconds * NANOSECONDS_PER_SECOND)
+    message = Time() if into is None else into
+    message.sec, message.nanosec = divmod(nanoseconds, NANOSECONDS_PER_SECOND)
+    return message
+
+
+def clock_message(seconds: float, into: Clock | None = None) -> Clock:
+    """Return a ``rosgraph_msgs/Clock`` for sim time ``seconds``."""
+    message = Clock() if into is None else into
+    stamp(seconds, message.clock)
+    return message
+
+
+def joint_state_message(time: float, names: Sequence[str], positions: Sequence[float],
+                        velocities: Sequence[float], efforts: Sequence[float],
+                        into: JointState | None = None) -> JointState:
+    """Return a ``sensor_msgs/JointState`` stamped with sim time (fields copied)."""
+    message = JointState() if into is None else into
+    stamp(time, message.header.stamp)
+    message.name = list(names)
+    message.position = positions
+    message.velocity = velocities
+    message.effort = efforts
+    return message

@@ -1,0 +1,185 @@
+"""sim_node: the seeds' Gazebo + gazebo_ros_control, as one headless rclpy node.
+
+Thin ROS glue around :class:`~pan_tilt_sim.engine.Simulation`: parameters
+in, command topics in, JointState and /clock out.  A wall timer ticks every
+``TICK_PERIOD_S`` and runs, per tick, the physics steps that wall time asks
+for (see :mod:`pan_tilt_sim.pacing`); subscription callbacks only store the
+latest command, and only the tick writes to the simulation.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import rclpy
+from rcl_interfaces.msg import SetParametersResult
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+
+from pan_tilt_sim import naming, parameters
+from pan_tilt_sim.controller_config import load_controllers_config
+from pan_tilt_sim.controllers import CommandController, CommandResult
+from pan_tilt_sim.controllers.joint_state_controller import JointStateController
+from pan_tilt_sim.description import load_description
+from pan_tilt_sim.engine import Simulation
+from pan_tilt_sim.errors import ConfigurationError
+from pan_tilt_sim.pacing import Pacer
+from pan_tilt_sim.ros_interfaces import COMMAND_MESSAGES, clock_message, joint_state_message
+
+NODE_NAME = 'sim_node'
+EXIT_CONFIGURATION_ERROR = 2
+TICK_PERIOD_S = 0.01  # wall seconds between ticks when paced to real time
+CLOCK_PERIOD_S = 0.01  # sim seconds between /clock messages (100 Hz of sim time)
+QUEUE_DEPTH = 10
+WARNING_THROTTLE_S = 1.0
+
+
+class SimNode(Node):
+    """Loads the robot and its controllers, and runs them in PyBullet."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__(NODE_NAME, **kwargs)
+        self.settings = parameters.declare_parameters(self)
+        description = load_description(
+            self.settings.robot_description_file, self.settings.xacro_args)
+        controllers = load_controllers_config(self.settings.controllers_file)
+        self.robot_namespace = naming.resolve_robot_namespace(
+            self.get_namespace(), self.settings.robot_namespace,
+            controllers.namespace, description.plugin_namespace)
+        self.simulation = Simulation(
+            description, controllers, self.settings.time_step, gui=self.settings.gui)
+        self._paused = self.settings.paused
+        self._pacer = Pacer(self.settings.real_time_factor, self.settings.time_step)
+        self._clock_every = max(1, round(CLOCK_PERIOD_S / self.settings.time_step))
+        self._clock_publisher = self.create_publisher(Clock, '/clock', QUEUE_DEPTH)
+        self._clock_message = Clock()
+        self._wire_controllers()
+        self._publish_clock()
+        self._timer = self.create_timer(self._tick_period(), self._on_tick)
+        self.add_on_set_parameters_callback(self._on_set_parameters)
+        self.get_logger().info(
+            f"simulating '{description.name}' from {description.source} "
+            f"with {len(self.simulation.controllers)} controllers; topics under "
+            f"'{self.robot_namespace or '/'}', time_step {self.settings.time_step} s, "
+            f'real_time_factor {self._pacer.real_time_factor}')
+
+    def topic(self, *names: str) -> str:
+        """Absolute name of a topic of the robot."""
+        return naming.join(self.robot_namespace, *names)
+
+    def run_steps(self, steps: int) -> None:
+        """Advance ``steps`` physics steps, publishing /clock when due."""
+        simulation = self.simulation
+        while steps > 0:
+            chunk = min(steps, self._clock_every - simulation.steps % self._clock_every)
+            simulation.advance(chunk)
+            steps -= chunk
+            if simulation.steps % self._clock_every == 0:
+                self._publish_clock()
+
+    @property
+    def paused(self) -> bool:
+        """Whether the physics is held."""
+        return self._paused
+
+    def set_paused(self, paused: bool) -> None:
+        """Hold or release the physics; topics stay alive either way."""
+        if paused != self._paused:
+            self._paused = paused
+            self._pacer.restart()
+
+    def destroy_node(self) -> None:
+        """Stop ticking and release PyBullet."""
+        self._timer.cancel()
+        self.simulation.close()
+        super().destroy_node()
+
+    def _tick_period(self) -> float:
+        return 0.0 if self._pacer.fast else TICK_PERIOD_S
+
+    def _on_tick(self) -> None:
+        if self._paused:
+            return
+        steps = self._pacer.steps_due()
+        if steps:
+            self.run_steps(steps)
+
+    def _publish_clock(self) -> None:
+        self._clock_publisher.publish(
+            clock_message(self.simulation.time, self._clock_message))
+
+    def _wire_controllers(self) -> None:
+        for controller in self.simulation.controllers:
+            if isinstance(controller, JointStateController):
+                publisher = self.create_publisher(
+                    JointState, self.topic('joint_states'), QUEUE_DEPTH)
+                controller.set_sink(self._joint_state_sink(publisher))
+            elif isinstance(controller, CommandController):
+                message_type, extract = COMMAND_MESSAGES[controller.command_kind]
+                self.create_subscription(
+                    message_type, self.topic(controller.name, controller.command_topic),
+                    self._command_callback(controller, extract), QUEUE_DEPTH)
+
+    def _joint_state_sink(self, publisher):
+        message = JointState()
+
+        def publish(time, names, positions, velocities, efforts) -> None:
+            publisher.publish(
+                joint_state_message(time, names, positions, velocities, efforts, message))
+        return publish
+
+    def _command_callback(self, controller: CommandController, extract):
+        logger = self.get_logger()
+
+        def store(message) -> None:
+            value = extract(message)
+            result = controller.set_command(value)
+            if result is CommandResult.REJECTED:
+                logger.warning(f"{controller.name}: ignored command {value!r}: not a finite "
+                               'number', throttle_duration_sec=WARNING_THROTTLE_S)
+            elif result is CommandResult.CLAMPED:
+                logger.warning(f"{controller.name}: command {value!r} is outside the joint's "
+                               'limits; clamped', throttle_duration_sec=WARNING_THROTTLE_S)
+        return store
+
+    def _on_set_parameters(self, changed: list[Parameter]) -> SetParametersResult:
+        try:
+            updates = {p.name: parameters.runtime_value(p) for p in changed}
+            if 'real_time_factor' in updates:
+                parameters.check_real_time_factor(updates['real_time_factor'])
+        except ConfigurationError as err:
+            return SetParametersResult(successful=False, reason=str(err))
+        if 'paused' in updates:
+            self.set_paused(updates['paused'])
+        if 'real_time_factor' in updates:
+            was_fast = self._pacer.fast
+            self._pacer.real_time_factor = updates['real_time_factor']
+            if was_fast != self._pacer.fast:
+                self._timer.cancel()
+                self._timer = self.create_timer(self._tick_period(), self._on_tick)
+        return SetParametersResult(successful=True)
+
+
+def main(args: list[str] | None = None) -> None:
+    """Run sim_node until Ctrl-C or shutdown; a configuration error exits with code 2."""
+    rclpy.init(args=args)
+    try:
+        node = SimNode()
+    except ConfigurationError as err:
+        print(f'{NODE_NAME}: error: {err}', file=sys.stderr)
+        rclpy.try_shutdown()
+        sys.exit(EXIT_CONFIGURATION_ERROR)
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == '__main__':
+    main()
