@@ -19,6 +19,8 @@ from collections.abc import Callable
 FAST_BATCH_STEPS = 100
 # Debt beyond this much wall time is dropped instead of caught up.
 MAX_CATCH_UP_S = 0.1
+# Wall clocks are floats: a step due "exactly now" must not round down.
+STEP_EPSILON = 1e-6
 
 
 class Pacer:
@@ -57,7 +59,7 @@ class Pacer:
         now = self._clock()
         if self._start is None:
             self._start = now
-        target = math.floor((now - self._start) * self._factor / self._time_step)
+        target = math.floor((now - self._start) * self._factor / self._time_step + STEP_EPSILON)
         due = target - self._done
         max_due = max(1, math.ceil(MAX_CATCH_UP_S * self._factor / self._time_step))
         if due > max_due:

@@ -52,6 +52,8 @@ class SimNode(Node):
         self.simulation = Simulation(
             description, controllers, self.settings.time_step, gui=self.settings.gui)
         self._paused = self.settings.paused
+        # Commands taken per controller (ignored ones included): a cheap health figure.
+        self.commands_received = {c.name: 0 for c in self.simulation.command_controllers()}
         self._pacer = Pacer(self.settings.real_time_factor, self.settings.time_step)
         self._clock_every = max(1, round(CLOCK_PERIOD_S / self.settings.time_step))
         self._clock_publisher = self.create_publisher(Clock, '/clock', QUEUE_DEPTH)
@@ -134,7 +136,10 @@ class SimNode(Node):
     def _command_callback(self, controller: CommandController, extract):
         logger = self.get_logger()
 
+        name = controller.name
+
         def store(message) -> None:
+            self.commands_received[name] += 1
             value = extract(message)
             result = controller.set_command(value)
             if result is CommandResult.REJECTED:

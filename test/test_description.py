@@ -1,0 +1,99 @@
+"""The description layer: the seed's xacro and ours give the same robot facts."""
+
+import math
+
+import pytest
+
+from pan_tilt_sim.description import JointKind, load_description, parse_xacro_args
+from pan_tilt_sim.errors import DescriptionError
+
+
+def _facts(description):
+    return {joint.name: joint for joint in description.joints}
+
+
+def test_our_pan_tilt_xacro_has_the_seeds_joints_limits_and_dynamics(repo_root):
+    description = load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
+    assert description.name == 'ex_urdf_pan_tilt'
+    assert description.plugin_namespace == '/ex_urdf_pan_tilt'
+    pan, tilt = description.joint('pan_joint'), description.joint('tilt_joint')
+    assert (pan.kind, pan.lower, pan.upper) == (JointKind.REVOLUTE, -3.14, 3.14)
+    assert (tilt.lower, tilt.upper) == (-4.71239, -1.570796)
+    for joint in (pan, tilt):
+        assert (joint.effort_limit, joint.velocity_limit) == (300.0, 0.1)
+        assert (joint.damping, joint.friction) == (50.0, 1.0)
+
+
+def test_the_seeds_own_xacro_loads_unchanged_and_matches_ours(seeds_dir, repo_root):
+    seed = load_description(seeds_dir / 'pan_tilt.xacro')
+    ours = load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
+    assert _facts(seed) == _facts(ours)
+    assert seed.plugin_namespace == ours.plugin_namespace == '/ex_urdf_pan_tilt'
+
+
+def test_our_xacro_keeps_the_seeds_links_geometry_and_inertia(seeds_dir, repo_root):
+    import xml.etree.ElementTree as ElementTree
+
+    def links(path):
+        root = ElementTree.fromstring(load_description(path).urdf_xml)
+        result = {}
+        for link in root.iter('link'):
+            result[link.get('name')] = (
+                [dict(c.attrib) for c in link.iter('cylinder')],
+                [dict(c.attrib) for c in link.iter('color')],
+                [dict(o.attrib) for o in link.iter('origin')],
+                dict(link.find('inertial/mass').attrib),
+                {k: float(v) for k, v in link.find('inertial/inertia').attrib.items()},
+            )
+        return result
+
+    def numeric(value):
+        cylinders, colours, origins, mass, inertia = value
+        return ([{k: float(v) for k, v in c.items()} for c in cylinders], colours, origins,
+                float(mass['value']), inertia)
+
+    seed, ours = links(seeds_dir / 'pan_tilt.xacro'), links(repo_root / 'urdf' / 'pan_tilt.xacro')
+    assert seed.keys() == ours.keys() == {'base_link', 'pan_link', 'tilt_link'}
+    for name in seed:
+        assert numeric(seed[name]) == numeric(ours[name]), name
+
+
+def test_initial_position_is_zero_or_the_nearest_limit(repo_root):
+    description = load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
+    assert description.joint('pan_joint').initial_position == 0.0
+    assert description.joint('tilt_joint').initial_position == -1.570796
+
+
+def test_xacro_args_are_mappings(tmp_path):
+    path = tmp_path / 'arm.xacro'
+    path.write_text(
+        '<robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:arg name="reach" default="1.0"/>'
+        '<link name="a"/><link name="b"/>'
+        '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+        '<limit lower="0" upper="$(arg reach)" effort="1" velocity="1"/></joint></robot>')
+    assert load_description(path).joint('j').upper == 1.0
+    assert load_description(path, ['reach:=2.5']).joint('j').upper == 2.5
+
+
+def test_a_continuous_joint_has_no_position_limits(tmp_path):
+    path = tmp_path / 'wheel.urdf'
+    path.write_text(
+        '<robot name="w"><link name="a"/><link name="b"/>'
+        '<joint name="wheel" type="continuous"><parent link="a"/><child link="b"/>'
+        '<limit effort="5" velocity="2"/></joint></robot>')
+    wheel = load_description(path).joint('wheel')
+    assert not wheel.has_position_limits
+    assert (wheel.lower, wheel.upper) == (-math.inf, math.inf)
+    assert wheel.clamp_position(100.0) == 100.0
+
+
+@pytest.mark.parametrize('args', [['reach'], [':=1']])
+def test_malformed_xacro_args_are_refused(args):
+    with pytest.raises(DescriptionError, match='name:=value'):
+        parse_xacro_args(args)
+
+
+def test_a_missing_file_names_the_file(tmp_path):
+    with pytest.raises(DescriptionError, match='nope.urdf: no such file'):
+        load_description(tmp_path / 'nope.urdf')

@@ -1,0 +1,55 @@
+"""Pacing: steps per tick follow wall time times the real-time factor."""
+
+from pan_tilt_sim.pacing import FAST_BATCH_STEPS, MAX_CATCH_UP_S, Pacer
+
+
+class FakeClock:
+    def __init__(self):
+        self.now = 100.0
+
+    def __call__(self):
+        return self.now
+
+
+def test_factor_zero_runs_fixed_batches():
+    assert Pacer(0.0, 0.001).steps_due() == FAST_BATCH_STEPS
+
+
+def test_real_time_runs_one_step_per_time_step_of_wall_time():
+    clock = FakeClock()
+    pacer = Pacer(1.0, 0.001, clock)
+    assert pacer.steps_due() == 0
+    total = 0
+    for _ in range(100):
+        clock.now += 0.01
+        total += pacer.steps_due()
+    assert abs(total - 1000) <= 1
+
+
+def test_faster_than_real_time_factor_scales_the_steps():
+    clock = FakeClock()
+    pacer = Pacer(2.5, 0.001, clock)
+    pacer.steps_due()
+    clock.now += 0.01
+    assert pacer.steps_due() == 25
+
+
+def test_a_stall_is_not_paid_back_in_one_burst():
+    clock = FakeClock()
+    pacer = Pacer(1.0, 0.001, clock)
+    pacer.steps_due()
+    clock.now += 5.0
+    assert pacer.steps_due() == round(MAX_CATCH_UP_S / 0.001)
+    clock.now += 0.01
+    assert pacer.steps_due() == 10
+
+
+def test_restart_forgets_time_spent_paused():
+    clock = FakeClock()
+    pacer = Pacer(1.0, 0.001, clock)
+    pacer.steps_due()
+    clock.now += 3.0
+    pacer.restart()
+    assert pacer.steps_due() == 0
+    clock.now += 0.02
+    assert pacer.steps_due() == 20
