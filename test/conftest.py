@@ -26,7 +26,8 @@ SEEDS_RESTORED = REPO_ROOT.parent / 'shared' / 'seeds' / 'restored'
 def seeds_dir() -> pathlib.Path:
     """Return the seeds' restored files, or skip where the folder is absent."""
     if not SEEDS_RESTORED.is_dir():
-        pytest.skip(f'seed files not found: {SEEDS_RESTORED} is absent (a user clone has no ../shared)')
+        pytest.skip(f'seed files not found: {SEEDS_RESTORED} is absent '
+                    '(a user clone has no ../shared)')
     return SEEDS_RESTORED
 
 

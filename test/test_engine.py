@@ -2,7 +2,7 @@
 
 import pytest
 
-from pan_tilt_sim.controller_config import ControllerSpec, ControllersConfig
+from pan_tilt_sim.controller_config import ControllersConfig, ControllerSpec
 from pan_tilt_sim.description import load_description
 from pan_tilt_sim.engine import Simulation, make_simulation
 from pan_tilt_sim.errors import ControllerConfigError
