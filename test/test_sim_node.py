@@ -97,7 +97,8 @@ def test_pan_settles_at_its_command_no_faster_than_the_velocity_limit(pan_tilt):
     speeds = pan_tilt.series('pan_joint', 'velocity', since=start)
     assert max(abs(v) for v in speeds) <= 0.1 + SPEED_TOLERANCE
     # 1 rad at 0.1 rad/s: not there before 10 s of sim time.
-    early = [p for m, p in zip(pan_tilt.states, pan_tilt.series('pan_joint', 'position'), strict=True)
+    positions = pan_tilt.series('pan_joint', 'position')
+    early = [p for m, p in zip(pan_tilt.states, positions, strict=True)
              if stamp_s(m) < start + 9.5]
     assert max(early) < 0.96
 
@@ -129,7 +130,8 @@ def test_joint_states_arrive_at_50_hz_of_sim_time_with_every_field(pan_tilt):
     assert 99 <= len(first_two_seconds) <= 101
     stamps = [stamp_s(m) for m in first_two_seconds]
     assert stamps[0] == pytest.approx(0.0)
-    assert all(b - a == pytest.approx(0.02, abs=1e-6) for a, b in zip(stamps, stamps[1:], strict=False))
+    assert all(b - a == pytest.approx(0.02, abs=1e-6)
+               for a, b in zip(stamps, stamps[1:], strict=False))
     message = first_two_seconds[-1]
     assert list(message.name) == ['pan_joint', 'tilt_joint']
     assert len(message.position) == len(message.velocity) == len(message.effort) == 2
@@ -140,7 +142,8 @@ def test_clock_publishes_sim_time_every_10_ms(pan_tilt):
     times = [m.clock.sec + m.clock.nanosec * 1e-9 for m in pan_tilt.clock]
     assert len(times) >= 100
     assert times[-1] == pytest.approx(pan_tilt.node.simulation.time, abs=0.011)
-    assert all(b - a == pytest.approx(0.01, abs=1e-6) for a, b in zip(times, times[1:], strict=False))
+    assert all(b - a == pytest.approx(0.01, abs=1e-6)
+               for a, b in zip(times, times[1:], strict=False))
 
 
 def test_an_effort_controller_meets_damping_and_friction(repo_root, tmp_path):
