@@ -12,18 +12,16 @@ a user cannot see (measured with PyBullet 3.2.7, DIRECT mode):
 - a DAE without ``<asset>``, ``<library_geometries>`` or ``<vertices>`` crashes
   the process (SIGSEGV) in the visual and in the collision role.
 
-So every mesh is checked here first, and the formats PyBullet cannot be
-trusted with are converted into a binary STL in a cache folder:
+So every mesh is checked here first, and what PyBullet cannot be trusted
+with is converted into a binary STL in a cache folder:
 
-======================  ==========================================  ===============
-file                    check                                       handed to PyBullet
-======================  ==========================================  ===============
-binary STL              size = 84 + 50 x triangle count, finite      as is
-binary STL + trailing   as above; the trailing bytes are dropped     converted
-ASCII STL               parsed                                       converted
-OBJ                     parsed; faces index existing vertices        as is
-DAE (Collada 1.4/1.5)   parsed (see :func:`read_collada`)            converted
-======================  ==========================================  ===============
+- binary STL: size must be 84 + 50 x triangle count, vertices finite;
+  handed over as it is (with trailing bytes: converted);
+- ASCII STL: parsed and converted;
+- OBJ: faces must have 3+ corners naming existing vertices; handed over
+  as it is (PyBullet's own OBJ reader keeps its materials);
+- DAE (Collada 1.4/1.5): parsed by :func:`read_collada` and converted, in
+  both roles, so PyBullet's crash-prone Collada reader is never used.
 
 PyBullet reads the URDF ``scale`` attribute itself, for every format and both
 roles (measured: ``scale="0.001 0.001 0.001"`` on a 1 m box gives a 1 mm
@@ -70,7 +68,10 @@ _STL_DTYPE = np.dtype([('normal', '<f4', (3,)), ('vertices', '<f4', (3, 3)),
 _STL_ASCII_END = b'endsolid'
 STL_ASCII_END_WINDOW = 1024
 """Bytes at the end of an ASCII STL searched for ``endsolid`` (it may carry a long name)."""
-_STL_ASCII_VERTEX = re.compile(rb'^\s*vertex\s+(\S+)\s+(\S+)\s+(\S+)', re.MULTILINE)
+_STL_ASCII_VERTEX = re.compile(rb'^[ \t]*vertex[ \t]+([^\r\n]*)', re.MULTILINE)
+_OBJ_VERTEX = re.compile(rb'^[ \t]*v[ \t]', re.MULTILINE)
+_OBJ_FACE = re.compile(rb'^[ \t]*f[ \t]+([^\r\n]*)', re.MULTILINE)
+_OBJ_CORNER_TAIL = re.compile(rb'/\S*')
 
 VECTOR3_LENGTH = 3
 TRIANGLE_CORNERS = 3
@@ -142,7 +143,7 @@ def _resolve(uri: str, base_dir: pathlib.Path) -> pathlib.Path:
         path = pathlib.Path(rest)
     elif match := _URI_SCHEME.match(uri):
         raise _UnusableError(f"unsupported URI scheme '{match.group(1)}://' "
-                          '(use package://, file:// or a file path)')
+                             '(use package://, file:// or a file path)')
     else:
         path = pathlib.Path(uri)
     if not path.is_absolute():
@@ -176,7 +177,8 @@ def localize_meshes(robot: ET.Element, base_dir: pathlib.Path,
     ``cache_dir`` when PyBullet cannot load it as it is, and rewrite
     ``filename`` to the absolute path of the loadable file.  ``scale`` is
     checked (three finite, non-zero numbers, as urdfdom requires) and left in
-    place for PyBullet to apply.  Each distinct file is checked once.
+    place for PyBullet to apply.  Each distinct file is checked once per
+    call, and a conversion already in ``cache_dir`` is not parsed again.
 
     ``cache_dir`` is created when first needed; file names there are derived
     from the source content, and written atomically, so the folder may be
@@ -234,11 +236,15 @@ def _check_scale(scale: str | None) -> None:
 
 
 def _loadable_mesh(path: pathlib.Path, cache_dir: pathlib.Path) -> pathlib.Path:
-    """Check the mesh at ``path``; return it, or a converted copy in ``cache_dir``."""
+    """Check the mesh at ``path``; return it, or a converted copy in ``cache_dir``.
+
+    A conversion is looked up by the source's content first, so a file
+    converted by an earlier run is neither parsed nor written again.
+    """
     suffix = path.suffix.lower()
     if suffix not in SUPPORTED_MESH_SUFFIXES:
         raise _UnusableError(f"unsupported mesh format '{path.suffix}' "
-                          f"(supported: {', '.join(SUPPORTED_MESH_SUFFIXES)})")
+                             f"(supported: {', '.join(SUPPORTED_MESH_SUFFIXES)})")
     try:
         data = path.read_bytes()
     except FileNotFoundError:
@@ -249,38 +255,52 @@ def _loadable_mesh(path: pathlib.Path, cache_dir: pathlib.Path) -> pathlib.Path:
         raise _UnusableError(f'cannot read file: {exc.strerror}') from None
     if not data:
         raise _UnusableError('file is empty')
-    if suffix == STL_SUFFIX:
-        triangles = _stl_needing_conversion(data)
-    elif suffix == OBJ_SUFFIX:
+    if suffix == OBJ_SUFFIX:
         check_obj(data)
-        triangles = None
-    else:
-        triangles = read_collada(data)
-    if triangles is None:
         return path
-    return _write_cached_stl(triangles, path.stem, data, cache_dir)
+    if suffix == STL_SUFFIX and _is_loadable_binary_stl(data):
+        return path
+    digest = hashlib.sha256(CONVERTER_VERSION + data).hexdigest()[:CACHE_DIGEST_CHARS]
+    target = cache_dir / f'{path.stem}-{digest}{STL_SUFFIX}'
+    if target.is_file():  # written atomically, and only after the source parsed
+        return target
+    triangles = _stl_triangles(data) if suffix == STL_SUFFIX else read_collada(data)
+    write_binary_stl(target, triangles)
+    return target
 
 
-def _stl_needing_conversion(data: bytes) -> np.ndarray | None:
-    """Check an STL; return its triangles if PyBullet cannot read the file as it is."""
+def _is_loadable_binary_stl(data: bytes) -> bool:
+    """Tell whether PyBullet reads this STL as it is; raise if it is no STL at all.
+
+    False means it needs converting: an ASCII STL, or a binary one with
+    trailing bytes (PyBullet requires the exact size and otherwise drops the
+    shape).
+    """
     count = read_binary_stl_count(data)
     expected = STL_PREAMBLE_BYTES + STL_TRIANGLE_BYTES * count if count is not None else None
     if expected is not None and count and len(data) >= expected:
-        triangles = np.frombuffer(data, _STL_DTYPE, count, STL_PREAMBLE_BYTES)['vertices']
-        _check_finite(triangles)
-        # PyBullet requires the exact size; trailing bytes make it drop the shape.
-        return None if len(data) == expected else triangles.astype(float)
+        _check_finite(np.frombuffer(data, _STL_DTYPE, count, STL_PREAMBLE_BYTES)['vertices'])
+        return len(data) == expected
     if data.lstrip().startswith(_STL_ASCII_START):
-        return read_ascii_stl(data)
+        return False
     if count == 0:
         raise _UnusableError('binary STL without triangles')
     if expected is not None and (len(data) - STL_PREAMBLE_BYTES) % STL_TRIANGLE_BYTES == 0:
         raise _UnusableError(f'truncated binary STL: {count} triangles need {expected} bytes, '
-                          f'the file has {len(data)}')
+                             f'the file has {len(data)}')
     announced = f', a binary header announcing {count} triangles needs {expected}' \
         if expected is not None else ''
     raise _UnusableError(f'neither ASCII STL (starts with "solid") nor binary STL '
-                      f'({len(data)} bytes{announced})')
+                         f'({len(data)} bytes{announced})')
+
+
+def _stl_triangles(data: bytes) -> np.ndarray:
+    """Return the triangles (N x 3 x 3) of an STL that :func:`_is_loadable_binary_stl` passed."""
+    count = read_binary_stl_count(data)
+    if count and len(data) >= STL_PREAMBLE_BYTES + STL_TRIANGLE_BYTES * count:
+        records = np.frombuffer(data, _STL_DTYPE, count, STL_PREAMBLE_BYTES)
+        return records['vertices'].astype(float)
+    return read_ascii_stl(data)
 
 
 def read_binary_stl_count(data: bytes) -> int | None:
@@ -291,17 +311,20 @@ def read_binary_stl_count(data: bytes) -> int | None:
 
 
 def read_ascii_stl(data: bytes) -> np.ndarray:
-    """Return the triangles (N x 3 x 3) of an ASCII STL; raise if it holds none."""
-    try:
-        coords = np.array(_STL_ASCII_VERTEX.findall(data), dtype=float)
-    except ValueError:
-        raise _UnusableError('ASCII STL with a non-numeric vertex') from None
-    if not len(coords):
+    """Return the triangles (N x 3 x 3) of an ASCII STL; raise if it holds none or is cut."""
+    lines = _STL_ASCII_VERTEX.findall(data)
+    if not lines:
         raise _UnusableError('ASCII STL without any facet')
-    if len(coords) % TRIANGLE_CORNERS:
-        raise _UnusableError(f'ASCII STL with {len(coords)} vertices, not a multiple of 3')
+    if len(lines) % TRIANGLE_CORNERS:
+        raise _UnusableError(f'ASCII STL with {len(lines)} vertices, not a multiple of 3')
     if _STL_ASCII_END not in data[-STL_ASCII_END_WINDOW:]:
         raise _UnusableError("ASCII STL without 'endsolid' at its end (truncated?)")
+    try:
+        coords = np.array(b' '.join(lines).split(), dtype=float)
+    except ValueError:
+        raise _UnusableError('ASCII STL with a non-numeric vertex') from None
+    if len(coords) != VECTOR3_LENGTH * len(lines):
+        raise _UnusableError('ASCII STL with a vertex of other than 3 coordinates')
     triangles = coords.reshape(-1, TRIANGLE_CORNERS, VECTOR3_LENGTH)
     _check_finite(triangles)
     return triangles
@@ -313,40 +336,27 @@ def _check_finite(values: np.ndarray) -> None:
 
 
 def check_obj(data: bytes) -> None:
-    """Check a Wavefront OBJ: finite vertices, and faces of 3+ corners naming existing ones."""
-    vertex_count = 0
-    face_count = 0
-    highest = 0
-    for number, line in enumerate(data.decode('utf-8', errors='replace').splitlines(), 1):
-        fields = line.split()
-        if not fields:
-            continue
-        if fields[0] == 'v':
-            try:
-                coords = [float(v) for v in fields[1:VECTOR3_LENGTH + 1]]
-            except ValueError:
-                coords = []
-            if len(coords) != VECTOR3_LENGTH or not np.isfinite(coords).all():
-                raise _UnusableError(f'line {number}: bad vertex {line.strip()!r}')
-            vertex_count += 1
-        elif fields[0] == 'f':
-            if len(fields) - 1 < TRIANGLE_CORNERS:
-                raise _UnusableError(f'line {number}: face with fewer than 3 corners')
-            for corner in fields[1:]:
-                try:
-                    index = int(corner.split('/', 1)[0])
-                except ValueError:
-                    raise _UnusableError(f'line {number}: bad face corner {corner!r}') from None
-                # Negative indices count back from the last vertex read so far.
-                if index == 0 or index < -vertex_count:
-                    raise _UnusableError(f'line {number}: face names vertex {index}, '
-                                      f'{vertex_count} defined before it')
-                highest = max(highest, index)
-            face_count += 1
-    if not face_count:
+    """Check a Wavefront OBJ: it has faces of 3+ corners, all naming existing vertices.
+
+    Vertex coordinates are counted, not parsed (that would cost about a
+    second per 100 000 vertices; PyBullet parses them anyway).  A negative
+    (relative) index is checked against the whole file's vertex count.
+    """
+    vertex_count = len(_OBJ_VERTEX.findall(data))
+    faces = _OBJ_FACE.findall(data)
+    if not faces:
         raise _UnusableError('OBJ without faces')
-    # Positive indices may name vertices defined further down, so they are
-    # checked against the final count.
+    fewest = min(map(len, map(bytes.split, faces)))
+    if fewest < TRIANGLE_CORNERS:
+        raise _UnusableError(f'a face with {fewest} corners')
+    # Keep each corner's vertex index: drop '/texture/normal' parts.
+    try:
+        indices = np.array(_OBJ_CORNER_TAIL.sub(b'', b' '.join(faces)).split(), dtype=np.int64)
+    except ValueError:
+        raise _UnusableError('a face corner is not a vertex index') from None
+    if (indices == 0).any():
+        raise _UnusableError('a face names vertex 0 (OBJ counts from 1)')
+    highest = int(np.abs(indices).max())
     if highest > vertex_count:
         raise _UnusableError(f'a face names vertex {highest}, the file has {vertex_count}')
 
@@ -515,7 +525,7 @@ class _ColladaReader:
         values = _floats(element, f'<{_local(element.tag)}>')
         if len(values) != length:
             raise _UnusableError(f'<{_local(element.tag)}> with {len(values)} values, '
-                              f'expected {length}')
+                                 f'expected {length}')
         return values
 
     def _geometry_parts(self, geometry: ET.Element,
@@ -555,7 +565,7 @@ class _ColladaReader:
             indices = _ints(p, f'<{tag}><p>')
             if len(indices) % stride:
                 raise _UnusableError(f'<{tag}><p> length {len(indices)} is not a multiple of '
-                                  f'the {stride} inputs')
+                                     f'the {stride} inputs')
             return indices.reshape(-1, stride)[:, vertex_offset]
 
         if tag == 'triangles':
@@ -569,7 +579,7 @@ class _ColladaReader:
             counts = _ints(primitive.find('{*}vcount'), '<polylist><vcount>')
             if counts.sum() != len(flat) or (counts < 0).any():
                 raise _UnusableError(f'<polylist> <vcount> sums to {counts.sum()}, '
-                                  f'<p> has {len(flat)} corners')
+                                     f'<p> has {len(flat)} corners')
             polygons = np.split(flat, np.cumsum(counts)[:-1]) if len(counts) else []
             index_triangles = self._joined([_fan(polygon) for polygon in polygons])
         else:
@@ -606,29 +616,26 @@ class _ColladaReader:
             stride = 0
         if stride < VECTOR3_LENGTH or len(values) % stride:
             raise _UnusableError(f"positions '{url}': {len(values)} values do not fit "
-                              f'stride {stride}')
+                                 f'stride {stride}')
         return values.reshape(-1, stride)[:, :VECTOR3_LENGTH]
 
 
-def _write_cached_stl(triangles: np.ndarray, stem: str, source: bytes,
-                      cache_dir: pathlib.Path) -> pathlib.Path:
-    """Write ``triangles`` as a binary STL named after ``source``'s content; return its path."""
-    digest = hashlib.sha256(CONVERTER_VERSION + source).hexdigest()[:CACHE_DIGEST_CHARS]
-    target = cache_dir / f'{stem}-{digest}{STL_SUFFIX}'
-    size = STL_PREAMBLE_BYTES + STL_TRIANGLE_BYTES * len(triangles)
-    if target.is_file() and target.stat().st_size == size:
-        return target
+def write_binary_stl(target: pathlib.Path, triangles: np.ndarray) -> None:
+    """Write ``triangles`` (N x 3 x 3) to ``target`` as a binary STL, atomically.
+
+    The file appears complete or not at all, so concurrent writers of the
+    same content (nodes sharing a cache folder) do not harm each other.
+    """
     records = np.zeros(len(triangles), _STL_DTYPE)
     records['vertices'] = triangles
     edges = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
     lengths = np.linalg.norm(edges, axis=1, keepdims=True)
     records['normal'] = np.divide(edges, lengths, out=np.zeros_like(edges), where=lengths > 0)
-    header = f'pan_tilt_sim {stem}'.encode()[:STL_HEADER_BYTES].ljust(STL_HEADER_BYTES, b'\0')
-    cache_dir.mkdir(parents=True, exist_ok=True)
+    header = f'pan_tilt_sim {target.stem}'.encode()[:STL_HEADER_BYTES]
+    target.parent.mkdir(parents=True, exist_ok=True)
     partial = target.with_name(f'.{target.name}.{os.getpid()}.part')
     with partial.open('wb') as out:
-        out.write(header)
+        out.write(header.ljust(STL_HEADER_BYTES, b'\0'))
         out.write(np.uint32(len(triangles)).tobytes())
         out.write(records.tobytes())
     os.replace(partial, target)
-    return target
