@@ -33,6 +33,10 @@ STL_HEADER_BYTES = 80
 _STL_TRIANGLE = struct.Struct('<12fH')
 """Binary STL record: normal, three vertices (float32 each) and a uint16 attribute."""
 
+STL_RECORD = np.dtype([('normal', '<f4', (3,)), ('vertices', '<f4', (3, 3)),
+                       ('attribute', '<u2')])
+"""The same record as a numpy dtype, to read binary STL triangles back."""
+
 _STL_COUNT = struct.Struct('<I')
 
 _CUBE_CORNERS = np.array(

@@ -15,13 +15,17 @@ import numpy as np
 import pybullet
 import pytest
 import xacro
+from hypothesis import HealthCheck, event, given, settings
+from hypothesis import strategies as st
 
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.resources import (
     LocalizedMesh,
     localize_meshes,
+    read_ascii_stl,
     read_collada,
     resolve_resource,
+    write_binary_stl,
 )
 
 MM = 0.001
@@ -245,8 +249,10 @@ BROKEN_MESHES = {
     'no_faces.obj': (''.join(line for line in mf.obj_text().splitlines(keepends=True)
                              if not line.startswith('f ')), 'OBJ without faces'),
     'bad_index.obj': (mf.obj_text() + 'f 1 2 99\n', 'a face names vertex 99, the file has 8'),
-    'bad_vertex.obj': ('v 1 2\n' + mf.obj_text(), "line 1: bad vertex 'v 1 2'"),
-    'short_face.obj': (mf.obj_text() + 'f 1 2\n', 'face with fewer than 3 corners'),
+    'relative_index.obj': (mf.obj_text() + 'f -1 -2 -9\n', 'a face names vertex 9'),
+    'zero_index.obj': (mf.obj_text() + 'f 0 1 2\n', 'a face names vertex 0 (OBJ counts from 1)'),
+    'word_index.obj': (mf.obj_text() + 'f 1/1 2/2 x/3\n', 'a face corner is not a vertex index'),
+    'short_face.obj': (mf.obj_text() + 'f 1 2\n', 'a face with 2 corners'),
     'box.ply': ('ply\nformat ascii 1.0\nend_header\n', "unsupported mesh format '.ply'"),
 }
 
@@ -437,6 +443,66 @@ def test_meshes_outside_links_visual_and_collision_are_left_alone(tmp_path, cach
                           '</gazebo></robot>')
     assert localize_meshes(robot, tmp_path, cache_dir) == []
     assert robot.find('gazebo/mesh').get('filename') == 'nowhere.stl'
+
+
+FUZZ_SEEDS = {
+    '.stl': [mf.binary_stl_bytes(), mf.ascii_stl_text().encode()],
+    '.obj': [mf.obj_text().encode()],
+    '.dae': [mf.dae_text().encode(), mf.dae_text(primitive='polylist').encode()],
+}
+
+
+@st.composite
+def damaged_meshes(draw: st.DrawFn) -> tuple[str, bytes]:
+    """Draw a valid mesh file with a random slice replaced by random bytes."""
+    suffix = draw(st.sampled_from(sorted(FUZZ_SEEDS)))
+    data = draw(st.sampled_from(FUZZ_SEEDS[suffix]))
+    start = draw(st.integers(0, len(data)))
+    end = draw(st.integers(start, min(len(data), start + 64)))
+    return suffix, data[:start] + draw(st.binary(max_size=64)) + data[end:]
+
+
+@settings(max_examples=300, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(mesh=damaged_meshes())
+def test_damaged_files_give_a_description_error_or_a_loadable_mesh(tmp_path, client, capfd,
+                                                                   mesh):
+    """Whatever the damage: a one-line DescriptionError, or a file PyBullet loads quietly."""
+    suffix, data = mesh
+    path = mf.write_file(tmp_path / f'fuzz{suffix}', data)
+    robot = mesh_robot(path.name, 'collision')
+    try:
+        localize_meshes(robot, tmp_path, tmp_path / 'cache')
+    except DescriptionError as exc:
+        assert '\n' not in str(exc)
+        event(f'{suffix} refused')
+        return
+    event(f'{suffix} loaded')
+    body = load(client, robot, tmp_path)
+    pybullet.removeBody(body, physicsClientId=client)
+    assert_quiet(capfd)
+
+
+@settings(max_examples=50, deadline=None)
+@given(triangles=st.lists(
+    st.lists(st.lists(st.floats(-1e6, 1e6, width=32), min_size=3, max_size=3),
+             min_size=3, max_size=3), min_size=1, max_size=20))
+def test_binary_stl_writer_round_trips(tmp_path_factory, triangles):
+    """What write_binary_stl writes reads back identically (float32) and is sized exactly."""
+    target = tmp_path_factory.mktemp('stl') / 'out.stl'
+    expected = np.array(triangles)
+    write_binary_stl(target, expected)
+    data = target.read_bytes()
+    assert len(data) == mf.STL_HEADER_BYTES + 4 + 50 * len(expected)
+    records = np.frombuffer(data, mf.STL_RECORD, offset=mf.STL_HEADER_BYTES + 4)
+    np.testing.assert_array_equal(records['vertices'], expected.astype(np.float32))
+
+
+def test_ascii_stl_reader_matches_the_binary_fixture():
+    """The ASCII and binary fixtures describe the same triangles."""
+    binary = np.frombuffer(mf.binary_stl_bytes(BOX_123), mf.STL_RECORD,
+                           offset=mf.STL_HEADER_BYTES + 4)['vertices']
+    np.testing.assert_allclose(read_ascii_stl(mf.ascii_stl_text(BOX_123).encode()), binary)
 
 
 # --- read_collada: primitives beyond <triangles> ------------------------------
