@@ -12,16 +12,20 @@ from __future__ import annotations
 import dataclasses
 import enum
 import math
+import os
 import pathlib
 import xml.etree.ElementTree as ElementTree
 from collections.abc import Sequence
 from xml.parsers.expat import ExpatError
 
 from pan_tilt_sim.errors import DescriptionError
+from pan_tilt_sim.resources import localize_meshes
 
 XACRO_SUFFIX = '.xacro'
 URDF_ROOT_TAG = 'robot'
 MAPPING_SEPARATOR = ':='
+# Converted meshes are kept between runs (keyed on content) under the user cache.
+MESH_CACHE_SUBDIR = pathlib.Path('pan_tilt_sim', 'meshes')
 # Gazebo plugins whose namespace element names the robot's topic namespace.
 GAZEBO_ROS_CONTROL_PLUGINS = ('libgazebo_ros_control.so', 'libgazebo_ros2_control.so')
 
@@ -180,6 +184,10 @@ def load_description(path: pathlib.Path | str, xacro_args: Sequence[str] = ()) -
     path = pathlib.Path(path).expanduser().resolve()
     urdf_xml = read_description_xml(path, xacro_args)
     root = parse_urdf(urdf_xml, path)
+    try:
+        localize_meshes(root, path.parent, mesh_cache_dir())
+    except DescriptionError as err:
+        raise DescriptionError(f'{path}: {err}') from None
     joints = tuple(_parse_joint(element, path) for element in root.findall('joint'))
     if not any(joint.kind.is_actuated for joint in joints):
         raise DescriptionError(f'{path}: the robot has no movable joints to control')
@@ -195,6 +203,12 @@ def load_description(path: pathlib.Path | str, xacro_args: Sequence[str] = ()) -
         source=path,
         plugin_namespace=_plugin_namespace(root),
     )
+
+
+def mesh_cache_dir() -> pathlib.Path:
+    """Return where converted meshes are cached (``$XDG_CACHE_HOME`` or ``~/.cache``)."""
+    base = os.environ.get('XDG_CACHE_HOME') or pathlib.Path.home() / '.cache'
+    return pathlib.Path(base) / MESH_CACHE_SUBDIR
 
 
 def _parse_joint(element: ElementTree.Element, source: pathlib.Path) -> JointSpec:
