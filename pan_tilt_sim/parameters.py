@@ -68,7 +68,8 @@ def _specs() -> tuple[_Spec, ...]:
     return (
         _Spec('robot_description_file', ParameterType.PARAMETER_STRING,
               str(share / DEFAULT_DESCRIPTION), 'A .urdf or .xacro file describing the robot.'),
-        _Spec('xacro_args', ParameterType.PARAMETER_STRING_ARRAY, [''],
+        # No default: rclpy cannot declare an empty string array, so "not set" means none.
+        _Spec('xacro_args', ParameterType.PARAMETER_STRING_ARRAY, Parameter.Type.STRING_ARRAY,
               "xacro mappings for a .xacro description, each 'name:=value'."),
         _Spec('controllers_file', ParameterType.PARAMETER_STRING,
               str(share / DEFAULT_CONTROLLERS),
@@ -113,7 +114,7 @@ def declare_parameters(node: Node) -> SimParameters:
             dynamic_typing=spec.type == ParameterType.PARAMETER_DOUBLE)
         parameter = node.declare_parameter(spec.name, spec.default, descriptor)
         values[spec.name] = coerce(spec.name, spec.type, parameter.value)
-    values['xacro_args'] = tuple(arg for arg in values['xacro_args'] if arg)
+    values['xacro_args'] = tuple(values['xacro_args'])
     checked = SimParameters(**values)
     check_time_step(checked.time_step)
     check_real_time_factor(checked.real_time_factor)
@@ -129,6 +130,8 @@ def coerce(name: str, wanted: int, value: Any) -> Any:
     if wanted == ParameterType.PARAMETER_DOUBLE and isinstance(value, int) and not isinstance(
             value, bool):
         return float(value)
+    if wanted == ParameterType.PARAMETER_STRING_ARRAY and value is None:
+        return []  # declared without a value: not set
     ok = {
         ParameterType.PARAMETER_BOOL: lambda v: isinstance(v, bool),
         ParameterType.PARAMETER_DOUBLE: lambda v: isinstance(v, float),

@@ -207,3 +207,21 @@ def test_paused_holds_sim_time_while_topics_stay_alive(repo_root):
         assert pan_tilt.position('pan_joint') == pytest.approx(0.5, abs=SETTLE_TOLERANCE)
     finally:
         harness.close()
+
+
+def test_xacro_args_reach_xacro(repo_root, tmp_path):
+    source = (repo_root / 'urdf' / 'pan_tilt.xacro').read_text()
+    path = tmp_path / 'pan_tilt_arg.xacro'
+    path.write_text(source.replace(
+        '<xacro:property name="base_link_length" value="0.01"/>',
+        '<xacro:arg name="pan_limit" default="3.14"/>'
+        '<xacro:property name="base_link_length" value="0.01"/>').replace(
+        'lower="-3.14" upper="3.14"', 'lower="-3.14" upper="$(arg pan_limit)"'))
+    harness = NodeHarness()
+    try:
+        node = harness.add(SimNode(context=harness.context, parameter_overrides=_overrides(
+            robot_description_file=str(path), xacro_args=['pan_limit:=0.25'])))
+        assert node.settings.xacro_args == ('pan_limit:=0.25',)
+        assert node.simulation.description.joint('pan_joint').upper == 0.25
+    finally:
+        harness.close()
