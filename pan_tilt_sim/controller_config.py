@@ -1,4 +1,4 @@
-"""Reading controller YAML in the layout the seeds use.
+"""Reading controller YAML: the seeds' ROS 1 layout and ros2_control's.
 
 ROS 1 style (``rosparam load``), as in both seeds::
 
@@ -13,11 +13,38 @@ ROS 1 style (``rosparam load``), as in both seeds::
 
 A single top-level key whose value holds the controllers is the robot's
 namespace, as ``rosparam load`` inside ``ns=...`` would make it.
+
+ros2_control style (a ROS 2 parameter file), recognised by its
+``ros__parameters`` keys::
+
+    controller_manager:
+      ros__parameters:
+        update_rate: 100
+        arm_controller:
+          type: joint_trajectory_controller/JointTrajectoryController
+    arm_controller:
+      ros__parameters:
+        joints: [shoulder_joint, elbow_joint]
+        gains: {shoulder_joint: {p: 100.0, i: 0.01, d: 10.0}}
+
+The controllers are the entries with a ``type`` under any node's
+``ros__parameters`` (normally the controller_manager's); each takes the
+``ros__parameters`` of the node of its name.  Node keys may carry a
+namespace (``/robot/arm_controller``, or nested mappings), which is
+ignored -- the last name token is the node -- and wildcard keys such as
+``/**`` give parameters to every node they match, under the node's own
+(the node's own win).  Dotted names (``gains.shoulder_joint.p: 100.0``)
+mean the same as nested mappings, as in ROS 2.  As in ros2_control, every
+controller's ``update_rate`` defaults to the controller_manager's, which
+defaults to 100 Hz.  The file gives no namespace: the robot's namespace
+comes from the node, the ``robot_namespace`` parameter or the URDF plugin.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import fnmatch
+import math
 import pathlib
 from collections.abc import Mapping
 from typing import Any
@@ -27,6 +54,14 @@ import yaml
 from pan_tilt_sim.errors import ControllerConfigError
 
 TYPE_FIELD = 'type'
+ROS2_PARAMETERS = 'ros__parameters'
+UPDATE_RATE_FIELD = 'update_rate'
+CONTROLLER_MANAGER = 'controller_manager'
+# ros2_control's controller_manager runs at 100 Hz unless told otherwise.
+DEFAULT_UPDATE_RATE = 100.0
+NAME_SEPARATOR = '/'
+PARAMETER_SEPARATOR = '.'
+WILDCARD_CHARACTERS = '*?['
 
 
 @dataclasses.dataclass(frozen=True)
@@ -72,6 +107,9 @@ def load_controllers_config(path: pathlib.Path | str) -> ControllersConfig:
     document = read_yaml(path)
     if not isinstance(document, Mapping) or not document:
         raise ControllerConfigError(f'{path}: no controllers in it (expected a YAML mapping)')
+    nodes = _ros2_nodes(document, path)
+    if nodes:
+        return _ros2_control_config(nodes, path)
     namespace = None
     controllers = _controllers_in(document)
     if not controllers and len(document) == 1:
@@ -91,3 +129,107 @@ def _controllers_in(mapping: Mapping[Any, Any]) -> list[ControllerSpec]:
         for name, value in mapping.items()
         if isinstance(value, Mapping) and TYPE_FIELD in value
     ]
+
+
+def _ros2_nodes(document: Mapping[Any, Any],
+                path: pathlib.Path) -> list[tuple[str, dict[str, Any]]]:
+    """Return ``(node name or pattern, parameters)`` for every ``ros__parameters`` key."""
+    nodes = []
+
+    def visit(mapping: Mapping[Any, Any], prefix: str) -> None:
+        for key, value in mapping.items():
+            if not isinstance(value, Mapping):
+                continue
+            key_path = f'{prefix}{NAME_SEPARATOR}{key}'
+            if ROS2_PARAMETERS in value:
+                parameters = value[ROS2_PARAMETERS]
+                if parameters is None:
+                    parameters = {}
+                if not isinstance(parameters, Mapping):
+                    raise ControllerConfigError(
+                        f'{path}: {key_path.lstrip(NAME_SEPARATOR)}.{ROS2_PARAMETERS}: '
+                        'expected a mapping of parameters')
+                node = key_path.rstrip(NAME_SEPARATOR).rsplit(NAME_SEPARATOR, 1)[-1]
+                nodes.append((node, _unflatten(parameters)))
+            else:
+                visit(value, key_path)
+
+    visit(document, '')
+    return nodes
+
+
+def _unflatten(parameters: Mapping[Any, Any]) -> dict[str, Any]:
+    """Turn ROS 2's dotted parameter names into nested mappings."""
+    nested: dict[str, Any] = {}
+    for key, value in parameters.items():
+        *parents, leaf = str(key).split(PARAMETER_SEPARATOR)
+        target = nested
+        for parent in parents:
+            inner = target.get(parent)
+            if not isinstance(inner, dict):
+                inner = target[parent] = {}
+            target = inner
+        value = _unflatten(value) if isinstance(value, Mapping) else value
+        _merge_into(target, {leaf: value})
+    return nested
+
+
+def _merge_into(target: dict[str, Any], overrides: Mapping[str, Any]) -> None:
+    """Deep-merge ``overrides`` into ``target``; overrides win, mappings merge."""
+    for key, value in overrides.items():
+        if isinstance(value, Mapping) and isinstance(target.get(key), dict):
+            _merge_into(target[key], value)
+        else:
+            target[key] = dict(value) if isinstance(value, Mapping) else value
+
+
+def _ros2_control_config(nodes: list[tuple[str, dict[str, Any]]],
+                         path: pathlib.Path) -> ControllersConfig:
+    patterns: list[tuple[str, dict[str, Any]]] = []
+    own: dict[str, dict[str, Any]] = {}
+    for name, params in nodes:
+        if any(character in name for character in WILDCARD_CHARACTERS):
+            patterns.append((name, params))
+        else:
+            _merge_into(own.setdefault(name, {}), params)
+
+    def parameters_of(node: str) -> dict[str, Any]:
+        merged: dict[str, Any] = {}
+        for pattern, params in patterns:
+            if fnmatch.fnmatchcase(node, pattern):
+                _merge_into(merged, params)
+        _merge_into(merged, own.get(node, {}))
+        return merged
+
+    update_rate = _update_rate(parameters_of(CONTROLLER_MANAGER), path)
+    # Controllers are declared as `<name>: {type: ...}` entries (normally the
+    # controller_manager's), or, since Jazzy, by a `type` among their own parameters.
+    declared: dict[str, Any] = {}
+    for node in [CONTROLLER_MANAGER, *own]:
+        for name, entry in parameters_of(node).items():
+            if isinstance(entry, Mapping) and TYPE_FIELD in entry:
+                declared.setdefault(str(name), entry[TYPE_FIELD])
+    for node, params in own.items():
+        if isinstance(params.get(TYPE_FIELD), str):
+            declared.setdefault(node, params[TYPE_FIELD])
+    controllers = []
+    for name, type_name in declared.items():
+        params: dict[str, Any] = {UPDATE_RATE_FIELD: update_rate}
+        _merge_into(params, parameters_of(name))
+        params[TYPE_FIELD] = type_name
+        controllers.append(ControllerSpec(name=name, type=type_name, params=params))
+    if not controllers:
+        raise ControllerConfigError(
+            f'{path}: no controllers in it (ros2_control style: expected '
+            f'{CONTROLLER_MANAGER}: {ROS2_PARAMETERS}: <name>: {{{TYPE_FIELD}: ...}})')
+    return ControllersConfig(controllers=tuple(controllers), source=path)
+
+
+def _update_rate(manager: Mapping[str, Any], path: pathlib.Path) -> float:
+    rate = manager.get(UPDATE_RATE_FIELD, DEFAULT_UPDATE_RATE)
+    if isinstance(rate, bool) or not isinstance(rate, int | float) or not (
+            math.isfinite(rate) and rate > 0):
+        raise ControllerConfigError(
+            f'{path}: {CONTROLLER_MANAGER}.{ROS2_PARAMETERS}.{UPDATE_RATE_FIELD}: '
+            f'{rate!r} must be a number of Hz > 0')
+    return float(rate)

@@ -1,10 +1,27 @@
-"""Reading controller YAML in the seeds' (ROS 1 rosparam) layout."""
+"""Reading controller YAML: the seeds' ROS 1 (rosparam) layout and ros2_control's."""
+
+import textwrap
 
 import pytest
 
-from pan_tilt_sim.controller_config import load_controllers_config
+from pan_tilt_sim.controller_config import DEFAULT_UPDATE_RATE, load_controllers_config
 from pan_tilt_sim.errors import ControllerConfigError
 
+
+@pytest.fixture
+def write_yaml(tmp_path):
+    def write(text, name='controllers.yaml'):
+        path = tmp_path / name
+        path.write_text(textwrap.dedent(text), encoding='utf-8')
+        return path
+    return write
+
+
+def by_name(config):
+    return {spec.name: spec for spec in config.controllers}
+
+
+# --- ROS 1 style (the seeds') ---------------------------------------------------------------
 
 def test_our_config_wraps_the_seeds_controllers_in_the_robot_namespace(repo_root):
     config = load_controllers_config(repo_root / 'config' / 'pan_tilt_control.yaml')
@@ -51,3 +68,191 @@ def test_a_file_without_controllers_is_refused(tmp_path, text):
 def test_a_missing_file_names_the_file(tmp_path):
     with pytest.raises(ControllerConfigError, match='missing.yaml: no such file'):
         load_controllers_config(tmp_path / 'missing.yaml')
+
+def test_ros1_files_get_no_update_rate(seeds_dir):
+    # publish_rate stays the only rate of a ROS 1 file's joint_state_controller.
+    config = load_controllers_config(seeds_dir / 'joint_controllers.yaml')
+    assert all('update_rate' not in spec.params for spec in config.controllers)
+
+
+# --- ros2_control style ---------------------------------------------------------------------
+
+ROS2_FILE = """
+    controller_manager:
+      ros__parameters:
+        update_rate: 250
+        joint_state_broadcaster:
+          type: joint_state_broadcaster/JointStateBroadcaster
+        arm_controller:
+          type: joint_trajectory_controller/JointTrajectoryController
+        gripper_controller:
+          type: forward_command_controller/ForwardCommandController
+
+    arm_controller:
+      ros__parameters:
+        joints: [shoulder_joint, elbow_joint]
+        command_interfaces: [effort]
+        gains:
+          shoulder_joint: {p: 100.0, i: 0.01, d: 10.0, i_clamp: 1.0}
+
+    gripper_controller:
+      ros__parameters:
+        joints: [finger_joint]
+        interface_name: position
+    """
+
+
+def test_ros2_controllers_come_from_the_controller_manager_in_file_order(write_yaml):
+    config = load_controllers_config(write_yaml(ROS2_FILE))
+    assert [(spec.name, spec.type) for spec in config.controllers] == [
+        ('joint_state_broadcaster', 'joint_state_broadcaster/JointStateBroadcaster'),
+        ('arm_controller', 'joint_trajectory_controller/JointTrajectoryController'),
+        ('gripper_controller', 'forward_command_controller/ForwardCommandController'),
+    ]
+
+
+def test_ros2_controller_takes_the_parameters_of_its_node(write_yaml):
+    specs = by_name(load_controllers_config(write_yaml(ROS2_FILE)))
+    arm = specs['arm_controller'].params
+    assert arm['joints'] == ['shoulder_joint', 'elbow_joint']
+    assert arm['gains'] == {'shoulder_joint': {'p': 100.0, 'i': 0.01, 'd': 10.0, 'i_clamp': 1.0}}
+    assert specs['gripper_controller'].params['interface_name'] == 'position'
+
+
+def test_ros2_file_gives_no_namespace(write_yaml):
+    assert load_controllers_config(write_yaml(ROS2_FILE)).namespace is None
+
+
+def test_ros2_controllers_inherit_the_manager_update_rate(write_yaml):
+    specs = by_name(load_controllers_config(write_yaml(ROS2_FILE)))
+    assert {spec.params['update_rate'] for spec in specs.values()} == {250.0}
+
+
+def test_ros2_update_rate_defaults_to_ros2_control_default(write_yaml):
+    config = load_controllers_config(write_yaml("""
+        controller_manager:
+          ros__parameters:
+            joint_state_broadcaster:
+              type: joint_state_broadcaster/JointStateBroadcaster
+        """))
+    assert config.controllers[0].params['update_rate'] == DEFAULT_UPDATE_RATE == 100.0
+
+
+def test_ros2_controller_own_update_rate_wins(write_yaml):
+    config = load_controllers_config(write_yaml("""
+        controller_manager:
+          ros__parameters:
+            update_rate: 200
+            joint_state_broadcaster:
+              type: joint_state_broadcaster/JointStateBroadcaster
+        joint_state_broadcaster:
+          ros__parameters:
+            update_rate: 20
+        """))
+    assert config.controllers[0].params['update_rate'] == 20
+
+
+def test_ros2_wildcard_parameters_reach_every_node_under_their_own(write_yaml):
+    specs = by_name(load_controllers_config(write_yaml("""
+        /**:
+          ros__parameters:
+            use_sim_time: true
+            interface_name: velocity
+        controller_manager:
+          ros__parameters:
+            fwd:
+              type: forward_command_controller/ForwardCommandController
+            other:
+              type: forward_command_controller/ForwardCommandController
+        fwd:
+          ros__parameters:
+            joints: [a]
+            interface_name: effort
+        other:
+          ros__parameters:
+            joints: [b]
+        """)))
+    assert specs['fwd'].params['use_sim_time'] is True
+    assert specs['fwd'].params['interface_name'] == 'effort'
+    assert specs['other'].params['interface_name'] == 'velocity'
+
+
+def test_ros2_namespaced_node_keys_are_matched_by_node_name(write_yaml):
+    config = load_controllers_config(write_yaml("""
+        /robot/controller_manager:
+          ros__parameters:
+            update_rate: 50
+            arm_controller:
+              type: position_controllers/JointGroupPositionController
+        robot:
+          arm_controller:
+            ros__parameters:
+              joints: [a, b]
+        """))
+    assert config.namespace is None
+    (arm,) = config.controllers
+    assert arm.params['joints'] == ['a', 'b']
+    assert arm.params['update_rate'] == 50
+
+
+def test_ros2_dotted_parameter_names_mean_nested_mappings(write_yaml):
+    (arm,) = load_controllers_config(write_yaml("""
+        controller_manager:
+          ros__parameters:
+            arm_controller.type: joint_trajectory_controller/JointTrajectoryController
+        arm_controller:
+          ros__parameters:
+            joints: [a]
+            gains.a.p: 50.0
+            gains.a.d: 5.0
+        """)).controllers
+    assert arm.type == 'joint_trajectory_controller/JointTrajectoryController'
+    assert arm.params['gains'] == {'a': {'p': 50.0, 'd': 5.0}}
+
+
+def test_ros2_type_may_sit_among_the_controller_own_parameters(write_yaml):
+    (fwd,) = load_controllers_config(write_yaml("""
+        controller_manager:
+          ros__parameters:
+            update_rate: 100
+        fwd:
+          ros__parameters:
+            type: forward_command_controller/ForwardCommandController
+            joints: [a]
+            interface_name: effort
+        """)).controllers
+    assert (fwd.name, fwd.type) == ('fwd', 'forward_command_controller/ForwardCommandController')
+
+
+@pytest.mark.parametrize('rate', ['0', '-5', '.nan', 'fast', 'true'])
+def test_ros2_bad_update_rate_names_the_field(write_yaml, rate):
+    path = write_yaml(f"""
+        controller_manager:
+          ros__parameters:
+            update_rate: {rate}
+            jsb:
+              type: joint_state_broadcaster/JointStateBroadcaster
+        """)
+    with pytest.raises(ControllerConfigError,
+                       match=r'controller_manager\.ros__parameters\.update_rate'):
+        load_controllers_config(path)
+
+
+def test_ros2_file_without_controllers_says_what_it_expected(write_yaml):
+    path = write_yaml("""
+        controller_manager:
+          ros__parameters:
+            update_rate: 100
+        """)
+    with pytest.raises(ControllerConfigError, match=r'no controllers.*ros2_control style') as err:
+        load_controllers_config(path)
+    assert str(path) in str(err.value)
+
+
+def test_ros2_parameters_must_be_a_mapping(write_yaml):
+    with pytest.raises(ControllerConfigError, match=r'arm_controller\.ros__parameters'):
+        load_controllers_config(write_yaml("""
+            arm_controller:
+              ros__parameters: [1, 2]
+            """))
+
