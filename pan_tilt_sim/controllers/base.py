@@ -47,6 +47,8 @@ class CommandKind(enum.Enum):
     """What a command controller's topic carries (the node maps kinds to message types)."""
 
     FLOAT64 = 'std_msgs/msg/Float64'
+    FLOAT64_ARRAY = 'std_msgs/msg/Float64MultiArray'
+    JOINT_TRAJECTORY = 'trajectory_msgs/msg/JointTrajectory'
 
 
 class CommandResult(enum.Enum):
@@ -88,15 +90,25 @@ class Controller(abc.ABC):
         where = f'{self._source}: ' if self._source else ''
         return ControllerConfigError(f'{where}{self.name}.{field}: {problem}')
 
-    def handle(self, joints: Mapping[str, JointHandle], joint: str, field: str) -> JointHandle:
-        """Look up ``joint``; the error lists the joints that exist."""
+    def handle(self, joints: Mapping[str, JointHandle], joint: str, field: str, *,
+               commanded: bool = True) -> JointHandle:
+        """Look up ``joint``; the error lists the joints that exist.
+
+        A ``<mimic>`` joint follows its leader, so it cannot be ``commanded``.
+        """
         try:
-            return joints[joint]
+            handle = joints[joint]
         except KeyError:
             existing = ', '.join(sorted(joints)) or 'none'
             raise self.error(
                 field, f"joint '{joint}' is not a movable joint of the robot "
                 f'(movable joints: {existing})') from None
+        mimic = handle.spec.mimic
+        if commanded and mimic is not None:
+            raise self.error(
+                field, f"joint '{joint}' mimics '{mimic.joint}': it follows that joint "
+                'and cannot be commanded')
+        return handle
 
     def required_joint(self) -> str:
         """Return the ``joint`` parameter, which must be a non-empty string."""
@@ -104,6 +116,21 @@ class Controller(abc.ABC):
         if not isinstance(joint, str) or not joint:
             raise self.error('joint', 'missing: name the joint this controller drives')
         return joint
+
+    def joint_list(self, field: str = 'joints', *, required: bool = True) -> tuple[str, ...]:
+        """Return the ``joints`` parameter: distinct joint names (may be empty if not required)."""
+        joints = self.params.get(field)
+        if joints is None and not required:
+            return ()
+        if not isinstance(joints, list | tuple) or not all(
+                isinstance(joint, str) and joint for joint in joints):
+            raise self.error(field, f'{joints!r} must be a list of joint names')
+        if required and not joints:
+            raise self.error(field, 'empty: name the joints this controller drives')
+        repeated = sorted({joint for joint in joints if joints.count(joint) > 1})
+        if repeated:
+            raise self.error(field, f"joint '{repeated[0]}' is named more than once")
+        return tuple(joints)
 
 
 class CommandController(Controller):
@@ -115,6 +142,12 @@ class CommandController(Controller):
     @abc.abstractmethod
     def set_command(self, value: Any) -> CommandResult:
         """Store the latest command (called from subscriptions; must be cheap)."""
+
+    def command_problem(self, value: Any, result: CommandResult) -> str:
+        """Describe what was wrong with ``value``, which ``set_command`` rejected or clamped."""
+        if result is CommandResult.REJECTED:
+            return f'ignored command {value!r}: not a finite number'
+        return f"command {value!r} is outside the joint's limits; clamped"
 
 
 def clamp(value: float, lower: float, upper: float) -> float:

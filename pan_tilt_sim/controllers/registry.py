@@ -6,7 +6,15 @@ from collections.abc import Mapping
 from typing import Any
 
 from pan_tilt_sim.controllers.base import Controller
+from pan_tilt_sim.controllers.forward_command_controller import ForwardCommandController
 from pan_tilt_sim.controllers.joint_effort_controller import JointEffortController
+from pan_tilt_sim.controllers.joint_group_effort_controller import JointGroupEffortController
+from pan_tilt_sim.controllers.joint_group_position_controller import (
+    JointGroupPositionController,
+)
+from pan_tilt_sim.controllers.joint_group_velocity_controller import (
+    JointGroupVelocityController,
+)
 from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
 from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
@@ -17,6 +25,10 @@ CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
     JointPositionController,
     JointVelocityController,
     JointEffortController,
+    ForwardCommandController,
+    JointGroupPositionController,
+    JointGroupVelocityController,
+    JointGroupEffortController,
 )
 
 CONTROLLER_TYPES: dict[str, type[Controller]] = {

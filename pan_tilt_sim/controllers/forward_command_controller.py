@@ -1,0 +1,129 @@
+"""``forward_command_controller/ForwardCommandController``: one command per joint, as a group.
+
+The controller drives the ``joints`` it names through one command
+interface, ``interface_name`` (position, velocity or effort), and takes
+``std_msgs/msg/Float64MultiArray`` commands on ``<controller>/commands``:
+element k is the command of the k-th joint.  Each joint behaves exactly
+like the one-joint controller of its interface (limits, ramp, PID), which
+it is built from, with gains from ``gains: {<joint>: {p, i, d, i_clamp}}``
+or, where a joint has none, that controller's defaults:
+
+* position: p 100, i 0.01, d 10 -- the seed's gains.  As a continuous-time
+  loop ``J q'' + (b + d) q' + p q = 0`` is stable for every positive
+  inertia J and damping b; the explicit 1 ms step keeps it stable while
+  ``d * time_step < 2 * J``, i.e. for inertias above 0.005 kg m^2 (or
+  masses above 5 g on a prismatic joint).  Lighter links need their own
+  gains (a smaller d) in the YAML.
+* velocity: p 10 -- a first-order loop, stable under the same bound.
+
+A command of the wrong length, or with a NaN or infinite element, is
+rejected whole and nothing changes.  The ``JointGroup*Controller`` types
+are this controller with the interface fixed.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any, ClassVar
+
+from pan_tilt_sim.controllers.base import (
+    CommandController,
+    CommandKind,
+    CommandResult,
+    JointHandle,
+)
+from pan_tilt_sim.controllers.gains import PID_FIELD, joint_gains_from_params
+from pan_tilt_sim.controllers.joint_effort_controller import JointEffortController
+from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
+from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
+
+INTERFACE_FIELD = 'interface_name'
+JOINTS_FIELD = 'joints'
+# The one-joint controller each command interface stands for.
+INTERFACE_CONTROLLERS: dict[str, type[CommandController]] = {
+    'position': JointPositionController,
+    'velocity': JointVelocityController,
+    'effort': JointEffortController,
+}
+
+
+class ForwardCommandController(CommandController):
+    """A group of joints, commanded together through one interface."""
+
+    type_names = ('forward_command_controller/ForwardCommandController',)
+    command_topic = 'commands'
+    command_kind = CommandKind.FLOAT64_ARRAY
+    # Set by the JointGroup*Controller types; otherwise ``interface_name`` says.
+    fixed_interface: ClassVar[str | None] = None
+
+    def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
+        super().__init__(name, params, source)
+        self._joint_names = self.joint_list(JOINTS_FIELD)
+        interface = self.fixed_interface or params.get(INTERFACE_FIELD)
+        if interface not in INTERFACE_CONTROLLERS:
+            raise self.error(INTERFACE_FIELD, f"{interface!r} must be one of "
+                             f"{', '.join(INTERFACE_CONTROLLERS)}")
+        self.interface_name = interface
+        gains = joint_gains_from_params(self, self._joint_names)
+        member_type = INTERFACE_CONTROLLERS[interface]
+        self._members = tuple(
+            member_type(name, {'joint': joint, PID_FIELD: gains.get(joint)}, source)
+            for joint in self._joint_names)
+        self._problem = ''
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """The joints, in the order of the command's elements."""
+        return self._joint_names
+
+    @property
+    def members(self) -> tuple[CommandController, ...]:
+        """The one-joint controller of each joint (their PIDs may be tuned live)."""
+        return self._members
+
+    def configure(self, joints: Mapping[str, JointHandle]) -> None:
+        """Bind every joint (named in errors as an entry of ``joints``)."""
+        for joint in self._joint_names:
+            self.handle(joints, joint, JOINTS_FIELD)
+        for member in self._members:
+            member.configure(joints)
+
+    def reset(self) -> None:
+        """Every joint back to its one-joint controller's initial command."""
+        for member in self._members:
+            member.reset()
+
+    def set_command(self, value: Sequence[float]) -> CommandResult:
+        """Store one command per joint; reject the whole command if any element is bad."""
+        members = self._members
+        expected = (f'expected {len(members)} values, one per joint '
+                    f"({', '.join(self._joint_names)})")
+        if isinstance(value, str | bytes) or not hasattr(value, '__len__'):
+            self._problem = f'ignored command {value!r}: {expected}'
+            return CommandResult.REJECTED
+        if len(value) != len(members):
+            self._problem = f'ignored command with {len(value)} values: {expected}'
+            return CommandResult.REJECTED
+        for joint, element in zip(self._joint_names, value, strict=True):
+            if not (isinstance(element, int | float) and math.isfinite(element)):
+                self._problem = (f'ignored command {list(value)!r}: the value for '
+                                 f"'{joint}' is not a finite number")
+                return CommandResult.REJECTED
+        clamped = [joint for joint, member, element in zip(
+            self._joint_names, members, value, strict=True)
+            if member.set_command(element) is CommandResult.CLAMPED]
+        if clamped:
+            self._problem = (f'command {list(value)!r} is outside the limits of '
+                             f"{', '.join(clamped)}; clamped")
+            return CommandResult.CLAMPED
+        return CommandResult.ACCEPTED
+
+    def command_problem(self, value: Any, result: CommandResult) -> str:
+        """Describe the last rejected or clamped command."""
+        return self._problem
+
+    def update(self, time: float, period: float) -> None:
+        """Update every joint's controller."""
+        for member in self._members:
+            member.update(time, period)

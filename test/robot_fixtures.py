@@ -1,0 +1,98 @@
+"""Small URDF robots for engine and node tests, written on the fly.
+
+:func:`star_robot_urdf` hangs one box link per joint directly off a fixed
+base, each at its own place, so the joints move independently of each
+other: a test can reason about one joint at a time.  Revolute and
+continuous joints turn about z and prismatic joints slide along x, so
+gravity loads none of them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import pathlib
+import textwrap
+from collections.abc import Sequence
+
+LINK_MASS = 2.0  # kg
+LINK_LENGTH = 0.2  # m, along x from the joint
+LINK_WIDTH = 0.02  # m
+JOINT_SPACING = 0.3  # m between joints along y
+
+
+@dataclasses.dataclass(frozen=True)
+class JointDef:
+    """One joint of a star robot (a limit of None is left out of the URDF)."""
+
+    name: str
+    kind: str = 'revolute'
+    lower: float | None = -1.5
+    upper: float | None = 1.5
+    effort: float = 50.0
+    velocity: float = 2.0
+    damping: float = 0.5
+    friction: float = 0.0
+    mimic: tuple[str, float, float] | None = None  # (leader, multiplier, offset)
+
+    @property
+    def axis(self) -> str:
+        return '1 0 0' if self.kind == 'prismatic' else '0 0 1'
+
+
+def _box_inertia(mass: float, x: float, y: float, z: float) -> str:
+    # About the link's centre of mass (URDF inertia is given at the inertial origin).
+    return (f'<inertia ixx="{mass * (y * y + z * z) / 12}" ixy="0" ixz="0" '
+            f'iyy="{mass * (x * x + z * z) / 12}" iyz="0" izz="{mass * (x * x + y * y) / 12}"/>')
+
+
+def star_robot_urdf(joints: Sequence[JointDef], name: str = 'star') -> str:
+    """Return a URDF with a fixed base and one link per joint, hung off the base."""
+    parts = [f'<?xml version="1.0"?>\n<robot name="{name}">',
+             '<link name="base_link"><inertial><mass value="10"/>'
+             '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>']
+    half = LINK_LENGTH / 2
+    for number, joint in enumerate(joints):
+        link = f'{joint.name}_link'
+        limit = [f'effort="{joint.effort}"', f'velocity="{joint.velocity}"']
+        if joint.lower is not None:
+            limit.append(f'lower="{joint.lower}"')
+        if joint.upper is not None:
+            limit.append(f'upper="{joint.upper}"')
+        mimic = ''
+        if joint.mimic is not None:
+            leader, multiplier, offset = joint.mimic
+            mimic = f'<mimic joint="{leader}" multiplier="{multiplier}" offset="{offset}"/>'
+        geometry = f'<geometry><box size="{LINK_LENGTH} {LINK_WIDTH} {LINK_WIDTH}"/></geometry>'
+        parts.append(textwrap.dedent(f"""
+            <joint name="{joint.name}" type="{joint.kind}">
+              <parent link="base_link"/><child link="{link}"/>
+              <origin xyz="0 {number * JOINT_SPACING} 0.1" rpy="0 0 0"/>
+              <axis xyz="{joint.axis}"/>
+              <limit {' '.join(limit)}/>
+              <dynamics damping="{joint.damping}" friction="{joint.friction}"/>
+              {mimic}
+            </joint>
+            <link name="{link}">
+              <visual><origin xyz="{half} 0 0"/>{geometry}</visual>
+              <collision><origin xyz="{half} 0 0"/>{geometry}</collision>
+              <inertial><origin xyz="{half} 0 0"/><mass value="{LINK_MASS}"/>
+                {_box_inertia(LINK_MASS, LINK_LENGTH, LINK_WIDTH, LINK_WIDTH)}
+              </inertial>
+            </link>"""))
+    parts.append('</robot>\n')
+    return '\n'.join(parts)
+
+
+def write_star_robot(folder: pathlib.Path, joints: Sequence[JointDef],
+                     name: str = 'star') -> pathlib.Path:
+    """Write :func:`star_robot_urdf` to ``folder/<name>.urdf`` and return the path."""
+    path = folder / f'{name}.urdf'
+    path.write_text(star_robot_urdf(joints, name), encoding='utf-8')
+    return path
+
+
+def write_text(folder: pathlib.Path, name: str, text: str) -> pathlib.Path:
+    """Write dedented ``text`` to ``folder/name`` and return the path."""
+    path = folder / name
+    path.write_text(textwrap.dedent(text), encoding='utf-8')
+    return path

@@ -1,0 +1,297 @@
+"""Group controllers: ForwardCommandController and the three JointGroup*Controllers.
+
+Pure-Python tests drive real JointHandles made from JointSpecs (no
+simulator); the engine tests run the controllers on a PyBullet robot.
+"""
+
+import math
+
+import pytest
+from robot_fixtures import (
+    LINK_LENGTH,
+    LINK_MASS,
+    LINK_WIDTH,
+    JointDef,
+    write_star_robot,
+    write_text,
+)
+
+from pan_tilt_sim.controllers import CommandKind, CommandResult, JointHandle, create_controller
+from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
+from pan_tilt_sim.controllers.joint_velocity_controller import DEFAULT_VELOCITY_GAINS
+from pan_tilt_sim.controllers.pid import PidGains
+from pan_tilt_sim.description import JointKind, JointSpec, Mimic
+from pan_tilt_sim.engine import make_simulation
+from pan_tilt_sim.errors import ControllerConfigError
+
+DT = 0.001
+GROUP_TYPES = {
+    'position': 'position_controllers/JointGroupPositionController',
+    'velocity': 'velocity_controllers/JointGroupVelocityController',
+    'effort': 'effort_controllers/JointGroupEffortController',
+}
+FORWARD = 'forward_command_controller/ForwardCommandController'
+
+
+def make_handles():
+    specs = [
+        JointSpec('shoulder', JointKind.REVOLUTE, lower=-1.0, upper=1.0, effort_limit=20.0,
+                  velocity_limit=2.0),
+        JointSpec('slide', JointKind.PRISMATIC, lower=0.0, upper=0.5, effort_limit=30.0,
+                  velocity_limit=0.5),
+        JointSpec('follower', JointKind.REVOLUTE, lower=-1.0, upper=1.0,
+                  mimic=Mimic('shoulder', -1.0, 0.0)),
+    ]
+    return {spec.name: JointHandle(spec) for spec in specs}
+
+
+def group(type_name, handles=None, **params):
+    params.setdefault('joints', ['shoulder', 'slide'])
+    controller = create_controller('grp', type_name, params, 'test.yaml')
+    controller.configure(handles if handles is not None else make_handles())
+    return controller
+
+
+def all_kinds():
+    """(type string, params) of every way to build a group on each interface."""
+    for interface, type_name in GROUP_TYPES.items():
+        yield interface, type_name, {}
+        yield interface, FORWARD, {'interface_name': interface}
+
+
+KINDS = list(all_kinds())
+KIND_IDS = [f'{type_name.split("/")[1]}-{interface}' for interface, type_name, _ in KINDS]
+
+
+# --- the interface every group shares -----------------------------------------------------
+
+@pytest.mark.parametrize(('interface', 'type_name', 'extra'), KINDS, ids=KIND_IDS)
+def test_group_takes_float64_arrays_on_commands(interface, type_name, extra):
+    controller = group(type_name, **extra)
+    assert controller.command_topic == 'commands'
+    assert controller.command_kind is CommandKind.FLOAT64_ARRAY
+    assert controller.joint_names == ('shoulder', 'slide')
+    assert controller.interface_name == interface
+
+
+def efforts_over_steps(controller, handles, steps, start=0):
+    """Update ``steps`` times (state frozen) and return every step's efforts."""
+    efforts = []
+    for step in range(start, start + steps):
+        controller.update(step * DT, DT)
+        efforts.append([handle.effort for handle in handles.values()])
+    return efforts
+
+
+@pytest.mark.parametrize(('interface', 'type_name', 'extra'), KINDS, ids=KIND_IDS)
+@pytest.mark.parametrize('command', [[0.5], [0.5, 0.1, 0.2], [], 'ab', 3.0])
+def test_wrong_length_is_rejected_and_changes_nothing(interface, type_name, extra, command):
+    handles, reference_handles = make_handles(), make_handles()
+    controller = group(type_name, handles, **extra)
+    reference = group(type_name, reference_handles, **extra)
+    for each in (controller, reference):
+        assert each.set_command([0.4, 0.2]) is CommandResult.ACCEPTED
+    assert efforts_over_steps(controller, handles, 5) == efforts_over_steps(
+        reference, reference_handles, 5)
+    assert controller.set_command(command) is CommandResult.REJECTED
+    problem = controller.command_problem(command, CommandResult.REJECTED)
+    assert 'expected 2 values, one per joint (shoulder, slide)' in problem
+    assert efforts_over_steps(controller, handles, 5, start=5) == efforts_over_steps(
+        reference, reference_handles, 5, start=5)
+
+
+@pytest.mark.parametrize(('interface', 'type_name', 'extra'), KINDS, ids=KIND_IDS)
+@pytest.mark.parametrize('bad', [math.nan, math.inf, -math.inf])
+def test_a_non_finite_element_rejects_the_whole_command(interface, type_name, extra, bad):
+    handles = make_handles()
+    controller = group(type_name, handles, **extra)
+    controller.update(0.0, DT)
+    idle = [handle.effort for handle in handles.values()]
+    assert controller.set_command([0.3, bad]) is CommandResult.REJECTED
+    assert "'slide' is not a finite number" in controller.command_problem(
+        None, CommandResult.REJECTED)
+    controller.update(DT, DT)
+    assert [handle.effort for handle in handles.values()] == idle
+
+
+def test_position_group_ramps_each_setpoint_and_pushes_toward_it():
+    handles = make_handles()
+    controller = group(GROUP_TYPES['position'], handles)
+    assert controller.set_command([0.5, 0.25]) is CommandResult.ACCEPTED
+    controller.update(0.0, DT)
+    shoulder, slide = controller.members
+    # Setpoints move at the velocity limits (2 rad/s, 0.5 m/s) from where the joints are.
+    assert shoulder.setpoint == pytest.approx(2.0 * DT)
+    assert slide.setpoint == pytest.approx(0.5 * DT)
+    assert handles['shoulder'].effort > 0.0 and handles['slide'].effort > 0.0
+    assert handles['follower'].effort == 0.0
+
+
+def test_position_group_clamps_to_limits_and_says_which_joint():
+    controller = group(GROUP_TYPES['position'])
+    assert controller.set_command([0.5, 0.9]) is CommandResult.CLAMPED
+    assert 'outside the limits of slide; clamped' in controller.command_problem(
+        None, CommandResult.CLAMPED)
+    for step in range(2000):
+        controller.update(step * DT, DT)
+    assert [member.setpoint for member in controller.members] == pytest.approx([0.5, 0.5])
+
+
+def test_velocity_group_pushes_by_the_velocity_error():
+    handles = make_handles()
+    handles['slide'].velocity = 0.1
+    controller = group(GROUP_TYPES['velocity'], handles)
+    controller.set_command([1.0, -0.2])
+    controller.update(0.0, DT)
+    p = DEFAULT_VELOCITY_GAINS.p
+    assert handles['shoulder'].effort == pytest.approx(p * 1.0)
+    assert handles['slide'].effort == pytest.approx(p * (-0.2 - 0.1))
+
+
+def test_effort_group_applies_the_efforts_clamped_to_the_limits():
+    handles = make_handles()
+    controller = group(GROUP_TYPES['effort'], handles)
+    assert controller.set_command([5.0, -100.0]) is CommandResult.CLAMPED
+    controller.update(0.0, DT)
+    assert (handles['shoulder'].effort, handles['slide'].effort) == (5.0, -30.0)
+
+
+def test_reset_forgets_the_commands():
+    handles = make_handles()
+    controller = group(GROUP_TYPES['effort'], handles)
+    controller.set_command([5.0, 5.0])
+    controller.reset()
+    controller.update(0.0, DT)
+    assert (handles['shoulder'].effort, handles['slide'].effort) == (0.0, 0.0)
+
+
+# --- gains and configuration errors --------------------------------------------------------
+
+def test_gains_section_sets_each_joint_pid_and_defaults_fill_the_rest():
+    controller = group(GROUP_TYPES['position'],
+                       gains={'slide': {'p': 500.0, 'i': 2.0, 'd': 20.0, 'i_clamp': 3.0}})
+    shoulder, slide = controller.members
+    assert shoulder.pid.gains == DEFAULT_POSITION_GAINS.with_default_clamp(20.0)
+    assert slide.pid.gains == PidGains(p=500.0, i=2.0, d=20.0, i_clamp_min=-3.0, i_clamp_max=3.0)
+
+
+def test_ros2_controllers_gain_options_are_accepted():
+    controller = group(GROUP_TYPES['velocity'], gains={
+        'shoulder': {'p': 5.0, 'ff_velocity_scale': 1.0, 'angle_wraparound': False}})
+    assert controller.members[0].pid.gains.p == 5.0
+
+
+@pytest.mark.parametrize(('params', 'field', 'problem'), [
+    ({'joints': None}, 'grp.joints', 'must be a list of joint names'),
+    ({'joints': []}, 'grp.joints', 'empty'),
+    ({'joints': ['shoulder', 'shoulder']}, 'grp.joints', "'shoulder' is named more than once"),
+    ({'joints': ['shoulder', 'elbow']}, 'grp.joints', "joint 'elbow' is not a movable joint"),
+    ({'joints': ['follower']}, 'grp.joints', "'follower' mimics 'shoulder'"),
+    ({'gains': {'elbow': {'p': 1.0}}}, 'grp.gains.elbow', "not one of this controller's joints"),
+    ({'gains': {'slide': {'p': -1.0}}}, 'grp.gains.slide', 'p: -1.0 must be'),
+    ({'gains': {'slide': {'q': 1.0}}}, 'grp.gains.slide', "unknown field 'q'"),
+    ({'gains': [1, 2]}, 'grp.gains', 'expected a mapping'),
+])
+def test_configuration_errors_name_the_field(params, field, problem):
+    with pytest.raises(ControllerConfigError) as err:
+        group(GROUP_TYPES['position'], **params)
+    assert str(err.value).startswith(f'test.yaml: {field}: ')
+    assert problem in str(err.value)
+
+
+@pytest.mark.parametrize('interface', [None, 'torque', 'Position'])
+def test_forward_command_controller_needs_a_known_interface(interface):
+    params = {} if interface is None else {'interface_name': interface}
+    with pytest.raises(ControllerConfigError,
+                       match=r'grp\.interface_name: .* must be one of position, velocity, effort'):
+        group(FORWARD, **params)
+
+
+def test_joint_group_types_fix_their_interface():
+    assert group(GROUP_TYPES['effort'], interface_name='position').interface_name == 'effort'
+
+
+# --- on a PyBullet robot -------------------------------------------------------------------
+
+# A star-robot link about its joint's z axis: box about its centre plus m * (L / 2)^2.
+PAN_INERTIA = LINK_MASS * (LINK_LENGTH ** 2 + LINK_WIDTH ** 2) / 12 + LINK_MASS * (
+    LINK_LENGTH / 2) ** 2
+STAR_JOINTS = [JointDef('pan', 'revolute', -1.5, 1.5, velocity=2.0),
+               JointDef('slide', 'prismatic', -0.3, 0.3, velocity=0.5)]
+
+
+def star_simulation(tmp_path, type_name, **params):
+    robot = write_star_robot(tmp_path, STAR_JOINTS)
+    lines = ''.join(f'\n            {key}: {value}' for key, value in params.items())
+    controllers = write_text(tmp_path, 'controllers.yaml', f"""
+        controller_manager:
+          ros__parameters:
+            group:
+              type: {type_name}
+        group:
+          ros__parameters:
+            joints: [pan, slide]{lines}
+        """)
+    return make_simulation(str(robot), str(controllers), DT)
+
+
+@pytest.mark.parametrize('type_name', [GROUP_TYPES['position'], FORWARD])
+def test_position_group_brings_its_joints_to_the_command(tmp_path, type_name):
+    extra = {'interface_name': 'position'} if type_name == FORWARD else {}
+    with star_simulation(tmp_path, type_name, **extra) as sim:
+        sim.controller('group').set_command([0.8, -0.2])
+        sim.advance(3000)
+        positions = sim.joint_positions()
+    assert positions['pan'] == pytest.approx(0.8, abs=0.01)
+    assert positions['slide'] == pytest.approx(-0.2, abs=0.005)
+
+
+@pytest.mark.parametrize('type_name', [GROUP_TYPES['velocity'], FORWARD])
+def test_velocity_group_spins_its_joints_at_the_command(tmp_path, type_name):
+    extra = {'interface_name': 'velocity'} if type_name == FORWARD else {}
+    commands, seconds = [0.5, -0.1], 0.5
+    with star_simulation(tmp_path, type_name, **extra) as sim:
+        sim.controller('group').set_command(commands)
+        sim.advance(round(seconds / DT))
+        velocities = sim.joint_velocities()
+    # inertia * v' = p * (command - v) - b * v: a first-order lag toward p * command / (p + b).
+    gain, damping = DEFAULT_VELOCITY_GAINS.p, STAR_JOINTS[0].damping
+    for joint, command, inertia in zip(('pan', 'slide'), commands, (PAN_INERTIA, LINK_MASS),
+                                       strict=True):
+        expected = gain * command / (gain + damping) * (
+            1.0 - math.exp(-(gain + damping) * seconds / inertia))
+        assert velocities[joint] == pytest.approx(expected, rel=0.03)
+
+
+@pytest.mark.parametrize('type_name', [GROUP_TYPES['effort'], FORWARD])
+def test_effort_group_drives_its_joints_with_the_efforts(tmp_path, type_name):
+    extra = {'interface_name': 'effort'} if type_name == FORWARD else {}
+    efforts, seconds = [0.5, -0.2], 0.5
+    with star_simulation(tmp_path, type_name, **extra) as sim:
+        sim.controller('group').set_command(efforts)
+        sim.advance(round(seconds / DT))
+        velocities = sim.joint_velocities()
+    # Against viscous damping b: v(t) = (F / b) * (1 - exp(-b t / inertia)).
+    damping = STAR_JOINTS[0].damping
+    for joint, effort, inertia in zip(('pan', 'slide'), efforts, (PAN_INERTIA, LINK_MASS),
+                                      strict=True):
+        expected = effort / damping * (1.0 - math.exp(-damping * seconds / inertia))
+        assert velocities[joint] == pytest.approx(expected, rel=0.03)
+
+
+@pytest.mark.parametrize(('interface', 'type_name', 'extra'), KINDS, ids=KIND_IDS)
+def test_wrong_length_command_leaves_the_motion_unchanged(tmp_path, interface, type_name, extra):
+    runs = []
+    for send_bad in (False, True):
+        folder = tmp_path / str(send_bad)
+        folder.mkdir()
+        with star_simulation(folder, type_name, **extra) as sim:
+            controller = sim.controller('group')
+            controller.set_command([0.3, 0.1])
+            sim.advance(200)
+            if send_bad:
+                assert controller.set_command([1.0, 1.0, 1.0]) is CommandResult.REJECTED
+            sim.advance(300)
+            runs.append(sim.joint_positions())
+    assert runs[0] == runs[1]
+    assert runs[0]['pan'] != 0.0
