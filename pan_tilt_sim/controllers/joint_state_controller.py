@@ -4,6 +4,14 @@ Every ``1 / publish_rate`` seconds of sim time it hands a sample of every
 movable joint -- name, position, velocity, effort -- to its sink (the node
 turns that into a ``sensor_msgs/msg/JointState`` stamped with sim time).
 The sample's lists are reused from call to call; a sink must copy them.
+
+The rate is ``publish_rate`` when given (ROS 1 style); otherwise
+``update_rate``, since ROS 2's joint_state_broadcaster publishes at every
+update of its controller_manager (a ros2_control-style file gives every
+controller the controller_manager's rate, 100 Hz by default); otherwise
+50 Hz, the seeds' rate.  ``joints`` (as joint_state_broadcaster names it)
+limits the sample to those joints, in that order; empty or absent means
+every movable joint.
 """
 
 from __future__ import annotations
@@ -15,6 +23,7 @@ from typing import Any
 from pan_tilt_sim.controllers.base import Controller, JointHandle
 
 DEFAULT_PUBLISH_RATE = 50.0  # Hz, as in the seeds' YAML
+RATE_FIELDS = ('publish_rate', 'update_rate')  # the first one given sets the rate
 # Tolerance on "publication due" so float sim times do not skip a sample.
 DUE_EPSILON = 1e-9
 
@@ -30,11 +39,13 @@ class JointStateController(Controller):
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
-        rate = params.get('publish_rate', DEFAULT_PUBLISH_RATE)
+        field = next((name for name in RATE_FIELDS if name in params), None)
+        rate = params[field] if field else DEFAULT_PUBLISH_RATE
         if isinstance(rate, bool) or not isinstance(rate, int | float) or not (
                 math.isfinite(rate) and rate > 0.0):
-            raise self.error('publish_rate', f'{rate!r} must be a number of Hz > 0')
+            raise self.error(field, f'{rate!r} must be a number of Hz > 0')
         self.publish_period = 1.0 / float(rate)
+        self._joint_names = self.joint_list(required=False)
         self._sink: JointStateSink | None = None
         self._handles: list[JointHandle] = []
 
@@ -48,8 +59,12 @@ class JointStateController(Controller):
         self._sink = sink
 
     def configure(self, joints: Mapping[str, JointHandle]) -> None:
-        """Take every movable joint, in the description's order."""
-        self._handles = list(joints.values())
+        """Take the ``joints`` named, else every movable joint in the description's order."""
+        if self._joint_names:
+            self._handles = [self.handle(joints, name, 'joints', commanded=False)
+                             for name in self._joint_names]
+        else:
+            self._handles = list(joints.values())
         self.names = [handle.name for handle in self._handles]
         count = len(self._handles)
         self.positions = [0.0] * count
