@@ -17,6 +17,7 @@ from pan_tilt_sim.controllers.joint_group_velocity_controller import (
 )
 from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
+from pan_tilt_sim.controllers.joint_trajectory_controller import JointTrajectoryController
 from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
 from pan_tilt_sim.errors import ControllerConfigError
 
@@ -29,6 +30,7 @@ CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
     JointGroupPositionController,
     JointGroupVelocityController,
     JointGroupEffortController,
+    JointTrajectoryController,
 )
 
 CONTROLLER_TYPES: dict[str, type[Controller]] = {

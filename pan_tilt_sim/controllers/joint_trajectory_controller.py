@@ -1,0 +1,233 @@
+"""``joint_trajectory_controller/JointTrajectoryController``: follow waypoints in sim time.
+
+Takes ``trajectory_msgs/msg/JointTrajectory`` on ``<controller>/joint_trajectory``
+(as ros2_controllers' controller does; its follow_joint_trajectory action
+needs control_msgs, which this simulator does without).
+
+* The message names every joint of the controller, in any order (partial
+  goals are rejected); points need increasing ``time_from_start``, finite
+  positions (clamped to the joints' limits) and velocities in every point
+  or in none.  Accelerations are not used.
+* A trajectory starts at its ``header.stamp`` in sim time; a zero stamp
+  means now.  Until then the previous trajectory goes on; from then on the
+  new one replaces it.  From the desired state at that moment the joints go
+  to the first point still in the future -- points already past are
+  skipped -- by cubic Hermite interpolation when the points carry
+  velocities, linearly otherwise, and hold the last point after the end.
+* Every joint is driven by effort from a PID on the position error whose
+  derivative acts on the velocity error (desired minus measured velocity),
+  plus ``ff_velocity_scale`` times the desired velocity, as in
+  ros2_controllers; gains per joint come from ``gains: {<joint>: {p, i, d,
+  i_clamp, ff_velocity_scale}}``, else the position controller's defaults
+  (p 100, i 0.01, d 10: see
+  :mod:`~pan_tilt_sim.controllers.forward_command_controller` for why they
+  are stable).  ``command_interfaces`` may name position, velocity or
+  effort; all of them are realised as effort through this PID.
+* Before the first trajectory every joint holds its position at start.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+from pan_tilt_sim.controllers.base import (
+    CommandController,
+    CommandKind,
+    CommandResult,
+    JointHandle,
+)
+from pan_tilt_sim.controllers.gains import feedforward_scales, joint_gains_from_params
+from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
+from pan_tilt_sim.controllers.limits import PositionLimits, clamp_effort
+from pan_tilt_sim.controllers.pid import Pid
+from pan_tilt_sim.controllers.trajectory import (
+    JointTrajectory,
+    TrajectoryPlan,
+    TrajectoryPoint,
+)
+
+JOINTS_FIELD = 'joints'
+COMMAND_INTERFACES_FIELD = 'command_interfaces'
+COMMAND_INTERFACES = ('position', 'velocity', 'effort')
+# A knot this close after the start is taken as at the start (float stamps).
+TIME_EPSILON = 1e-9
+
+
+class JointTrajectoryController(CommandController):
+    """Follows a joint trajectory with one PID per joint."""
+
+    type_names = ('joint_trajectory_controller/JointTrajectoryController',)
+    command_topic = 'joint_trajectory'
+    command_kind = CommandKind.JOINT_TRAJECTORY
+
+    def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
+        super().__init__(name, params, source)
+        self._joint_names = self.joint_list(JOINTS_FIELD)
+        interfaces = params.get(COMMAND_INTERFACES_FIELD, [])
+        if not isinstance(interfaces, list | tuple) or any(
+                interface not in COMMAND_INTERFACES for interface in interfaces):
+            raise self.error(COMMAND_INTERFACES_FIELD, f'{interfaces!r} must be a list of '
+                             f"{', '.join(COMMAND_INTERFACES)}")
+        gains = joint_gains_from_params(self, self._joint_names)
+        self._gains = [gains.get(joint, DEFAULT_POSITION_GAINS) for joint in self._joint_names]
+        scales = feedforward_scales(self, self._joint_names)
+        self._feedforward = [scales[joint] for joint in self._joint_names]
+        self._problem = ''
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """The joints, in the order of every list this controller keeps."""
+        return self._joint_names
+
+    @property
+    def pids(self) -> tuple[Pid, ...]:
+        """One PID per joint (their gains may be changed live)."""
+        return tuple(self._pids)
+
+    @property
+    def desired_positions(self) -> list[float]:
+        """The positions the PIDs track now, per joint."""
+        return list(self._desired_positions)
+
+    def configure(self, joints: Mapping[str, JointHandle]) -> None:
+        """Bind the joints, their limits and a PID each."""
+        self._handles = [self.handle(joints, joint, JOINTS_FIELD) for joint in self._joint_names]
+        self._limits = [PositionLimits(handle.spec) for handle in self._handles]
+        self._effort_limits = [handle.spec.effort_limit for handle in self._handles]
+        self._pids = [Pid(gains.with_default_clamp(limit))
+                      for gains, limit in zip(self._gains, self._effort_limits, strict=True)]
+        count = len(self._handles)
+        self._desired_positions = [0.0] * count
+        self._desired_velocities = [0.0] * count
+        self._indices = range(count)
+        self.reset()
+
+    def reset(self) -> None:
+        """Hold every joint where it is; forget trajectories and integrals."""
+        for index, handle in enumerate(self._handles):
+            self._desired_positions[index] = handle.position
+            self._desired_velocities[index] = 0.0
+            self._pids[index].reset()
+        self._plan: TrajectoryPlan | None = None
+        self._pending: JointTrajectory | None = None
+
+    def set_command(self, value: JointTrajectory) -> CommandResult:
+        """Check a trajectory, put it in the controller's joint order and queue it."""
+        problem = self._check(value)
+        if problem:
+            self._problem = f'ignored trajectory: {problem}'
+            return CommandResult.REJECTED
+        order = [value.joint_names.index(joint) for joint in self._joint_names]
+        clamped = set()
+        points = []
+        for point in value.points:
+            positions = []
+            for index, column in enumerate(order):
+                position, result = self._limits[index].check(point.positions[column])
+                if result is CommandResult.CLAMPED:
+                    clamped.add(self._joint_names[index])
+                positions.append(position)
+            velocities = tuple(point.velocities[column] for column in order
+                               ) if point.velocities else ()
+            points.append(TrajectoryPoint(point.time_from_start, tuple(positions), velocities))
+        self._pending = JointTrajectory(self._joint_names, tuple(points), value.start_time)
+        if clamped:
+            self._problem = (f"trajectory positions of {', '.join(sorted(clamped))} are "
+                             "outside the joints' limits; clamped")
+            return CommandResult.CLAMPED
+        return CommandResult.ACCEPTED
+
+    def command_problem(self, value: Any, result: CommandResult) -> str:
+        """Describe the last rejected or clamped trajectory."""
+        return self._problem
+
+    def update(self, time: float, period: float) -> None:
+        """Start a due trajectory, sample the desired state, run the PIDs."""
+        pending = self._pending
+        if pending is not None and (pending.start_time is None
+                                    or time + TIME_EPSILON >= pending.start_time):
+            self._start(pending, time)
+        desired_positions = self._desired_positions
+        desired_velocities = self._desired_velocities
+        if self._plan is not None:
+            self._plan.sample(time, desired_positions, desired_velocities)
+        handles, pids = self._handles, self._pids
+        feedforward, effort_limits = self._feedforward, self._effort_limits
+        for index in self._indices:
+            handle = handles[index]
+            desired_velocity = desired_velocities[index]
+            effort = pids[index].compute(
+                desired_positions[index], handle.position, period,
+                handle.velocity - desired_velocity)
+            effort += feedforward[index] * desired_velocity
+            handle.effort = clamp_effort(effort, effort_limits[index])
+
+    def _start(self, trajectory: JointTrajectory, time: float) -> None:
+        """Replace the plan by ``trajectory``, from the desired state at ``time``.
+
+        The first knot is the desired state now -- or a point that falls due
+        exactly now; points already past are skipped.
+        """
+        self._pending = None
+        if self._plan is not None:
+            self._plan.sample(time, self._desired_positions, self._desired_velocities)
+        start = time if trajectory.start_time is None else trajectory.start_time
+        past = [point for point in trajectory.points
+                if start + point.time_from_start <= time + TIME_EPSILON]
+        future = trajectory.points[len(past):]
+        cubic = bool(trajectory.points[0].velocities)
+        if past and start + past[-1].time_from_start >= time - TIME_EPSILON:
+            first = past[-1]  # due now: it is the start
+            first_positions, first_velocities = first.positions, first.velocities
+        elif future:
+            first_positions = self._desired_positions
+            first_velocities = self._desired_velocities
+        else:  # every point is past: go to the last one and hold it
+            self._plan = TrajectoryPlan([time], [trajectory.points[-1].positions], None)
+            return
+        times = [time] + [start + point.time_from_start for point in future]
+        positions = [first_positions] + [point.positions for point in future]
+        velocities = ([first_velocities] + [point.velocities for point in future]
+                      if cubic else None)
+        self._plan = TrajectoryPlan(times, positions, velocities)
+
+    def _check(self, trajectory: Any) -> str:
+        """Return what is wrong with ``trajectory``, or '' if it can be followed."""
+        if not isinstance(trajectory, JointTrajectory):
+            return f'expected a JointTrajectory, got {type(trajectory).__name__}'
+        names = trajectory.joint_names
+        if len(set(names)) != len(names):
+            return 'a joint is named more than once'
+        missing = [joint for joint in self._joint_names if joint not in names]
+        unknown = [joint for joint in names if joint not in self._joint_names]
+        if missing or unknown:
+            return (f"joint_names must be this controller's joints "
+                    f"({', '.join(self._joint_names)}) in any order; "
+                    + '; '.join(filter(None, (
+                        f"missing {', '.join(missing)}" if missing else '',
+                        f"unknown {', '.join(unknown)}" if unknown else ''))))
+        if not trajectory.points:
+            return 'no points'
+        if trajectory.start_time is not None and not math.isfinite(trajectory.start_time):
+            return 'the start time is not finite'
+        with_velocities = bool(trajectory.points[0].velocities)
+        previous = -math.inf
+        for number, point in enumerate(trajectory.points):
+            when = point.time_from_start
+            if not (math.isfinite(when) and when >= 0.0 and when > previous):
+                return f'point {number}: time_from_start {when} must be >= 0 and increasing'
+            previous = when
+            if len(point.positions) != len(names):
+                return (f'point {number}: {len(point.positions)} positions for '
+                        f'{len(names)} joints')
+            if bool(point.velocities) != with_velocities:
+                return 'velocities must be given in every point or in none'
+            if with_velocities and len(point.velocities) != len(names):
+                return (f'point {number}: {len(point.velocities)} velocities for '
+                        f'{len(names)} joints')
+            if not all(math.isfinite(v) for v in (*point.positions, *point.velocities)):
+                return f'point {number}: a position or velocity is not a finite number'
+        return ''
+

@@ -1,0 +1,280 @@
+"""joint_trajectory_controller/JointTrajectoryController and trajectory interpolation.
+
+The pure-Python part drives real JointHandles made from JointSpecs and
+reads the controller's desired positions; the engine part follows
+trajectories with the shipped three-joint arm in PyBullet.
+"""
+
+import math
+
+import pytest
+
+from pan_tilt_sim.controllers import CommandKind, CommandResult, JointHandle, create_controller
+from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
+from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPlan, TrajectoryPoint
+from pan_tilt_sim.description import JointKind, JointSpec
+from pan_tilt_sim.errors import ControllerConfigError
+
+DT = 0.001
+JTC = 'joint_trajectory_controller/JointTrajectoryController'
+JOINTS = ('a', 'b')
+
+
+# --- TrajectoryPlan ------------------------------------------------------------------------
+
+def sample(plan, time):
+    positions, velocities = [0.0, 0.0], [0.0, 0.0]
+    plan.sample(time, positions, velocities)
+    return positions, velocities
+
+
+def test_linear_plan_moves_at_constant_velocity_between_knots():
+    plan = TrajectoryPlan([1.0, 3.0], [[0.0, 1.0], [1.0, -1.0]], None)
+    positions, velocities = sample(plan, 1.5)
+    assert positions == pytest.approx([0.25, 0.5])
+    assert velocities == pytest.approx([0.5, -1.0])
+
+
+def test_cubic_plan_matches_positions_and_velocities_at_the_knots():
+    plan = TrajectoryPlan([0.0, 1.0, 2.0], [[0.0, 0.0], [1.0, 2.0], [0.5, 0.0]],
+                          [[0.0, 1.0], [0.5, 0.0], [0.0, 0.0]])
+    for time, position, velocity in [(0.0, [0.0, 0.0], [0.0, 1.0]),
+                                     (1.0, [1.0, 2.0], [0.5, 0.0])]:
+        assert sample(plan, time) == (pytest.approx(position), pytest.approx(velocity))
+        just_before = sample(plan, time - 1e-7) if time > 0.0 else None
+        if just_before:
+            assert just_before[0] == pytest.approx(position, abs=1e-6)
+            assert just_before[1] == pytest.approx(velocity, abs=1e-5)
+
+
+def test_cubic_plan_velocity_is_the_derivative_of_its_position():
+    plan = TrajectoryPlan([0.0, 2.0], [[0.0, 1.0], [1.0, -2.0]], [[0.3, 0.0], [-0.2, 1.0]])
+    for time in (0.1, 0.7, 1.3, 1.9):
+        step = 1e-6
+        ahead, behind = sample(plan, time + step)[0], sample(plan, time - step)[0]
+        numeric = [(x - y) / (2 * step) for x, y in zip(ahead, behind, strict=True)]
+        assert sample(plan, time)[1] == pytest.approx(numeric, abs=1e-6)
+
+
+def test_plan_holds_the_last_knot_at_rest_after_the_end():
+    plan = TrajectoryPlan([0.0, 1.0], [[0.0, 0.0], [1.0, 2.0]], [[0.0, 0.0], [3.0, 3.0]])
+    assert sample(plan, 5.0) == ([1.0, 2.0], [0.0, 0.0])
+
+
+def test_plan_sampling_goes_back_after_a_reset_of_time():
+    plan = TrajectoryPlan([0.0, 1.0, 2.0], [[0.0, 0.0], [1.0, 1.0], [3.0, 3.0]], None)
+    late = sample(plan, 1.5)
+    assert sample(plan, 0.5)[0] == pytest.approx([0.5, 0.5])
+    assert sample(plan, 1.5) == late
+
+
+# --- the controller, without a simulator ---------------------------------------------------
+
+def make_handles():
+    specs = [JointSpec('a', JointKind.REVOLUTE, -2.0, 2.0, effort_limit=1000.0),
+             JointSpec('b', JointKind.PRISMATIC, -0.5, 0.5, effort_limit=1000.0),
+             JointSpec('c', JointKind.CONTINUOUS)]
+    return {spec.name: JointHandle(spec) for spec in specs}
+
+
+def controller_for(handles=None, **params):
+    params.setdefault('joints', list(JOINTS))
+    controller = create_controller('arm', JTC, params, 'test.yaml')
+    controller.configure(handles if handles is not None else make_handles())
+    return controller
+
+
+def trajectory(*points, names=JOINTS, start=None):
+    """Points as (time_from_start, positions[, velocities])."""
+    return JointTrajectory(tuple(names), tuple(TrajectoryPoint(*point) for point in points),
+                           start)
+
+
+class Clock:
+    """Steps a controller through sim time, one update per physics step."""
+
+    def __init__(self, controller):
+        self.controller = controller
+        self.step = -1
+
+    def run_to(self, time):
+        """Update at every step up to and including ``time``; return the desired positions."""
+        while self.step < round(time / DT):
+            self.step += 1
+            self.controller.update(self.step * DT, DT)
+        return self.controller.desired_positions
+
+
+def test_takes_joint_trajectories_on_joint_trajectory():
+    controller = controller_for()
+    assert controller.command_topic == 'joint_trajectory'
+    assert controller.command_kind is CommandKind.JOINT_TRAJECTORY
+    assert controller.joint_names == JOINTS
+
+
+def test_holds_the_start_position_before_any_trajectory():
+    handles = make_handles()
+    handles['a'].position = 0.3
+    controller = controller_for(handles)
+    clock = Clock(controller)
+    assert clock.run_to(0.5) == [0.3, 0.0]
+    assert handles['a'].effort == 0.0
+
+
+def test_linear_trajectory_is_followed_in_sim_time():
+    controller = controller_for()
+    clock = Clock(controller)
+    controller.set_command(trajectory((1.0, (1.0, 0.2)), (2.0, (-1.0, 0.4))))
+    assert clock.run_to(0.5) == pytest.approx([0.5, 0.1])
+    assert clock.run_to(1.5) == pytest.approx([0.0, 0.3])
+    assert clock.run_to(4.0) == pytest.approx([-1.0, 0.4])
+
+
+def test_joints_may_come_in_any_order():
+    controller = controller_for()
+    clock = Clock(controller)
+    controller.set_command(trajectory((1.0, (0.2, 1.0)), names=('b', 'a')))
+    assert clock.run_to(2.0) == pytest.approx([1.0, 0.2])
+
+
+def test_zero_stamp_starts_at_the_next_update():
+    controller = controller_for()
+    clock = Clock(controller)
+    clock.run_to(1.0)
+    controller.set_command(trajectory((1.0, (1.0, 0.0))))
+    # The next update is at 1.001 s: the trajectory runs from there.
+    assert clock.run_to(1.5) == pytest.approx([0.499, 0.0])
+
+
+def test_future_stamp_waits_and_the_old_trajectory_goes_on_until_then():
+    controller = controller_for()
+    clock = Clock(controller)
+    controller.set_command(trajectory((2.0, (2.0, 0.0))))
+    clock.run_to(0.5)
+    controller.set_command(trajectory((1.0, (-1.0, 0.0)), start=1.0))
+    assert clock.run_to(1.0) == pytest.approx([1.0, 0.0], abs=DT)
+    # From 1.0 s the new trajectory takes over, starting from the desired state then.
+    assert clock.run_to(1.5) == pytest.approx([0.0, 0.0], abs=2 * DT)
+    assert clock.run_to(3.0) == pytest.approx([-1.0, 0.0])
+
+
+def test_points_already_past_are_skipped():
+    controller = controller_for()
+    clock = Clock(controller)
+    clock.run_to(2.0)
+    controller.set_command(trajectory((1.0, (5.0, 0.0)), (3.0, (1.0, 0.0)), start=0.5))
+    # Point 0 fell due at 1.5 s: the plan goes from here (0) to point 1 at 3.5 s.
+    assert clock.run_to(2.75) == pytest.approx([0.5, 0.0], abs=DT)
+
+
+def test_a_point_due_exactly_now_is_the_start():
+    controller = controller_for()
+    clock = Clock(controller)
+    controller.set_command(trajectory((0.0, (1.0, 0.1)), (1.0, (1.0, 0.3))))
+    assert clock.run_to(0.0) == pytest.approx([1.0, 0.1])
+
+
+def test_a_trajectory_entirely_in_the_past_goes_to_its_last_point():
+    controller = controller_for()
+    clock = Clock(controller)
+    clock.run_to(5.0)
+    controller.set_command(trajectory((1.0, (0.7, 0.2)), start=1.0))
+    assert clock.run_to(5.001) == [0.7, 0.2]
+
+
+def test_cubic_when_velocities_are_given():
+    controller = controller_for()
+    clock = Clock(controller)
+    controller.set_command(trajectory((1.0, (1.0, 0.0), (0.0, 0.0))))
+    # Hermite from rest to rest: halfway in time is halfway in position, at 1.5x the mean speed.
+    assert clock.run_to(0.25) == pytest.approx([0.15625, 0.0], abs=2e-3)
+    assert clock.run_to(0.5) == pytest.approx([0.5, 0.0], abs=2e-3)
+
+
+def test_new_trajectory_starts_from_the_desired_state_not_the_measured_one():
+    handles = make_handles()
+    controller = controller_for(handles)
+    clock = Clock(controller)
+    controller.set_command(trajectory((1.0, (1.0, 0.0))))
+    clock.run_to(0.5)
+    handles['a'].position = -1.0  # the joint lags far behind
+    controller.set_command(trajectory((0.5, (1.0, 0.0))))
+    assert clock.run_to(0.5 + DT) == pytest.approx([0.5, 0.0], abs=3 * DT)
+
+
+def test_positions_outside_the_limits_are_clamped():
+    controller = controller_for()
+    clock = Clock(controller)
+    assert controller.set_command(trajectory((1.0, (3.0, 0.2)))) is CommandResult.CLAMPED
+    assert 'trajectory positions of a' in controller.command_problem(None, CommandResult.CLAMPED)
+    assert clock.run_to(2.0) == pytest.approx([2.0, 0.2])
+
+
+def test_continuous_joints_are_neither_clamped_nor_wrapped():
+    controller = controller_for(joints=['c'])
+    clock = Clock(controller)
+    assert controller.set_command(trajectory((1.0, (7.5,)), names=('c',))) is (
+        CommandResult.ACCEPTED)
+    assert clock.run_to(2.0) == [7.5]
+
+
+@pytest.mark.parametrize(('bad', 'problem'), [
+    (trajectory((1.0, (1.0,)), names=('a',)), 'missing b'),
+    (trajectory((1.0, (1.0, 1.0, 1.0)), names=('a', 'b', 'z')), 'unknown z'),
+    (trajectory((1.0, (1.0, 1.0)), names=('a', 'a')), 'named more than once'),
+    (trajectory(), 'no points'),
+    (trajectory((1.0, (1.0, 0.0)), (1.0, (2.0, 0.0))), 'point 1: time_from_start 1.0 must be'),
+    (trajectory((-1.0, (1.0, 0.0))), 'point 0: time_from_start -1.0'),
+    (trajectory((1.0, (1.0,))), 'point 0: 1 positions for 2 joints'),
+    (trajectory((1.0, (1.0, 0.0), (0.0,))), 'point 0: 1 velocities for 2 joints'),
+    (trajectory((1.0, (1.0, 0.0), (0.0, 0.0)), (2.0, (1.0, 0.0))), 'in every point or in none'),
+    (trajectory((1.0, (math.nan, 0.0))), 'point 0: a position or velocity is not a finite'),
+    (trajectory((1.0, (0.0, 0.0), (math.inf, 0.0))), 'not a finite number'),
+    (trajectory((1.0, (1.0, 0.0)), start=math.nan), 'start time is not finite'),
+    ([1.0, 2.0], 'expected a JointTrajectory'),
+])
+def test_bad_trajectories_are_rejected_and_change_nothing(bad, problem):
+    handles = make_handles()
+    controller = controller_for(handles)
+    clock = Clock(controller)
+    controller.set_command(trajectory((1.0, (1.0, 0.2))))
+    clock.run_to(0.5)
+    assert controller.set_command(bad) is CommandResult.REJECTED
+    message = controller.command_problem(bad, CommandResult.REJECTED)
+    assert message.startswith('ignored trajectory: ') and problem in message
+    assert clock.run_to(1.0) == pytest.approx([1.0, 0.2])
+
+
+def test_effort_is_pid_on_position_with_derivative_on_velocity_error():
+    handles = make_handles()
+    controller = controller_for(handles, gains={'a': {'p': 50.0, 'd': 5.0,
+                                                      'ff_velocity_scale': 2.0}})
+    controller.set_command(trajectory((1.0, (1.0, 0.0))))
+    handles['a'].velocity = 0.25
+    controller.update(0.0, DT)
+    controller.update(0.1, DT)
+    # Desired 0.1 rad moving at 1 rad/s; measured 0 rad at 0.25 rad/s.
+    expected = 50.0 * 0.1 + 5.0 * (1.0 - 0.25) + 2.0 * 1.0
+    assert handles['a'].effort == pytest.approx(expected)
+    assert controller.pids[1].gains == DEFAULT_POSITION_GAINS.with_default_clamp(1000.0)
+
+
+@pytest.mark.parametrize(('params', 'field'), [
+    ({'joints': []}, 'arm.joints'),
+    ({'command_interfaces': ['torque']}, 'arm.command_interfaces'),
+    ({'gains': {'a': {'p': 'high'}}}, 'arm.gains.a'),
+    ({'gains': {'a': {'ff_velocity_scale': 'x'}}}, 'arm.gains.a.ff_velocity_scale'),
+])
+def test_configuration_errors_name_the_field(params, field):
+    with pytest.raises(ControllerConfigError, match=rf'^test.yaml: {field}: '):
+        controller_for(**params)
+
+
+def test_reset_forgets_the_trajectory():
+    controller = controller_for()
+    clock = Clock(controller)
+    controller.set_command(trajectory((1.0, (1.0, 0.2))))
+    clock.run_to(0.5)
+    controller.reset()
+    assert Clock(controller).run_to(2.0) == [0.0, 0.0]
+
