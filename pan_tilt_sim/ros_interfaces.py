@@ -5,18 +5,40 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from builtin_interfaces.msg import Time
+from builtin_interfaces.msg import Duration, Time
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64
+from std_msgs.msg import Float64, Float64MultiArray
+from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage
 
 from pan_tilt_sim.controllers import CommandKind
+from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
 
 NANOSECONDS_PER_SECOND = 1_000_000_000
+
+
+def seconds(time: Time | Duration) -> float:
+    """Return a ``builtin_interfaces`` Time or Duration in seconds."""
+    return time.sec + time.nanosec / NANOSECONDS_PER_SECOND
+
+
+def joint_trajectory(message: JointTrajectoryMessage) -> JointTrajectory:
+    """Return a ``trajectory_msgs/JointTrajectory`` as a plain value (zero stamp: start now)."""
+    stamp_ = message.header.stamp
+    return JointTrajectory(
+        joint_names=tuple(message.joint_names),
+        points=tuple(
+            TrajectoryPoint(seconds(point.time_from_start), tuple(point.positions),
+                            tuple(point.velocities))
+            for point in message.points),
+        start_time=seconds(stamp_) if stamp_.sec or stamp_.nanosec else None)
+
 
 # Message type of each command kind, and how to get the command value out of it.
 COMMAND_MESSAGES: dict[CommandKind, tuple[type, Callable[[Any], Any]]] = {
     CommandKind.FLOAT64: (Float64, lambda msg: msg.data),
+    CommandKind.FLOAT64_ARRAY: (Float64MultiArray, lambda msg: list(msg.data)),
+    CommandKind.JOINT_TRAJECTORY: (JointTrajectoryMessage, joint_trajectory),
 }
 
 

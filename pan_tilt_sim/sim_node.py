@@ -142,12 +142,9 @@ class SimNode(Node):
             self.commands_received[name] += 1
             value = extract(message)
             result = controller.set_command(value)
-            if result is CommandResult.REJECTED:
-                logger.warning(f"{controller.name}: ignored command {value!r}: not a finite "
-                               'number', throttle_duration_sec=WARNING_THROTTLE_S)
-            elif result is CommandResult.CLAMPED:
-                logger.warning(f"{controller.name}: command {value!r} is outside the joint's "
-                               'limits; clamped', throttle_duration_sec=WARNING_THROTTLE_S)
+            if result is not CommandResult.ACCEPTED:
+                logger.warning(f'{controller.name}: {controller.command_problem(value, result)}',
+                               throttle_duration_sec=WARNING_THROTTLE_S)
         return store
 
     def _on_set_parameters(self, changed: list[Parameter]) -> SetParametersResult:

@@ -1,0 +1,62 @@
+"""ros_interfaces: command messages to the plain values controllers take."""
+
+import math
+
+from builtin_interfaces.msg import Duration, Time
+from std_msgs.msg import Float64, Float64MultiArray
+from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage
+from trajectory_msgs.msg import JointTrajectoryPoint
+
+from pan_tilt_sim.controllers import CommandKind
+from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
+from pan_tilt_sim.ros_interfaces import COMMAND_MESSAGES, joint_trajectory, seconds
+
+
+def test_every_command_kind_has_a_message_type():
+    assert set(COMMAND_MESSAGES) == set(CommandKind)
+    for kind, (message_type, _extract) in COMMAND_MESSAGES.items():
+        package, _, name = kind.value.partition('/msg/')
+        assert (message_type.__module__.split('.')[0], message_type.__name__) == (package, name)
+
+
+def test_float64_arrays_become_lists_of_floats():
+    _type, extract = COMMAND_MESSAGES[CommandKind.FLOAT64_ARRAY]
+    value = extract(Float64MultiArray(data=[1.0, -2.5, math.nan]))
+    assert isinstance(value, list)
+    assert value[:2] == [1.0, -2.5] and math.isnan(value[2])
+
+
+def test_float64_is_its_data():
+    _type, extract = COMMAND_MESSAGES[CommandKind.FLOAT64]
+    assert extract(Float64(data=1.57)) == 1.57
+
+
+def test_seconds_of_time_and_duration():
+    assert seconds(Time(sec=3, nanosec=250_000_000)) == 3.25
+    assert seconds(Duration(sec=0, nanosec=1_000_000)) == 0.001
+
+
+def trajectory_message(stamp=None):
+    message = JointTrajectoryMessage(joint_names=['b', 'a'])
+    if stamp is not None:
+        message.header.stamp = stamp
+    message.points = [
+        JointTrajectoryPoint(positions=[0.1, 0.2], time_from_start=Duration(sec=1)),
+        JointTrajectoryPoint(positions=[0.3, 0.4], velocities=[0.0, 0.5],
+                             accelerations=[1.0, 1.0],
+                             time_from_start=Duration(sec=2, nanosec=500_000_000)),
+    ]
+    return message
+
+
+def test_joint_trajectory_becomes_a_plain_value_in_message_order():
+    assert joint_trajectory(trajectory_message(Time(sec=4, nanosec=500_000_000))) == (
+        JointTrajectory(
+            joint_names=('b', 'a'),
+            points=(TrajectoryPoint(1.0, (0.1, 0.2), ()),
+                    TrajectoryPoint(2.5, (0.3, 0.4), (0.0, 0.5))),
+            start_time=4.5))
+
+
+def test_zero_stamp_means_start_now():
+    assert joint_trajectory(trajectory_message()).start_time is None
