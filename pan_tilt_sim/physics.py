@@ -7,7 +7,9 @@ motors are switched off, so every actuated joint moves only by the torque
 the controllers ask for.  URDF ``damping`` is applied by PyBullet itself as
 viscous torque; URDF ``friction`` is modelled as Coulomb friction by a
 velocity motor held at zero speed whose force is capped at the friction
-value, which also gives the static friction Gazebo users know.
+value, which also gives the static friction Gazebo users know.  A
+``<mimic>`` joint is held at ``multiplier * leader + offset`` by a gear
+constraint (see :mod:`pan_tilt_sim.mimic`).
 """
 
 from __future__ import annotations
@@ -20,12 +22,17 @@ from collections.abc import Iterator, Sequence
 
 from pan_tilt_sim.description import JointSpec, RobotDescription
 from pan_tilt_sim.errors import DescriptionError
+from pan_tilt_sim.mimic import follow_leaders, mimic_couplings
 
 STANDARD_GRAVITY = 9.81  # m/s^2, along -z as in Gazebo's default world
 URDF_FILE_NAME = 'robot.urdf'
 # Index of the position and velocity in one entry of pybullet.getJointStates.
 STATE_POSITION = 0
 STATE_VELOCITY = 1
+# Gear constraints of mimic joints: force bound high enough to be rigid, and
+# the share of the position error corrected per step (1 would be all at once).
+MIMIC_MAX_FORCE = 1e9
+MIMIC_ERROR_REDUCTION = 0.8
 
 
 @contextlib.contextmanager
@@ -72,7 +79,9 @@ class Physics:
         index_of = self._joint_indices()
         self._indices = [index_of[joint.name] for joint in self._joints]
         self._torque_mode = pybullet.TORQUE_CONTROL
+        self._mimics = mimic_couplings(self._joints, description.source)
         self._configure_motors()
+        self._couple_mimic_joints(index_of)
         self.reset_joints([joint.initial_position for joint in self._joints])
 
     @property
@@ -113,7 +122,10 @@ class Physics:
         return pybullet.getJointStates(self._body, self._indices, physicsClientId=client)
 
     def reset_joints(self, positions: Sequence[float]) -> None:
-        """Put every actuated joint at ``positions`` with zero velocity."""
+        """Put every actuated joint at ``positions`` (mimic joints by their leader), at rest."""
+        if self._mimics:
+            positions = follow_leaders(
+                [joint.name for joint in self._joints], positions, self._mimics)
         for index, position in zip(self._indices, positions, strict=True):
             pybullet.resetJointState(
                 self._body, index, position, targetVelocity=0.0, physicsClientId=self._client)
@@ -163,3 +175,14 @@ class Physics:
             targetVelocities=[0.0] * len(self._indices),
             forces=[joint.friction for joint in self._joints],
             physicsClientId=self._client)
+
+    def _couple_mimic_joints(self, index_of: dict[str, int]) -> None:
+        # A gear constraint keeps q_follower - multiplier * q_leader at offset.
+        for coupling in self._mimics:
+            constraint = pybullet.createConstraint(
+                self._body, index_of[coupling.follower], self._body, index_of[coupling.leader],
+                pybullet.JOINT_GEAR, (0.0, 0.0, 1.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0),
+                physicsClientId=self._client)
+            pybullet.changeConstraint(
+                constraint, gearRatio=-coupling.multiplier, relativePositionTarget=coupling.offset,
+                maxForce=MIMIC_MAX_FORCE, erp=MIMIC_ERROR_REDUCTION, physicsClientId=self._client)
