@@ -1,5 +1,6 @@
 """Reading controller YAML: the seeds' ROS 1 (rosparam) layout and ros2_control's."""
 
+import math
 import textwrap
 
 import pytest
@@ -256,3 +257,12 @@ def test_ros2_parameters_must_be_a_mapping(write_yaml):
               ros__parameters: [1, 2]
             """))
 
+
+def test_shipped_three_joint_arm_controllers_load(repo_root):
+    config = load_controllers_config(repo_root / 'config' / 'three_joint_arm_controllers.yaml')
+    specs = by_name(config)
+    assert config.namespace is None
+    assert specs['arm_controller'].params['joints'] == [
+        'shoulder_joint', 'extend_joint', 'wrist_joint']
+    assert specs['gripper_controller'].type == 'position_controllers/JointGroupPositionController'
+    assert math.isclose(specs['joint_state_broadcaster'].params['update_rate'], 100.0)

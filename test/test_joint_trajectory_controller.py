@@ -13,6 +13,7 @@ from pan_tilt_sim.controllers import CommandKind, CommandResult, JointHandle, cr
 from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
 from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPlan, TrajectoryPoint
 from pan_tilt_sim.description import JointKind, JointSpec
+from pan_tilt_sim.engine import make_simulation
 from pan_tilt_sim.errors import ControllerConfigError
 
 DT = 0.001
@@ -278,3 +279,47 @@ def test_reset_forgets_the_trajectory():
     controller.reset()
     assert Clock(controller).run_to(2.0) == [0.0, 0.0]
 
+
+
+# --- on the three-joint arm in PyBullet ----------------------------------------------------
+
+ARM_JOINTS = ('wrist_joint', 'shoulder_joint', 'extend_joint')  # not the controller's order
+WAYPOINTS = [(1.0, (1.0, 0.5, 0.05)), (2.0, (3.0, 1.0, 0.15)), (3.0, (7.0, -0.5, 0.1))]
+START = 0.5  # s of sim time
+
+
+@pytest.fixture
+def arm(repo_root):
+    with make_simulation(str(repo_root / 'urdf' / 'three_joint_arm.xacro'),
+                         str(repo_root / 'config' / 'three_joint_arm_controllers.yaml'),
+                         DT) as simulation:
+        yield simulation
+
+
+def errors_at_waypoints(simulation, points):
+    simulation.controller('arm_controller').set_command(
+        JointTrajectory(ARM_JOINTS, points, START))
+    errors = []
+    for point in points:
+        simulation.advance(round((START + point.time_from_start - simulation.time) / DT))
+        measured = simulation.joint_positions()
+        errors.append([measured[joint] - target
+                       for joint, target in zip(ARM_JOINTS, point.positions, strict=True)])
+    return errors
+
+
+@pytest.mark.parametrize('with_velocities', [False, True], ids=['linear', 'cubic'])
+def test_three_point_trajectory_passes_within_20_mrad_of_each_waypoint(arm, with_velocities):
+    points = tuple(TrajectoryPoint(when, positions, (0.0, 0.0, 0.0) if with_velocities else ())
+                   for when, positions in WAYPOINTS)
+    errors = errors_at_waypoints(arm, points)
+    assert max(abs(error) for row in errors for error in row) < 0.02, errors
+
+
+def test_arm_holds_the_last_waypoint_after_the_end(arm):
+    points = tuple(TrajectoryPoint(when, positions) for when, positions in WAYPOINTS)
+    errors_at_waypoints(arm, points)
+    arm.advance(2000)
+    measured = arm.joint_positions()
+    assert [measured[joint] for joint in ARM_JOINTS] == pytest.approx(WAYPOINTS[-1][1], abs=0.005)
+    assert max(abs(v) for v in arm.joint_velocities().values()) < 1e-3
