@@ -6,6 +6,7 @@ import textwrap
 import pytest
 
 from pan_tilt_sim.controller_config import DEFAULT_UPDATE_RATE, load_controllers_config
+from pan_tilt_sim.engine import make_simulation
 from pan_tilt_sim.errors import ControllerConfigError
 
 
@@ -266,3 +267,69 @@ def test_shipped_three_joint_arm_controllers_load(repo_root):
         'shoulder_joint', 'extend_joint', 'wrist_joint']
     assert specs['gripper_controller'].type == 'position_controllers/JointGroupPositionController'
     assert math.isclose(specs['joint_state_broadcaster'].params['update_rate'], 100.0)
+
+
+# --- the same robot, both styles ------------------------------------------------------------
+
+ARM_GAINS = {'shoulder_joint': '{p: 100.0, i: 1.0, d: 10.0, i_clamp: 5.0}',
+             'extend_joint': '{p: 1000.0, i: 10.0, d: 60.0, i_clamp: 10.0}',
+             'wrist_joint': '{p: 10.0, i: 0.1, d: 0.3, i_clamp: 0.5}'}
+ARM_TARGETS = {'shoulder_joint': 0.8, 'extend_joint': 0.15, 'wrist_joint': -4.0}
+
+
+def ros1_arm_yaml():
+    lines = ['three_joint_arm:',
+             '  joint_state_controller:',
+             '    type: joint_state_controller/JointStateController',
+             '    publish_rate: 100']
+    for joint, gains in ARM_GAINS.items():
+        lines += [f'  {joint}_position_controller:',
+                  '    type: effort_controllers/JointPositionController',
+                  f'    joint: {joint}',
+                  f'    pid: {gains}']
+    return '\n'.join(lines) + '\n'
+
+
+def ros2_arm_yaml():
+    gains = ''.join(f'\n                  {joint}: {value}' for joint, value in ARM_GAINS.items())
+    return f"""
+        controller_manager:
+          ros__parameters:
+            update_rate: 100
+            joint_state_broadcaster:
+              type: joint_state_broadcaster/JointStateBroadcaster
+            arm_controller:
+              type: position_controllers/JointGroupPositionController
+        arm_controller:
+          ros__parameters:
+            joints: [{', '.join(ARM_GAINS)}]
+            gains:{gains}
+        """
+
+
+def arm_motion(repo_root, controllers_file, command):
+    """Command the arm's targets and record every joint's position each 10 ms for 3 s."""
+    with make_simulation(str(repo_root / 'urdf' / 'three_joint_arm.xacro'),
+                         str(controllers_file), 0.001) as simulation:
+        command(simulation)
+        samples = []
+        for _ in range(300):
+            simulation.advance(10)
+            samples.append(simulation.joint_positions())
+    return samples
+
+
+def test_ros1_and_ros2_control_yaml_give_the_same_motion(repo_root, write_yaml):
+    def per_joint(simulation):
+        for joint, target in ARM_TARGETS.items():
+            simulation.controller(f'{joint}_position_controller').set_command(target)
+
+    def as_group(simulation):
+        simulation.controller('arm_controller').set_command(
+            [ARM_TARGETS[joint] for joint in ARM_GAINS])
+
+    ros1 = arm_motion(repo_root, write_yaml(ros1_arm_yaml(), 'ros1.yaml'), per_joint)
+    ros2 = arm_motion(repo_root, write_yaml(ros2_arm_yaml(), 'ros2.yaml'), as_group)
+    assert ros1 == ros2
+    assert ros1[-1]['wrist_joint'] == pytest.approx(-4.0, abs=0.01)
+    assert ros1[-1]['shoulder_joint'] == pytest.approx(0.8, abs=0.01)
