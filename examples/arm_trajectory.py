@@ -45,6 +45,7 @@ def trajectory_message():
 
 
 def main(argv=None):
+    """Send the trajectory and the gripper command; return 0 once the last waypoint is reached."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--namespace', default='', help="the robot's namespace (default none)")
     parser.add_argument('--tolerance', type=float, default=0.02)
