@@ -97,7 +97,8 @@ class ForwardCommandController(CommandController):
     def set_command(self, value: Sequence[float]) -> CommandResult:
         """Store one command per joint; reject the whole command if any element is bad."""
         members = self._members
-        expected = (f'expected {len(members)} values, one per joint '
+        plural = '' if len(members) == 1 else 's'
+        expected = (f'expected {len(members)} value{plural}, one per joint '
                     f"({', '.join(self._joint_names)})")
         if isinstance(value, str | bytes) or not hasattr(value, '__len__'):
             self._problem = f'ignored command {value!r}: {expected}'
