@@ -17,6 +17,7 @@ or ``--timeout`` wall seconds pass.
 """
 
 import argparse
+import math
 import sys
 import time
 
@@ -44,17 +45,8 @@ def trajectory_message():
     return message
 
 
-def main(argv=None):
-    """Send the trajectory and the gripper command; return 0 once the last waypoint is reached."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument('--namespace', default='', help="the robot's namespace (default none)")
-    parser.add_argument('--tolerance', type=float, default=0.02)
-    parser.add_argument('--timeout', type=float, default=60.0, help='wall seconds')
-    args = parser.parse_args(argv)
-    namespace = args.namespace.rstrip('/')
-
-    rclpy.init()
-    node = Node('arm_trajectory')
+def follow(node, namespace, tolerance, deadline):
+    """Send the commands, print joint_states; return whether the last waypoint was reached."""
     latest = {}
     node.create_subscription(JointState, f'{namespace}/joint_states', lambda m: latest.update(
         zip(m.name, m.position, strict=False)), 10)
@@ -62,34 +54,43 @@ def main(argv=None):
                                 10)
     gripper = node.create_publisher(Float64MultiArray,
                                     f'{namespace}/gripper_controller/commands', 10)
-    deadline = time.monotonic() + args.timeout
+    while not (arm.get_subscription_count() and gripper.get_subscription_count()):
+        if time.monotonic() > deadline:
+            return False
+        rclpy.spin_once(node, timeout_sec=0.1)
+    arm.publish(trajectory_message())
+    gripper.publish(Float64MultiArray(data=[GRIPPER_OPENING]))
     target = dict(zip(JOINTS, WAYPOINTS[-1][1], strict=True))
-    reached = False
+    next_print = 0.0
+    while time.monotonic() < deadline:
+        rclpy.spin_once(node, timeout_sec=0.1)
+        if latest and time.monotonic() >= next_print:
+            print('  '.join(f'{name}: {value:+.3f}' for name, value in latest.items()),
+                  flush=True)
+            next_print = time.monotonic() + 0.5
+        if all(abs(latest.get(name, math.inf) - value) <= tolerance
+               for name, value in target.items()):
+            print('last waypoint reached')
+            return True
+    return False
+
+
+def main(argv=None):
+    """Run :func:`follow` on a fresh node; exit status 0 once the last waypoint is reached."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--namespace', default='', help="the robot's namespace (default none)")
+    parser.add_argument('--tolerance', type=float, default=0.02)
+    parser.add_argument('--timeout', type=float, default=60.0, help='wall seconds')
+    args = parser.parse_args(argv)
+    rclpy.init()
+    node = Node('arm_trajectory')
     try:
-        while (arm.get_subscription_count() == 0 or gripper.get_subscription_count() == 0) \
-                and time.monotonic() < deadline:
-            rclpy.spin_once(node, timeout_sec=0.1)
-        arm.publish(trajectory_message())
-        gripper.publish(Float64MultiArray(data=[GRIPPER_OPENING]))
-        last_print = 0.0
-        while time.monotonic() < deadline:
-            rclpy.spin_once(node, timeout_sec=0.1)
-            if not latest:
-                continue
-            if time.monotonic() - last_print > 0.5:
-                print('  '.join(f'{name}: {value:+.3f}' for name, value in latest.items()),
-                      flush=True)
-                last_print = time.monotonic()
-            if all(abs(latest.get(name, float('inf')) - value) <= args.tolerance
-                   for name, value in target.items()):
-                print('last waypoint reached')
-                reached = True
-                break
+        reached = follow(node, args.namespace.rstrip('/'), args.tolerance,
+                         time.monotonic() + args.timeout)
     except KeyboardInterrupt:
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+        reached = False
+    node.destroy_node()
+    rclpy.try_shutdown()
     return 0 if reached else 1
 
 
