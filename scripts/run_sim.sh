@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Run the simulator: scripts/run_sim.sh [sim_node arguments...]
+#   e.g. scripts/run_sim.sh --ros-args -p real_time_factor:=0
+#
+# First use creates .venv (python3.11) and installs the dependencies and this
+# package; later runs reinstall only what changed. Then it starts sim_node the
+# way `ros2 run pan_tilt_sim sim_node` does: looks the package up in the ament
+# index and execs <prefix>/lib/pan_tilt_sim/sim_node, so sim_node gets this
+# script's PID and signals (Ctrl-C, kill) reach it directly.
+set -euo pipefail
+
+# shellcheck source=scripts/_prepare_venv.sh
+source "$(dirname -- "${BASH_SOURCE[0]}")/_prepare_venv.sh"
+prepare_venv runtime
+
+# DDS on this machine only, unless the caller chose otherwise.
+export ROS_AUTOMATIC_DISCOVERY_RANGE=${ROS_AUTOMATIC_DISCOVERY_RANGE:-LOCALHOST}
+# The venv is an ament prefix (share/ament_index/...); it goes first so this
+# checkout's pan_tilt_sim wins, other prefixes stay for package:// look-ups.
+export AMENT_PREFIX_PATH=$VENV${AMENT_PREFIX_PATH:+:$AMENT_PREFIX_PATH}
+
+prefix=$("$VENV/bin/python" -c \
+    'from ament_index_python.packages import get_package_prefix as p; print(p("pan_tilt_sim"))')
+exec "$prefix/lib/pan_tilt_sim/sim_node" "$@"
