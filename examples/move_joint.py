@@ -19,7 +19,8 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
+    """Publish the command and watch the joint; 0 when it arrived, 1 on timeout."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('topic', help='a Float64 command topic, e.g. '
                         '/ex_urdf_pan_tilt/joint1_position_controller/command')

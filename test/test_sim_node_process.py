@@ -11,10 +11,9 @@ import signal
 import subprocess
 
 import pytest
+from node_harness import PROBE_QUEUE, NodeHarness
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
-
-from node_harness import PROBE_QUEUE, NodeHarness
 
 NS = '/ex_urdf_pan_tilt'
 STARTUP_BUDGET_S = 20.0
