@@ -23,7 +23,7 @@ import time
 
 from pan_tilt_sim.camera import CameraSettings, Renderer
 from pan_tilt_sim.engine import make_simulation
-from pan_tilt_sim.parameters import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
 
 FRAMES = 50
 ENGINE_STEPS = 50_000
