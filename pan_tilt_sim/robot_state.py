@@ -22,6 +22,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import String
 
 from pan_tilt_sim import extra_parameters as params
+from pan_tilt_sim.description import Mimic
 from pan_tilt_sim.engine import Simulation
 from pan_tilt_sim.kinematics import KinematicTree, Transform, parse_kinematics
 from pan_tilt_sim.ros_interfaces import stamp
@@ -31,6 +32,8 @@ TF_TOPIC = '/tf'
 TF_STATIC_TOPIC = '/tf_static'
 TF_QUEUE_DEPTH = 100
 DUE_EPSILON = 1e-9
+# A TF edge: parent frame, child frame, child pose in the parent frame.
+Frame = tuple[str, str, Transform]
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
@@ -62,11 +65,37 @@ def transform_message(parent: str, child: str, transform: Transform, time: float
     return message
 
 
+def joint_position(positions: Mapping[str, float], joint: str,
+                   mimics: Mapping[str, Mimic]) -> float:
+    """Return ``joint``'s position; a joint the physics does not drive follows its mimic."""
+    if joint in positions:
+        return positions[joint]
+    mimic = mimics.get(joint)
+    if mimic is None:
+        return 0.0
+    return mimic.multiplier * positions.get(mimic.joint, 0.0) + mimic.offset
+
+
+def static_transforms(tree: KinematicTree, extra: Sequence[Frame] = ()) -> list[Frame]:
+    """Return (parent, child, transform) of every fixed joint, then the ``extra`` frames."""
+    fixed = [(joint.parent, joint.child, joint.transform()) for joint in tree.fixed_joints]
+    return fixed + list(extra)
+
+
+def moving_transforms(tree: KinematicTree, positions: Mapping[str, float],
+                      mimics: Mapping[str, Mimic] | None = None) -> list[Frame]:
+    """Return (parent, child, transform) of every moving joint at ``positions``."""
+    mimics = mimics or {}
+    return [(joint.parent, joint.child,
+             joint.transform(joint_position(positions, joint.name, mimics)))
+            for joint in tree.moving_joints]
+
+
 class RobotStatePublisher:
     """Publishes robot_description once and, where tf2_msgs exists, the robot's TF."""
 
     def __init__(self, node: Node, simulation: Simulation, description_topic: str,
-                 extra_static: Sequence[tuple[str, str, Transform]] = ()) -> None:
+                 extra_static: Sequence[Frame] = ()) -> None:
         self._simulation = simulation
         self._description_publisher = latched_publisher(node, String, description_topic)
         self._description_publisher.publish(String(data=simulation.description.urdf_xml))
@@ -77,6 +106,7 @@ class RobotStatePublisher:
         self.tree: KinematicTree = parse_kinematics(simulation.description.urdf_xml)
         self._mimics = {joint.name: joint.mimic for joint in simulation.description.joints
                         if joint.mimic is not None}
+        self.static_frames = static_transforms(self.tree, extra_static)
         self._tf_type = tf_message_type() if enabled else None
         self._next_due = 0.0
         if self._tf_type is None:
@@ -86,14 +116,12 @@ class RobotStatePublisher:
                     'robot_state_publisher can publish TF from it and joint_states)')
             return
         self._tf_publisher = node.create_publisher(self._tf_type, TF_TOPIC, TF_QUEUE_DEPTH)
-        static = [(joint.parent, joint.child, joint.transform())
-                  for joint in self.tree.fixed_joints]
-        static.extend(extra_static)
+        self._static_publisher = latched_publisher(node, self._tf_type, TF_STATIC_TOPIC)
         time = simulation.time
-        latched_publisher(node, self._tf_type, TF_STATIC_TOPIC).publish(self._tf_type(
-            transforms=[transform_message(*entry, time) for entry in static]))
-        self._moving = self.tree.moving_joints
-        self._message = self._tf_type(transforms=[TransformStamped() for _ in self._moving])
+        self._static_publisher.publish(self._tf_type(transforms=[
+            transform_message(*frame, time) for frame in self.static_frames]))
+        self._message = self._tf_type(
+            transforms=[TransformStamped() for _ in self.tree.moving_joints])
 
     @property
     def publishes_tf(self) -> bool:
@@ -108,18 +136,7 @@ class RobotStatePublisher:
         if now + DUE_EPSILON < self._next_due:
             return
         self._next_due = (int((now + DUE_EPSILON) / TF_PERIOD_S) + 1) * TF_PERIOD_S
-        positions = self._simulation.joint_positions()
-        for joint, message in zip(self._moving, self._message.transforms, strict=True):
-            transform_message(joint.parent, joint.child,
-                              joint.transform(self._position(positions, joint.name)), now,
-                              message)
+        frames = moving_transforms(self.tree, self._simulation.joint_positions(), self._mimics)
+        for frame, message in zip(frames, self._message.transforms, strict=True):
+            transform_message(*frame, now, message)
         self._tf_publisher.publish(self._message)
-
-    def _position(self, positions: Mapping[str, float], joint: str) -> float:
-        # A joint the physics does not drive (a mimic) follows its leader.
-        if joint in positions:
-            return positions[joint]
-        mimic = self._mimics.get(joint)
-        if mimic is None:
-            return 0.0
-        return mimic.multiplier * positions.get(mimic.joint, 0.0) + mimic.offset
