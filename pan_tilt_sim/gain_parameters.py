@@ -131,8 +131,10 @@ class GainParameters:
     @staticmethod
     def _declare(node: Node, controller: str, field: str, value: float) -> float:
         name = _parameter_name(controller, field)
+        # Dynamic typing lets integers through; coerce() checks the type instead.
         descriptor = ParameterDescriptor(
-            name=name, description=f'{controller}: {DESCRIPTIONS[field]}', dynamic_typing=True)
+            name=name, type=DOUBLE, description=f'{controller}: {DESCRIPTIONS[field]}',
+            dynamic_typing=True)
         return coerce(name, DOUBLE, node.declare_parameter(name, value, descriptor).value)
 
 
