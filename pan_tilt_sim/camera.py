@@ -39,7 +39,7 @@ from pan_tilt_sim.kinematics import (
     rotate,
 )
 from pan_tilt_sim.physics import Physics, pybullet
-from pan_tilt_sim.world import DEFAULT_WORLD, build_world
+from pan_tilt_sim.world import DEFAULT_WORLD, GROUND_RGB, build_world, has_ground
 
 DEFAULT_LINK = 'tilt_link'
 DEFAULT_WIDTH = 320
@@ -52,6 +52,7 @@ MAX_FOV_DEG = 179.0
 OPTICAL_SUFFIX = '_optical'
 RGBA_CHANNELS = 4
 RGB_CHANNELS = 3
+BACKGROUND_DEPTH = 1.0  # OpenGL depth where nothing was drawn (the far plane)
 BASE_LINK_INDEX = -1  # PyBullet's index of a body's base link
 # Link axes that may serve as the camera's "up" (perpendicular to its +z view axis).
 UP_CANDIDATES: tuple[Vector, ...] = ((1.0, 0.0, 0.0), (-1.0, 0.0, 0.0),
@@ -170,6 +171,11 @@ class Renderer:
             self._body = self._scene.body_id
             self._link_index = self._find_link(settings.link)
             build_world(world, self._client)
+            self._ground = has_ground(world)
+            camera = intrinsics(settings)
+            # Each pixel's viewing ray in optical axes: ((u - cx) / fx, (v - cy) / fy, 1).
+            self._ray_x = (numpy.arange(settings.width) - camera.cx) / camera.fx
+            self._ray_y = (numpy.arange(settings.height) - camera.cy) / camera.fy
             initial = {joint.name: joint.initial_position for joint in self._scene.joints}
             self.mount = camera_mount(description.urdf_xml, settings.link, initial)
             self._projection = pybullet.computeProjectionMatrixFOV(
@@ -190,13 +196,15 @@ class Renderer:
         target = [e + f for e, f in zip(eye, forward, strict=True)]
         view = pybullet.computeViewMatrix(eye, target, up, physicsClientId=self._client)
         settings = self.settings
-        _, _, rgba, _, _ = pybullet.getCameraImage(
+        _, _, rgba, depth, _ = pybullet.getCameraImage(
             settings.width, settings.height, view, self._projection,
             renderer=pybullet.ER_TINY_RENDERER, flags=pybullet.ER_NO_SEGMENTATION_MASK,
             physicsClientId=self._client)
-        pixels = numpy.asarray(rgba, dtype=numpy.uint8).reshape(
-            settings.height, settings.width, RGBA_CHANNELS)
-        return pixels[:, :, :RGB_CHANNELS].tobytes()
+        pixels = numpy.array(rgba, dtype=numpy.uint8).reshape(
+            settings.height, settings.width, RGBA_CHANNELS)[:, :, :RGB_CHANNELS]
+        if self._ground:
+            self._paint_ground(pixels, depth, eye, forward, up)
+        return pixels.tobytes()
 
     def optical_axes(self) -> tuple[Vector, Vector, Vector]:
         """Return the camera's eye position, forward and up vectors in the world frame."""
@@ -205,6 +213,15 @@ class Renderer:
         forward = rotate(optical.rotation, FORWARD)
         up = rotate(optical.rotation, (0.0, -1.0, 0.0))
         return optical.translation, forward, up
+
+    def _paint_ground(self, pixels: numpy.ndarray, depth, eye: Vector, forward: Vector,
+                      up: Vector) -> None:
+        # Where nothing was drawn and the viewing ray meets z = 0, the ground shows.
+        background = numpy.asarray(depth).reshape(pixels.shape[:2]) >= BACKGROUND_DEPTH
+        right_z = forward[0] * up[1] - forward[1] * up[0]  # z of forward x up
+        ray_z = (forward[2] + self._ray_x[numpy.newaxis, :] * right_z
+                 - self._ray_y[:, numpy.newaxis] * up[2])
+        pixels[background & (ray_z * eye[2] < 0.0)] = GROUND_RGB
 
     def link_pose(self) -> Transform:
         """Return the camera link's pose in the world frame, as the scene has it now."""

@@ -32,7 +32,7 @@ class NodeFeatures:
         settings = declare_camera(node, simulation.description.urdf_xml)
         if gui:
             # Show the scenery in the PyBullet window too (visual only: no physics cost).
-            build_world(world, simulation.physics.client_id)
+            build_world(world, simulation.physics.client_id, ground=True)
         self.camera: CameraPublisher | None = None
         static = []
         if settings is not None:

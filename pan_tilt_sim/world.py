@@ -6,6 +6,14 @@ nothing and can never touch the robot.  It lives in the camera's own PyBullet
 client (see :mod:`pan_tilt_sim.camera`), and in the physics client only when
 a GUI window should show it too.
 
+The ground is the plane z = 0.  TinyRenderer's cost grows with the pixels it
+shades, and a ground body covers half of every horizontal view (measured: 9 ms
+per 320x240 frame with a ground box, under 3 ms without), so the camera does
+not render a ground body: it paints the ground into the background pixels
+whose viewing ray points down (exact for an infinite plane, which a plane
+lit by a directional light shows in one flat colour).  ``build_world(...,
+ground=True)`` adds a ground box for the GUI window.
+
 Targets stand on the ground around the origin, one per compass direction,
 each a different colour, their centres at the height of the seed's camera
 when the tilt is horizontal.  With the seed's pan/tilt the camera looks
@@ -25,9 +33,10 @@ TARGETS = 'targets'
 WORLDS = (EMPTY, TARGETS)
 DEFAULT_WORLD = TARGETS
 
-GROUND_HALF_SIZE = 15.0  # m: the ground is a 30 m square ...
+GROUND_HALF_SIZE = 15.0  # m: the GUI's ground box is a 30 m square ...
 GROUND_HALF_THICKNESS = 0.005  # m: ... whose top face is at z = 0
-GROUND_RGBA = (0.55, 0.55, 0.55, 1.0)
+GROUND_RGB = (130, 130, 130)  # the ground's colour in camera images (rgb8)
+GROUND_RGBA = (*(channel / 255.0 for channel in GROUND_RGB), 1.0)
 STATIC_MASS = 0.0  # PyBullet: mass 0 makes a body static
 NO_SHAPE = -1
 
@@ -66,13 +75,25 @@ def check_world(name: str) -> str:
     return name
 
 
-def build_world(name: str, client: int) -> list[int]:
-    """Add the world called ``name`` to PyBullet ``client``; return the new body ids."""
+def has_ground(name: str) -> bool:
+    """Whether the world called ``name`` has a ground plane."""
+    return check_world(name) != EMPTY
+
+
+def build_world(name: str, client: int, *, ground: bool = False) -> list[int]:
+    """Add the world's bodies to PyBullet ``client``; return their ids.
+
+    The ground plane becomes a body only with ``ground`` (for a GUI window);
+    the camera paints it instead (see the module docstring).
+    """
     check_world(name)
     if name == EMPTY:
         return []
-    bodies = [_visual_box(client, (GROUND_HALF_SIZE, GROUND_HALF_SIZE, GROUND_HALF_THICKNESS),
-                          (0.0, 0.0, -GROUND_HALF_THICKNESS), GROUND_RGBA)]
+    bodies = []
+    if ground:
+        bodies.append(_visual_box(
+            client, (GROUND_HALF_SIZE, GROUND_HALF_SIZE, GROUND_HALF_THICKNESS),
+            (0.0, 0.0, -GROUND_HALF_THICKNESS), GROUND_RGBA))
     for target in TARGET_SET:
         half = target.half_size
         bodies.append(_visual_box(client, (half, half, half), target.position, target.rgba))

@@ -18,7 +18,7 @@ from pan_tilt_sim.description import load_description
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.kinematics import rotate
 from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
-from pan_tilt_sim.world import TARGET_SET, Target
+from pan_tilt_sim.world import GROUND_RGB, TARGET_SET, Target
 
 HORIZONTAL_TILT = -math.pi / 2  # the seed's tilt start: the camera looks horizontally
 PAN_LIMIT = 3.14
@@ -149,7 +149,25 @@ def test_panning_away_from_a_target_takes_it_out_of_the_image(renderer, target):
 def test_the_image_is_upright_sky_above_ground_below(renderer):
     image = as_array(renderer.render([math.pi / 4, HORIZONTAL_TILT]), renderer.settings)
     assert image[0].min() == 255  # background above the horizon
-    assert image[-1].max() < 200  # grey ground below
+    assert (image[-1] == GROUND_RGB).all()  # ground below
+
+
+@pytest.mark.parametrize('down', [0.0, 0.2, -0.3])
+def test_the_ground_meets_the_background_at_the_horizon_k_predicts(renderer, down):
+    """Looking ``down`` rad below horizontal, the horizon is fy * tan(down) above cy."""
+    image = as_array(renderer.render([math.pi / 4, HORIZONTAL_TILT - down]), renderer.settings)
+    column = image[:, 100]  # a column with no target in it at pan pi/4
+    ground_rows = numpy.nonzero((column == GROUND_RGB).all(axis=1))[0]
+    camera = intrinsics(renderer.settings)
+    horizon = camera.cy - camera.fy * math.tan(down)
+    assert ground_rows.min() == pytest.approx(horizon, abs=1.0)
+    assert (ground_rows == numpy.arange(ground_rows.min(), 240)).all()  # ground to the bottom
+
+
+def test_looking_straight_down_the_camera_sees_only_the_yellow_base_disc(renderer):
+    # From 0.1 m up, a 60 degree view spans 0.11 m of the 0.4 m wide base disc.
+    image = as_array(renderer.render([0.0, -math.pi]), renderer.settings)
+    assert colour_mask(image, (1.0, 1.0, 0.0, 1.0)).all()
 
 
 def test_a_target_appears_where_the_camera_info_intrinsics_project_it(renderer):
