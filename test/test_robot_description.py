@@ -5,8 +5,8 @@ import math
 
 import pytest
 from geometry_msgs.msg import TransformStamped
-from node_harness import sim_node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sim_harness import sim_node
 from std_msgs.msg import String
 
 from pan_tilt_sim.description import Mimic, load_description
@@ -35,7 +35,7 @@ def test_robot_description_reaches_a_subscriber_that_comes_late():
         harness.run_until_sim_time(0.5)  # the node has long published it
         received = harness.collect(String, harness.node.topic('robot_description'),
                                    LATE_SUBSCRIBER_QOS)
-        assert harness.spin_until(lambda: received, timeout_s=10.0)
+        assert harness.spin_until(lambda: received, budget_s=10.0)
         urdf = harness.simulation.description.urdf_xml
     assert harness.node.topic('robot_description') == '/ex_urdf_pan_tilt/robot_description'
     assert received[0].data == urdf
