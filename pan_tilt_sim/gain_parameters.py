@@ -1,8 +1,14 @@
 """Live PID tuning: every PID gain is a node parameter, as dynamic_reconfigure made it.
 
-For each controller with a PID, ``<controller>.pid.p``, ``.i``, ``.d`` and
-``.i_clamp`` are declared from the gains in effect (the YAML's, or the
-controller's defaults).  ``ros2 param set /sim_node
+For each PID, ``<prefix>.p``, ``.i``, ``.d`` and ``.i_clamp`` are declared
+from the gains in effect (the YAML's, or the controller's defaults).  The
+prefix follows the YAML the gains come from:
+
+* ``<controller>.pid`` for a one-joint controller (ROS 1 style, as the seed's
+  ``joint1_position_controller.pid.p``);
+* ``<controller>.gains.<joint>`` for each joint of a multi-joint controller
+  (ros2_controllers style, as ``arm_controller.gains.shoulder_joint.p``).
+  ``ros2 param set /sim_node
 joint1_position_controller.pid.p 50`` changes the gain at the next physics
 step; the integral term is kept (:class:`~pan_tilt_sim.controllers.pid.Pid`
 stores it already multiplied by ``i``).  Invalid values -- negative, not
@@ -30,6 +36,7 @@ from pan_tilt_sim.extra_parameters import DOUBLE
 from pan_tilt_sim.parameters import coerce
 
 PID_PREFIX = 'pid'
+GAINS_PREFIX = 'gains'
 SYMMETRIC_FIELDS = ('p', 'i', 'd', 'i_clamp')
 ASYMMETRIC_FIELDS = ('p', 'i', 'd', 'i_clamp_min', 'i_clamp_max')
 DESCRIPTIONS = {
@@ -67,76 +74,76 @@ def apply_fields(gains: PidGains, updates: dict[str, float]) -> PidGains:
     return dataclasses.replace(gains, **changes)
 
 
+def controller_pids(controller: Controller) -> dict[str, Pid]:
+    """Return the PIDs of ``controller`` by parameter prefix (none for PID-less types)."""
+    pid = getattr(controller, 'pid', None)
+    if isinstance(pid, Pid):
+        return {f'{controller.name}.{PID_PREFIX}': pid}
+    pids = {}
+    members = getattr(controller, 'members', None)
+    if members is not None:  # a group: one one-joint controller per joint
+        for member in members:
+            member_pid = getattr(member, 'pid', None)
+            if isinstance(member_pid, Pid):
+                pids[f'{controller.name}.{GAINS_PREFIX}.{member.joint_names[0]}'] = member_pid
+    joint_pids = getattr(controller, 'pids', None)
+    if joint_pids is not None:  # one PID per joint, in joint order
+        for joint, joint_pid in zip(controller.joint_names, joint_pids, strict=True):
+            pids[f'{controller.name}.{GAINS_PREFIX}.{joint}'] = joint_pid
+    return pids
+
+
 class GainParameters:
     """Declares the PID gain parameters of ``controllers`` on ``node`` and applies changes."""
 
     def __init__(self, node: Node, controllers: Iterable[Controller]) -> None:
         self._pids: dict[str, Pid] = {}
-        self._fields: dict[str, tuple[str, ...]] = {}
         for controller in controllers:
-            pid = getattr(controller, 'pid', None)
-            if not isinstance(pid, Pid):
-                continue
-            fields = gain_fields(pid.gains)
-            self._pids[controller.name] = pid
-            self._fields[controller.name] = fields
+            self._pids.update(controller_pids(controller))
+        self._fields = {prefix: gain_fields(pid.gains) for prefix, pid in self._pids.items()}
         # Declare before listening; values given at start-up (-p ...) pass the same check.
-        for name, pid in self._pids.items():
-            declared = {field: self._declare(node, name, field, value)
-                        for field, value in field_values(pid.gains, self._fields[name]).items()}
-            pid.gains = self._checked(name, declared)
+        for prefix, pid in self._pids.items():
+            declared = {field: self._declare(node, prefix, field, value)
+                        for field, value in field_values(pid.gains, self._fields[prefix]).items()}
+            pid.gains = self._checked(prefix, declared)
         node.add_on_set_parameters_callback(self.on_set_parameters)
 
     def parameter_names(self) -> list[str]:
         """Return the names of every gain parameter."""
-        return [_parameter_name(controller, field)
-                for controller, fields in self._fields.items() for field in fields]
+        return [f'{prefix}.{field}' for prefix, fields in self._fields.items() for field in fields]
 
     def on_set_parameters(self, changed: list[Parameter]) -> SetParametersResult:
         """Validate and apply the gain parameters among ``changed``; ignore the rest."""
         updates: dict[str, dict[str, float]] = {}
         try:
             for parameter in changed:
-                owner = self._owner(parameter.name)
-                if owner is None:
+                prefix, _, field = parameter.name.rpartition('.')
+                if field not in self._fields.get(prefix, ()):
                     continue
-                controller, field = owner
-                updates.setdefault(controller, {})[field] = coerce(
+                updates.setdefault(prefix, {})[field] = coerce(
                     parameter.name, DOUBLE, parameter.value)
-            new_gains = {controller: self._checked(controller, fields)
-                         for controller, fields in updates.items()}
+            new_gains = {prefix: self._checked(prefix, fields)
+                         for prefix, fields in updates.items()}
         except ParameterError as err:
             return SetParametersResult(successful=False, reason=str(err))
-        for controller, gains in new_gains.items():
-            self._pids[controller].gains = gains
+        for prefix, gains in new_gains.items():
+            self._pids[prefix].gains = gains
         return SetParametersResult(successful=True)
 
-    def _owner(self, name: str) -> tuple[str, str] | None:
-        controller, separator, rest = name.rpartition(f'.{PID_PREFIX}.')
-        if not separator or rest not in self._fields.get(controller, ()):
-            return None
-        return controller, rest
-
-    def _checked(self, controller: str, fields: dict[str, float]) -> PidGains:
+    def _checked(self, prefix: str, fields: dict[str, float]) -> PidGains:
         try:
-            return apply_fields(self._pids[controller].gains, fields)
+            return apply_fields(self._pids[prefix].gains, fields)
         except GainsError as err:
             field, _, problem = str(err).partition(': ')
-            if field in self._fields[controller]:
-                raise ParameterError(
-                    f"parameter '{_parameter_name(controller, field)}': {problem}") from None
-            raise ParameterError(
-                f"parameters '{controller}.{PID_PREFIX}.*': {err}") from None
+            if field in self._fields[prefix]:
+                raise ParameterError(f"parameter '{prefix}.{field}': {problem}") from None
+            raise ParameterError(f"parameters '{prefix}.*': {err}") from None
 
     @staticmethod
-    def _declare(node: Node, controller: str, field: str, value: float) -> float:
-        name = _parameter_name(controller, field)
+    def _declare(node: Node, prefix: str, field: str, value: float) -> float:
+        name = f'{prefix}.{field}'
         # Dynamic typing lets integers through; coerce() checks the type instead.
         descriptor = ParameterDescriptor(
-            name=name, type=DOUBLE, description=f'{controller}: {DESCRIPTIONS[field]}',
+            name=name, type=DOUBLE, description=f'{prefix}: {DESCRIPTIONS[field]}',
             dynamic_typing=True)
         return coerce(name, DOUBLE, node.declare_parameter(name, value, descriptor).value)
-
-
-def _parameter_name(controller: str, field: str) -> str:
-    return f'{controller}.{PID_PREFIX}.{field}'

@@ -137,3 +137,24 @@ def test_a_negative_gain_given_at_start_up_is_a_configuration_error():
 def test_a_gain_given_at_start_up_replaces_the_yaml_one():
     with sim_node(**{f'{TILT}.pid.d': 20}) as harness:
         assert harness.simulation.controller(TILT).pid.gains.d == 20.0
+
+
+def test_multi_joint_controllers_get_one_set_of_gains_per_joint(repo_root):
+    model = str(repo_root / 'urdf' / 'three_joint_arm.xacro')
+    controllers = str(repo_root / 'config' / 'three_joint_arm_controllers.yaml')
+    with sim_node(robot_description_file=model, controllers_file=controllers) as harness:
+        node = harness.node
+        assert node.get_parameter('arm_controller.gains.shoulder_joint.p').value == 100.0
+        assert node.get_parameter('arm_controller.gains.wrist_joint.i_clamp').value == 0.5
+        assert node.get_parameter('gripper_controller.gains.left_finger_joint.p').value == 400.0
+        results = harness.set_parameters(**{'arm_controller.gains.extend_joint.d': 50.0,
+                                            'gripper_controller.gains.left_finger_joint.i': 2})
+        assert all(result.successful for result in results)
+        arm = harness.simulation.controller('arm_controller')
+        assert [pid.gains.d for pid in arm.pids] == [10.0, 50.0, 0.3]
+        gripper = harness.simulation.controller('gripper_controller')
+        assert gripper.members[0].pid.gains.i == 2.0
+        refused = harness.set_parameters(**{'arm_controller.gains.wrist_joint.p': -1.0})
+        assert "'arm_controller.gains.wrist_joint.p'" in refused[0].reason
+        # The arm has no tilt_link: no camera unless asked for.
+        assert node.features.camera is None
