@@ -1,11 +1,13 @@
 """sim_node's camera: parameters, ``image_raw`` and ``camera_info`` topics.
 
-A frame is due every ``1 / camera.rate`` seconds of sim time.  When one is
-due and someone subscribes to the image, the joint positions are snapshot
-and handed to the renderer (:mod:`pan_tilt_sim.camera`); the image is
-stamped with the sim time of the snapshot and published in the
-``<link>_optical`` frame, with a CameraInfo whose K and P follow from
-``camera.fov_deg`` and the image size.
+A frame is due every ``1 / camera.rate`` seconds of sim time; it is taken
+after the first batch of physics steps that reaches the due time (at
+real_time_factor 1 a batch is ~10 ms of sim time, at 0 it is 0.1 s, so with
+the default 10 Hz the frames then fall exactly on the 0.1 s grid).  When
+someone subscribes to the image, the joint positions are snapshot and handed
+to the renderer (:mod:`pan_tilt_sim.camera`); the image is stamped with the
+sim time of the snapshot and published in the ``<link>_optical`` frame, with
+a CameraInfo whose K and P follow from ``camera.fov_deg`` and the image size.
 
 Rendering runs on the physics thread, between batches of steps: a 320x240
 TinyRenderer frame of the seed in the targets world costs ~3 ms (measured by
