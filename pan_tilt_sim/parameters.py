@@ -11,8 +11,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import pathlib
-import sys
 from typing import Any
 
 from rcl_interfaces.msg import ParameterDescriptor, ParameterType
@@ -21,28 +19,16 @@ from rclpy.parameter import Parameter
 
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.naming import check_namespace
+from pan_tilt_sim.share import (  # noqa: F401 -- re-exported: the defaults live there
+    DEFAULT_CONTROLLERS,
+    DEFAULT_DESCRIPTION,
+    PACKAGE_NAME,
+    package_share,
+)
 
-PACKAGE_NAME = 'pan_tilt_sim'
-DEFAULT_DESCRIPTION = pathlib.Path('urdf', 'pan_tilt.xacro')
-DEFAULT_CONTROLLERS = pathlib.Path('config', 'pan_tilt_control.yaml')
 DEFAULT_TIME_STEP = 0.001  # s, PyBullet's recommended range is 1/1000 .. 1/240
 MAX_TIME_STEP = 0.1  # s; beyond this the PID loop is meaningless
 DEFAULT_REAL_TIME_FACTOR = 1.0
-
-
-def package_share() -> pathlib.Path:
-    """Locate ``share/pan_tilt_sim`` (ament index, this prefix, or the source tree)."""
-    try:
-        from ament_index_python.packages import get_package_share_directory
-
-        return pathlib.Path(get_package_share_directory(PACKAGE_NAME))
-    except (ImportError, LookupError, OSError):
-        # Not indexed (AMENT_PREFIX_PATH unset or without us): try where pip
-        # puts data files, then the source checkout this module lives in.
-        installed = pathlib.Path(sys.prefix, 'share', PACKAGE_NAME)
-        if installed.is_dir():
-            return installed
-        return pathlib.Path(__file__).resolve().parents[1]
 
 
 @dataclasses.dataclass(frozen=True)

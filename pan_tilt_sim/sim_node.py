@@ -9,6 +9,7 @@ latest command, and only the tick writes to the simulation.
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 
 import rclpy
@@ -26,6 +27,8 @@ from pan_tilt_sim.controllers.joint_state_controller import JointStateController
 from pan_tilt_sim.description import load_description
 from pan_tilt_sim.engine import Simulation
 from pan_tilt_sim.errors import ConfigurationError
+from pan_tilt_sim.features import NodeFeatures
+from pan_tilt_sim.gain_parameters import GainParameters
 from pan_tilt_sim.pacing import Pacer
 from pan_tilt_sim.ros_interfaces import COMMAND_MESSAGES, clock_message, joint_state_message
 
@@ -35,6 +38,7 @@ TICK_PERIOD_S = 0.01  # wall seconds between ticks when paced to real time
 CLOCK_PERIOD_S = 0.01  # sim seconds between /clock messages (100 Hz of sim time)
 QUEUE_DEPTH = 10
 WARNING_THROTTLE_S = 1.0
+_OWN_PARAMETERS = {field.name for field in dataclasses.fields(parameters.SimParameters)}
 
 
 class SimNode(Node):
@@ -59,6 +63,12 @@ class SimNode(Node):
         self._clock_publisher = self.create_publisher(Clock, '/clock', QUEUE_DEPTH)
         self._clock_message = Clock()
         self._wire_controllers()
+        try:
+            self.gain_parameters = GainParameters(self, self.simulation.controllers)
+            self.features = NodeFeatures(self, gui=self.settings.gui)
+        except BaseException:
+            self.simulation.close()
+            raise
         self._publish_clock()
         self._timer = self.create_timer(self._tick_period(), self._on_tick)
         self.add_on_set_parameters_callback(self._on_set_parameters)
@@ -81,6 +91,7 @@ class SimNode(Node):
             steps -= chunk
             if simulation.steps % self._clock_every == 0:
                 self._publish_clock()
+        self.features.after_steps()
 
     @property
     def paused(self) -> bool:
@@ -96,6 +107,7 @@ class SimNode(Node):
     def destroy_node(self) -> None:
         """Stop ticking and release PyBullet."""
         self._timer.cancel()
+        self.features.close()
         self.simulation.close()
         super().destroy_node()
 
@@ -149,7 +161,8 @@ class SimNode(Node):
 
     def _on_set_parameters(self, changed: list[Parameter]) -> SetParametersResult:
         try:
-            updates = {p.name: parameters.runtime_value(p) for p in changed}
+            updates = {p.name: parameters.runtime_value(p) for p in changed
+                       if p.name in _OWN_PARAMETERS}  # other callbacks own the rest
             if 'real_time_factor' in updates:
                 parameters.check_real_time_factor(updates['real_time_factor'])
         except ConfigurationError as err:

@@ -1,0 +1,262 @@
+"""A camera on a robot link, rendered headless with PyBullet's TinyRenderer. No ROS.
+
+Where the camera sits: at the tip of its link -- as far along the link's +z
+as the link's visual geometry reaches -- looking along the link's +z.  It is
+rigidly mounted: its "up" is the link axis (+-x or +-y) that points most
+nearly up (world +z) in the robot's initial pose, so the image is upright
+there.  For the seed's pan/tilt the tilt link starts horizontal (tilt
+-pi/2), the camera looks along world -x at pan 0, and its up is the link's
++x; at tilt -pi it looks straight down.
+
+The optical frame follows REP-103: z forward, x right, y down.  ``fov_deg``
+is the horizontal field of view (Gazebo's ``horizontal_fov``); pixels are
+square, so ``fx = fy = (width / 2) / tan(fov / 2)``, and the principal
+point is the image centre in OpenCV's convention (pixel centres at integer
+coordinates): ``cx = (width - 1) / 2``, ``cy = (height - 1) / 2``.
+
+:class:`Renderer` keeps its own PyBullet client holding a copy of the robot
+and the scenery (:mod:`pan_tilt_sim.world`).  It renders from a snapshot of
+the joint positions, so the physics client is never touched by rendering and
+the scenery can never slow or disturb the physics.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping, Sequence
+
+import numpy
+
+from pan_tilt_sim.description import RobotDescription
+from pan_tilt_sim.errors import ParameterError
+from pan_tilt_sim.kinematics import (
+    Transform,
+    Vector,
+    link_reach,
+    parse_kinematics,
+    quaternion_from_matrix,
+    rotate,
+)
+from pan_tilt_sim.physics import Physics, pybullet
+from pan_tilt_sim.world import DEFAULT_WORLD, GROUND_RGB, build_world, has_ground
+
+DEFAULT_LINK = 'tilt_link'
+DEFAULT_WIDTH = 320
+DEFAULT_HEIGHT = 240
+DEFAULT_FOV_DEG = 60.0
+DEFAULT_RATE = 10.0  # frames per second of sim time
+DEFAULT_NEAR = 0.01  # m
+DEFAULT_FAR = 50.0  # m
+MAX_FOV_DEG = 179.0
+OPTICAL_SUFFIX = '_optical'
+RGBA_CHANNELS = 4
+RGB_CHANNELS = 3
+BACKGROUND_DEPTH = 1.0  # OpenGL depth where nothing was drawn (the far plane)
+BASE_LINK_INDEX = -1  # PyBullet's index of a body's base link
+# Link axes that may serve as the camera's "up" (perpendicular to its +z view axis).
+UP_CANDIDATES: tuple[Vector, ...] = ((1.0, 0.0, 0.0), (-1.0, 0.0, 0.0),
+                                     (0.0, 1.0, 0.0), (0.0, -1.0, 0.0))
+FORWARD: Vector = (0.0, 0.0, 1.0)
+WORLD_UP: Vector = (0.0, 0.0, 1.0)
+# The scene copy is never stepped; any valid time step will do.
+SCENE_TIME_STEP = 0.001
+
+
+@dataclasses.dataclass(frozen=True)
+class CameraSettings:
+    """What the camera parameters ask for, checked (errors name the parameter)."""
+
+    link: str = DEFAULT_LINK
+    width: int = DEFAULT_WIDTH
+    height: int = DEFAULT_HEIGHT
+    fov_deg: float = DEFAULT_FOV_DEG
+    rate: float = DEFAULT_RATE
+    near: float = DEFAULT_NEAR
+    far: float = DEFAULT_FAR
+
+    def __post_init__(self) -> None:
+        for name in ('width', 'height'):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
+                raise ParameterError(f"parameter 'camera.{name}' must be an integer > 0, "
+                                     f'got {value!r}')
+        if not (math.isfinite(self.fov_deg) and 0.0 < self.fov_deg <= MAX_FOV_DEG):
+            raise ParameterError(f"parameter 'camera.fov_deg' must be > 0 and <= {MAX_FOV_DEG}"
+                                 f' degrees, got {self.fov_deg}')
+        if not (math.isfinite(self.rate) and self.rate > 0.0):
+            raise ParameterError(f"parameter 'camera.rate' must be a number of Hz > 0, "
+                                 f'got {self.rate}')
+        if not (math.isfinite(self.near) and self.near > 0.0):
+            raise ParameterError(f"parameter 'camera.near' must be > 0 m, got {self.near}")
+        if not (math.isfinite(self.far) and self.far > self.near):
+            raise ParameterError(f"parameter 'camera.far' must be finite and greater than "
+                                 f'camera.near ({self.near} m), got {self.far}')
+
+    @property
+    def period(self) -> float:
+        """Seconds of sim time between frames."""
+        return 1.0 / self.rate
+
+    @property
+    def optical_frame(self) -> str:
+        """Name of the optical frame (REP-103) the images are in."""
+        return self.link + OPTICAL_SUFFIX
+
+
+@dataclasses.dataclass(frozen=True)
+class Intrinsics:
+    """Pinhole intrinsics of the image, in pixels."""
+
+    width: int
+    height: int
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+
+    @property
+    def k(self) -> tuple[float, ...]:
+        """The 3x3 camera matrix K, row-major (as ``sensor_msgs/CameraInfo.k``)."""
+        return (self.fx, 0.0, self.cx, 0.0, self.fy, self.cy, 0.0, 0.0, 1.0)
+
+    @property
+    def p(self) -> tuple[float, ...]:
+        """The 3x4 projection matrix P of a monocular camera, row-major."""
+        return (self.fx, 0.0, self.cx, 0.0, 0.0, self.fy, self.cy, 0.0, 0.0, 0.0, 1.0, 0.0)
+
+
+def intrinsics(settings: CameraSettings) -> Intrinsics:
+    """Return the intrinsics for the settings' size and horizontal field of view."""
+    focal = (settings.width / 2.0) / math.tan(math.radians(settings.fov_deg) / 2.0)
+    return Intrinsics(settings.width, settings.height, focal, focal,
+                      (settings.width - 1) / 2.0, (settings.height - 1) / 2.0)
+
+
+def vertical_fov_deg(settings: CameraSettings) -> float:
+    """Return the vertical field of view (PyBullet's ``fov``) for square pixels."""
+    half = math.atan(math.tan(math.radians(settings.fov_deg) / 2.0)
+                     * settings.height / settings.width)
+    return math.degrees(2.0 * half)
+
+
+def camera_mount(urdf_xml: str, link: str,
+                 initial_positions: Mapping[str, float]) -> Transform:
+    """Return the pose of the optical frame in ``link``'s frame.
+
+    The origin is the tip of the link on its +z axis; the optical z is the
+    link's +z, the optical y (image down) is minus the link axis that points
+    most nearly up in the initial pose, and optical x = y cross z (image right).
+    """
+    reach = link_reach(urdf_xml, link)
+    poses = parse_kinematics(urdf_xml).link_poses(initial_positions)
+    link_pose = poses.get(link, Transform())
+    up = max(UP_CANDIDATES,
+             key=lambda axis: _dot(rotate(link_pose.rotation, axis), WORLD_UP))
+    down = tuple(-c for c in up)
+    right = _cross(down, FORWARD)
+    rotation = quaternion_from_matrix((right, down, FORWARD))  # type: ignore[arg-type]
+    return Transform((0.0, 0.0, reach), rotation)
+
+
+class Renderer:
+    """Renders the camera's view of the robot, posed from a joint snapshot, in its scenery."""
+
+    def __init__(self, description: RobotDescription, settings: CameraSettings,
+                 world: str = DEFAULT_WORLD) -> None:
+        self.settings = settings
+        self._scene = Physics(description, SCENE_TIME_STEP)
+        try:
+            self._client = self._scene.client_id
+            self._body = self._scene.body_id
+            self._link_index = self._find_link(settings.link)
+            build_world(world, self._client)
+            self._ground = has_ground(world)
+            camera = intrinsics(settings)
+            # Each pixel's viewing ray in optical axes: ((u - cx) / fx, (v - cy) / fy, 1).
+            self._ray_x = (numpy.arange(settings.width) - camera.cx) / camera.fx
+            self._ray_y = (numpy.arange(settings.height) - camera.cy) / camera.fy
+            initial = {joint.name: joint.initial_position for joint in self._scene.joints}
+            self.mount = camera_mount(description.urdf_xml, settings.link, initial)
+            self._projection = pybullet.computeProjectionMatrixFOV(
+                vertical_fov_deg(settings), settings.width / settings.height,
+                settings.near, settings.far, physicsClientId=self._client)
+        except BaseException:
+            self._scene.close()
+            raise
+        self.joint_names = tuple(joint.name for joint in self._scene.joints)
+
+    def render(self, positions: Sequence[float]) -> bytes:
+        """Return an rgb8 image (rows top first) with the joints at ``positions``.
+
+        ``positions`` are in :attr:`joint_names` order (the physics layer's order).
+        """
+        self._scene.reset_joints(positions)
+        eye, forward, up = self.optical_axes()
+        target = [e + f for e, f in zip(eye, forward, strict=True)]
+        view = pybullet.computeViewMatrix(eye, target, up, physicsClientId=self._client)
+        settings = self.settings
+        _, _, rgba, depth, _ = pybullet.getCameraImage(
+            settings.width, settings.height, view, self._projection,
+            renderer=pybullet.ER_TINY_RENDERER, flags=pybullet.ER_NO_SEGMENTATION_MASK,
+            physicsClientId=self._client)
+        pixels = numpy.array(rgba, dtype=numpy.uint8).reshape(
+            settings.height, settings.width, RGBA_CHANNELS)[:, :, :RGB_CHANNELS]
+        if self._ground:
+            self._paint_ground(pixels, depth, eye, forward, up)
+        return pixels.tobytes()
+
+    def optical_axes(self) -> tuple[Vector, Vector, Vector]:
+        """Return the camera's eye position, forward and up vectors in the world frame."""
+        link = self.link_pose()
+        optical = link.then(self.mount)
+        forward = rotate(optical.rotation, FORWARD)
+        up = rotate(optical.rotation, (0.0, -1.0, 0.0))
+        return optical.translation, forward, up
+
+    def _paint_ground(self, pixels: numpy.ndarray, depth, eye: Vector, forward: Vector,
+                      up: Vector) -> None:
+        # Where nothing was drawn and the viewing ray meets z = 0, the ground shows.
+        background = numpy.asarray(depth).reshape(pixels.shape[:2]) >= BACKGROUND_DEPTH
+        right_z = forward[0] * up[1] - forward[1] * up[0]  # z of forward x up
+        ray_z = (forward[2] + self._ray_x[numpy.newaxis, :] * right_z
+                 - self._ray_y[:, numpy.newaxis] * up[2])
+        pixels[background & (ray_z * eye[2] < 0.0)] = GROUND_RGB
+
+    def link_pose(self) -> Transform:
+        """Return the camera link's pose in the world frame, as the scene has it now."""
+        if self._link_index == BASE_LINK_INDEX:
+            position, orientation = pybullet.getBasePositionAndOrientation(
+                self._body, physicsClientId=self._client)
+        else:
+            state = pybullet.getLinkState(self._body, self._link_index,
+                                          computeForwardKinematics=True,
+                                          physicsClientId=self._client)
+            position, orientation = state[4], state[5]  # the URDF link frame
+        return Transform(tuple(position), tuple(orientation))
+
+    def close(self) -> None:
+        """Release the scene's PyBullet client."""
+        self._scene.close()
+
+    def _find_link(self, link: str) -> int:
+        client, body = self._client, self._body
+        base = pybullet.getBodyInfo(body, physicsClientId=client)[0].decode('utf-8')
+        if link == base:
+            return BASE_LINK_INDEX
+        names = [base]
+        for index in range(pybullet.getNumJoints(body, physicsClientId=client)):
+            child = pybullet.getJointInfo(body, index, physicsClientId=client)[12]
+            names.append(child.decode('utf-8'))
+            if names[-1] == link:
+                return index
+        raise ParameterError(f"parameter 'camera.link': '{link}' is not a link of the robot "
+                             f"(links: {', '.join(names)})")
+
+
+def _dot(a: Sequence[float], b: Sequence[float]) -> float:
+    return sum(x * y for x, y in zip(a, b, strict=True))
+
+
+def _cross(a: Sequence[float], b: Sequence[float]) -> Vector:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])

@@ -1,0 +1,162 @@
+"""sim_node's camera: parameters, ``image_raw`` and ``camera_info`` topics.
+
+A frame is due every ``1 / camera.rate`` seconds of sim time; it is taken
+after the first batch of physics steps that reaches the due time (at
+real_time_factor 1 a batch is ~10 ms of sim time, at 0 it is 0.1 s, so with
+the default 10 Hz the frames then fall exactly on the 0.1 s grid).  When
+someone subscribes to the image, the joint positions are snapshot and handed
+to the renderer (:mod:`pan_tilt_sim.camera`); the image is stamped with the
+sim time of the snapshot and published in the ``<link>_optical`` frame, with
+a CameraInfo whose K and P follow from ``camera.fov_deg`` and the image size.
+
+Rendering runs on the physics thread, between batches of steps: a 320x240
+TinyRenderer frame of the seed in the targets world costs ~3 ms (measured by
+scripts/camera_benchmark.py), and PyBullet holds the GIL while it renders,
+so a Python thread would not run it in parallel.  Sim time is not affected
+(every frame shows the state at its stamp); wall-time pacing absorbs the
+cost at real_time_factor 1, and at real_time_factor 0 frames take their
+share of the machine.  Like Gazebo's camera plugin, nothing is rendered
+while nobody subscribes to ``image_raw``, so the camera then costs nothing.
+"""
+
+from __future__ import annotations
+
+import array
+
+from rclpy.node import Node
+from sensor_msgs.msg import CameraInfo, Image
+
+from pan_tilt_sim import extra_parameters as params
+from pan_tilt_sim.camera import (
+    DEFAULT_FAR,
+    DEFAULT_FOV_DEG,
+    DEFAULT_HEIGHT,
+    DEFAULT_LINK,
+    DEFAULT_NEAR,
+    DEFAULT_RATE,
+    DEFAULT_WIDTH,
+    CameraSettings,
+    Intrinsics,
+    Renderer,
+    intrinsics,
+)
+from pan_tilt_sim.engine import Simulation
+from pan_tilt_sim.errors import ParameterError
+from pan_tilt_sim.kinematics import Transform, link_names
+from pan_tilt_sim.ros_interfaces import stamp
+from pan_tilt_sim.world import DEFAULT_WORLD, WORLDS, check_world
+
+IMAGE_ENCODING = 'rgb8'
+BYTES_PER_PIXEL = 3
+DISTORTION_MODEL = 'plumb_bob'
+NO_DISTORTION = [0.0] * 5
+IDENTITY_3X3 = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+QUEUE_DEPTH = 5
+# Tolerance on "frame due" so float sim times do not skip a frame.
+DUE_EPSILON = 1e-9
+
+
+def declare_world(node: Node) -> str:
+    """Declare the ``world`` parameter and return its checked value."""
+    return check_world(params.declare(
+        node, 'world', params.STRING, DEFAULT_WORLD,
+        f"Scenery the camera sees: {' or '.join(WORLDS)} (a ground plane and coloured "
+        'targets). Visual only: it never touches the physics.'))
+
+
+def declare_camera(node: Node, urdf_xml: str) -> CameraSettings | None:
+    """Declare the ``camera.*`` parameters; return the settings, or None when it is off."""
+    link = params.declare(node, 'camera.link', params.STRING, DEFAULT_LINK,
+                          'Link carrying the camera, at its tip, looking along its +z.')
+    links = link_names(urdf_xml)
+    enabled = params.declare(
+        node, 'camera.enabled', params.BOOL, link in links,
+        'Render and publish camera images (default: true when the robot has camera.link).')
+    values = {
+        'width': params.declare(node, 'camera.width', params.INTEGER, DEFAULT_WIDTH,
+                                'Image width in pixels.'),
+        'height': params.declare(node, 'camera.height', params.INTEGER, DEFAULT_HEIGHT,
+                                 'Image height in pixels.'),
+        'fov_deg': params.declare(node, 'camera.fov_deg', params.DOUBLE, DEFAULT_FOV_DEG,
+                                  'Horizontal field of view in degrees.'),
+        'rate': params.declare(node, 'camera.rate', params.DOUBLE, DEFAULT_RATE,
+                               'Frames per second of sim time.'),
+        'near': params.declare(node, 'camera.near', params.DOUBLE, DEFAULT_NEAR,
+                               'Near clipping distance in metres.'),
+        'far': params.declare(node, 'camera.far', params.DOUBLE, DEFAULT_FAR,
+                              'Far clipping distance in metres.'),
+    }
+    if not enabled:
+        return None
+    if link not in links:
+        raise ParameterError(f"parameter 'camera.link': '{link}' is not a link of the robot "
+                             f"(links: {', '.join(links)})")
+    return CameraSettings(link=link, **values)
+
+
+def camera_info_message(camera: Intrinsics, frame_id: str) -> CameraInfo:
+    """Return the CameraInfo of an ideal pinhole camera with these intrinsics."""
+    message = CameraInfo()
+    message.header.frame_id = frame_id
+    message.width = camera.width
+    message.height = camera.height
+    message.distortion_model = DISTORTION_MODEL
+    message.d = list(NO_DISTORTION)
+    message.k = list(camera.k)
+    message.r = list(IDENTITY_3X3)
+    message.p = list(camera.p)
+    return message
+
+
+class CameraPublisher:
+    """Renders the camera when a frame is due and publishes it with its CameraInfo."""
+
+    def __init__(self, node: Node, simulation: Simulation, settings: CameraSettings,
+                 world: str, image_topic: str, info_topic: str) -> None:
+        self._simulation = simulation
+        self.settings = settings
+        self._renderer = Renderer(simulation.description, settings, world)
+        self._image_publisher = node.create_publisher(Image, image_topic, QUEUE_DEPTH)
+        self._info_publisher = node.create_publisher(CameraInfo, info_topic, QUEUE_DEPTH)
+        self._info = camera_info_message(intrinsics(settings), settings.optical_frame)
+        self._image = Image(height=settings.height, width=settings.width,
+                            encoding=IMAGE_ENCODING, is_bigendian=0,
+                            step=settings.width * BYTES_PER_PIXEL)
+        self._image.header.frame_id = settings.optical_frame
+        self._frames = 0
+        self._next_due = 0.0
+
+    @property
+    def mount(self) -> Transform:
+        """Pose of the optical frame in the camera link's frame."""
+        return self._renderer.mount
+
+    @property
+    def frames(self) -> int:
+        """Images rendered and published so far."""
+        return self._frames
+
+    def update(self) -> None:
+        """Publish a frame if one is due at the present sim time (render it if watched)."""
+        now = self._simulation.time
+        if now + DUE_EPSILON < self._next_due:
+            return
+        period = self.settings.period
+        # Count periods from zero, so no rounding error accumulates.
+        self._next_due = (int((now + DUE_EPSILON) / period) + 1) * period
+        stamp(now, self._info.header.stamp)
+        if self._image_publisher.get_subscription_count() > 0:
+            positions = self._simulation.joint_positions()
+            pixels = self._renderer.render(
+                [positions[name] for name in self._renderer.joint_names])
+            image = self._image
+            stamp(now, image.header.stamp)
+            image.data = array.array('B', pixels)
+            self._image_publisher.publish(image)
+            self._frames += 1
+        if self._info_publisher.get_subscription_count() > 0:
+            self._info_publisher.publish(self._info)
+
+    def close(self) -> None:
+        """Release the renderer."""
+        self._renderer.close()

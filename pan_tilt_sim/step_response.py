@@ -1,0 +1,339 @@
+"""step_response: step a joint's position controller and measure the response. No ROS graph.
+
+::
+
+    ros2 run pan_tilt_sim step_response --joint pan_joint --target 1.0 --plot step.png
+
+runs the simulation in this process as fast as it goes (it never imports
+rclpy), commands the joint's position controller to ``--target`` at t = 0,
+records position, setpoint and effort every physics step for ``--duration``
+seconds of sim time, and prints JSON:
+
+* ``rise_time_s`` -- 10 % to 90 % of the step (linear interpolation between samples);
+* ``overshoot_percent`` -- how far past the target the joint went, in % of the step;
+* ``settling_time_s`` -- from the step until the position stays within 2 % of the step
+  around the target (null if it never does within the run);
+* ``steady_state_error`` -- target minus the final position (rad or m);
+* ``peak_effort`` -- the largest absolute effort applied (N*m or N);
+* ``velocity_limit_active`` -- whether the URDF velocity limit ramped the setpoint
+  (joint_limits_interface), and ``setpoint_reached_s``, when the ramp reached the target.
+
+``--plot FILE`` writes a PNG (matplotlib, Agg backend): position and setpoint
+over time, the effort on a second axis, the metrics in the legend.  Errors in
+the arguments or files: one line on stderr, exit code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import math
+import pathlib
+import sys
+from collections.abc import Sequence
+
+from pan_tilt_sim.controllers import CommandResult
+from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
+from pan_tilt_sim.description import JointKind
+from pan_tilt_sim.engine import Simulation, make_simulation
+from pan_tilt_sim.errors import ConfigurationError
+from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
+
+PROGRAM = 'step_response'
+EXIT_CONFIGURATION_ERROR = 2
+DEFAULT_TIME_STEP = 0.001  # s, sim_node's default
+SETTLE_ALLOWANCE_S = 5.0  # s of sim time after the setpoint ramp, by default
+RISE_LOW = 0.1
+RISE_HIGH = 0.9
+SETTLING_BAND = 0.02
+PERCENT = 100.0
+# A setpoint this close to the target has reached it.
+SETPOINT_TOLERANCE = 1e-9
+PLOT_SIZE_IN = (8.0, 4.5)
+PLOT_DPI = 80
+DIGITS = 4
+ANGULAR_UNITS = ('rad', 'N m')  # position, effort
+LINEAR_UNITS = ('m', 'N')
+
+
+@dataclasses.dataclass(frozen=True)
+class StepRecord:
+    """One step response, sampled every physics step (t = 0 is the step)."""
+
+    joint: str
+    controller: str
+    initial: float
+    target: float
+    velocity_limit: float
+    position_unit: str
+    effort_unit: str
+    times: tuple[float, ...]
+    positions: tuple[float, ...]
+    setpoints: tuple[float, ...]
+    efforts: tuple[float, ...]
+
+
+@dataclasses.dataclass(frozen=True)
+class StepMetrics:
+    """The usual figures of merit of a step response."""
+
+    rise_time_s: float | None
+    overshoot_percent: float
+    settling_time_s: float | None
+    steady_state_error: float
+    peak_effort: float
+    velocity_limit_active: bool
+    setpoint_reached_s: float | None
+
+
+def crossing_time(times: Sequence[float], values: Sequence[float], level: float) -> float | None:
+    """Return when ``values`` (rising) first reach ``level``, interpolated; None if never."""
+    for index, value in enumerate(values):
+        if value >= level:
+            if index == 0:
+                return times[0]
+            before, t_before = values[index - 1], times[index - 1]
+            fraction = (level - before) / (value - before)
+            return t_before + fraction * (times[index] - t_before)
+    return None
+
+
+def normalized(values: Sequence[float], initial: float, target: float) -> list[float]:
+    """Map ``values`` so that ``initial`` is 0 and ``target`` is 1 (steps either way)."""
+    step = target - initial
+    if step == 0.0:
+        raise ValueError('the step is zero: initial and target are equal')
+    return [(value - initial) / step for value in values]
+
+
+def rise_time(times: Sequence[float], values: Sequence[float], initial: float,
+              target: float) -> float | None:
+    """Return the 10 %-90 % rise time; None if the response never reaches 90 %."""
+    fractions = normalized(values, initial, target)
+    low = crossing_time(times, fractions, RISE_LOW)
+    high = crossing_time(times, fractions, RISE_HIGH)
+    return None if low is None or high is None else high - low
+
+
+def overshoot_percent(values: Sequence[float], initial: float, target: float) -> float:
+    """Return the peak's excursion past the target in % of the step (0 if none)."""
+    return max(0.0, max(normalized(values, initial, target)) - 1.0) * PERCENT
+
+
+def settling_time(times: Sequence[float], values: Sequence[float], initial: float,
+                  target: float, band: float = SETTLING_BAND) -> float | None:
+    """Return when the response enters, for good, the band of ``band`` x step around target.
+
+    None if the last sample is outside the band (not settled within the record).
+    """
+    fractions = normalized(values, initial, target)
+    settled_from = None
+    for time, fraction in zip(times, fractions, strict=True):
+        if abs(fraction - 1.0) > band:
+            settled_from = None
+        elif settled_from is None:
+            settled_from = time
+    return settled_from
+
+
+def setpoint_reached(times: Sequence[float], setpoints: Sequence[float],
+                     target: float) -> float | None:
+    """Return when the setpoint first equals the target; None if it never does."""
+    for time, setpoint in zip(times, setpoints, strict=True):
+        if abs(setpoint - target) <= SETPOINT_TOLERANCE:
+            return time
+    return None
+
+
+def step_metrics(record: StepRecord) -> StepMetrics:
+    """Compute every metric of ``record``."""
+    times, positions = record.times, record.positions
+    reached = setpoint_reached(times, record.setpoints, record.target)
+    # Without a velocity limit the setpoint jumps at the first step.
+    first_step = times[1] if len(times) > 1 else times[0]
+    return StepMetrics(
+        rise_time_s=rise_time(times, positions, record.initial, record.target),
+        overshoot_percent=overshoot_percent(positions, record.initial, record.target),
+        settling_time_s=settling_time(times, positions, record.initial, record.target),
+        steady_state_error=record.target - positions[-1],
+        peak_effort=max(abs(effort) for effort in record.efforts),
+        velocity_limit_active=reached is None or reached > first_step,
+        setpoint_reached_s=reached,
+    )
+
+
+def position_controller(simulation: Simulation, joint: str) -> JointPositionController:
+    """Return the position controller driving ``joint``; ConfigurationError if none."""
+    if joint not in simulation.handles:
+        raise ConfigurationError(
+            f"--joint: '{joint}' is not a movable joint of the robot "
+            f"(movable joints: {', '.join(simulation.handles)})")
+    for controller in simulation.controllers:
+        if joint in controller.joint_names:
+            if isinstance(controller, JointPositionController):
+                return controller
+            raise ConfigurationError(
+                f"--joint: '{joint}' is driven by '{controller.name}', which is not a "
+                'position controller; step_response steps position controllers')
+    raise ConfigurationError(f"--joint: no controller drives '{joint}'")
+
+
+def record_step(simulation: Simulation, joint: str, target: float,
+                duration: float | None = None) -> StepRecord:
+    """Step ``joint`` to ``target`` at the present state and record the response.
+
+    ``duration`` (s of sim time) defaults to the velocity-limited ramp's
+    length plus ``SETTLE_ALLOWANCE_S``.
+    """
+    controller = position_controller(simulation, joint)
+    spec = simulation.handles[joint].spec
+    initial = simulation.joint_positions()[joint]
+    result = controller.set_command(target)
+    if result is CommandResult.REJECTED:
+        raise ConfigurationError(f'--target: {target!r} is not a finite number')
+    commanded = spec.clamp_position(target)
+    if commanded == initial:
+        raise ConfigurationError(
+            f"--target: {commanded} is where '{joint}' already is; there is no step")
+    if duration is None:
+        ramp = abs(commanded - initial) / spec.velocity_limit
+        duration = ramp + SETTLE_ALLOWANCE_S
+    if not (math.isfinite(duration) and duration > 0.0):
+        raise ConfigurationError(f'--duration: {duration} must be a number of seconds > 0')
+    steps = max(1, round(duration / simulation.time_step))
+    start = simulation.time
+    handle = simulation.handles[joint]
+    times, positions = [0.0], [initial]
+    setpoints, efforts = [controller.setpoint], [handle.effort]
+    for _ in range(steps):
+        simulation.advance(1)
+        times.append(simulation.time - start)
+        positions.append(simulation.joint_positions()[joint])
+        setpoints.append(controller.setpoint)
+        efforts.append(handle.effort)
+    units = LINEAR_UNITS if spec.kind is JointKind.PRISMATIC else ANGULAR_UNITS
+    return StepRecord(joint=joint, controller=controller.name, initial=initial,
+                      target=commanded, velocity_limit=spec.velocity_limit,
+                      position_unit=units[0], effort_unit=units[1],
+                      times=tuple(times), positions=tuple(positions),
+                      setpoints=tuple(setpoints), efforts=tuple(efforts))
+
+
+def report(record: StepRecord, metrics: StepMetrics, gains: dict[str, float]) -> dict:
+    """Return the JSON-ready summary of one step response."""
+    def rounded(value: float | None) -> float | None:
+        return None if value is None or not math.isfinite(value) else round(value, DIGITS)
+
+    summary = {
+        'joint': record.joint,
+        'controller': record.controller,
+        'initial': rounded(record.initial),
+        'target': rounded(record.target),
+        'duration_s': rounded(record.times[-1]),
+        'gains': {name: rounded(value) for name, value in gains.items()},
+        'velocity_limit': rounded(record.velocity_limit),
+    }
+    for field in dataclasses.fields(metrics):
+        value = getattr(metrics, field.name)
+        summary[field.name] = value if isinstance(value, bool) else rounded(value)
+    return summary
+
+
+def plot(record: StepRecord, metrics: StepMetrics, path: pathlib.Path) -> None:
+    """Write a PNG: position and setpoint, effort on a second axis, metrics in the legend."""
+    import matplotlib
+
+    matplotlib.use('Agg')
+    from matplotlib import pyplot
+    from matplotlib.lines import Line2D
+
+    figure, position_axis = pyplot.subplots(figsize=PLOT_SIZE_IN, dpi=PLOT_DPI)
+    effort_axis = position_axis.twinx()
+    lines = [
+        position_axis.plot(record.times, record.setpoints, '--', color='tab:gray',
+                           label='setpoint')[0],
+        position_axis.plot(record.times, record.positions, color='tab:blue',
+                           label='position')[0],
+        effort_axis.plot(record.times, record.efforts, color='tab:orange', alpha=0.7,
+                         label='effort')[0],
+    ]
+    position_axis.set_xlabel('sim time after the step [s]')
+    position_axis.set_ylabel(f'{record.joint} position [{record.position_unit}]')
+    effort_axis.set_ylabel(f'effort [{record.effort_unit}]')
+
+    def shown(value: float | None, unit: str) -> str:
+        return 'n/a' if value is None else f'{value:.3g} {unit}'
+
+    facts = [
+        f'rise 10-90 %: {shown(metrics.rise_time_s, "s")}',
+        f'overshoot: {metrics.overshoot_percent:.2f} %',
+        f'settling 2 %: {shown(metrics.settling_time_s, "s")}',
+        f'steady-state error: {metrics.steady_state_error:.3g} {record.position_unit}',
+        f'peak effort: {metrics.peak_effort:.3g} {record.effort_unit}',
+        f'velocity limit active: {"yes" if metrics.velocity_limit_active else "no"}',
+    ]
+    blanks = [Line2D([], [], linestyle='none') for _ in facts]
+    position_axis.legend(lines + blanks, [line.get_label() for line in lines] + facts,
+                         loc='lower right', fontsize='small')
+    position_axis.set_title(f'{record.controller}: step {record.initial:g} -> {record.target:g}')
+    position_axis.grid(True, alpha=0.3)
+    figure.tight_layout()
+    figure.savefig(path)
+    pyplot.close(figure)
+
+
+def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
+    """Read the command line."""
+    share = package_share()
+    parser = argparse.ArgumentParser(
+        prog=PROGRAM, description='Step a joint position controller in the simulator '
+        '(no ROS graph) and print rise time, overshoot, settling time, ... as JSON.')
+    parser.add_argument('--joint', required=True, help='joint to step, e.g. pan_joint')
+    parser.add_argument('--target', required=True, type=float, help='position to step to')
+    parser.add_argument('--model', default=str(share / DEFAULT_DESCRIPTION),
+                        help='.urdf or .xacro file (default: the pan/tilt model)')
+    parser.add_argument('--xacro-args', nargs='*', default=[], metavar='NAME:=VALUE',
+                        help='xacro mappings for a .xacro model')
+    parser.add_argument('--controllers', default=str(share / DEFAULT_CONTROLLERS),
+                        help='controllers YAML (default: the pan/tilt controllers)')
+    parser.add_argument('--time-step', type=float, default=DEFAULT_TIME_STEP,
+                        help=f'physics step in s (default {DEFAULT_TIME_STEP})')
+    parser.add_argument('--duration', type=float, default=None,
+                        help='seconds of sim time to record (default: the velocity-limited '
+                        f'ramp plus {SETTLE_ALLOWANCE_S:g} s)')
+    parser.add_argument('--plot', type=pathlib.Path, default=None, metavar='FILE.png',
+                        help='also write a plot of the response to this PNG file')
+    return parser.parse_args(argv)
+
+
+def run(args: argparse.Namespace) -> dict:
+    """Simulate the step that ``args`` ask for; return the JSON summary."""
+    if not (math.isfinite(args.time_step) and 0.0 < args.time_step):
+        raise ConfigurationError(f'--time-step: {args.time_step} must be > 0 s')
+    with make_simulation(args.model, args.controllers, args.time_step,
+                         xacro_args=args.xacro_args) as simulation:
+        record = record_step(simulation, args.joint, args.target, args.duration)
+        gains = position_controller(simulation, args.joint).pid.gains
+    metrics = step_metrics(record)
+    if args.plot is not None:
+        try:
+            plot(record, metrics, args.plot)
+        except OSError as err:
+            raise ConfigurationError(f'--plot: cannot write {args.plot}: {err}') from None
+    return report(record, metrics, {'p': gains.p, 'i': gains.i, 'd': gains.d})
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    """Run the step_response command line; errors exit with code 2 and one line."""
+    args = parse_args(argv)
+    try:
+        summary = run(args)
+    except ConfigurationError as err:
+        print(f'{PROGRAM}: error: {err}', file=sys.stderr)
+        sys.exit(EXIT_CONFIGURATION_ERROR)
+    print(json.dumps(summary, indent=2))
+
+
+if __name__ == '__main__':
+    main()

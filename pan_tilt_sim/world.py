@@ -1,0 +1,110 @@
+"""Scenery for the camera: a ground plane and a few coloured targets, or nothing.
+
+The world is built from PyBullet primitives (no ``pybullet_data`` files) and
+is visual only: its bodies have no collision shapes, so they cost the physics
+nothing and can never touch the robot.  It lives in the camera's own PyBullet
+client (see :mod:`pan_tilt_sim.camera`), and in the physics client only when
+a GUI window should show it too.
+
+The ground is the plane z = 0.  TinyRenderer's cost grows with the pixels it
+shades, and a ground body covers half of every horizontal view (measured: 9 ms
+per 320x240 frame with a ground box, under 3 ms without), so the camera does
+not render a ground body: it paints the ground into the background pixels
+whose viewing ray points down (exact for an infinite plane, which a plane
+lit by a directional light shows in one flat colour).  ``build_world(...,
+ground=True)`` adds a ground box for the GUI window.
+
+Targets stand on the ground around the origin, one per compass direction,
+each a different colour, their centres at the height of the seed's camera
+when the tilt is horizontal.  With the seed's pan/tilt the camera looks
+along world -x at pan 0, so pan = azimuth - pi faces a target.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+from pan_tilt_sim.errors import ParameterError
+from pan_tilt_sim.physics import pybullet
+
+EMPTY = 'empty'
+TARGETS = 'targets'
+WORLDS = (EMPTY, TARGETS)
+DEFAULT_WORLD = TARGETS
+
+GROUND_HALF_SIZE = 15.0  # m: the GUI's ground box is a 30 m square ...
+GROUND_HALF_THICKNESS = 0.005  # m: ... whose top face is at z = 0
+GROUND_RGB = (130, 130, 130)  # the ground's colour in camera images (rgb8)
+GROUND_RGBA = (*(channel / 255.0 for channel in GROUND_RGB), 1.0)
+STATIC_MASS = 0.0  # PyBullet: mass 0 makes a body static
+NO_SHAPE = -1
+
+
+@dataclasses.dataclass(frozen=True)
+class Target:
+    """A coloured box standing on the ground."""
+
+    name: str
+    rgba: tuple[float, float, float, float]
+    azimuth_deg: float  # direction from the origin, counter-clockwise from +x
+    distance: float = 2.5  # m from the origin to the box's centre
+    half_size: float = 0.3  # m: the box is a cube of twice this side
+
+    @property
+    def position(self) -> tuple[float, float, float]:
+        """Centre of the box in the world frame."""
+        azimuth = math.radians(self.azimuth_deg)
+        return (self.distance * math.cos(azimuth), self.distance * math.sin(azimuth),
+                self.half_size)
+
+
+TARGET_SET = (
+    Target('red', (0.9, 0.1, 0.1, 1.0), 0.0),
+    Target('green', (0.1, 0.8, 0.1, 1.0), 90.0),
+    Target('blue', (0.1, 0.2, 0.9, 1.0), 180.0),
+    Target('yellow', (0.9, 0.85, 0.1, 1.0), 270.0),
+)
+
+
+def check_world(name: str) -> str:
+    """Return ``name`` if it names a world; ParameterError naming the choices otherwise."""
+    if name not in WORLDS:
+        raise ParameterError(
+            f"parameter 'world' must be one of {', '.join(WORLDS)}, got '{name}'")
+    return name
+
+
+def has_ground(name: str) -> bool:
+    """Whether the world called ``name`` has a ground plane."""
+    return check_world(name) != EMPTY
+
+
+def build_world(name: str, client: int, *, ground: bool = False) -> list[int]:
+    """Add the world's bodies to PyBullet ``client``; return their ids.
+
+    The ground plane becomes a body only with ``ground`` (for a GUI window);
+    the camera paints it instead (see the module docstring).
+    """
+    check_world(name)
+    if name == EMPTY:
+        return []
+    bodies = []
+    if ground:
+        bodies.append(_visual_box(
+            client, (GROUND_HALF_SIZE, GROUND_HALF_SIZE, GROUND_HALF_THICKNESS),
+            (0.0, 0.0, -GROUND_HALF_THICKNESS), GROUND_RGBA))
+    for target in TARGET_SET:
+        half = target.half_size
+        bodies.append(_visual_box(client, (half, half, half), target.position, target.rgba))
+    return bodies
+
+
+def _visual_box(client: int, half_extents: tuple[float, float, float],
+                position: tuple[float, float, float],
+                rgba: tuple[float, float, float, float]) -> int:
+    shape = pybullet.createVisualShape(
+        pybullet.GEOM_BOX, halfExtents=half_extents, rgbaColor=rgba, physicsClientId=client)
+    return pybullet.createMultiBody(
+        baseMass=STATIC_MASS, baseCollisionShapeIndex=NO_SHAPE, baseVisualShapeIndex=shape,
+        basePosition=position, physicsClientId=client)

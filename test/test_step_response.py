@@ -1,0 +1,162 @@
+"""step_response: metrics on synthetic signals, and the seed's pan against a hand computation."""
+
+import json
+import math
+import subprocess
+import sys
+
+import pytest
+
+from pan_tilt_sim import step_response
+from pan_tilt_sim.step_response import (
+    StepRecord,
+    overshoot_percent,
+    rise_time,
+    settling_time,
+    step_metrics,
+)
+
+DT = 0.001
+
+
+def sampled(function, duration, dt=DT):
+    """Return times and values of ``function`` sampled every ``dt`` over ``duration``."""
+    times = [index * dt for index in range(round(duration / dt) + 1)]
+    return times, [function(t) for t in times]
+
+
+def first_order(tau, initial=0.0, target=1.0):
+    """Return the step response of a first-order lag with time constant ``tau``."""
+    return lambda t: target + (initial - target) * math.exp(-t / tau)
+
+
+def second_order(zeta, omega):
+    """Return the unit step response of an underdamped second-order system."""
+    damped = omega * math.sqrt(1 - zeta * zeta)
+    phase = math.acos(zeta)
+    return lambda t: 1 - math.exp(-zeta * omega * t) * math.sin(damped * t + phase) / math.sqrt(
+        1 - zeta * zeta)
+
+
+# --- metrics on synthetic signals -------------------------------------------------
+
+def test_rise_time_of_a_first_order_lag_is_tau_ln_9():
+    times, values = sampled(first_order(0.5), 5.0)
+    assert rise_time(times, values, 0.0, 1.0) == pytest.approx(0.5 * math.log(9), abs=1e-5)
+
+
+def test_settling_time_of_a_first_order_lag_is_tau_ln_50():
+    times, values = sampled(first_order(0.5), 5.0)
+    assert settling_time(times, values, 0.0, 1.0) == pytest.approx(0.5 * math.log(50),
+                                                                   abs=DT)
+
+
+def test_a_first_order_lag_does_not_overshoot():
+    _, values = sampled(first_order(0.5), 5.0)
+    assert overshoot_percent(values, 0.0, 1.0) == 0.0
+
+
+def test_overshoot_of_a_second_order_system_matches_the_textbook_formula():
+    zeta = 0.3
+    _, values = sampled(second_order(zeta, 4.0), 10.0)
+    expected = 100 * math.exp(-zeta * math.pi / math.sqrt(1 - zeta * zeta))  # 37.2 %
+    assert overshoot_percent(values, 0.0, 1.0) == pytest.approx(expected, abs=0.01)
+
+
+def test_settling_waits_for_the_last_excursion_out_of_the_band():
+    zeta, omega = 0.3, 4.0
+    times, values = sampled(second_order(zeta, omega), 10.0)
+    settled = settling_time(times, values, 0.0, 1.0)
+    assert all(abs(v - 1.0) <= 0.02 for t, v in zip(times, values, strict=True) if t >= settled)
+    before = times[times.index(settled) - 1]
+    assert abs(values[times.index(before)] - 1.0) > 0.02
+    # The envelope bound 4 / (zeta * omega) is an upper limit for 2 %.
+    assert settled < 4.0 / (zeta * omega)
+
+
+def test_downward_steps_are_measured_like_upward_ones():
+    times, values = sampled(first_order(0.5, initial=2.0, target=1.0), 5.0)
+    assert rise_time(times, values, 2.0, 1.0) == pytest.approx(0.5 * math.log(9), abs=1e-5)
+    assert overshoot_percent(values, 2.0, 1.0) == 0.0
+
+
+def test_a_response_that_never_arrives_has_no_rise_or_settling_time():
+    times, values = sampled(lambda t: 0.5 * t, 1.0)  # reaches 0.5 of a unit step
+    assert rise_time(times, values, 0.0, 1.0) is None
+    assert settling_time(times, values, 0.0, 1.0) is None
+
+
+def test_a_setpoint_that_jumps_means_the_velocity_limit_was_not_active():
+    times, positions = sampled(first_order(0.2), 2.0)
+    record = StepRecord('j', 'c', 0.0, 1.0, math.inf, 'rad', 'N m', tuple(times),
+                        tuple(positions), (0.0,) + (1.0,) * (len(times) - 1),
+                        (0.0,) * len(times))
+    metrics = step_metrics(record)
+    assert not metrics.velocity_limit_active
+    assert metrics.setpoint_reached_s == pytest.approx(DT)
+
+
+# --- the seed's pan, against a hand computation -----------------------------------
+
+@pytest.fixture(scope='module')
+def pan_step():
+    """Return the JSON the tool prints for the seed's pan stepped from 0 to 1 rad."""
+    completed = subprocess.run(
+        [sys.executable, '-c', 'import sys; from pan_tilt_sim import step_response; '
+         "step_response.main(sys.argv[1:]); assert 'rclpy' not in sys.modules, 'rclpy'",
+         '--joint', 'pan_joint', '--target', '1.0'],
+        capture_output=True, text=True, timeout=120, check=False)
+    assert completed.returncode == 0, completed.stderr
+    return json.loads(completed.stdout)
+
+
+def test_the_pan_setpoint_ramps_at_the_velocity_limit_for_10_s(pan_step):
+    # 1 rad at the URDF's 0.1 rad/s: the setpoint arrives after 10 s, not before.
+    assert pan_step['velocity_limit_active'] is True
+    assert pan_step['setpoint_reached_s'] == pytest.approx(1.0 / 0.1, abs=0.002)
+
+
+def test_the_pan_rise_time_is_the_ramp_time_from_10_to_90_percent(pan_step):
+    # Following the ramp with a constant lag, 0.1 -> 0.9 rad takes 0.8 / 0.1 = 8 s.
+    assert pan_step['rise_time_s'] == pytest.approx(8.0, abs=0.1)
+
+
+def test_the_pan_cannot_settle_before_its_setpoint_arrives(pan_step):
+    # Within 2 % means >= 0.98 rad, and during the ramp the joint lags by
+    # (50*0.1 + 1 + 10*0.1)/100 = 0.07 rad, so not before the ramp ends at 10 s;
+    # then the lag decays with time constant (damping + d) / p = 0.6 s.
+    assert 10.0 <= pan_step['settling_time_s'] <= 10.0 + 0.6 * math.log(0.07 / 0.01) + 0.5
+
+
+def test_the_pan_effort_peaks_at_what_damping_and_friction_need_at_0_1_rad_s(pan_step):
+    assert pan_step['peak_effort'] == pytest.approx(50.0 * 0.1 + 1.0, rel=0.03)  # 6 N m
+
+
+def test_the_pan_ends_within_friction_over_p_without_overshoot(pan_step):
+    # Coulomb friction 1 N m against P = 100 holds up to 0.01 rad of error.
+    assert 0.0 <= pan_step['steady_state_error'] <= 1.0 / 100.0 + 1e-3
+    assert pan_step['overshoot_percent'] < 0.5
+    assert pan_step['gains'] == {'p': 100.0, 'i': 0.01, 'd': 10.0}
+
+
+def test_the_plot_is_a_png(tmp_path):
+    path = tmp_path / 'step.png'
+    step_response.main(['--joint', 'tilt_joint', '--target', '-1.8', '--duration', '3',
+                        '--plot', str(path)])
+    assert path.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+
+
+@pytest.mark.parametrize(('argv', 'message'), [
+    (['--joint', 'elbow', '--target', '1'], "--joint: 'elbow' is not a movable joint"),
+    (['--joint', 'pan_joint', '--target', 'nan'], '--target: nan is not a finite number'),
+    (['--joint', 'pan_joint', '--target', '0'], 'there is no step'),
+    (['--joint', 'pan_joint', '--target', '1', '--duration', '-2'], '--duration'),
+    (['--joint', 'pan_joint', '--target', '1', '--model', '/nonexistent.urdf'],
+     '/nonexistent.urdf'),
+])
+def test_user_errors_exit_2_with_one_line(capsys, argv, message):
+    with pytest.raises(SystemExit) as exit_info:
+        step_response.main(argv)
+    err = capsys.readouterr().err
+    assert exit_info.value.code == 2
+    assert message in err and err.count('\n') == 1
