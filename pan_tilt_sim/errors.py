@@ -19,3 +19,7 @@ class ControllerConfigError(ConfigurationError):
 
 class ParameterError(ConfigurationError):
     """A node parameter has a wrong type or value."""
+
+
+class ArgumentError(ConfigurationError):
+    """The command line's ROS arguments (``--ros-args ...``) cannot be parsed."""

@@ -2,9 +2,10 @@
 
 Users type ``-p real_time_factor:=0`` and ``-p time_step:=1e-3`` without
 thinking about types, so a double parameter also takes an integer (rclpy
-would otherwise raise InvalidParameterTypeException): those parameters are
+would otherwise raise InvalidParameterTypeException).  Every parameter is
 declared with dynamic typing, and this module checks and converts the type
-itself, naming the parameter and the type it wants when it is wrong.
+itself, naming the parameter and the type it wants when it is wrong -- at
+start-up (a one-line error) and when it is set at run time (a refusal).
 """
 
 from __future__ import annotations
@@ -96,8 +97,10 @@ def declare_parameters(node: Node) -> SimParameters:
         descriptor = ParameterDescriptor(
             name=spec.name, type=spec.type, description=spec.description,
             read_only=spec.read_only,
-            # Doubles accept integers; the type is checked by coerce() instead.
-            dynamic_typing=spec.type == ParameterType.PARAMETER_DOUBLE)
+            # rclpy's own type check would end start-up with an
+            # InvalidParameterTypeException traceback (and refuse integers for
+            # doubles): coerce() checks every type instead, naming what it wants.
+            dynamic_typing=True)
         parameter = node.declare_parameter(spec.name, spec.default, descriptor)
         values[spec.name] = coerce(spec.name, spec.type, parameter.value)
     values['xacro_args'] = tuple(values['xacro_args'])

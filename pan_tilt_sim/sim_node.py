@@ -12,15 +12,13 @@ from __future__ import annotations
 import dataclasses
 import sys
 
-import rclpy
 from rcl_interfaces.msg import SetParametersResult
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
-from pan_tilt_sim import naming, parameters
+from pan_tilt_sim import naming, parameters, runner
 from pan_tilt_sim.controller_config import load_controllers_config
 from pan_tilt_sim.controllers import CommandController, CommandResult
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
@@ -33,7 +31,7 @@ from pan_tilt_sim.pacing import Pacer
 from pan_tilt_sim.ros_interfaces import COMMAND_MESSAGES, clock_message, joint_state_message
 
 NODE_NAME = 'sim_node'
-EXIT_CONFIGURATION_ERROR = 2
+EXIT_CONFIGURATION_ERROR = runner.EXIT_CONFIGURATION_ERROR
 TICK_PERIOD_S = 0.01  # wall seconds between ticks when paced to real time
 CLOCK_PERIOD_S = 0.01  # sim seconds between /clock messages (100 Hz of sim time)
 QUEUE_DEPTH = 10
@@ -179,21 +177,10 @@ class SimNode(Node):
 
 
 def main(args: list[str] | None = None) -> None:
-    """Run sim_node until Ctrl-C or shutdown; a configuration error exits with code 2."""
-    rclpy.init(args=args)
-    try:
-        node = SimNode()
-    except ConfigurationError as err:
-        print(f'{NODE_NAME}: error: {err}', file=sys.stderr)
-        rclpy.try_shutdown()
-        sys.exit(EXIT_CONFIGURATION_ERROR)
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    """Run sim_node until SIGINT/SIGTERM (exit 0); a configuration error exits with code 2."""
+    status = runner.run(SimNode, args, program=NODE_NAME)
+    if status != runner.EXIT_OK:
+        sys.exit(status)
 
 
 if __name__ == '__main__':

@@ -1,0 +1,195 @@
+"""Running a node as a command-line program: start-up errors, signals, a clean exit.
+
+* Malformed ``--ros-args`` (rcl refuses them in ``rclpy.init``) and every
+  :class:`~pan_tilt_sim.errors.ConfigurationError` raised while the node is
+  built end the program with exit code 2 and ONE line on stderr.  rcl's own
+  log lines about bad arguments are folded into that line; the traceback is
+  printed only with ``--ros-args --log-level debug``.
+* SIGINT and SIGTERM stop the program: the node is destroyed (for sim_node
+  that disconnects PyBullet) and the exit code is 0, without a traceback.
+  Both handlers are installed before ``rclpy.init`` and unconditionally: a
+  shell starts background jobs with SIGINT ignored (Python then leaves it
+  ignored), and ``ros2 run`` does not forward signals -- Ctrl-C reaches the
+  node through the terminal's process group.  rclpy chains its own handlers
+  (which shut the context down and so end ``rclpy.spin``) to these.  A signal
+  while the node is being built aborts the build; while spinning it ends the
+  spin; while the node is being destroyed it is only noted.
+"""
+
+from __future__ import annotations
+
+import ast
+import contextlib
+import os
+import re
+import signal
+import sys
+import tempfile
+import threading
+import traceback
+from collections.abc import Callable, Iterator, Sequence
+
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+
+from pan_tilt_sim.errors import ArgumentError, ConfigurationError
+
+EXIT_OK = 0
+EXIT_CONFIGURATION_ERROR = 2
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+LOG_LEVEL_FLAG = '--log-level'
+DEBUG_LEVEL = 'debug'
+STDERR_FD = 2
+# rcl's generic last word on any bad argument; the specific reason comes before it.
+_RCL_GENERIC_ERROR = 'Failed to parse global arguments'
+_RCL_LOG_LINE = re.compile(r'^\[(?:WARN|ERROR|FATAL)\] \[[^\]]*\] \[rcl[^\]]*\]: (?P<text>.*)$')
+_RCL_PREFIX = 'failed to initialize rcl: '
+# Source locations rcl appends to its errors (", at /project/src/rcl/arguments.c:352").
+_RCL_SOURCE_LOCATION = re.compile(r',? at [^\s,]+\.c:\d+')
+# rcl's lexer detail ("Expected lexeme type (22) not found ...") helps no user.
+_RCL_LEXER_DETAIL = re.compile(r'\. Error: Expected lexeme.*$')
+
+
+class StopRequested(KeyboardInterrupt):
+    """SIGINT or SIGTERM asked the program to stop."""
+
+
+class StopSignals:
+    """SIGINT/SIGTERM handlers for the life of the program (a context manager).
+
+    Every signal is recorded in :attr:`received`; the first one raises
+    :class:`StopRequested` only inside :meth:`interruptible` (the node's
+    start-up), so that destroying the node is never cut short.  Previous
+    handlers come back on exit.  Outside the main thread nothing is installed.
+    """
+
+    def __init__(self) -> None:
+        self.received: signal.Signals | None = None
+        self._interruptible = False
+        self._previous: dict[signal.Signals, object] = {}
+
+    def __enter__(self) -> StopSignals:
+        if threading.current_thread() is threading.main_thread():
+            for signum in STOP_SIGNALS:
+                self._previous[signum] = signal.signal(signum, self._handle)
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        for signum, handler in self._previous.items():
+            signal.signal(signum, handler)
+        self._previous.clear()
+
+    @contextlib.contextmanager
+    def interruptible(self) -> Iterator[None]:
+        """Let the first signal raise :class:`StopRequested` inside this block."""
+        if self.received is not None:
+            raise StopRequested(self.received.name)
+        self._interruptible = True
+        try:
+            yield
+        finally:
+            self._interruptible = False
+
+    def _handle(self, signum: int, frame: object) -> None:
+        first = self.received is None
+        self.received = signal.Signals(signum)
+        if first and self._interruptible:
+            self._interruptible = False
+            raise StopRequested(self.received.name)
+
+
+def debug_requested(argv: Sequence[str]) -> bool:
+    """Whether ``--log-level debug`` (for any logger) is among ``argv``."""
+    return any(flag == LOG_LEVEL_FLAG and value.rpartition(':=')[2].lower() == DEBUG_LEVEL
+               for flag, value in zip(argv, argv[1:], strict=False))
+
+
+@contextlib.contextmanager
+def _captured_native_stderr() -> Iterator[list[str]]:
+    """Send C-level stderr (rcl's console logging) elsewhere; the text lands in the list."""
+    text: list[str] = []
+    sys.stderr.flush()
+    with tempfile.TemporaryFile() as captured:
+        saved = os.dup(STDERR_FD)
+        os.dup2(captured.fileno(), STDERR_FD)
+        try:
+            yield text
+        finally:
+            sys.stderr.flush()
+            os.dup2(saved, STDERR_FD)
+            os.close(saved)
+            captured.seek(0)
+            text.append(captured.read().decode('utf-8', errors='replace'))
+
+
+def _rcl_reason(err: Exception, log: str) -> str:
+    """One line from rclpy.init's exception and the lines rcl logged about it."""
+    if type(err).__name__ == 'UnknownROSArgsError':
+        try:
+            unknown = ast.literal_eval(str(err))
+        except (SyntaxError, ValueError):
+            unknown = [str(err)]
+        return 'unknown ROS argument ' + ', '.join(f"'{arg}'" for arg in unknown)
+    reason = str(err).removeprefix(_RCL_PREFIX)
+    reason = _RCL_SOURCE_LOCATION.sub('', reason)
+    reason = _RCL_LEXER_DETAIL.sub('', reason).rstrip('.').replace('. Error: ', ': ')
+    details = [match['text'] for match in map(_RCL_LOG_LINE.match, log.splitlines())
+               if match and _RCL_GENERIC_ERROR not in match['text']]
+    if details:
+        reason += ' (' + '; '.join(details) + ')'
+    reason = ' '.join(reason.split())
+    return reason[:1].lower() + reason[1:]
+
+
+def init_ros(args: list[str] | None, *, debug: bool = False) -> None:
+    """Initialise rclpy; malformed ROS arguments raise a one-line :class:`ArgumentError`."""
+    if debug:
+        rclpy.init(args=args)
+        return
+    failure = None
+    with _captured_native_stderr() as captured:
+        try:
+            rclpy.init(args=args)
+        except Exception as err:  # rclpy raises RCLError / UnknownROSArgsError, not exported
+            failure = err
+    log = ''.join(captured)
+    if failure is not None:
+        raise ArgumentError(f'ROS arguments: {_rcl_reason(failure, log)}') from failure
+    # Nothing went wrong: whatever rcl said is the user's to see.
+    sys.stderr.write(log)
+
+
+def report_error(program: str, err: ConfigurationError, *, debug: bool) -> None:
+    """Print ``program: error: ...`` on stderr, after the traceback when debugging."""
+    if debug:
+        traceback.print_exception(err)
+    print(f'{program}: error: {err}', file=sys.stderr)
+
+
+def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
+        program: str) -> int:
+    """Build a node with ``make_node``, spin it until stopped; return the exit code."""
+    debug = debug_requested(sys.argv if args is None else args)
+    node: Node | None = None
+    with StopSignals() as stop:
+        try:
+            with stop.interruptible():
+                init_ros(args, debug=debug)
+                node = make_node()
+            if stop.received is None:
+                rclpy.spin(node)
+        except ConfigurationError as err:
+            report_error(program, err, debug=debug)
+            return EXIT_CONFIGURATION_ERROR
+        except (KeyboardInterrupt, ExternalShutdownException):
+            pass
+        except Exception:
+            # A signal shuts the context down before the handler runs: calls on it fail.
+            if stop.received is None and rclpy.ok():
+                raise
+        finally:
+            if node is not None:
+                node.destroy_node()
+            rclpy.try_shutdown()
+    return EXIT_OK
