@@ -51,6 +51,7 @@ from typing import Any
 
 import yaml
 
+from pan_tilt_sim import naming
 from pan_tilt_sim.errors import ControllerConfigError
 
 TYPE_FIELD = 'type'
@@ -84,6 +85,8 @@ class ControllersConfig:
 
 def read_yaml(path: pathlib.Path) -> Any:
     """Parse a YAML file; errors name the file and, for syntax errors, the line."""
+    if path.is_dir():
+        raise ControllerConfigError(f'controllers file {path}: is a directory, not a file')
     if not path.is_file():
         raise ControllerConfigError(f'controllers file {path}: no such file')
     try:
@@ -120,7 +123,22 @@ def load_controllers_config(path: pathlib.Path | str) -> ControllersConfig:
     if not controllers:
         raise ControllerConfigError(
             f"{path}: no controllers in it (a controller is a mapping with a '{TYPE_FIELD}')")
+    _check_names(path, controllers, namespace)
     return ControllersConfig(controllers=tuple(controllers), source=path, namespace=namespace)
+
+
+def _check_names(path: pathlib.Path, controllers: list[ControllerSpec],
+                 namespace: str | None) -> None:
+    """Names end up in topic names: refuse what rclpy would refuse later, with a traceback."""
+    if namespace is not None and not naming.is_valid_namespace(naming.normalize(namespace)):
+        raise ControllerConfigError(
+            f"{path}: top-level key '{namespace}' (the robot's namespace) is not a valid ROS "
+            f'namespace ({naming.NAMESPACE_RULE})')
+    for spec in controllers:
+        if not naming.is_valid_name(spec.name):
+            raise ControllerConfigError(
+                f"{path}: controller name '{spec.name}' is not a valid ROS name "
+                f'({naming.NAME_RULE}); it becomes part of its topic names')
 
 
 def _controllers_in(mapping: Mapping[Any, Any]) -> list[ControllerSpec]:

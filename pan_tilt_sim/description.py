@@ -18,6 +18,7 @@ import xml.etree.ElementTree as ElementTree
 from collections.abc import Sequence
 from xml.parsers.expat import ExpatError
 
+from pan_tilt_sim import naming
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.resources import localize_meshes
 
@@ -151,6 +152,8 @@ def run_xacro(path: pathlib.Path, mappings: dict[str, str]) -> str:
 
 def read_description_xml(path: pathlib.Path, xacro_args: Sequence[str] = ()) -> str:
     """Return the URDF text of a .urdf or .xacro file."""
+    if path.is_dir():
+        raise DescriptionError(f'robot description file {path}: is a directory, not a file')
     if not path.is_file():
         raise DescriptionError(f'robot description file {path}: no such file')
     mappings = parse_xacro_args(xacro_args)
@@ -196,12 +199,17 @@ def load_description(path: pathlib.Path | str, xacro_args: Sequence[str] = ()) -
             raise DescriptionError(
                 f"{path}: joint '{joint.name}' mimics '{joint.mimic.joint}', "
                 'which is not a joint of this robot')
+    plugin_namespace = _plugin_namespace(root)
+    if plugin_namespace and not naming.is_valid_namespace(naming.normalize(plugin_namespace)):
+        raise DescriptionError(
+            f"{path}: the gazebo_ros_control plugin's namespace '{plugin_namespace}' is not a "
+            f'valid ROS namespace ({naming.NAMESPACE_RULE})')
     return RobotDescription(
         name=root.get('name', ''),
         urdf_xml=ElementTree.tostring(root, encoding='unicode'),
         joints=joints,
         source=path,
-        plugin_namespace=_plugin_namespace(root),
+        plugin_namespace=plugin_namespace,
     )
 
 

@@ -14,22 +14,31 @@ from collections.abc import Sequence
 
 from pan_tilt_sim.controller_config import ControllersConfig
 from pan_tilt_sim.controllers import CommandController, Controller, JointHandle, create_controller
-from pan_tilt_sim.description import RobotDescription
+from pan_tilt_sim.description import JointSpec, RobotDescription
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.physics import STATE_POSITION, STATE_VELOCITY, Physics
 
 _LOG = logging.getLogger(__name__)
 
 
-def build_controllers(config: ControllersConfig,
-                      handles: dict[str, JointHandle]) -> list[Controller]:
-    """Create and configure the controllers of ``config``; one owner per joint."""
+def build_controllers(config: ControllersConfig, handles: dict[str, JointHandle],
+                      joints: Sequence[JointSpec] = ()) -> list[Controller]:
+    """Create and configure the controllers of ``config``; one owner per joint.
+
+    ``joints`` (all of the robot's) lets the error for a fixed joint say so.
+    """
     source = str(config.source)
+    unmovable = {joint.name: joint.kind for joint in joints if not joint.kind.is_actuated}
     owners: dict[str, str] = {}
     controllers = []
     for spec in config.controllers:
         controller = create_controller(spec.name, spec.type, spec.params, source)
         for joint in controller.joint_names:
+            if joint in unmovable:
+                raise ControllerConfigError(
+                    f"{source}: {spec.name}: joint '{joint}' is a {unmovable[joint].value} "
+                    'joint; a controller can only drive revolute, continuous and prismatic '
+                    'joints')
             if joint in owners:
                 raise ControllerConfigError(
                     f"{source}: joint '{joint}' is claimed by both '{owners[joint]}' "
@@ -51,7 +60,8 @@ class Simulation:
         self.physics = Physics(description, time_step, gui=gui)
         try:
             self.handles = {joint.name: JointHandle(joint) for joint in self.physics.joints}
-            self.controllers = build_controllers(controllers, self.handles)
+            self.controllers = build_controllers(
+                controllers, self.handles, description.joints)
         except BaseException:
             self.physics.close()
             raise

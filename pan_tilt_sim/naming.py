@@ -20,17 +20,29 @@ ROOT = '/'
 _TOKEN = re.compile(r'[A-Za-z_][A-Za-z0-9_]*')
 
 
+NAMESPACE_RULE = ("tokens of letters, digits and underscores, not starting with a digit, "
+                  "separated by '/'")
+NAME_RULE = 'letters, digits and underscores, not starting with a digit'
+
+
+def is_valid_name(name: str) -> bool:
+    """Whether ``name`` is one ROS name token (a controller's name in its topic)."""
+    return _TOKEN.fullmatch(name) is not None
+
+
+def is_valid_namespace(namespace: str) -> bool:
+    """Whether ``namespace`` is empty, ``/`` or a valid ROS namespace (no trailing ``/``)."""
+    if not namespace or namespace == ROOT:
+        return True
+    tokens = namespace.removeprefix(ROOT).split(ROOT)
+    return all(_TOKEN.fullmatch(token) for token in tokens)
+
+
 def check_namespace(field: str, namespace: str) -> None:
     """Raise ParameterError unless ``namespace`` is empty or a valid ROS namespace."""
-    if not namespace or namespace == ROOT:
-        return
-    tokens = namespace.strip(ROOT).split(ROOT) if namespace != ROOT else []
-    if namespace.endswith(ROOT) or '//' in namespace or not all(
-            _TOKEN.fullmatch(token) for token in tokens):
+    if not is_valid_namespace(namespace):
         raise ParameterError(
-            f"parameter '{field}': '{namespace}' is not a valid ROS namespace "
-            '(tokens of letters, digits and underscores, not starting with a digit, '
-            "separated by '/')")
+            f"parameter '{field}': '{namespace}' is not a valid ROS namespace ({NAMESPACE_RULE})")
 
 
 def normalize(namespace: str | None) -> str:

@@ -113,8 +113,10 @@ class Controller(abc.ABC):
     def required_joint(self) -> str:
         """Return the ``joint`` parameter, which must be a non-empty string."""
         joint = self.params.get('joint')
-        if not isinstance(joint, str) or not joint:
+        if joint is None or joint == '':
             raise self.error('joint', 'missing: name the joint this controller drives')
+        if not isinstance(joint, str):
+            raise self.error('joint', f'{joint!r} is not a joint name (expected one string)')
         return joint
 
     def joint_list(self, field: str = 'joints', *, required: bool = True) -> tuple[str, ...]:
