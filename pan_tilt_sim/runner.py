@@ -14,6 +14,9 @@
   (which shut the context down and so end ``rclpy.spin``) to these.  A signal
   while the node is being built aborts the build; while spinning it ends the
   spin; while the node is being destroyed it is only noted.
+* Importing rclpy and PyBullet takes about half a second, so this module
+  imports neither until the handlers are in place: :func:`sim_node_main` is
+  the entry point that covers a Ctrl-C from the very start.
 """
 
 from __future__ import annotations
@@ -28,13 +31,14 @@ import tempfile
 import threading
 import traceback
 from collections.abc import Callable, Iterator, Sequence
-
-import rclpy
-from rclpy.executors import ExternalShutdownException
-from rclpy.node import Node
+from typing import TYPE_CHECKING
 
 from pan_tilt_sim.errors import ArgumentError, ConfigurationError
 
+if TYPE_CHECKING:
+    from rclpy.node import Node
+
+SIM_NODE_PROGRAM = 'sim_node'
 EXIT_OK = 0
 EXIT_CONFIGURATION_ERROR = 2
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -144,6 +148,8 @@ def _rcl_reason(err: Exception, log: str) -> str:
 
 def init_ros(args: list[str] | None, *, debug: bool = False) -> None:
     """Initialise rclpy; malformed ROS arguments raise a one-line :class:`ArgumentError`."""
+    import rclpy  # slow: only once the signal handlers are in place
+
     if debug:
         rclpy.init(args=args)
         return
@@ -167,29 +173,54 @@ def report_error(program: str, err: ConfigurationError, *, debug: bool) -> None:
     print(f'{program}: error: {err}', file=sys.stderr)
 
 
+def _ros_is_shut_down() -> bool:
+    rclpy = sys.modules.get('rclpy')
+    return rclpy is not None and not rclpy.ok()
+
+
 def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
         program: str) -> int:
     """Build a node with ``make_node``, spin it until stopped; return the exit code."""
     debug = debug_requested(sys.argv if args is None else args)
     node: Node | None = None
+    initialized = False
     with StopSignals() as stop:
         try:
             with stop.interruptible():
                 init_ros(args, debug=debug)
+                initialized = True
                 node = make_node()
             if stop.received is None:
+                import rclpy
+
                 rclpy.spin(node)
         except ConfigurationError as err:
             report_error(program, err, debug=debug)
             return EXIT_CONFIGURATION_ERROR
-        except (KeyboardInterrupt, ExternalShutdownException):
+        except KeyboardInterrupt:
             pass
         except Exception:
-            # A signal shuts the context down before the handler runs: calls on it fail.
-            if stop.received is None and rclpy.ok():
+            # rclpy's signal handler shuts the context down (ending the spin with
+            # ExternalShutdownException, or failing calls on it) before ours runs.
+            if stop.received is None and not (initialized and _ros_is_shut_down()):
                 raise
         finally:
             if node is not None:
                 node.destroy_node()
-            rclpy.try_shutdown()
+            if initialized:
+                sys.modules['rclpy'].try_shutdown()
     return EXIT_OK
+
+
+def _make_sim_node() -> Node:
+    from pan_tilt_sim.sim_node import SimNode  # slow: imports rclpy and PyBullet
+
+    return SimNode()
+
+
+def sim_node_main(args: list[str] | None = None,
+                  make_node: Callable[[], Node] = _make_sim_node) -> None:
+    """Run the sim_node program; exit 0 when stopped by a signal, 2 on a configuration error."""
+    status = run(make_node, args, program=SIM_NODE_PROGRAM)
+    if status != EXIT_OK:
+        sys.exit(status)

@@ -10,7 +10,6 @@ latest command, and only the tick writes to the simulation.
 from __future__ import annotations
 
 import dataclasses
-import sys
 
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
@@ -178,9 +177,7 @@ class SimNode(Node):
 
 def main(args: list[str] | None = None) -> None:
     """Run sim_node until SIGINT/SIGTERM (exit 0); a configuration error exits with code 2."""
-    status = runner.run(SimNode, args, program=NODE_NAME)
-    if status != runner.EXIT_OK:
-        sys.exit(status)
+    runner.sim_node_main(args, SimNode)
 
 
 if __name__ == '__main__':
