@@ -17,7 +17,7 @@ from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
-from pan_tilt_sim import naming, parameters, runner
+from pan_tilt_sim import naming, parameters, runner, services
 from pan_tilt_sim.controller_config import load_controllers_config
 from pan_tilt_sim.controllers import CommandController, CommandResult
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
@@ -27,7 +27,12 @@ from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.features import NodeFeatures
 from pan_tilt_sim.gain_parameters import GainParameters
 from pan_tilt_sim.pacing import Pacer
-from pan_tilt_sim.ros_interfaces import COMMAND_MESSAGES, clock_message, joint_state_message
+from pan_tilt_sim.ros_interfaces import (
+    COMMAND_MESSAGES,
+    NANOSECONDS_PER_SECOND,
+    clock_message,
+    joint_state_message,
+)
 
 NODE_NAME = 'sim_node'
 EXIT_CONFIGURATION_ERROR = runner.EXIT_CONFIGURATION_ERROR
@@ -69,6 +74,7 @@ class SimNode(Node):
         self._publish_clock()
         self._timer = self.create_timer(self._tick_period(), self._on_tick)
         self.add_on_set_parameters_callback(self._on_set_parameters)
+        self._world_services = services.create_world_services(self)
         self.get_logger().info(
             f"simulating '{description.name}' from {description.source} "
             f"with {len(self.simulation.controllers)} controllers; topics under "
@@ -100,6 +106,13 @@ class SimNode(Node):
         if paused != self._paused:
             self._paused = paused
             self._pacer.restart()
+            self._retime()
+
+    def reset(self, *, reset_time: bool = True) -> None:
+        """Put the robot back to its initial state; sim time to 0 if asked (/clock says so)."""
+        self.simulation.reset(reset_time=reset_time)
+        self._pacer.restart()
+        self._publish_clock()
 
     def destroy_node(self) -> None:
         """Stop ticking and release PyBullet."""
@@ -109,7 +122,15 @@ class SimNode(Node):
         super().destroy_node()
 
     def _tick_period(self) -> float:
-        return 0.0 if self._pacer.fast else TICK_PERIOD_S
+        # Paused, a zero-period timer would spin the CPU for nothing.
+        return 0.0 if self._pacer.fast and not self._paused else TICK_PERIOD_S
+
+    def _retime(self) -> None:
+        """Give the tick timer the period that the pace and the pause state call for."""
+        period_ns = round(self._tick_period() * NANOSECONDS_PER_SECOND)
+        if self._timer.timer_period_ns != period_ns:
+            self._timer.timer_period_ns = period_ns
+            self._timer.reset()
 
     def _on_tick(self) -> None:
         if self._paused:
@@ -167,11 +188,8 @@ class SimNode(Node):
         if 'paused' in updates:
             self.set_paused(updates['paused'])
         if 'real_time_factor' in updates:
-            was_fast = self._pacer.fast
             self._pacer.real_time_factor = updates['real_time_factor']
-            if was_fast != self._pacer.fast:
-                self._timer.cancel()
-                self._timer = self.create_timer(self._tick_period(), self._on_tick)
+            self._retime()
         return SetParametersResult(successful=True)
 
 

@@ -19,6 +19,10 @@ from typing import Any, ClassVar
 from pan_tilt_sim.description import JointSpec
 from pan_tilt_sim.errors import ControllerConfigError
 
+# Largest command magnitude taken on a side without a limit (rad, m, rad/s, N*m...):
+# far beyond any real joint, small enough that PID arithmetic on it stays finite.
+MAX_COMMAND_MAGNITUDE = 1e12
+
 
 class JointHandle:
     """State and effort command of one joint, shared by simulation and controllers."""
@@ -148,7 +152,8 @@ class CommandController(Controller):
     def command_problem(self, value: Any, result: CommandResult) -> str:
         """Describe what was wrong with ``value``, which ``set_command`` rejected or clamped."""
         if result is CommandResult.REJECTED:
-            return f'ignored command {value!r}: not a finite number'
+            return (f'ignored command {value!r}: not a finite number (or beyond '
+                    f'+-{MAX_COMMAND_MAGNITUDE:g} where the joint has no limit)')
         return f"command {value!r} is outside the joint's limits; clamped"
 
 
@@ -158,9 +163,15 @@ def clamp(value: float, lower: float, upper: float) -> float:
 
 
 def bounded_command(value: float, lower: float, upper: float) -> tuple[float, CommandResult]:
-    """Check a scalar command: non-finite is rejected, out-of-range is clamped."""
+    """Check a scalar command: non-finite is rejected, out-of-range is clamped.
+
+    Where a side has no limit, a command beyond MAX_COMMAND_MAGNITUDE is
+    rejected too: no joint means it, and gains times such an error overflow.
+    """
     if not math.isfinite(value):
         return value, CommandResult.REJECTED
     if value < lower or value > upper:
         return clamp(value, lower, upper), CommandResult.CLAMPED
+    if abs(value) > MAX_COMMAND_MAGNITUDE:
+        return value, CommandResult.REJECTED
     return value, CommandResult.ACCEPTED

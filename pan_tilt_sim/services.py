@@ -1,0 +1,59 @@
+"""gazebo_ros's world services for sim_node: reset and pause (``std_srvs/srv/Empty``).
+
+The names are relative, so they follow the node's namespace as gazebo_ros's do
+(``/reset_simulation`` for a node at the root, ``/left/reset_simulation``
+under ``-r __ns:=/left``):
+
+* ``reset_simulation``: joints back to their initial state, setpoints and PID
+  integrators reset, sim time back to 0 -- and a /clock message says so at once;
+* ``reset_world``: the same, but sim time goes on;
+* ``pause_physics`` / ``unpause_physics``: hold / release the physics.  They set
+  the node's ``paused`` parameter, so the parameter always tells the state and
+  ``ros2 param set /sim_node paused true`` is the same switch.  While paused,
+  sim time stands still and commands are still taken; they act on unpause.
+
+The callbacks run on the node's executor, in the node's default (mutually
+exclusive) callback group, so a reset never lands inside a batch of steps.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from rclpy.parameter import Parameter
+from rclpy.service import Service
+from std_srvs.srv import Empty
+
+if TYPE_CHECKING:
+    from pan_tilt_sim.sim_node import SimNode
+
+RESET_SIMULATION = 'reset_simulation'
+RESET_WORLD = 'reset_world'
+PAUSE_PHYSICS = 'pause_physics'
+UNPAUSE_PHYSICS = 'unpause_physics'
+PAUSED_PARAMETER = 'paused'
+
+
+def create_world_services(node: SimNode) -> list[Service]:
+    """Offer ``reset_simulation``, ``reset_world``, ``pause_physics``, ``unpause_physics``."""
+
+    def reset(reset_time: bool):
+        def serve(request: Empty.Request, response: Empty.Response) -> Empty.Response:
+            node.reset(reset_time=reset_time)
+            return response
+        return serve
+
+    def pause(paused: bool):
+        def serve(request: Empty.Request, response: Empty.Response) -> Empty.Response:
+            result, = node.set_parameters([Parameter(PAUSED_PARAMETER, value=paused)])
+            if not result.successful:
+                node.get_logger().error(f"cannot set '{PAUSED_PARAMETER}': {result.reason}")
+            return response
+        return serve
+
+    return [
+        node.create_service(Empty, RESET_SIMULATION, reset(reset_time=True)),
+        node.create_service(Empty, RESET_WORLD, reset(reset_time=False)),
+        node.create_service(Empty, PAUSE_PHYSICS, pause(paused=True)),
+        node.create_service(Empty, UNPAUSE_PHYSICS, pause(paused=False)),
+    ]
