@@ -56,7 +56,7 @@ def _specs() -> tuple[_Spec, ...]:
         _Spec('robot_description_file', ParameterType.PARAMETER_STRING,
               str(share / DEFAULT_DESCRIPTION), 'A .urdf or .xacro file describing the robot.'),
         # No default: rclpy cannot declare an empty string array, so "not set" means none.
-        _Spec('xacro_args', ParameterType.PARAMETER_STRING_ARRAY, Parameter.Type.STRING_ARRAY,
+        _Spec('xacro_args', ParameterType.PARAMETER_STRING_ARRAY, None,
               "xacro mappings for a .xacro description, each 'name:=value'."),
         _Spec('controllers_file', ParameterType.PARAMETER_STRING,
               str(share / DEFAULT_CONTROLLERS),

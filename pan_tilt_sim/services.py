@@ -7,10 +7,11 @@ under ``-r __ns:=/left``):
 * ``reset_simulation``: joints back to their initial state, setpoints and PID
   integrators reset, sim time back to 0 -- and a /clock message says so at once;
 * ``reset_world``: the same, but sim time goes on;
-* ``pause_physics`` / ``unpause_physics``: hold / release the physics.  They set
-  the node's ``paused`` parameter, so the parameter always tells the state and
-  ``ros2 param set /sim_node paused true`` is the same switch.  While paused,
-  sim time stands still and commands are still taken; they act on unpause.
+* ``pause_physics`` / ``unpause_physics``: hold / release the physics, through
+  the node's ``paused`` parameter (``SimNode.set_paused``), so the parameter
+  always tells the state and ``ros2 param set /sim_node paused true`` is the
+  same switch.  While paused, sim time stands still and commands are still
+  taken; they act on unpause.
 
 The callbacks run on the node's executor, in the node's default (mutually
 exclusive) callback group, so a reset never lands inside a batch of steps.
@@ -20,7 +21,6 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from rclpy.parameter import Parameter
 from rclpy.service import Service
 from std_srvs.srv import Empty
 
@@ -31,7 +31,6 @@ RESET_SIMULATION = 'reset_simulation'
 RESET_WORLD = 'reset_world'
 PAUSE_PHYSICS = 'pause_physics'
 UNPAUSE_PHYSICS = 'unpause_physics'
-PAUSED_PARAMETER = 'paused'
 
 
 def create_world_services(node: SimNode) -> list[Service]:
@@ -45,9 +44,7 @@ def create_world_services(node: SimNode) -> list[Service]:
 
     def pause(paused: bool):
         def serve(request: Empty.Request, response: Empty.Response) -> Empty.Response:
-            result, = node.set_parameters([Parameter(PAUSED_PARAMETER, value=paused)])
-            if not result.successful:
-                node.get_logger().error(f"cannot set '{PAUSED_PARAMETER}': {result.reason}")
+            node.set_paused(paused)
             return response
         return serve
 

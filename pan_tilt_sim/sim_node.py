@@ -41,6 +41,7 @@ CLOCK_PERIOD_S = 0.01  # sim seconds between /clock messages (100 Hz of sim time
 QUEUE_DEPTH = 10
 WARNING_THROTTLE_S = 1.0
 _OWN_PARAMETERS = {field.name for field in dataclasses.fields(parameters.SimParameters)}
+PAUSED = 'paused'  # the parameter; services and set_paused() go through it
 
 
 class SimNode(Node):
@@ -102,7 +103,12 @@ class SimNode(Node):
         return self._paused
 
     def set_paused(self, paused: bool) -> None:
-        """Hold or release the physics; topics stay alive either way."""
+        """Hold or release the physics (topics stay alive); the ``paused`` parameter follows."""
+        result, = self.set_parameters([Parameter(PAUSED, value=paused)])
+        if not result.successful:
+            self.get_logger().error(f"cannot set '{PAUSED}': {result.reason}")
+
+    def _apply_paused(self, paused: bool) -> None:
         if paused != self._paused:
             self._paused = paused
             self._pacer.restart()
@@ -185,8 +191,8 @@ class SimNode(Node):
                 parameters.check_real_time_factor(updates['real_time_factor'])
         except ConfigurationError as err:
             return SetParametersResult(successful=False, reason=str(err))
-        if 'paused' in updates:
-            self.set_paused(updates['paused'])
+        if PAUSED in updates:
+            self._apply_paused(updates[PAUSED])
         if 'real_time_factor' in updates:
             self._pacer.real_time_factor = updates['real_time_factor']
             self._retime()
