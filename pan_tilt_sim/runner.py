@@ -184,6 +184,7 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
     debug = debug_requested(sys.argv if args is None else args)
     node: Node | None = None
     initialized = False
+    failure: ConfigurationError | None = None
     with StopSignals() as stop:
         try:
             with stop.interruptible():
@@ -195,8 +196,7 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
 
                 rclpy.spin(node)
         except ConfigurationError as err:
-            report_error(program, err, debug=debug)
-            return EXIT_CONFIGURATION_ERROR
+            failure = err
         except KeyboardInterrupt:
             pass
         except Exception:
@@ -209,6 +209,10 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
                 node.destroy_node()
             if initialized:
                 sys.modules['rclpy'].try_shutdown()
+    if failure is not None:
+        # Last, after rcl's shutdown chatter when debugging: the line the user reads.
+        report_error(program, failure, debug=debug)
+        return EXIT_CONFIGURATION_ERROR
     return EXIT_OK
 
 

@@ -1,0 +1,48 @@
+"""sim_node as a program in its own process, started from the package the tests import.
+
+``python -m pan_tilt_sim.sim_node`` with this package first on PYTHONPATH:
+the source tree under test, installed or not.  The child inherits the test
+process's ROS_DOMAIN_ID and ROS_AUTOMATIC_DISCOVERY_RANGE (see conftest.py).
+"""
+
+from __future__ import annotations
+
+import os
+import pathlib
+import subprocess
+import sys
+
+import pan_tilt_sim
+
+PACKAGE_ROOT = pathlib.Path(pan_tilt_sim.__file__).resolve().parents[1]
+MODULE_ENTRY = ('-m', 'pan_tilt_sim.sim_node')
+# The entry point that handles signals from its very first import (see runner.py).
+RUNNER_ENTRY = ('-c', 'from pan_tilt_sim.runner import sim_node_main; sim_node_main()')
+
+
+def environment() -> dict[str, str]:
+    """Return this process's environment with the package under test first on PYTHONPATH."""
+    env = dict(os.environ)
+    paths = [str(PACKAGE_ROOT), *filter(None, env.get('PYTHONPATH', '').split(os.pathsep))]
+    env['PYTHONPATH'] = os.pathsep.join(paths)
+    return env
+
+
+def command(*ros_args: str, entry: tuple[str, ...] = MODULE_ENTRY) -> list[str]:
+    """Return the command line of sim_node with ``--ros-args`` and ``ros_args`` (if any)."""
+    args = ['--ros-args', *ros_args] if ros_args else []
+    return [sys.executable, *entry, *args]
+
+
+def run(*ros_args: str, timeout: float = 30.0) -> subprocess.CompletedProcess:
+    """Run sim_node to its end (a start-up error) and return what it did."""
+    return subprocess.run(command(*ros_args), env=environment(), capture_output=True,
+                          text=True, timeout=timeout, check=False)
+
+
+def start(*ros_args: str, entry: tuple[str, ...] = MODULE_ENTRY,
+          **popen_kwargs) -> subprocess.Popen:
+    """Start sim_node in the background (stdout/stderr piped, text)."""
+    return subprocess.Popen(command(*ros_args, entry=entry), env=environment(),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            **popen_kwargs)

@@ -1,0 +1,313 @@
+"""Start-up errors: every bad file, parameter or argument gets one line naming it, exit code 2.
+
+Most cases build SimNode in-process (fast) and read the ConfigurationError it
+raises: the right kind, one line, naming the file/field/parameter and what is
+wrong.  A few run sim_node as a program to prove the contract end to end:
+exit code 2, exactly one line on stderr (no traceback, no PyBullet banner, no
+rcl log lines) and nothing on stdout -- and the traceback only with
+``--ros-args --log-level debug``.
+"""
+
+from __future__ import annotations
+
+import os
+import pathlib
+
+import pytest
+import rclpy
+import sim_process
+from rclpy.context import Context
+from rclpy.parameter import Parameter
+
+from pan_tilt_sim.errors import (
+    ConfigurationError,
+    ControllerConfigError,
+    DescriptionError,
+    ParameterError,
+)
+from pan_tilt_sim.sim_node import SimNode
+
+EXIT_CONFIGURATION_ERROR = 2
+PAN_TILT_URDF = sim_process.PACKAGE_ROOT / 'urdf' / 'pan_tilt.xacro'
+PAN_TILT_YAML = sim_process.PACKAGE_ROOT / 'config' / 'pan_tilt_control.yaml'
+
+_INERTIAL = ('<inertial><mass value="1"/>'
+             '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>')
+_XACRO_HEAD = '<?xml version="1.0"?>\n<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+
+# Files the cases below point at, written into a temporary folder per test.
+FILES = {
+    'not_xml.urdf': 'hello, this is not XML\n',
+    'sdf.urdf': '<sdf version="1.6"><model name="m"/></sdf>\n',
+    'binary.urdf': b'\xff\xfe\x00\x01binary',
+    'syntax.xacro': _XACRO_HEAD + '<link name="a">\n</robot>\n',
+    'undefined_property.xacro': _XACRO_HEAD + '<link name="${no_such_property}"/>\n</robot>\n',
+    'undefined_arg.xacro': _XACRO_HEAD + '<link name="$(arg no_such_arg)"/>\n</robot>\n',
+    'no_joints.urdf': '<?xml version="1.0"?>\n<robot name="r"><link name="a"/></robot>\n',
+    'fixed.urdf': f'''<?xml version="1.0"?>
+<robot name="r">
+  <link name="a">{_INERTIAL}</link><link name="b">{_INERTIAL}</link>
+  <link name="c">{_INERTIAL}</link>
+  <joint name="hinge" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+  <joint name="weld" type="fixed"><parent link="b"/><child link="c"/></joint>
+</robot>
+''',
+    'bad_plugin_namespace.urdf': f'''<?xml version="1.0"?>
+<robot name="r">
+  <link name="a">{_INERTIAL}</link><link name="b">{_INERTIAL}</link>
+  <joint name="hinge" type="continuous"><parent link="a"/><child link="b"/></joint>
+  <gazebo><plugin name="gazebo_ros_control" filename="libgazebo_ros_control.so">
+    <robotNamespace>/my robot</robotNamespace></plugin></gazebo>
+</robot>
+''',
+    'weld.yaml': 'weld_controller: {type: effort_controllers/JointEffortController, '
+                 'joint: weld}\n',
+    'yaml_syntax.yaml': 'a:\n  type: [unclosed\n  joint: pan_joint\n',
+    'empty.yaml': '',
+    'list.yaml': '- a\n- b\n',
+    'no_type.yaml': 'a: {joint: pan_joint}\n',
+    'unknown_type.yaml': 'a: {type: foo_controllers/Bar, joint: pan_joint}\n',
+    'no_joint.yaml': 'a: {type: position_controllers/JointPositionController}\n',
+    'number_joint.yaml': 'a: {type: position_controllers/JointPositionController, joint: 5}\n',
+    'unknown_joint.yaml': 'a: {type: position_controllers/JointPositionController, '
+                          'joint: elbow_joint}\n',
+    'twice.yaml': 'a: {type: position_controllers/JointPositionController, joint: pan_joint}\n'
+                  'b: {type: effort_controllers/JointEffortController, joint: pan_joint}\n',
+    'negative_rate.yaml': 'j: {type: joint_state_controller/JointStateController, '
+                          'publish_rate: -5}\n',
+    'zero_rate.yaml': 'j: {type: joint_state_controller/JointStateController, publish_rate: 0}\n',
+    'text_rate.yaml': 'j: {type: joint_state_controller/JointStateController, '
+                      'publish_rate: fast}\n',
+    'text_gain.yaml': 'a: {type: position_controllers/JointPositionController, joint: pan_joint, '
+                      'pid: {p: high, i: 0, d: 0}}\n',
+    'negative_gain.yaml': 'a: {type: position_controllers/JointPositionController, '
+                          'joint: pan_joint, pid: {p: 1, i: 0, d: -2}}\n',
+    'negative_clamp.yaml': 'a: {type: position_controllers/JointPositionController, '
+                           'joint: pan_joint, pid: {p: 1, i_clamp: -3}}\n',
+    'bad_namespace_key.yaml': 'my robot:\n  a: {type: position_controllers/'
+                              'JointPositionController, joint: pan_joint}\n',
+    'bad_controller_name.yaml': '"pan controller": {type: position_controllers/'
+                                'JointPositionController, joint: pan_joint}\n',
+}
+
+
+def _case(case_id, overrides, error, *expected):
+    return pytest.param(overrides, error, expected, id=case_id)
+
+
+# (overrides, error class, substrings of the message); '{dir}' is the files' folder.
+CASES = [
+    # The description file.
+    _case('description missing', {'robot_description_file': '{dir}/missing.urdf'},
+          DescriptionError, '{dir}/missing.urdf', 'no such file'),
+    _case('description is a folder', {'robot_description_file': '{dir}'},
+          DescriptionError, '{dir}', 'is a directory'),
+    _case('description not XML', {'robot_description_file': '{dir}/not_xml.urdf'},
+          DescriptionError, '{dir}/not_xml.urdf:1', 'not well-formed XML'),
+    _case('description not URDF', {'robot_description_file': '{dir}/sdf.urdf'},
+          DescriptionError, '{dir}/sdf.urdf', 'not a URDF', '<sdf>'),
+    _case('description unreadable bytes', {'robot_description_file': '{dir}/binary.urdf'},
+          DescriptionError, '{dir}/binary.urdf', 'cannot read'),
+    _case('xacro syntax error', {'robot_description_file': '{dir}/syntax.xacro'},
+          DescriptionError, '{dir}/syntax.xacro:4', 'not well-formed XML'),
+    _case('xacro undefined property',
+          {'robot_description_file': '{dir}/undefined_property.xacro'},
+          DescriptionError, '{dir}/undefined_property.xacro', 'no_such_property'),
+    _case('xacro undefined argument', {'robot_description_file': '{dir}/undefined_arg.xacro'},
+          DescriptionError, '{dir}/undefined_arg.xacro', 'no_such_arg'),
+    _case('xacro mapping malformed', {'xacro_args': ['no_separator']},
+          DescriptionError, 'xacro_args', "'no_separator'", 'name:=value'),
+    _case('no joints to control', {'robot_description_file': '{dir}/no_joints.urdf'},
+          DescriptionError, '{dir}/no_joints.urdf', 'no movable joints'),
+    _case('plugin namespace invalid',
+          {'robot_description_file': '{dir}/bad_plugin_namespace.urdf'},
+          DescriptionError, '{dir}/bad_plugin_namespace.urdf', "'/my robot'",
+          'not a valid ROS namespace'),
+    # The controllers file.
+    _case('controllers missing', {'controllers_file': '{dir}/missing.yaml'},
+          ControllerConfigError, '{dir}/missing.yaml', 'no such file'),
+    _case('controllers YAML syntax', {'controllers_file': '{dir}/yaml_syntax.yaml'},
+          ControllerConfigError, '{dir}/yaml_syntax.yaml:3', 'YAML syntax error'),
+    _case('controllers empty', {'controllers_file': '{dir}/empty.yaml'},
+          ControllerConfigError, '{dir}/empty.yaml', 'no controllers'),
+    _case('controllers a list', {'controllers_file': '{dir}/list.yaml'},
+          ControllerConfigError, '{dir}/list.yaml', 'no controllers'),
+    _case('controller without type', {'controllers_file': '{dir}/no_type.yaml'},
+          ControllerConfigError, '{dir}/no_type.yaml', 'no controllers', "'type'"),
+    _case('controller type unknown', {'controllers_file': '{dir}/unknown_type.yaml'},
+          ControllerConfigError, 'a.type', "'foo_controllers/Bar'",
+          'supported: effort_controllers/JointEffortController',
+          'position_controllers/JointPositionController'),
+    _case('controller without joint', {'controllers_file': '{dir}/no_joint.yaml'},
+          ControllerConfigError, '{dir}/no_joint.yaml', 'a.joint', 'missing'),
+    _case('controller joint not a name', {'controllers_file': '{dir}/number_joint.yaml'},
+          ControllerConfigError, 'a.joint', '5 is not a joint name'),
+    _case('joint not in the URDF', {'controllers_file': '{dir}/unknown_joint.yaml'},
+          ControllerConfigError, 'a.joint', "'elbow_joint'", 'pan_joint, tilt_joint'),
+    _case('fixed joint commanded', {'robot_description_file': '{dir}/fixed.urdf',
+                                    'controllers_file': '{dir}/weld.yaml'},
+          ControllerConfigError, '{dir}/weld.yaml', 'weld_controller', "'weld'", 'fixed joint'),
+    _case('joint claimed twice', {'controllers_file': '{dir}/twice.yaml'},
+          ControllerConfigError, '{dir}/twice.yaml', "'pan_joint'", "both 'a' and 'b'"),
+    _case('publish_rate negative', {'controllers_file': '{dir}/negative_rate.yaml'},
+          ControllerConfigError, 'j.publish_rate', '-5', '> 0'),
+    _case('publish_rate zero', {'controllers_file': '{dir}/zero_rate.yaml'},
+          ControllerConfigError, 'j.publish_rate', '0', '> 0'),
+    _case('publish_rate text', {'controllers_file': '{dir}/text_rate.yaml'},
+          ControllerConfigError, 'j.publish_rate', "'fast'"),
+    _case('PID gain text', {'controllers_file': '{dir}/text_gain.yaml'},
+          ControllerConfigError, 'a.pid', "p: 'high' is not a number"),
+    _case('PID gain negative', {'controllers_file': '{dir}/negative_gain.yaml'},
+          ControllerConfigError, 'a.pid', 'd: -2', '>= 0'),
+    _case('PID clamp negative', {'controllers_file': '{dir}/negative_clamp.yaml'},
+          ControllerConfigError, 'a.pid', 'i_clamp: -3'),
+    _case('namespace key invalid', {'controllers_file': '{dir}/bad_namespace_key.yaml'},
+          ControllerConfigError, '{dir}/bad_namespace_key.yaml', "'my robot'",
+          'not a valid ROS namespace'),
+    _case('controller name invalid', {'controllers_file': '{dir}/bad_controller_name.yaml'},
+          ControllerConfigError, "'pan controller'", 'not a valid ROS name'),
+    # Parameters: values.
+    _case('time_step zero', {'time_step': 0.0}, ParameterError, "'time_step'", '> 0', '0.0'),
+    _case('time_step negative', {'time_step': -0.001}, ParameterError, "'time_step'", '-0.001'),
+    _case('time_step above 0.1', {'time_step': 0.2}, ParameterError, "'time_step'", '<= 0.1'),
+    _case('time_step NaN', {'time_step': float('nan')}, ParameterError, "'time_step'", 'nan'),
+    _case('real_time_factor negative', {'real_time_factor': -1.0},
+          ParameterError, "'real_time_factor'", '>= 0', '-1.0'),
+    _case('real_time_factor infinite', {'real_time_factor': float('inf')},
+          ParameterError, "'real_time_factor'", 'finite', 'inf'),
+    _case('real_time_factor NaN', {'real_time_factor': float('nan')},
+          ParameterError, "'real_time_factor'", 'finite', 'nan'),
+    _case('robot_namespace starts with a digit', {'robot_namespace': '1robot'},
+          ParameterError, "'robot_namespace'", "'1robot'", 'not a valid ROS namespace'),
+    _case('robot_namespace with a space', {'robot_namespace': 'my robot'},
+          ParameterError, "'robot_namespace'", "'my robot'"),
+    # Parameters: types (integers for doubles are accepted: test_sim_node.py).
+    _case('time_step a string', {'time_step': 'fast'},
+          ParameterError, "'time_step' must be a double", "string 'fast'"),
+    _case('time_step a bool', {'time_step': True},
+          ParameterError, "'time_step' must be a double", 'bool True'),
+    _case('paused an integer', {'paused': 1},
+          ParameterError, "'paused' must be a bool", 'integer 1'),
+    _case('gui a string', {'gui': 'maybe'}, ParameterError, "'gui' must be a bool"),
+    _case('xacro_args a string', {'xacro_args': 'a:=1'},
+          ParameterError, "'xacro_args' must be a string array", "string 'a:=1'"),
+    _case('robot_description_file an integer', {'robot_description_file': 5},
+          ParameterError, "'robot_description_file' must be a string", 'integer 5'),
+    _case('robot_namespace a list', {'robot_namespace': ['a', 'b']},
+          ParameterError, "'robot_namespace' must be a string"),
+]
+
+
+@pytest.fixture
+def files(tmp_path: pathlib.Path) -> pathlib.Path:
+    for name, content in FILES.items():
+        path = tmp_path / name
+        if isinstance(content, bytes):
+            path.write_bytes(content)
+        else:
+            path.write_text(content)
+    return tmp_path
+
+
+@pytest.fixture
+def context():
+    context = Context()
+    rclpy.init(context=context)
+    yield context
+    rclpy.try_shutdown(context=context)
+
+
+def _fill(value, directory):
+    if isinstance(value, str):
+        return value.replace('{dir}', str(directory))
+    if isinstance(value, list):
+        return [_fill(item, directory) for item in value]
+    return value
+
+
+def _overrides(values: dict) -> list[Parameter]:
+    values = {'robot_description_file': str(PAN_TILT_URDF),
+              'controllers_file': str(PAN_TILT_YAML), 'real_time_factor': 0.0, **values}
+    return [Parameter(name, value=value) for name, value in values.items()]
+
+
+@pytest.mark.parametrize(('overrides', 'error', 'expected'), CASES)
+def test_a_bad_start_up_input_raises_one_line_naming_it(context, files, overrides, error,
+                                                        expected):
+    overrides = {name: _fill(value, files) for name, value in overrides.items()}
+    with pytest.raises(ConfigurationError) as raised:
+        node = SimNode(context=context, parameter_overrides=_overrides(overrides))
+        node.destroy_node()
+    message = str(raised.value)
+    assert isinstance(raised.value, error), f'{type(raised.value).__name__}: {message}'
+    assert '\n' not in message
+    for part in expected:
+        assert _fill(part, files) in message
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason='root reads files whatever their mode')
+def test_an_unreadable_description_names_the_file(context, files):
+    path = files / 'fixed.urdf'
+    path.chmod(0)
+    with pytest.raises(DescriptionError, match='cannot read'):
+        SimNode(context=context, parameter_overrides=_overrides(
+            {'robot_description_file': str(path)}))
+
+
+# --- as a program: exit code 2, one line, nothing else ----------------------------------
+
+def _assert_one_line_exit_2(result, *expected: str) -> str:
+    assert result.returncode == EXIT_CONFIGURATION_ERROR, result.stderr
+    assert result.stdout == ''
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1, result.stderr
+    line = lines[0]
+    assert line.startswith('sim_node: error: ')
+    for part in expected:
+        assert part in line
+    return line
+
+
+@pytest.mark.parametrize(('ros_args', 'expected'), [
+    pytest.param(['-p', 'time_step:=fast'], ["parameter 'time_step' must be a double"],
+                 id='wrong parameter type'),
+    pytest.param(['-p', 'paused:=1'], ["parameter 'paused' must be a bool"],
+                 id='integer for a bool'),
+    pytest.param(['-p', 'robot_description_file:={dir}/syntax.xacro'],
+                 ['{dir}/syntax.xacro:4', 'not well-formed'], id='xacro syntax error'),
+    pytest.param(['-p', 'robot_description_file:={dir}/fixed.urdf',
+                  '-p', 'controllers_file:={dir}/weld.yaml'], ["'weld'", 'fixed joint'],
+                 id='fixed joint (after PyBullet loaded the robot)'),
+    pytest.param(['-p', 'controllers_file:={dir}/bad_controller_name.yaml'],
+                 ["'pan controller'"], id='controller name not a ROS name'),
+])
+def test_the_program_prints_one_line_and_exits_2(files, ros_args, expected):
+    result = sim_process.run(*(_fill(arg, files) for arg in ros_args))
+    _assert_one_line_exit_2(result, *(_fill(part, files) for part in expected))
+
+
+@pytest.mark.parametrize(('ros_args', 'expected'), [
+    pytest.param(['-p', 'time_step'], ["'-p time_step'"], id='override without :='),
+    pytest.param(['--no-such-flag'], ["unknown ROS argument '--no-such-flag'"],
+                 id='unknown flag'),
+    pytest.param(['-r', '__ns:=bad//ns'], ["'-r __ns:=bad//ns'", 'found: bad//ns'],
+                 id='invalid namespace remap'),
+    pytest.param(['--params-file', '{dir}/missing.yaml'], ['{dir}/missing.yaml'],
+                 id='missing params file'),
+    pytest.param(['--log-level', 'loud'], ["'--log-level loud'", 'severity'],
+                 id='unknown log level'),
+])
+def test_malformed_ros_arguments_get_one_line_not_rcl_noise(files, ros_args, expected):
+    result = sim_process.run(*(_fill(arg, files) for arg in ros_args))
+    line = _assert_one_line_exit_2(result, 'ROS arguments: ', *(_fill(p, files) for p in expected))
+    assert '[rcl]' not in line and '.c:' not in line
+
+
+def test_log_level_debug_adds_the_traceback_before_the_line():
+    result = sim_process.run('-p', 'time_step:=0', '--log-level', 'debug')
+    assert result.returncode == EXIT_CONFIGURATION_ERROR
+    assert 'Traceback (most recent call last)' in result.stderr
+    assert 'ParameterError' in result.stderr
+    ours = [line for line in result.stderr.splitlines() if not line.startswith('[DEBUG]')]
+    assert ours[-1] == "sim_node: error: parameter 'time_step' must be > 0 and <= 0.1 s, got 0.0"
