@@ -106,7 +106,7 @@ def test_fixed_joints_are_skipped(tmp_path):
 def test_a_fixed_joint_cannot_be_commanded(tmp_path):
     urdf = star_robot_urdf([JointDef('hinge'), JointDef('weld')]).replace(
         'name="weld" type="revolute"', 'name="weld" type="fixed"')
-    with pytest.raises(ControllerConfigError, match="joint 'weld' is not a movable joint"):
+    with pytest.raises(ControllerConfigError, match="joint 'weld' is a fixed joint"):
         simulation(tmp_path, [], {'pos': position_controller('weld')}, urdf=urdf)
 
 
