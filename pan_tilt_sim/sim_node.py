@@ -125,7 +125,10 @@ class SimNode(Node):
         self._timer.cancel()
         self.features.close()
         self.simulation.close()
+        logger = self.get_logger()
         super().destroy_node()
+        # Once the node is gone: its rosout publisher may share a dead context.
+        logger.debug('PyBullet disconnected, node destroyed')
 
     def _tick_period(self) -> float:
         # Paused, a zero-period timer would spin the CPU for nothing.
