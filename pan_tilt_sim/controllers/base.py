@@ -162,6 +162,12 @@ def clamp(value: float, lower: float, upper: float) -> float:
     return lower if value < lower else upper if value > upper else value
 
 
+def is_sane_number(value: Any) -> bool:
+    """Whether ``value`` is a finite number within +-MAX_COMMAND_MAGNITUDE."""
+    return isinstance(value, int | float) and math.isfinite(value) and (
+        abs(value) <= MAX_COMMAND_MAGNITUDE)
+
+
 def bounded_command(value: float, lower: float, upper: float) -> tuple[float, CommandResult]:
     """Check a scalar command: non-finite is rejected, out-of-range is clamped.
 

@@ -23,15 +23,16 @@ are this controller with the interface fixed.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.base import (
+    MAX_COMMAND_MAGNITUDE,
     CommandController,
     CommandKind,
     CommandResult,
     JointHandle,
+    is_sane_number,
 )
 from pan_tilt_sim.controllers.gains import PID_FIELD, joint_gains_from_params
 from pan_tilt_sim.controllers.joint_effort_controller import JointEffortController
@@ -107,9 +108,10 @@ class ForwardCommandController(CommandController):
             self._problem = f'ignored command with {len(value)} values: {expected}'
             return CommandResult.REJECTED
         for joint, element in zip(self._joint_names, value, strict=True):
-            if not (isinstance(element, int | float) and math.isfinite(element)):
+            if not is_sane_number(element):
                 self._problem = (f'ignored command {list(value)!r}: the value for '
-                                 f"'{joint}' is not a finite number")
+                                 f"'{joint}' is not a finite number (within "
+                                 f'+-{MAX_COMMAND_MAGNITUDE:g})')
                 return CommandResult.REJECTED
         clamped = [joint for joint, member, element in zip(
             self._joint_names, members, value, strict=True)

@@ -33,10 +33,12 @@ from collections.abc import Mapping
 from typing import Any
 
 from pan_tilt_sim.controllers.base import (
+    MAX_COMMAND_MAGNITUDE,
     CommandController,
     CommandKind,
     CommandResult,
     JointHandle,
+    is_sane_number,
 )
 from pan_tilt_sim.controllers.gains import feedforward_scales, joint_gains_from_params
 from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
@@ -227,7 +229,8 @@ class JointTrajectoryController(CommandController):
             if with_velocities and len(point.velocities) != len(names):
                 return (f'point {number}: {len(point.velocities)} velocities for '
                         f'{len(names)} joints')
-            if not all(math.isfinite(v) for v in (*point.positions, *point.velocities)):
-                return f'point {number}: a position or velocity is not a finite number'
+            if not all(map(is_sane_number, (*point.positions, *point.velocities))):
+                return (f'point {number}: a position or velocity is not a finite number '
+                        f'(within +-{MAX_COMMAND_MAGNITUDE:g})')
         return ''
 
