@@ -18,6 +18,7 @@ import contextlib
 import os
 import pathlib
 import tempfile
+import weakref
 from collections.abc import Iterator, Sequence
 
 from pan_tilt_sim.description import JointSpec, RobotDescription
@@ -56,6 +57,11 @@ with quiet_native_output():
     import pybullet  # noqa: E402
 
 
+def _disconnect(client: int) -> None:
+    with contextlib.suppress(pybullet.error):
+        pybullet.disconnect(physicsClientId=client)
+
+
 class Physics:
     """A PyBullet world holding one fixed-base robot."""
 
@@ -70,6 +76,9 @@ class Physics:
         if self._client < 0:
             self._workdir.cleanup()
             raise DescriptionError('PyBullet: cannot connect a physics client')
+        # Disconnects even if nobody calls close(): an owner abandoned half-built
+        # (a signal during start-up) or left behind at interpreter exit.
+        self._disconnect = weakref.finalize(self, _disconnect, self._client)
         try:
             self._body = self._load(description)
         except BaseException:
@@ -133,8 +142,7 @@ class Physics:
     def close(self) -> None:
         """Disconnect the PyBullet client and remove temporary files (idempotent)."""
         if self._client >= 0:
-            with contextlib.suppress(pybullet.error):
-                pybullet.disconnect(physicsClientId=self._client)
+            self._disconnect()
             self._client = -1
         self._workdir.cleanup()
 

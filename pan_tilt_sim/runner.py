@@ -191,10 +191,14 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
                 init_ros(args, debug=debug)
                 initialized = True
                 node = make_node()
-            if stop.received is None:
-                import rclpy
+            import rclpy
 
-                rclpy.spin(node)
+            if stop.received is None and rclpy.ok():
+                # Made while the context is alive: an executor whose construction
+                # a signal cuts short complains from __del__ with a traceback.
+                executor = rclpy.get_global_executor()
+                node.get_logger().debug('started; spinning until SIGINT or SIGTERM')
+                rclpy.spin(node, executor)
         except ConfigurationError as err:
             failure = err
         except KeyboardInterrupt:
