@@ -1,0 +1,98 @@
+"""Two sim_node processes with different namespaces on one domain do not cross-talk.
+
+Each runs the seed's pan/tilt under its own node namespace (``-r __ns:=/left``,
+``/right``), so its topics and services are under that namespace.  /clock is
+absolute by ROS convention, as with two Gazebos: each process remaps it
+(``-r /clock:=/left/clock``), which the test does and checks.
+"""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+
+import pytest
+import sim_process
+from node_harness import PROBE_QUEUE, NodeHarness
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64
+from std_srvs.srv import Empty
+
+SIDES = ('left', 'right')
+STARTUP_BUDGET_S = 30.0
+MOVE_BUDGET_S = 10.0
+STOP_BUDGET_S = 2.0
+MOVED_RAD = 0.01
+HELD_WALL_S = 0.5
+
+
+def _stamp(message) -> float:
+    stamp = message.clock if isinstance(message, Clock) else message.header.stamp
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+@pytest.fixture
+def two_sims():
+    processes = {side: sim_process.start('-r', f'__ns:=/{side}',
+                                         '-r', f'/clock:=/{side}/clock',
+                                         '-p', 'real_time_factor:=1.0')
+                 for side in SIDES}
+    harness = NodeHarness()
+    try:
+        yield harness
+    finally:
+        harness.close()
+        for process in processes.values():
+            process.send_signal(signal.SIGINT)
+        for side, process in processes.items():
+            try:
+                _out, err = process.communicate(timeout=STOP_BUDGET_S)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                _out, err = process.communicate()
+            assert process.returncode == 0, f'{side}: {err}'
+
+
+def test_two_namespaced_sims_keep_to_their_own_topics_services_and_clocks(two_sims):
+    harness, probe = two_sims, two_sims.probe
+    states = {side: [] for side in SIDES}
+    clocks = {side: [] for side in SIDES}
+    global_clock = []
+    for side in SIDES:
+        probe.create_subscription(JointState, f'/{side}/joint_states', states[side].append,
+                                  PROBE_QUEUE)
+        probe.create_subscription(Clock, f'/{side}/clock', clocks[side].append, PROBE_QUEUE)
+    probe.create_subscription(Clock, '/clock', global_clock.append, PROBE_QUEUE)
+    left_pan = probe.create_publisher(Float64, '/left/joint1_position_controller/command', 10)
+    assert harness.spin_until(
+        lambda: all(states.values()) and all(clocks.values())
+        and left_pan.get_subscription_count() == 1, STARTUP_BUDGET_S), 'sims did not come up'
+
+    left_pan.publish(Float64(data=1.0))
+    assert harness.spin_until(lambda: states['left'][-1].position[0] > MOVED_RAD, MOVE_BUDGET_S)
+    assert all(message.position[0] == pytest.approx(0.0, abs=1e-6)
+               for message in states['right'])
+
+    def call(service: str) -> None:
+        client = probe.create_client(Empty, service)
+        assert harness.spin_until(client.service_is_ready, STARTUP_BUDGET_S)
+        future = client.call_async(Empty.Request())
+        assert harness.spin_until(future.done)
+
+    # Pausing the left sim stops its clock only.
+    call('/left/pause_physics')
+    harness.spin_until(lambda: False, HELD_WALL_S)
+    left_held, right_before = _stamp(clocks['left'][-1]), _stamp(clocks['right'][-1])
+    harness.spin_until(lambda: False, HELD_WALL_S)
+    assert _stamp(clocks['left'][-1]) == left_held
+    assert _stamp(clocks['right'][-1]) > right_before
+
+    # Resetting the left sim sends its clock back to 0, not the right one.
+    right_count = len(clocks['right'])
+    call('/left/reset_simulation')
+    assert harness.spin_until(lambda: _stamp(clocks['left'][-1]) == 0.0)
+    harness.spin_until(lambda: len(clocks['right']) > right_count + 10, STARTUP_BUDGET_S)
+    right_times = [_stamp(message) for message in clocks['right']]
+    assert right_times == sorted(right_times)
+    assert global_clock == []
