@@ -382,7 +382,8 @@ def read_collada(data: bytes) -> np.ndarray:
     """
     try:
         root = ET.fromstring(data)
-    except ET.ParseError as exc:
+    except (ET.ParseError, LookupError, ValueError) as exc:
+        # LookupError / ValueError: an unknown or multi-byte encoding in the declaration.
         raise _UnusableError(f'not valid XML: {exc}') from None
     if _local(root.tag) != _COLLADA_ROOT:
         raise _UnusableError(f'not a Collada file (root element <{_local(root.tag)}>)')
