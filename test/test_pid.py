@@ -96,3 +96,11 @@ def test_without_clamp_the_default_bound_applies():
 def test_invalid_gains_are_refused_naming_the_field(values, field):
     with pytest.raises(GainsError, match=field):
         PidGains.from_mapping(values)
+
+
+@pytest.mark.parametrize('bounds', [{'i_clamp_min': math.inf},
+                                    {'i_clamp_max': -math.inf},
+                                    {'i_clamp_min': math.inf, 'i_clamp_max': math.inf}])
+def test_an_integral_clamp_pinned_at_infinity_is_refused(bounds):
+    with pytest.raises(GainsError, match='must be < inf'):
+        PidGains(p=1.0, i=1.0, **bounds)

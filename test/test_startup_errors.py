@@ -85,6 +85,8 @@ FILES = {
                           'joint: pan_joint, pid: {p: 1, i: 0, d: -2}}\n',
     'negative_clamp.yaml': 'a: {type: position_controllers/JointPositionController, '
                            'joint: pan_joint, pid: {p: 1, i_clamp: -3}}\n',
+    'infinite_clamp.yaml': 'a: {type: position_controllers/JointPositionController, '
+                           'joint: pan_joint, pid: {p: 1, i: 1, i_clamp_min: .inf}}\n',
     'bad_namespace_key.yaml': 'my robot:\n  a: {type: position_controllers/'
                               'JointPositionController, joint: pan_joint}\n',
     'bad_controller_name.yaml': '"pan controller": {type: position_controllers/'
@@ -162,6 +164,8 @@ CASES = [
           ControllerConfigError, 'a.pid', 'd: -2', '>= 0'),
     _case('PID clamp negative', {'controllers_file': '{dir}/negative_clamp.yaml'},
           ControllerConfigError, 'a.pid', 'i_clamp: -3'),
+    _case('PID clamp pinned at infinity', {'controllers_file': '{dir}/infinite_clamp.yaml'},
+          ControllerConfigError, 'a.pid', 'i_clamp_min (inf) must be < inf'),
     _case('namespace key invalid', {'controllers_file': '{dir}/bad_namespace_key.yaml'},
           ControllerConfigError, '{dir}/bad_namespace_key.yaml', "'my robot'",
           'not a valid ROS namespace'),

@@ -47,6 +47,11 @@ class PidGains:
             if isinstance(value, bool) or not isinstance(value, int | float) or math.isnan(value):
                 raise GainsError(f'{name}: {value!r} is not a number')
             object.__setattr__(self, name, float(value))
+        if self.i_clamp_min == math.inf or self.i_clamp_max == -math.inf:
+            # The integral term would be pinned at infinity, and the output with it.
+            raise GainsError(
+                f'i_clamp_min ({self.i_clamp_min}) must be < inf and '
+                f'i_clamp_max ({self.i_clamp_max}) > -inf')
         if self.i_clamp_min > self.i_clamp_max:
             raise GainsError(
                 f'i_clamp_min ({self.i_clamp_min}) is greater than '
