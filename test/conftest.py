@@ -35,3 +35,9 @@ def seeds_dir() -> pathlib.Path:
 def repo_root() -> pathlib.Path:
     """Return the source checkout's root folder."""
     return REPO_ROOT
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """Register the ``soak`` marker: minutes-long flood/soak tests, off unless asked for."""
+    config.addinivalue_line(
+        'markers', 'soak: flood and soak tests (minutes); run only with PAN_TILT_SIM_SLOW=1')
