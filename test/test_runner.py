@@ -1,0 +1,86 @@
+"""runner: what a program run says about bad ROS arguments, and how it takes stop signals.
+
+The program-level behaviour (exit codes, one stderr line, stopping on signals)
+is tested end to end in test_startup_errors.py and test_signals.py; these are
+the pieces, in-process.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+
+import pytest
+
+from pan_tilt_sim.errors import ArgumentError
+from pan_tilt_sim.runner import StopRequested, StopSignals, debug_requested, init_ros
+
+
+def _python_call() -> None:
+    """Python runs pending signal handlers at calls like this one."""
+
+
+@pytest.fixture
+def default_context():
+    import rclpy
+
+    yield
+    rclpy.try_shutdown()
+
+
+@pytest.mark.parametrize(('argv', 'debug'), [
+    (['sim_node', '--ros-args', '--log-level', 'debug'], True),
+    (['sim_node', '--ros-args', '--log-level', 'DEBUG'], True),
+    (['sim_node', '--ros-args', '--log-level', 'sim_node:=debug'], True),
+    (['sim_node', '--ros-args', '--log-level', 'info'], False),
+    (['sim_node', '--ros-args', '-p', 'time_step:=0.001'], False),
+    (['sim_node', 'debug'], False),
+])
+def test_debug_is_asked_for_with_log_level_debug(argv, debug):
+    assert debug_requested(argv) is debug
+
+
+@pytest.mark.parametrize(('args', 'expected'), [
+    (['sim_node', '--ros-args', '--no-such-flag'],
+     "ROS arguments: unknown ROS argument '--no-such-flag'"),
+    (['sim_node', '--ros-args', '-p', 'time_step'],
+     "ROS arguments: couldn't parse parameter override rule: '-p time_step'"),
+    (['sim_node', '--ros-args', '-r', '__node:=9node'],
+     "ROS arguments: couldn't parse remap rule: '-r __node:=9node' "
+     "(Node name not remapped to invalid name: '9node')"),
+])
+def test_malformed_ros_arguments_raise_one_clean_line(args, expected, capfd, default_context):
+    with pytest.raises(ArgumentError) as raised:
+        init_ros(args)
+    assert str(raised.value) == expected
+    # rcl's own log lines were folded into the message, not printed.
+    assert capfd.readouterr().err == ''
+
+
+def test_the_first_signal_interrupts_only_an_interruptible_block():
+    with StopSignals() as stop:
+        os.kill(os.getpid(), signal.SIGTERM)  # outside the block: noted only
+        _python_call()
+        assert stop.received is signal.SIGTERM
+    with StopSignals() as stop:
+        with pytest.raises(StopRequested), stop.interruptible():
+            os.kill(os.getpid(), signal.SIGINT)
+            _python_call()
+        os.kill(os.getpid(), signal.SIGINT)  # later ones: noted, never raised
+        _python_call()
+    assert stop.received is signal.SIGINT
+
+
+def test_a_stop_noted_before_the_block_ends_it_at_once():
+    with StopSignals() as stop:
+        os.kill(os.getpid(), signal.SIGTERM)
+        _python_call()
+        with pytest.raises(StopRequested), stop.interruptible():
+            pytest.fail('the block should not run after a stop was asked for')
+
+
+def test_the_previous_handlers_come_back():
+    before = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
+    with StopSignals():
+        assert signal.getsignal(signal.SIGTERM) is not before[signal.SIGTERM]
+    assert {signum: signal.getsignal(signum) for signum in before} == before
