@@ -73,6 +73,8 @@ def test_reset_simulation_restores_joints_controllers_and_time_zero(world):
     assert world.pan_position() > 0.1
     assert pan.pid.integral_term != 0.0
 
+    # Paused, so that no tick runs between the reset and the checks.
+    world.node.set_paused(True)
     world.call('/reset_simulation')
 
     simulation = world.node.simulation
@@ -85,6 +87,7 @@ def test_reset_simulation_restores_joints_controllers_and_time_zero(world):
     # /clock says time went back: a message at 0 after the ones at 2 s.
     assert world.harness.spin_until(lambda: any(_clock_s(m) == 0.0 for m in world.clock[1:]))
     # The old command is forgotten: the pan holds still at 0.
+    world.node.set_paused(False)
     world.run_for(1.0)
     assert abs(world.pan_position()) < 1e-3
 
@@ -92,6 +95,7 @@ def test_reset_simulation_restores_joints_controllers_and_time_zero(world):
 def test_reset_world_restores_joints_but_keeps_time(world):
     world.command_pan(1.0)
     world.run_for(2.0)
+    world.node.set_paused(True)
     world.call('/reset_world')
     assert world.node.simulation.time >= 2.0
     assert world.pan_position() == 0.0
