@@ -144,3 +144,11 @@ def test_service_names_follow_the_node_namespace():
                 '/left/unpause_physics'} <= names
     finally:
         harness.close()
+
+
+def test_a_paused_value_of_the_wrong_type_is_refused_at_run_time(world):
+    result, = world.node.set_parameters([Parameter('paused', value='yes')])
+    assert not result.successful
+    assert "'paused' must be a bool" in result.reason
+    assert world.node.get_parameter('paused').value is False
+    assert not world.node.paused
