@@ -139,7 +139,11 @@ def test_ros2_run_sees_exactly_the_entry_points(prefix):
     entry_points = {
         ep.name: ep.value for ep in importlib.metadata.entry_points(group='console_scripts')
         if ep.dist is not None and ep.dist.name.replace('-', '_') == PACKAGE}
-    assert entry_points == {name: f'{PACKAGE}.{name}:main' for name in EXECUTABLES}
+    expected = {name: f'{PACKAGE}.{name}:main' for name in EXECUTABLES}
+    # sim_node starts through the runner, which installs its signal handlers
+    # before rclpy and PyBullet are imported (a Ctrl-C during start-up is clean).
+    expected['sim_node'] = f'{PACKAGE}.runner:sim_node_main'
+    assert entry_points == expected
     # `ros2 run` offers every executable file in lib/<package>/.
     lib = prefix / 'lib' / PACKAGE
     assert {p.name for p in lib.iterdir() if _is_executable_file(p)} == set(EXECUTABLES)

@@ -25,11 +25,12 @@ from pan_tilt_sim.errors import (
     DescriptionError,
     ParameterError,
 )
+from pan_tilt_sim.share import package_share
 from pan_tilt_sim.sim_node import SimNode
 
 EXIT_CONFIGURATION_ERROR = 2
-PAN_TILT_URDF = sim_process.PACKAGE_ROOT / 'urdf' / 'pan_tilt.xacro'
-PAN_TILT_YAML = sim_process.PACKAGE_ROOT / 'config' / 'pan_tilt_control.yaml'
+PAN_TILT_URDF = package_share() / 'urdf' / 'pan_tilt.xacro'
+PAN_TILT_YAML = package_share() / 'config' / 'pan_tilt_control.yaml'
 
 _INERTIAL = ('<inertial><mass value="1"/>'
              '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>')
