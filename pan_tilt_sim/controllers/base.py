@@ -152,8 +152,8 @@ class CommandController(Controller):
     def command_problem(self, value: Any, result: CommandResult) -> str:
         """Describe what was wrong with ``value``, which ``set_command`` rejected or clamped."""
         if result is CommandResult.REJECTED:
-            return (f'ignored command {value!r}: not a finite number (or beyond '
-                    f'+-{MAX_COMMAND_MAGNITUDE:g} where the joint has no limit)')
+            return (f'ignored command {value!r}: not a finite number within '
+                    f'+-{MAX_COMMAND_MAGNITUDE:g}')
         return f"command {value!r} is outside the joint's limits; clamped"
 
 
@@ -169,15 +169,14 @@ def is_sane_number(value: Any) -> bool:
 
 
 def bounded_command(value: float, lower: float, upper: float) -> tuple[float, CommandResult]:
-    """Check a scalar command: non-finite is rejected, out-of-range is clamped.
+    """Check a scalar command: non-finite or huge is rejected, out-of-range is clamped.
 
-    Where a side has no limit, a command beyond MAX_COMMAND_MAGNITUDE is
-    rejected too: no joint means it, and gains times such an error overflow.
+    A command beyond +-MAX_COMMAND_MAGNITUDE (1e308, say) is rejected, not
+    clamped: no joint means it, it is a broken sender, and on a side without
+    a limit gains times such an error would overflow.
     """
-    if not math.isfinite(value):
+    if not is_sane_number(value):
         return value, CommandResult.REJECTED
     if value < lower or value > upper:
         return clamp(value, lower, upper), CommandResult.CLAMPED
-    if abs(value) > MAX_COMMAND_MAGNITUDE:
-        return value, CommandResult.REJECTED
     return value, CommandResult.ACCEPTED
