@@ -4,8 +4,8 @@ import math
 
 import numpy
 import pytest
+from node_harness import sim_node
 from sensor_msgs.msg import CameraInfo, Image
-from sim_harness import sim_node
 
 from pan_tilt_sim.camera import (
     CameraSettings,

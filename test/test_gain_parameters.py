@@ -4,7 +4,7 @@ import math
 import re
 
 import pytest
-from sim_harness import sim_node
+from node_harness import sim_node
 
 from pan_tilt_sim.controllers.pid import GainsError, PidGains
 from pan_tilt_sim.errors import ParameterError

@@ -5,8 +5,8 @@ import math
 
 import pytest
 from geometry_msgs.msg import TransformStamped
+from node_harness import sim_node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from sim_harness import sim_node
 from std_msgs.msg import String
 
 from pan_tilt_sim.description import Mimic, load_description
