@@ -12,15 +12,11 @@ import math
 import time
 
 import pytest
-from node_harness import PROBE_QUEUE, NodeHarness
+from node_harness import PROBE_QUEUE, sim_node
 from rcl_interfaces.msg import Log
-from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64, Float64MultiArray
 
-from pan_tilt_sim.sim_node import SimNode
-
-NS = '/ex_urdf_pan_tilt'
 PAN = 'joint1_position_controller'
 PAN_LIMIT = 3.14
 PAN_SPEED = 0.1  # rad/s, the URDF velocity limit
@@ -36,69 +32,24 @@ WARNING_THROTTLE_S = 1.0
 FLOOD_COUNT = 100
 
 
-class Sim:
-    """The node, the JointStates it published, and a publisher per command topic."""
-
-    def __init__(self, harness: NodeHarness, node: SimNode) -> None:
-        self.harness, self.node = harness, node
-        self.states: list[JointState] = []
-        self.log: list[Log] = []
-        harness.probe.create_subscription(JointState, f'{NS}/joint_states', self.states.append,
-                                          PROBE_QUEUE)
-        harness.probe.create_subscription(Log, '/rosout', self.log.append, PROBE_QUEUE)
-        self._publishers = {}
-
-    def send(self, controller: str, message) -> None:
-        topic = f'{NS}/{controller}/{"commands" if controller == GROUP else "command"}'
-        publisher = self._publishers.get(topic)
-        if publisher is None:
-            publisher = self.harness.probe.create_publisher(type(message), topic, 10)
-            self._publishers[topic] = publisher
-            assert self.harness.spin_until(lambda: publisher.get_subscription_count() > 0)
-        counts = self.node.commands_received
-        before = counts[controller]
-        publisher.publish(message)
-        assert self.harness.spin_until(lambda: counts[controller] > before)
-
-    def send_paused(self, controller: str, message) -> float:
-        """Send while the physics is held, so the command takes effect at a known time."""
-        self.node.set_paused(True)
-        self.send(controller, message)
-        self.node.set_paused(False)
-        return self.node.simulation.time
-
-    def run_for(self, seconds: float) -> None:
-        target = self.node.simulation.time + seconds
-        assert self.harness.spin_until(lambda: self.node.simulation.time >= target)
-
-    def setpoints(self, controller: str) -> list[float]:
-        found = self.node.simulation.controller(controller)
-        members = getattr(found, 'members', (found,))
-        return [member.setpoint for member in members]
-
-
-def _start(overrides) -> tuple[NodeHarness, Sim]:
-    harness = NodeHarness()
-    node = harness.add(SimNode(context=harness.context, parameter_overrides=[
-        Parameter(name, value=value) for name, value in
-        {'real_time_factor': 0.0, **overrides}.items()]))
-    return harness, Sim(harness, node)
-
-
 @pytest.fixture
 def seed_sim():
-    harness, sim = _start({})
-    yield sim
-    harness.close()
+    with sim_node() as sim:
+        yield sim
 
 
 @pytest.fixture
 def group_sim(tmp_path):
     config = tmp_path / 'group.yaml'
     config.write_text(GROUP_YAML)
-    harness, sim = _start({'controllers_file': str(config)})
-    yield sim
-    harness.close()
+    with sim_node(controllers_file=str(config)) as sim:
+        yield sim
+
+
+@pytest.fixture
+def log(seed_sim) -> list[Log]:
+    """What the probe hears on /rosout."""
+    return seed_sim.collect(Log, '/rosout', PROBE_QUEUE)
 
 
 def _all_finite(states: list[JointState]) -> bool:
@@ -108,12 +59,12 @@ def _all_finite(states: list[JointState]) -> bool:
 
 @pytest.mark.parametrize('bad', [math.nan, math.inf, -math.inf, 1e308, -1e308,
                                  1.7976931348623157e308])
-def test_a_non_finite_or_huge_command_leaves_the_setpoint_and_the_joint_alone(seed_sim, bad):
+def test_a_non_finite_or_huge_command_leaves_the_setpoint_and_the_joint_alone(seed_sim, log, bad):
     start = seed_sim.send_paused(PAN, Float64(data=0.2))
     seed_sim.run_for(0.5)
     seed_sim.node.set_paused(True)
     setpoint = seed_sim.setpoints(PAN)
-    seed_sim.send(PAN, Float64(data=bad))
+    seed_sim.command(PAN, Float64(data=bad))
     assert seed_sim.setpoints(PAN) == setpoint
     seed_sim.node.set_paused(False)
     seed_sim.run_for(1.0)
@@ -121,11 +72,10 @@ def test_a_non_finite_or_huge_command_leaves_the_setpoint_and_the_joint_alone(se
     ramp_s = seed_sim.node.simulation.time - start
     assert seed_sim.setpoints(PAN)[0] == pytest.approx(min(0.2, PAN_SPEED * ramp_s), abs=1e-6)
     assert _all_finite(seed_sim.states)
-    seed_sim.harness.drain(lambda: len(seed_sim.log))
-    assert 'ignored' in _warnings(seed_sim)[0].msg
+    assert 'ignored' in _warnings(log)[0].msg
 
 
-def test_an_out_of_range_command_is_clamped_to_the_limit(seed_sim):
+def test_an_out_of_range_command_is_clamped_to_the_limit(seed_sim, log):
     start = seed_sim.send_paused(PAN, Float64(data=10.0))
     seed_sim.run_for(2.0)
     setpoint, = seed_sim.setpoints(PAN)
@@ -133,8 +83,7 @@ def test_an_out_of_range_command_is_clamped_to_the_limit(seed_sim):
     assert setpoint == pytest.approx(PAN_SPEED * (seed_sim.node.simulation.time - start),
                                      abs=1e-6)
     assert seed_sim.states and _all_finite(seed_sim.states)
-    seed_sim.harness.drain(lambda: len(seed_sim.log))
-    assert 'clamped' in _warnings(seed_sim)[0].msg
+    assert 'clamped' in _warnings(log)[0].msg
 
 
 @pytest.mark.parametrize('bad', [
@@ -147,30 +96,30 @@ def test_an_out_of_range_command_is_clamped_to_the_limit(seed_sim):
 ])
 def test_a_bad_array_command_is_rejected_whole(group_sim, bad):
     before = group_sim.setpoints(GROUP)
-    group_sim.send(GROUP, Float64MultiArray(data=bad))
+    group_sim.command(GROUP, Float64MultiArray(data=bad))
     group_sim.run_for(0.5)
     assert group_sim.setpoints(GROUP) == pytest.approx(before)
     assert before == pytest.approx([0.0, TILT_START])
     # A good command afterwards is taken.
-    group_sim.send(GROUP, Float64MultiArray(data=[0.5, -2.0]))
+    group_sim.command(GROUP, Float64MultiArray(data=[0.5, -2.0]))
     group_sim.run_for(0.5)
     pan, tilt = group_sim.setpoints(GROUP)
     assert pan > 0.0 and tilt < TILT_START
     assert _all_finite(group_sim.states)
 
 
-def _warnings(sim: Sim) -> list[Log]:
-    return [entry for entry in sim.log
+def _warnings(log: list[Log]) -> list[Log]:
+    return [entry for entry in log
             if entry.name == 'sim_node' and entry.level == Log.WARN and PAN in entry.msg]
 
 
-def test_a_stream_of_bad_commands_warns_at_most_once_per_second(seed_sim):
+def test_a_stream_of_bad_commands_warns_at_most_once_per_second(seed_sim, log):
     start = time.monotonic()
     for _ in range(FLOOD_COUNT):
-        seed_sim.send(PAN, Float64(data=math.nan))
+        seed_sim.command(PAN, Float64(data=math.nan))
     elapsed = time.monotonic() - start
-    seed_sim.harness.drain(lambda: len(seed_sim.log))
-    warnings = _warnings(seed_sim)
+    seed_sim.drain()
+    warnings = _warnings(log)
     assert warnings, 'no warning at all'
     assert 'ignored command nan' in warnings[0].msg
     assert len(warnings) <= 1 + int(elapsed / WARNING_THROTTLE_S)

@@ -7,112 +7,76 @@ calls the services and commands the pan joint; every wait is a bounded spin.
 from __future__ import annotations
 
 import pytest
-from node_harness import PROBE_QUEUE, NodeHarness
+from node_harness import PROBE_QUEUE, sim_node, stamp_s
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
 from std_srvs.srv import Empty
 
-from pan_tilt_sim.sim_node import SimNode
-
-NS = '/ex_urdf_pan_tilt'
 PAN = 'joint1_position_controller'
 TILT_START = -1.570796
 PAUSED_WALL_S = 0.3
 
 
-class World:
-    """The node, the probe's service clients, a pan command publisher and the /clock seen."""
-
-    def __init__(self, harness: NodeHarness, node: SimNode) -> None:
-        self.harness, self.node = harness, node
-        self.clock: list[Clock] = []
-        harness.probe.create_subscription(Clock, '/clock', self.clock.append, PROBE_QUEUE)
-        self.pan = harness.probe.create_publisher(Float64, f'{NS}/{PAN}/command', 10)
-        assert harness.spin_until(lambda: self.pan.get_subscription_count() > 0)
-
-    def call(self, service: str) -> None:
-        client = self.harness.probe.create_client(Empty, service)
-        assert self.harness.spin_until(lambda: client.service_is_ready())
-        future = client.call_async(Empty.Request())
-        assert self.harness.spin_until(future.done)
-        assert future.result() is not None
-        self.harness.probe.destroy_client(client)
-
-    def command_pan(self, value: float) -> None:
-        counts = self.node.commands_received
-        before = counts[PAN]
-        self.pan.publish(Float64(data=value))
-        assert self.harness.spin_until(lambda: counts[PAN] > before)
-
-    def run_for(self, seconds: float) -> None:
-        target = self.node.simulation.time + seconds
-        assert self.harness.spin_until(lambda: self.node.simulation.time >= target)
-
-    def pan_position(self) -> float:
-        return self.node.simulation.joint_positions()['pan_joint']
-
-
 @pytest.fixture
 def world():
-    harness = NodeHarness()
-    node = harness.add(SimNode(context=harness.context,
-                               parameter_overrides=[Parameter('real_time_factor', value=0.0)]))
-    yield World(harness, node)
-    harness.close()
+    with sim_node() as sim:
+        yield sim
 
 
-def _clock_s(message: Clock) -> float:
-    return message.clock.sec + message.clock.nanosec * 1e-9
+def _pan_position(world) -> float:
+    return world.simulation.joint_positions()['pan_joint']
 
 
 def test_reset_simulation_restores_joints_controllers_and_time_zero(world):
-    world.command_pan(1.0)
+    clock = world.collect(Clock, '/clock', PROBE_QUEUE)
+    world.wait_for_subscribers('/clock')
+    world.command(PAN, Float64(data=1.0))
     world.run_for(2.0)
     pan = world.node.simulation.controller(PAN)
-    assert world.pan_position() > 0.1
+    assert _pan_position(world) > 0.1
     assert pan.pid.integral_term != 0.0
 
     # Paused, so that no tick runs between the reset and the checks.
     world.node.set_paused(True)
-    world.call('/reset_simulation')
+    world.call(Empty, '/reset_simulation')
 
     simulation = world.node.simulation
     assert simulation.time == 0.0
-    assert world.pan_position() == 0.0
+    assert _pan_position(world) == 0.0
     assert simulation.joint_positions()['tilt_joint'] == pytest.approx(TILT_START)
     assert simulation.joint_velocities() == {'pan_joint': 0.0, 'tilt_joint': 0.0}
     assert pan.setpoint == 0.0
     assert pan.pid.integral_term == 0.0
     # /clock says time went back: a message at 0 after the ones at 2 s.
-    assert world.harness.spin_until(lambda: any(_clock_s(m) == 0.0 for m in world.clock[1:]))
+    assert world.spin_until(lambda: any(stamp_s(m) == 0.0 for m in clock[1:]))
     # The old command is forgotten: the pan holds still at 0.
     world.node.set_paused(False)
     world.run_for(1.0)
-    assert abs(world.pan_position()) < 1e-3
+    assert abs(_pan_position(world)) < 1e-3
 
 
 def test_reset_world_restores_joints_but_keeps_time(world):
-    world.command_pan(1.0)
+    world.command(PAN, Float64(data=1.0))
     world.run_for(2.0)
     world.node.set_paused(True)
-    world.call('/reset_world')
+    world.call(Empty, '/reset_world')
     assert world.node.simulation.time >= 2.0
-    assert world.pan_position() == 0.0
+    assert _pan_position(world) == 0.0
     assert world.node.simulation.controller(PAN).setpoint == 0.0
 
 
 def test_pause_holds_sim_time_takes_commands_and_they_act_on_unpause(world):
-    world.call('/pause_physics')
+    world.call(Empty, '/pause_physics')
     assert world.node.paused
     assert world.node.get_parameter('paused').value is True
     held = world.node.simulation.time
-    world.command_pan(1.0)
-    world.harness.spin_until(lambda: False, budget_s=PAUSED_WALL_S)
+    world.command(PAN, Float64(data=1.0))
+    world.spin_for(PAUSED_WALL_S)
     assert world.node.simulation.time == held
-    assert world.pan_position() == 0.0
+    assert _pan_position(world) == 0.0
 
-    world.call('/unpause_physics')
+    world.call(Empty, '/unpause_physics')
     assert not world.node.paused
     assert world.node.get_parameter('paused').value is False
     world.run_for(1.0)
@@ -120,30 +84,24 @@ def test_pause_holds_sim_time_takes_commands_and_they_act_on_unpause(world):
     ramp_s = world.node.simulation.time - held
     assert world.node.simulation.controller(PAN).setpoint == pytest.approx(0.1 * ramp_s,
                                                                           abs=1e-3)
-    assert world.pan_position() > 0.02
+    assert _pan_position(world) > 0.02
 
 
 def test_the_paused_parameter_is_the_same_switch(world):
     world.node.set_parameters([Parameter('paused', value=True)])
     assert world.node.paused
-    world.call('/unpause_physics')
+    world.call(Empty, '/unpause_physics')
     assert world.node.get_parameter('paused').value is False
     world.node.set_paused(True)
     assert world.node.get_parameter('paused').value is True
 
 
 def test_service_names_follow_the_node_namespace():
-    harness = NodeHarness()
-    try:
-        node = harness.add(SimNode(context=harness.context, namespace='/left',
-                                   parameter_overrides=[Parameter('real_time_factor',
-                                                                  value=0.0)]))
-        names = {name for name, _types in node.get_service_names_and_types_by_node(
+    with sim_node(node_namespace='/left') as sim:
+        names = {name for name, _types in sim.node.get_service_names_and_types_by_node(
             'sim_node', '/left')}
-        assert {'/left/reset_simulation', '/left/reset_world', '/left/pause_physics',
-                '/left/unpause_physics'} <= names
-    finally:
-        harness.close()
+    assert {'/left/reset_simulation', '/left/reset_world', '/left/pause_physics',
+            '/left/unpause_physics'} <= names
 
 
 def test_a_paused_value_of_the_wrong_type_is_refused_at_run_time(world):

@@ -7,78 +7,23 @@ real_time_factor 0 (as fast as possible), and every wait is a bounded spin.
 import math
 
 import pytest
-from node_harness import PROBE_QUEUE, NodeHarness
-from rclpy.parameter import Parameter
+from node_harness import PROBE_QUEUE, sim_node, stamp_s
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
-from pan_tilt_sim.sim_node import SimNode
-
 NS = '/ex_urdf_pan_tilt'
-PAN_COMMAND = f'{NS}/joint1_position_controller/command'
-TILT_COMMAND = f'{NS}/joint2_position_controller/command'
+PAN = 'joint1_position_controller'
+TILT = 'joint2_position_controller'
+PAN_COMMAND = f'{NS}/{PAN}/command'
+TILT_COMMAND = f'{NS}/{TILT}/command'
 SPEED_TOLERANCE = 0.002  # rad/s above the URDF velocity limit of 0.1
 SETTLE_TOLERANCE = 0.015  # rad: friction 1 N*m against P = 100 leaves up to 0.01 rad
 
 
-class PanTilt:
-    """The node under test plus the probe's publishers and received messages."""
-
-    def __init__(self, harness, node):
-        self.harness, self.node = harness, node
-        self.states: list[JointState] = []
-        self.clock: list[Clock] = []
-        probe = harness.probe
-        probe.create_subscription(JointState, f'{NS}/joint_states', self.states.append,
-                                  PROBE_QUEUE)
-        probe.create_subscription(Clock, '/clock', self.clock.append, PROBE_QUEUE)
-        self._publishers = {}
-
-    def command(self, topic, value):
-        publisher = self._publishers.get(topic)
-        if publisher is None:
-            publisher = self.harness.probe.create_publisher(Float64, topic, 10)
-            self._publishers[topic] = publisher
-            assert self.harness.spin_until(lambda: publisher.get_subscription_count() > 0)
-        counts = self.node.commands_received
-        name = topic.split('/')[-2]
-        before = counts[name]
-        publisher.publish(Float64(data=value))
-        assert self.harness.spin_until(lambda: counts[name] > before)
-
-    def run_for(self, seconds):
-        """Let sim time advance by ``seconds``, then pause and take every queued message."""
-        target = self.node.simulation.time + seconds
-        assert self.harness.spin_until(lambda: self.node.simulation.time >= target)
-        self.node.set_paused(True)
-        self.harness.drain(lambda: len(self.states) + len(self.clock))
-        self.node.set_paused(False)
-
-    def position(self, joint):
-        last = self.states[-1]
-        return last.position[list(last.name).index(joint)]
-
-    def series(self, joint, field, since=0.0):
-        return [getattr(m, field)[list(m.name).index(joint)] for m in self.states
-                if stamp_s(m) >= since]
-
-
-def stamp_s(message):
-    return message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
-
-
-def _overrides(**values):
-    values.setdefault('real_time_factor', 0.0)
-    return [Parameter(name, value=value) for name, value in values.items()]
-
-
 @pytest.fixture
-def pan_tilt(repo_root):
-    harness = NodeHarness()
-    node = harness.add(SimNode(context=harness.context, parameter_overrides=_overrides()))
-    yield PanTilt(harness, node)
-    harness.close()
+def pan_tilt():
+    with sim_node() as sim:
+        yield sim
 
 
 def test_topics_are_those_of_the_seed(pan_tilt):
@@ -90,8 +35,8 @@ def test_topics_are_those_of_the_seed(pan_tilt):
 
 
 def test_pan_settles_at_its_command_no_faster_than_the_velocity_limit(pan_tilt):
-    start = pan_tilt.node.simulation.time
-    pan_tilt.command(PAN_COMMAND, 1.0)
+    start = pan_tilt.simulation.time
+    pan_tilt.command(PAN, Float64(data=1.0))
     pan_tilt.run_for(15.0)
     assert pan_tilt.position('pan_joint') == pytest.approx(1.0, abs=SETTLE_TOLERANCE)
     speeds = pan_tilt.series('pan_joint', 'velocity', since=start)
@@ -104,20 +49,20 @@ def test_pan_settles_at_its_command_no_faster_than_the_velocity_limit(pan_tilt):
 
 
 def test_tilt_starts_at_its_upper_limit_and_follows_commands_within_limits(pan_tilt):
-    assert pan_tilt.harness.spin_until(lambda: pan_tilt.states)
+    assert pan_tilt.spin_until(lambda: pan_tilt.states)
     assert pan_tilt.states[0].position[1] == pytest.approx(-1.570796, abs=1e-6)
-    pan_tilt.command(TILT_COMMAND, 0.0)  # above the upper limit: clamped there
+    pan_tilt.command(TILT, Float64(data=0.0))  # above the upper limit: clamped there
     pan_tilt.run_for(3.0)
     assert pan_tilt.position('tilt_joint') == pytest.approx(-1.570796, abs=SETTLE_TOLERANCE)
-    pan_tilt.command(TILT_COMMAND, -2.0)
+    pan_tilt.command(TILT, Float64(data=-2.0))
     pan_tilt.run_for(8.0)
     assert pan_tilt.position('tilt_joint') == pytest.approx(-2.0, abs=SETTLE_TOLERANCE)
 
 
 @pytest.mark.parametrize('bad', [math.nan, math.inf, -math.inf])
 def test_non_finite_commands_change_nothing(pan_tilt, bad):
-    pan_tilt.command(PAN_COMMAND, 0.2)
-    pan_tilt.command(PAN_COMMAND, bad)
+    pan_tilt.command(PAN, Float64(data=0.2))
+    pan_tilt.command(PAN, Float64(data=bad))
     pan_tilt.run_for(4.0)
     assert pan_tilt.position('pan_joint') == pytest.approx(0.2, abs=SETTLE_TOLERANCE)
     assert all(math.isfinite(v) for m in pan_tilt.states for v in (*m.position, *m.velocity,
@@ -138,75 +83,57 @@ def test_joint_states_arrive_at_50_hz_of_sim_time_with_every_field(pan_tilt):
 
 
 def test_clock_publishes_sim_time_every_10_ms(pan_tilt):
+    clock = pan_tilt.collect(Clock, '/clock', PROBE_QUEUE)
     pan_tilt.run_for(1.0)
-    times = [m.clock.sec + m.clock.nanosec * 1e-9 for m in pan_tilt.clock]
+    times = [stamp_s(m) for m in clock]
     assert len(times) >= 100
-    assert times[-1] == pytest.approx(pan_tilt.node.simulation.time, abs=0.011)
+    assert times[-1] == pytest.approx(pan_tilt.simulation.time, abs=0.011)
     assert all(b - a == pytest.approx(0.01, abs=1e-6)
                for a, b in zip(times, times[1:], strict=False))
 
 
-def test_an_effort_controller_meets_damping_and_friction(repo_root, tmp_path):
+def test_an_effort_controller_meets_damping_and_friction(tmp_path):
     config = tmp_path / 'effort.yaml'
     config.write_text(
         'ex_urdf_pan_tilt:\n'
         '  joint_state_controller: {type: joint_state_controller/JointStateController,'
         ' publish_rate: 50}\n'
         '  pan_effort: {type: effort_controllers/JointEffortController, joint: pan_joint}\n')
-    harness = NodeHarness()
-    try:
-        node = harness.add(SimNode(context=harness.context, parameter_overrides=_overrides(
-            controllers_file=str(config))))
-        pan_tilt = PanTilt(harness, node)
-        pan_tilt.command(f'{NS}/pan_effort/command', 50.0)
+    with sim_node(controllers_file=str(config)) as pan_tilt:
+        assert pan_tilt.node.topic('pan_effort', 'command') == f'{NS}/pan_effort/command'
+        pan_tilt.command('pan_effort', Float64(data=50.0))
         pan_tilt.run_for(1.0)
         # Steady speed (50 - 1) / 50 = 0.98 rad/s.
         assert pan_tilt.states[-1].velocity[0] == pytest.approx(0.98, abs=0.01)
         assert pan_tilt.states[-1].effort[0] == pytest.approx(50.0)
-    finally:
-        harness.close()
 
 
 def test_the_seeds_own_files_drive_the_same_topics(seeds_dir):
-    harness = NodeHarness()
-    try:
-        node = harness.add(SimNode(context=harness.context, parameter_overrides=_overrides(
-            robot_description_file=str(seeds_dir / 'pan_tilt.xacro'),
-            controllers_file=str(seeds_dir / 'pan_tilt_control.yaml'))))
-        pan_tilt = PanTilt(harness, node)
-        pan_tilt.command(PAN_COMMAND, -0.3)
+    with sim_node(robot_description_file=str(seeds_dir / 'pan_tilt.xacro'),
+                  controllers_file=str(seeds_dir / 'pan_tilt_control.yaml')) as pan_tilt:
+        topics = dict(pan_tilt.node.get_topic_names_and_types())
+        assert topics[PAN_COMMAND] == ['std_msgs/msg/Float64']
+        assert topics[f'{NS}/joint_states'] == ['sensor_msgs/msg/JointState']
+        pan_tilt.command(PAN, Float64(data=-0.3))
         pan_tilt.run_for(5.0)
         assert pan_tilt.position('pan_joint') == pytest.approx(-0.3, abs=SETTLE_TOLERANCE)
-    finally:
-        harness.close()
 
 
 def test_integers_are_accepted_for_double_parameters():
-    harness = NodeHarness()
-    try:
-        node = harness.add(SimNode(context=harness.context, parameter_overrides=[
-            Parameter('real_time_factor', value=0), Parameter('time_step', value=0.002)]))
-        assert node.settings.real_time_factor == 0.0
-        assert isinstance(node.settings.real_time_factor, float)
-        assert node.settings.time_step == 0.002
-    finally:
-        harness.close()
+    with sim_node(real_time_factor=0, time_step=0.002) as sim:
+        assert sim.node.settings.real_time_factor == 0.0
+        assert isinstance(sim.node.settings.real_time_factor, float)
+        assert sim.node.settings.time_step == 0.002
 
 
-def test_paused_holds_sim_time_while_topics_stay_alive(repo_root):
-    harness = NodeHarness()
-    try:
-        node = harness.add(SimNode(context=harness.context,
-                                   parameter_overrides=_overrides(paused=True)))
-        pan_tilt = PanTilt(harness, node)
-        pan_tilt.command(PAN_COMMAND, 0.5)  # accepted while paused
-        harness.spin_until(lambda: False, budget_s=0.3)
-        assert node.simulation.time == 0.0
-        node.set_paused(False)
+def test_paused_holds_sim_time_while_topics_stay_alive():
+    with sim_node(paused=True) as pan_tilt:
+        pan_tilt.command(PAN, Float64(data=0.5))  # accepted while paused
+        pan_tilt.spin_for(0.3)
+        assert pan_tilt.simulation.time == 0.0
+        pan_tilt.node.set_paused(False)
         pan_tilt.run_for(8.0)
         assert pan_tilt.position('pan_joint') == pytest.approx(0.5, abs=SETTLE_TOLERANCE)
-    finally:
-        harness.close()
 
 
 def test_xacro_args_reach_xacro(repo_root, tmp_path):
@@ -217,11 +144,6 @@ def test_xacro_args_reach_xacro(repo_root, tmp_path):
         '<xacro:arg name="pan_limit" default="3.14"/>'
         '<xacro:property name="base_link_length" value="0.01"/>').replace(
         'lower="-3.14" upper="3.14"', 'lower="-3.14" upper="$(arg pan_limit)"'))
-    harness = NodeHarness()
-    try:
-        node = harness.add(SimNode(context=harness.context, parameter_overrides=_overrides(
-            robot_description_file=str(path), xacro_args=['pan_limit:=0.25'])))
-        assert node.settings.xacro_args == ('pan_limit:=0.25',)
-        assert node.simulation.description.joint('pan_joint').upper == 0.25
-    finally:
-        harness.close()
+    with sim_node(robot_description_file=str(path), xacro_args=['pan_limit:=0.25']) as sim:
+        assert sim.node.settings.xacro_args == ('pan_limit:=0.25',)
+        assert sim.simulation.description.joint('pan_joint').upper == 0.25

@@ -5,6 +5,7 @@ real_time_factor 0, bounded spins), except the start-up error test, which
 needs the exit code and so runs sim_node in its own process.
 """
 
+import contextlib
 import os
 import pathlib
 import subprocess
@@ -13,77 +14,22 @@ import sys
 import mesh_fixtures as mf
 import pytest
 from builtin_interfaces.msg import Duration
-from node_harness import PROBE_QUEUE, NodeHarness
-from rclpy.parameter import Parameter
+from node_harness import sim_node, stamp_s
 from robot_fixtures import JointDef, write_star_robot, write_text
-from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64, Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from pan_tilt_sim.ros_interfaces import stamp
-from pan_tilt_sim.sim_node import EXIT_CONFIGURATION_ERROR, SimNode
+from pan_tilt_sim.sim_node import EXIT_CONFIGURATION_ERROR
 
 STARTUP_BUDGET_S = 30.0
 
 
-def stamp_s(message):
-    return message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
-
-
-class Robot:
-    """The node under test, the probe's publishers and the joint states it received."""
-
-    def __init__(self, harness, node, namespace=''):
-        self.harness, self.node, self.namespace = harness, node, namespace
-        self.states: list[JointState] = []
-        harness.probe.create_subscription(JointState, f'{namespace}/joint_states',
-                                          self.states.append, PROBE_QUEUE)
-        self._publishers = {}
-
-    def command(self, controller, topic, message):
-        """Publish ``message`` to ``<ns>/<controller>/<topic>`` and wait until the node took it."""
-        name = f'{self.namespace}/{controller}/{topic}'
-        publisher = self._publishers.get(name)
-        if publisher is None:
-            publisher = self.harness.probe.create_publisher(type(message), name, 10)
-            self._publishers[name] = publisher
-            assert self.harness.spin_until(lambda: publisher.get_subscription_count() > 0)
-        counts = self.node.commands_received
-        before = counts[controller]
-        publisher.publish(message)
-        assert self.harness.spin_until(lambda: counts[controller] > before)
-
-    def run_for(self, seconds):
-        """Let sim time advance by ``seconds``, then take every queued joint state."""
-        target = self.node.simulation.time + seconds
-        assert self.harness.spin_until(lambda: self.node.simulation.time >= target)
-        self.node.set_paused(True)
-        self.harness.drain(lambda: len(self.states))
-        self.node.set_paused(False)
-
-    def position(self, joint, message=None):
-        message = message or self.states[-1]
-        return message.position[list(message.name).index(joint)]
-
-    def state_at(self, time):
-        return next(m for m in self.states if abs(stamp_s(m) - time) < 1e-6)
-
-
 @pytest.fixture
 def start_node():
-    harnesses = []
-
-    def start(namespace='', **parameters):
-        parameters.setdefault('real_time_factor', 0.0)
-        harness = NodeHarness()
-        harnesses.append(harness)
-        node = harness.add(SimNode(context=harness.context, parameter_overrides=[
-            Parameter(name, value=value) for name, value in parameters.items()]))
-        return Robot(harness, node, namespace)
-
-    yield start
-    for harness in harnesses:
-        harness.close()
+    """Start sim_nodes with the given parameters; all are stopped after the test."""
+    with contextlib.ExitStack() as running:
+        yield lambda **parameters: running.enter_context(sim_node(**parameters))
 
 
 # --- seed 2: my_robot_pkg from an ament prefix, with generated meshes ----------------------
@@ -104,14 +50,13 @@ def seed2_package(tmp_path, monkeypatch, seeds_dir):
 def test_seed2_arm_joint_reaches_its_command_under_the_plugin_namespace(seed2_package,
                                                                       start_node):
     robot = start_node(
-        '/my_robot',
         robot_description_file=str(seed2_package / mf.SEED2_URDF_RELPATH),
         controllers_file=str(seed2_package / 'config' / 'joint_controllers.yaml'))
     assert robot.node.robot_namespace == '/my_robot'
     topics = dict(robot.node.get_topic_names_and_types())
     assert topics['/my_robot/arm_controller/command'] == ['std_msgs/msg/Float64']
     assert topics['/my_robot/joint_states'] == ['sensor_msgs/msg/JointState']
-    robot.command('arm_controller', 'command', Float64(data=1.57))
+    robot.command('arm_controller', Float64(data=1.57))
     robot.run_for(4.0)  # 1.57 rad at the URDF's 1 rad/s, then settling
     assert robot.position('arm_joint') == pytest.approx(1.57, abs=0.01)
     assert list(robot.states[-1].name) == ['arm_joint']
@@ -171,7 +116,7 @@ def test_arm_follows_a_three_point_trajectory_sent_on_its_topic(arm):
         positions=[targets[joint] for joint in names],
         time_from_start=Duration(sec=int(when), nanosec=round(when % 1 * 1e9)))
         for when, targets in waypoints]
-    arm.command('arm_controller', 'joint_trajectory', message)
+    arm.command('arm_controller', message)
     arm.run_for(start + 3.5 - arm.node.simulation.time)
     for when, targets in waypoints:
         state = arm.state_at(start + when)
@@ -180,12 +125,12 @@ def test_arm_follows_a_three_point_trajectory_sent_on_its_topic(arm):
 
 
 def test_gripper_moves_both_fingers_and_ignores_a_wrong_length_command(arm, capfd):
-    arm.command('gripper_controller', 'commands', Float64MultiArray(data=[0.03]))
+    arm.command('gripper_controller', Float64MultiArray(data=[0.03]))
     arm.run_for(1.0)
     assert arm.position('left_finger_joint') == pytest.approx(0.03, abs=0.001)
     assert arm.position('right_finger_joint') == pytest.approx(-0.03, abs=0.001)
     capfd.readouterr()
-    arm.command('gripper_controller', 'commands', Float64MultiArray(data=[0.0, 0.0]))
+    arm.command('gripper_controller', Float64MultiArray(data=[0.0, 0.0]))
     arm.run_for(1.0)
     assert arm.position('left_finger_joint') == pytest.approx(0.03, abs=0.001)
     assert ('gripper_controller: ignored command with 2 values: expected 1 value, one per '
@@ -221,12 +166,15 @@ def test_group_controller_moves_its_joints_through_its_commands_topic(
             joints: [pan, slide]
             {extra}
         """)
-    robot = start_node('/star', robot_namespace='star', robot_description_file=str(robot_file),
+    robot = start_node(robot_namespace='star', robot_description_file=str(robot_file),
                        controllers_file=str(controllers))
-    robot.command('group', 'commands', Float64MultiArray(data=[1.0, 1.0, 1.0]))
+    topics = dict(robot.node.get_topic_names_and_types())
+    assert topics['/star/group/commands'] == ['std_msgs/msg/Float64MultiArray']
+    assert topics['/star/joint_states'] == ['sensor_msgs/msg/JointState']
+    robot.command('group', Float64MultiArray(data=[1.0, 1.0, 1.0]))
     robot.run_for(0.2)
     assert [robot.position('pan'), robot.position('slide')] == [0.0, 0.0]
-    robot.command('group', 'commands', Float64MultiArray(data=command))
+    robot.command('group', Float64MultiArray(data=command))
     robot.run_for(1.0)
     for joint, value in zip(('pan', 'slide'), command, strict=True):
         moved = robot.position(joint)
