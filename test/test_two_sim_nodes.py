@@ -13,7 +13,7 @@ import subprocess
 
 import pytest
 import sim_process
-from node_harness import PROBE_QUEUE, NodeHarness
+from node_harness import PROBE_QUEUE, NodeHarness, stamp_s
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
@@ -25,11 +25,6 @@ MOVE_BUDGET_S = 10.0
 STOP_BUDGET_S = 2.0
 MOVED_RAD = 0.01
 HELD_WALL_S = 0.5
-
-
-def _stamp(message) -> float:
-    stamp = message.clock if isinstance(message, Clock) else message.header.stamp
-    return stamp.sec + stamp.nanosec * 1e-9
 
 
 @pytest.fixture
@@ -74,25 +69,19 @@ def test_two_namespaced_sims_keep_to_their_own_topics_services_and_clocks(two_si
     assert all(message.position[0] == pytest.approx(0.0, abs=1e-6)
                for message in states['right'])
 
-    def call(service: str) -> None:
-        client = probe.create_client(Empty, service)
-        assert harness.spin_until(client.service_is_ready, STARTUP_BUDGET_S)
-        future = client.call_async(Empty.Request())
-        assert harness.spin_until(future.done)
-
     # Pausing the left sim stops its clock only.
-    call('/left/pause_physics')
-    harness.spin_until(lambda: False, HELD_WALL_S)
-    left_held, right_before = _stamp(clocks['left'][-1]), _stamp(clocks['right'][-1])
-    harness.spin_until(lambda: False, HELD_WALL_S)
-    assert _stamp(clocks['left'][-1]) == left_held
-    assert _stamp(clocks['right'][-1]) > right_before
+    harness.call(Empty, '/left/pause_physics', budget_s=STARTUP_BUDGET_S)
+    harness.spin_for(HELD_WALL_S)
+    left_held, right_before = stamp_s(clocks['left'][-1]), stamp_s(clocks['right'][-1])
+    harness.spin_for(HELD_WALL_S)
+    assert stamp_s(clocks['left'][-1]) == left_held
+    assert stamp_s(clocks['right'][-1]) > right_before
 
     # Resetting the left sim sends its clock back to 0, not the right one.
     right_count = len(clocks['right'])
-    call('/left/reset_simulation')
-    assert harness.spin_until(lambda: _stamp(clocks['left'][-1]) == 0.0)
+    harness.call(Empty, '/left/reset_simulation', budget_s=STARTUP_BUDGET_S)
+    assert harness.spin_until(lambda: stamp_s(clocks['left'][-1]) == 0.0)
     harness.spin_until(lambda: len(clocks['right']) > right_count + 10, STARTUP_BUDGET_S)
-    right_times = [_stamp(message) for message in clocks['right']]
+    right_times = [stamp_s(message) for message in clocks['right']]
     assert right_times == sorted(right_times)
     assert global_clock == []
