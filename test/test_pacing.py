@@ -11,6 +11,14 @@ class FakeClock:
         return self.now
 
 
+def _started(factor):
+    """Return a pacer at ``factor`` on a fake clock, past its first tick, and the clock."""
+    clock = FakeClock()
+    pacer = Pacer(factor, 0.001, clock)
+    pacer.steps_due()
+    return pacer, clock
+
+
 def test_factor_zero_runs_fixed_batches():
     assert Pacer(0.0, 0.001).steps_due() == FAST_BATCH_STEPS
 
@@ -27,17 +35,13 @@ def test_real_time_runs_one_step_per_time_step_of_wall_time():
 
 
 def test_faster_than_real_time_factor_scales_the_steps():
-    clock = FakeClock()
-    pacer = Pacer(2.5, 0.001, clock)
-    pacer.steps_due()
+    pacer, clock = _started(2.5)
     clock.now += 0.01
     assert pacer.steps_due() == 25
 
 
 def test_a_stall_is_not_paid_back_in_one_burst():
-    clock = FakeClock()
-    pacer = Pacer(1.0, 0.001, clock)
-    pacer.steps_due()
+    pacer, clock = _started(1.0)
     clock.now += 5.0
     assert pacer.steps_due() == round(MAX_CATCH_UP_S / 0.001)
     clock.now += 0.01
@@ -45,9 +49,7 @@ def test_a_stall_is_not_paid_back_in_one_burst():
 
 
 def test_restart_forgets_time_spent_paused():
-    clock = FakeClock()
-    pacer = Pacer(1.0, 0.001, clock)
-    pacer.steps_due()
+    pacer, clock = _started(1.0)
     clock.now += 3.0
     pacer.restart()
     assert pacer.steps_due() == 0
