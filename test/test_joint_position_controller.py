@@ -21,6 +21,12 @@ def _controller(params=SEED_PARAMS, spec=PAN):
     return controller, handle
 
 
+def _run(controller, steps):
+    """Update the controller ``steps`` times, DT apart, from time 0 (joint state frozen)."""
+    for step in range(steps):
+        controller.update(step * DT, DT)
+
+
 def test_before_the_first_command_the_joint_holds_its_start_position():
     controller, handle = _controller()
     handle.position = 0.2
@@ -34,8 +40,7 @@ def test_before_the_first_command_the_joint_holds_its_start_position():
 def test_the_setpoint_ramps_toward_the_command_at_the_velocity_limit():
     controller, handle = _controller()
     assert controller.set_command(1.0) is CommandResult.ACCEPTED
-    for step in range(1000):
-        controller.update(step * DT, DT)
+    _run(controller, 1000)
     assert controller.setpoint == pytest.approx(0.1, abs=1e-9)
 
 
@@ -52,8 +57,7 @@ def test_effort_is_clamped_to_the_effort_limit():
     params = dict(SEED_PARAMS, pid={'p': 1e6})
     controller, handle = _controller(params)
     controller.set_command(3.0)
-    for step in range(100):
-        controller.update(step * DT, DT)
+    _run(controller, 100)
     assert handle.effort == 300.0
 
 
@@ -62,16 +66,14 @@ def test_non_finite_commands_change_nothing(value):
     controller, handle = _controller()
     controller.set_command(0.5)
     assert controller.set_command(value) is CommandResult.REJECTED
-    for step in range(10_000):
-        controller.update(step * DT, DT)
+    _run(controller, 10_000)
     assert controller.setpoint == pytest.approx(0.5)
 
 
 def test_commands_beyond_the_limits_are_clamped():
     controller, _handle = _controller()
     assert controller.set_command(10.0) is CommandResult.CLAMPED
-    for step in range(40_000):
-        controller.update(step * DT, DT)
+    _run(controller, 40_000)
     assert controller.setpoint == pytest.approx(3.14)
 
 
