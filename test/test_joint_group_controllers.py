@@ -218,6 +218,7 @@ PAN_INERTIA = LINK_MASS * (LINK_LENGTH ** 2 + LINK_WIDTH ** 2) / 12 + LINK_MASS 
     LINK_LENGTH / 2) ** 2
 STAR_JOINTS = [JointDef('pan', 'revolute', -1.5, 1.5, velocity=2.0),
                JointDef('slide', 'prismatic', -0.3, 0.3, velocity=0.5)]
+STAR_INERTIAS = {'pan': PAN_INERTIA, 'slide': LINK_MASS}  # about / along each joint's axis
 
 
 def star_simulation(tmp_path, type_name, **params):
@@ -235,10 +236,27 @@ def star_simulation(tmp_path, type_name, **params):
     return make_simulation(str(robot), str(controllers), DT)
 
 
+def interface_params(type_name, interface):
+    """The ForwardCommandController is told its interface; a JointGroup*Controller knows it."""
+    return {'interface_name': interface} if type_name == FORWARD else {}
+
+
+def star_velocities_after(tmp_path, type_name, interface, commands, seconds):
+    """Command a fresh star robot's group from rest; return the joint velocities ``seconds`` on."""
+    with star_simulation(tmp_path, type_name, **interface_params(type_name, interface)) as sim:
+        sim.controller('group').set_command(commands)
+        sim.advance(round(seconds / DT))
+        return sim.joint_velocities()
+
+
+def first_order_speed(drive, damping, inertia, seconds):
+    """Solve inertia * v' = drive - damping * v from rest: v after ``seconds``."""
+    return drive / damping * (1.0 - math.exp(-damping * seconds / inertia))
+
+
 @pytest.mark.parametrize('type_name', [GROUP_TYPES['position'], FORWARD])
 def test_position_group_brings_its_joints_to_the_command(tmp_path, type_name):
-    extra = {'interface_name': 'position'} if type_name == FORWARD else {}
-    with star_simulation(tmp_path, type_name, **extra) as sim:
+    with star_simulation(tmp_path, type_name, **interface_params(type_name, 'position')) as sim:
         sim.controller('group').set_command([0.8, -0.2])
         sim.advance(3000)
         positions = sim.joint_positions()
@@ -248,34 +266,23 @@ def test_position_group_brings_its_joints_to_the_command(tmp_path, type_name):
 
 @pytest.mark.parametrize('type_name', [GROUP_TYPES['velocity'], FORWARD])
 def test_velocity_group_spins_its_joints_at_the_command(tmp_path, type_name):
-    extra = {'interface_name': 'velocity'} if type_name == FORWARD else {}
     commands, seconds = [0.5, -0.1], 0.5
-    with star_simulation(tmp_path, type_name, **extra) as sim:
-        sim.controller('group').set_command(commands)
-        sim.advance(round(seconds / DT))
-        velocities = sim.joint_velocities()
+    velocities = star_velocities_after(tmp_path, type_name, 'velocity', commands, seconds)
     # inertia * v' = p * (command - v) - b * v: a first-order lag toward p * command / (p + b).
     gain, damping = DEFAULT_VELOCITY_GAINS.p, STAR_JOINTS[0].damping
-    for joint, command, inertia in zip(('pan', 'slide'), commands, (PAN_INERTIA, LINK_MASS),
-                                       strict=True):
-        expected = gain * command / (gain + damping) * (
-            1.0 - math.exp(-(gain + damping) * seconds / inertia))
+    for (joint, inertia), command in zip(STAR_INERTIAS.items(), commands, strict=True):
+        expected = first_order_speed(gain * command, gain + damping, inertia, seconds)
         assert velocities[joint] == pytest.approx(expected, rel=0.03)
 
 
 @pytest.mark.parametrize('type_name', [GROUP_TYPES['effort'], FORWARD])
 def test_effort_group_drives_its_joints_with_the_efforts(tmp_path, type_name):
-    extra = {'interface_name': 'effort'} if type_name == FORWARD else {}
     efforts, seconds = [0.5, -0.2], 0.5
-    with star_simulation(tmp_path, type_name, **extra) as sim:
-        sim.controller('group').set_command(efforts)
-        sim.advance(round(seconds / DT))
-        velocities = sim.joint_velocities()
+    velocities = star_velocities_after(tmp_path, type_name, 'effort', efforts, seconds)
     # Against viscous damping b: v(t) = (F / b) * (1 - exp(-b t / inertia)).
     damping = STAR_JOINTS[0].damping
-    for joint, effort, inertia in zip(('pan', 'slide'), efforts, (PAN_INERTIA, LINK_MASS),
-                                      strict=True):
-        expected = effort / damping * (1.0 - math.exp(-damping * seconds / inertia))
+    for (joint, inertia), effort in zip(STAR_INERTIAS.items(), efforts, strict=True):
+        expected = first_order_speed(effort, damping, inertia, seconds)
         assert velocities[joint] == pytest.approx(expected, rel=0.03)
 
 
