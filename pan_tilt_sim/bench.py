@@ -1,0 +1,599 @@
+"""bench: how fast sim_node runs, printed as one JSON object.
+
+``ros2 run pan_tilt_sim bench`` (or ``python -m pan_tilt_sim.bench``) runs the
+seed's pan/tilt model and prints, measured in one run so that ratios hold on
+a noisy machine:
+
+* ``raw_steps_per_s``: bare ``stepSimulation()`` on the same model and time
+  step, in this process, on its own PyBullet client -- the physical limit;
+* ``node_steps_per_s`` and ``x_real_time``: sim_node at real_time_factor 0,
+  both position controllers moving, JointState and /clock published,
+  measured from outside the node's process: a probe takes the latest
+  JointState every ``SAMPLE_PERIOD_S`` and divides sim time by wall time;
+* ``ratio_to_raw`` = node_steps_per_s / raw_steps_per_s;
+* at real_time_factor 1: ``rtf_error`` (|sim/wall - 1|, the slope of the
+  JointState stamps against their arrival times), JointState inter-arrival
+  ``joint_states_p50_ms`` / ``joint_states_p99_ms`` (wall ms) and
+  ``cpu_percent``, the node process's CPU time per wall time (% of one core);
+* ``startup_s``: process start to the first JointState at the probe, median
+  of ``STARTUP_RUNS``;
+* ``scaling``: node_steps_per_s at real_time_factor 0 for generated serial
+  chains of 2, 8 and 32 revolute joints, each with a position controller
+  (keys are the joint counts).
+
+Rates are medians over windows of ``RATE_WINDOW_S``.  ``--runs N`` repeats
+everything and prints the median of each figure; ``--quick`` is a smoke run
+of a few seconds (every key present, no timing meaningful).
+
+Every sim_node runs as a child process with ``ROS_AUTOMATIC_DISCOVERY_RANGE=
+LOCALHOST`` and the bench's ROS domain: ``--domain-id``, else the
+environment's ``ROS_DOMAIN_ID``, else one derived from the bench's process id.
+The children's output goes to log files, so stdout carries only the JSON.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import dataclasses
+import json
+import math
+import os
+import pathlib
+import signal
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Iterator, Sequence
+
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.qos import QoSProfile
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64
+
+from pan_tilt_sim import naming
+from pan_tilt_sim.controller_config import load_controllers_config
+from pan_tilt_sim.controllers import create_controller
+from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
+from pan_tilt_sim.description import load_description
+from pan_tilt_sim.errors import ConfigurationError
+from pan_tilt_sim.parameters import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.physics import Physics, pybullet
+
+DEFAULT_TIME_STEP = 0.001  # s, the issue's reference step
+CHAIN_JOINTS = (2, 8, 32)
+STARTUP_RUNS = 5
+EXIT_FAILURE = 1
+EXIT_USAGE = 2
+NANOSECONDS_PER_SECOND = 1e9
+MILLISECONDS_PER_SECOND = 1e3
+PERCENT = 100.0
+P99 = 98  # index of the 99th percentile among statistics.quantiles(n=100)
+
+SAMPLE_PERIOD_S = 0.05  # at factor 0 the probe takes the latest JointState this often
+RATE_WINDOW_S = 0.5  # rates are medians over windows this long
+COMMAND_PERIOD_S = 0.25  # wall seconds between alternating position commands
+COMMAND_SPAN = 0.25  # targets sit this fraction of the range inside each limit
+UNLIMITED_TARGET = 1.0  # rad, +- target of a joint without position limits
+FIRST_MESSAGE_TIMEOUT_S = 30.0
+STOP_TIMEOUT_S = 10.0
+SPIN_TIMEOUT_S = 0.01
+RAW_CALIBRATION_STEPS = 1000
+LOG_TAIL_CHARS = 2000
+# A domain derived from the process id, when neither option nor environment gives one:
+# 150..229 keeps DDS ports valid and away from the low ids people use by hand.
+PID_DOMAIN_BASE = 150
+PID_DOMAIN_COUNT = 80
+
+
+@dataclasses.dataclass(frozen=True)
+class Plan:
+    """How long each part of a run lasts (wall seconds) and how often it repeats."""
+
+    raw_s: float
+    warmup_s: float
+    fast_s: float
+    paced_s: float
+    startup_runs: int
+    chain_s: float
+
+
+FULL_PLAN = Plan(raw_s=3.0, warmup_s=1.0, fast_s=5.0, paced_s=10.0,
+                 startup_runs=STARTUP_RUNS, chain_s=3.0)
+QUICK_PLAN = Plan(raw_s=0.3, warmup_s=0.2, fast_s=0.6, paced_s=0.6, startup_runs=1,
+                  chain_s=0.4)
+
+
+class BenchError(RuntimeError):
+    """The benchmark could not run (sim_node died, no JointState arrived...)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Model:
+    """The files of one robot, and the topics the bench talks to."""
+
+    description_file: pathlib.Path
+    controllers_file: pathlib.Path
+    joint_states_topic: str
+    # Command topic -> the two position targets it alternates between.
+    commands: dict[str, tuple[float, float]]
+
+
+def load_model(description_file: pathlib.Path, controllers_file: pathlib.Path) -> Model:
+    """Find the JointState and position command topics of a description + controllers pair."""
+    description = load_description(description_file)
+    config = load_controllers_config(controllers_file)
+    namespace = naming.resolve_robot_namespace(
+        naming.ROOT, '', config.namespace, description.plugin_namespace)
+    commands = {}
+    for spec in config.controllers:
+        controller = create_controller(spec.name, spec.type, spec.params, str(config.source))
+        if isinstance(controller, JointPositionController):
+            joint = description.joint(controller.joint_names[0])
+            topic = naming.join(namespace, controller.name, controller.command_topic)
+            commands[topic] = position_targets(joint.lower, joint.upper,
+                                               joint.has_position_limits)
+    return Model(description_file, controllers_file,
+                 naming.join(namespace, 'joint_states'), commands)
+
+
+def position_targets(lower: float, upper: float, limited: bool) -> tuple[float, float]:
+    """Return two targets well inside [lower, upper], so that the joint keeps moving."""
+    if not limited or not (math.isfinite(lower) and math.isfinite(upper)):
+        return (-UNLIMITED_TARGET, UNLIMITED_TARGET)
+    margin = COMMAND_SPAN * (upper - lower)
+    return (lower + margin, upper - margin)
+
+
+def chain_files(joints: int, folder: pathlib.Path) -> tuple[pathlib.Path, pathlib.Path]:
+    """Write a serial chain of ``joints`` revolute joints and its controllers into ``folder``.
+
+    Links are 5 cm cylinders of 1 kg (inertia 0.1 kg m^2, as stiff to simulate as
+    the seed's links); axes alternate between z and y; every joint has a
+    position controller, and a JointState controller publishes at 50 Hz.
+    """
+    links = ['<link name="link_0">' + _CHAIN_LINK_BODY + '</link>']
+    for index in range(1, joints + 1):
+        axis = '0 0 1' if index % 2 else '0 1 0'
+        links.append(
+            f'<joint name="joint_{index}" type="revolute">'
+            f'<parent link="link_{index - 1}"/><child link="link_{index}"/>'
+            f'<origin xyz="0 0 0.05"/><axis xyz="{axis}"/>'
+            '<limit effort="100" velocity="1.0" lower="-3.14" upper="3.14"/>'
+            '<dynamics damping="1.0" friction="0.0"/></joint>'
+            f'<link name="link_{index}">{_CHAIN_LINK_BODY}</link>')
+    urdf = folder / f'chain_{joints}.urdf'
+    urdf.write_text(f'<?xml version="1.0"?><robot name="chain_{joints}">'
+                    + ''.join(links) + '</robot>\n', encoding='utf-8')
+    lines = [f'chain_{joints}:',
+             '  joint_state_controller:',
+             '    type: joint_state_controller/JointStateController',
+             '    publish_rate: 50']
+    for index in range(1, joints + 1):
+        lines += [f'  joint_{index}_position_controller:',
+                  '    type: position_controllers/JointPositionController',
+                  f'    joint: joint_{index}',
+                  '    pid: {p: 100.0, i: 0.01, d: 10.0}']
+    controllers = folder / f'chain_{joints}.yaml'
+    controllers.write_text('\n'.join(lines) + '\n', encoding='utf-8')
+    return urdf, controllers
+
+
+_CHAIN_LINK_BODY = (
+    '<visual><geometry><cylinder length="0.05" radius="0.01"/></geometry></visual>'
+    '<collision><geometry><cylinder length="0.05" radius="0.01"/></geometry></collision>'
+    '<inertial><mass value="1.0"/>'
+    '<inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>')
+
+
+def windowed_rate(samples: Sequence[tuple[float, float]], window: float) -> float:
+    """Median over consecutive windows of at least ``window`` x of (x, y) of dy/dx."""
+    rates = []
+    start = 0
+    for end in range(1, len(samples)):
+        dx = samples[end][0] - samples[start][0]
+        if dx >= window:
+            rates.append((samples[end][1] - samples[start][1]) / dx)
+            start = end
+    if not rates and len(samples) >= 2 and samples[-1][0] > samples[0][0]:
+        rates.append((samples[-1][1] - samples[0][1]) / (samples[-1][0] - samples[0][0]))
+    if not rates:
+        raise BenchError('too few samples to measure a rate')
+    return statistics.median(rates)
+
+
+def slope(samples: Sequence[tuple[float, float]]) -> float:
+    """Least-squares slope of y against x."""
+    if len(samples) < 2:
+        raise BenchError('too few samples to fit a slope')
+    mean_x = statistics.fmean(x for x, _ in samples)
+    mean_y = statistics.fmean(y for _, y in samples)
+    num = sum((x - mean_x) * (y - mean_y) for x, y in samples)
+    den = sum((x - mean_x) ** 2 for x, _ in samples)
+    if den <= 0.0:
+        raise BenchError('samples span no time')
+    return num / den
+
+
+def raw_steps_per_s(description_file: pathlib.Path, time_step: float, duration: float) -> float:
+    """Time bare ``stepSimulation()`` on the model; median over windows of RATE_WINDOW_S."""
+    with Physics(load_description(description_file), time_step) as physics:
+        step = pybullet.stepSimulation
+        client = physics.client_id
+        started = time.perf_counter()
+        for _ in range(RAW_CALIBRATION_STEPS):
+            step(physicsClientId=client)
+        per_window = max(1, round(
+            RAW_CALIBRATION_STEPS * RATE_WINDOW_S / (time.perf_counter() - started)))
+        rates = []
+        deadline = time.perf_counter() + duration
+        while not rates or time.perf_counter() < deadline:
+            started = time.perf_counter()
+            for _ in range(per_window):
+                step(physicsClientId=client)
+            rates.append(per_window / (time.perf_counter() - started))
+    return statistics.median(rates)
+
+
+def cpu_seconds(pid: int) -> float:
+    """CPU time (user + system, all threads) a process has used so far."""
+    try:
+        import psutil
+    except ImportError:
+        fields = pathlib.Path(f'/proc/{pid}/stat').read_text().rpartition(')')[2].split()
+        # utime and stime are fields 14 and 15 of proc(5); the split starts at field 3.
+        return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+    times = psutil.Process(pid).cpu_times()
+    return times.user + times.system
+
+
+class NodeProcess:
+    """sim_node in a child process; its output goes to a log file, never to our stdout."""
+
+    def __init__(self, model: Model, parameters: dict[str, str], env: dict[str, str],
+                 log_file: pathlib.Path) -> None:
+        arguments = {'robot_description_file': str(model.description_file),
+                     'controllers_file': str(model.controllers_file), **parameters}
+        command = [sys.executable, '-m', 'pan_tilt_sim.sim_node', '--ros-args']
+        for name, value in arguments.items():
+            command += ['-p', f'{name}:={value}']
+        self._log_file = log_file
+        with open(log_file, 'wb') as log:
+            self.started = time.monotonic()
+            self.process = subprocess.Popen(
+                command, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
+                env=env)
+
+    def check_alive(self) -> None:
+        """Raise BenchError, with the end of its log, if the node has exited."""
+        code = self.process.poll()
+        if code is not None:
+            log = self._log_file.read_text(errors='replace')[-LOG_TAIL_CHARS:]
+            raise BenchError(f'sim_node exited with code {code}:\n{log}')
+
+    def cpu_seconds(self) -> float:
+        """CPU seconds the node has used so far."""
+        return cpu_seconds(self.process.pid)
+
+    def stop(self) -> None:
+        """Ctrl-C the node and wait for it; kill it if it does not stop."""
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGINT)
+            try:
+                self.process.wait(STOP_TIMEOUT_S)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait()
+
+
+class Probe:
+    """The bench's own ROS node: listens to JointState and sends position commands."""
+
+    def __init__(self, domain_id: int) -> None:
+        self._context = Context()
+        rclpy.init(args=[], context=self._context, domain_id=domain_id)
+        self.node = rclpy.create_node('sim_bench_probe', context=self._context)
+        self.executor = SingleThreadedExecutor(context=self._context)
+        self.executor.add_node(self.node)
+        self._publishers: dict[str, object] = {}
+
+    def close(self) -> None:
+        """Destroy the node and shut the context down."""
+        self.executor.shutdown()
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self._context)
+
+    @contextlib.contextmanager
+    def joint_states(self, topic: str, depth: int,
+                     on_message: Callable[[float, float], None]) -> Iterator[None]:
+        """Call ``on_message(arrival monotonic s, stamp s)`` for JointStates while open."""
+        def callback(message: JointState) -> None:
+            stamp = message.header.stamp
+            on_message(time.monotonic(), stamp.sec + stamp.nanosec / NANOSECONDS_PER_SECOND)
+
+        subscription = self.node.create_subscription(
+            JointState, topic, callback, QoSProfile(depth=depth))
+        try:
+            yield
+        finally:
+            self.node.destroy_subscription(subscription)
+
+    def spin_once(self, timeout: float) -> None:
+        """Run at most one callback, waiting up to ``timeout`` s for one."""
+        self.executor.spin_once(timeout_sec=timeout)
+
+    def command(self, topic: str, value: float) -> None:
+        """Publish a position command."""
+        publisher = self._publishers.get(topic)
+        if publisher is None:
+            publisher = self.node.create_publisher(Float64, topic, QoSProfile(depth=1))
+            self._publishers[topic] = publisher
+        publisher.publish(Float64(data=value))
+
+
+class Bench:
+    """One run of every measurement, sharing a probe, a ROS domain and a log folder."""
+
+    def __init__(self, probe: Probe, env: dict[str, str], folder: pathlib.Path,
+                 time_step: float, plan: Plan, log: Callable[[str], None]) -> None:
+        self.probe = probe
+        self.env = env
+        self.folder = folder
+        self.time_step = time_step
+        self.plan = plan
+        self.log = log
+        self._node_count = 0
+
+    @contextlib.contextmanager
+    def node(self, model: Model, real_time_factor: float | None) -> Iterator[NodeProcess]:
+        """Run sim_node on ``model`` for the duration of the block."""
+        parameters = {'time_step': repr(float(self.time_step))}
+        if real_time_factor is not None:
+            parameters['real_time_factor'] = repr(float(real_time_factor))
+        self._node_count += 1
+        process = NodeProcess(model, parameters, self.env,
+                              self.folder / f'sim_node_{self._node_count}.log')
+        try:
+            yield process
+        finally:
+            process.stop()
+
+    def spin_until(self, node: NodeProcess, done: Callable[[], bool], timeout: float,
+                   what: str) -> None:
+        """Spin the probe until ``done()``; BenchError if the node dies or time runs out."""
+        deadline = time.monotonic() + timeout
+        while not done():
+            node.check_alive()
+            if time.monotonic() > deadline:
+                raise BenchError(f'no {what} within {timeout} s')
+            self.probe.spin_once(SPIN_TIMEOUT_S)
+
+    def fast_steps_per_s(self, model: Model, duration: float) -> float:
+        """Measure sim_node's steps per wall second at factor 0, seen from this process."""
+        samples: list[tuple[float, float]] = []
+        with self.node(model, 0.0) as node, self.probe.joint_states(
+                model.joint_states_topic, 1, lambda wall, sim: samples.append((wall, sim))):
+            self.spin_until(node, lambda: bool(samples), FIRST_MESSAGE_TIMEOUT_S,
+                            f'JointState on {model.joint_states_topic}')
+            commander = Commander(self.probe, model)
+            for phase, seconds in (('warm-up', self.plan.warmup_s), ('measure', duration)):
+                samples.clear()
+                deadline = time.monotonic() + seconds
+                while time.monotonic() < deadline:
+                    node.check_alive()
+                    commander.send_when_due()
+                    # Sleep, then take the newest sample (depth 1): the probe stays idle.
+                    time.sleep(SAMPLE_PERIOD_S)
+                    self.probe.spin_once(SPIN_TIMEOUT_S)
+                if phase == 'measure' and len(samples) < 2:
+                    raise BenchError('too few JointState samples at real_time_factor 0')
+        return windowed_rate(samples, RATE_WINDOW_S) / self.time_step
+
+    def paced(self, model: Model) -> dict[str, float]:
+        """Measure rtf error, JointState inter-arrival and CPU share at real_time_factor 1."""
+        samples: list[tuple[float, float]] = []
+        with self.node(model, 1.0) as node, self.probe.joint_states(
+                model.joint_states_topic, 10, lambda wall, sim: samples.append((wall, sim))):
+            self.spin_until(node, lambda: bool(samples), FIRST_MESSAGE_TIMEOUT_S,
+                            f'JointState on {model.joint_states_topic}')
+            commander = Commander(self.probe, model)
+            for seconds in (self.plan.warmup_s, self.plan.paced_s):
+                samples.clear()
+                cpu_start, wall_start = node.cpu_seconds(), time.monotonic()
+                while time.monotonic() < wall_start + seconds:
+                    node.check_alive()
+                    commander.send_when_due()
+                    self.probe.spin_once(SPIN_TIMEOUT_S)
+                cpu = (node.cpu_seconds() - cpu_start) / (time.monotonic() - wall_start)
+        if len(samples) < 3:
+            raise BenchError('too few JointState messages at real_time_factor 1')
+        gaps = [later[0] - earlier[0] for earlier, later in zip(samples, samples[1:], strict=False)]
+        return {
+            'rtf_error': abs(slope(samples) - 1.0),
+            'joint_states_p50_ms': statistics.median(gaps) * MILLISECONDS_PER_SECOND,
+            'joint_states_p99_ms': percentile_99(gaps) * MILLISECONDS_PER_SECOND,
+            'cpu_percent': cpu * PERCENT,
+        }
+
+    def startup_s(self, model: Model) -> float:
+        """Median wall time from starting sim_node's process to its first JointState here."""
+        times = []
+        for _ in range(self.plan.startup_runs):
+            times.append(self._first_joint_state_after_start(model))
+        return statistics.median(times)
+
+    def _first_joint_state_after_start(self, model: Model) -> float:
+        first: list[float] = []
+        with self.probe.joint_states(model.joint_states_topic, 1,
+                                     lambda wall, sim: first.append(wall)):
+            with self.node(model, None) as node:
+                self.spin_until(node, lambda: bool(first), FIRST_MESSAGE_TIMEOUT_S,
+                                f'JointState on {model.joint_states_topic}')
+                return first[0] - node.started
+
+
+class Commander:
+    """Alternates every position controller between its two targets."""
+
+    def __init__(self, probe: Probe, model: Model) -> None:
+        self._probe = probe
+        self._commands = model.commands
+        self._next = time.monotonic()
+        self._which = 0
+
+    def send_when_due(self) -> None:
+        """Send the next targets if COMMAND_PERIOD_S has passed since the last ones."""
+        now = time.monotonic()
+        if now < self._next:
+            return
+        for topic, targets in self._commands.items():
+            self._probe.command(topic, targets[self._which])
+        self._which = 1 - self._which
+        self._next = now + COMMAND_PERIOD_S
+
+
+def percentile_99(values: Sequence[float]) -> float:
+    """Return the 99th percentile of ``values`` (inclusive method)."""
+    if len(values) < 2:
+        return values[0]
+    return statistics.quantiles(values, n=100, method='inclusive')[P99]
+
+
+def run_once(bench: Bench, model: Model) -> dict:
+    """Measure every figure once; return them as the JSON object's fields."""
+    plan = bench.plan
+    bench.log('raw stepSimulation')
+    raw = raw_steps_per_s(model.description_file, bench.time_step, plan.raw_s)
+    bench.log('sim_node at real_time_factor 0')
+    node = bench.fast_steps_per_s(model, plan.fast_s)
+    bench.log('sim_node at real_time_factor 1')
+    paced = bench.paced(model)
+    bench.log('start-up')
+    startup = bench.startup_s(model)
+    scaling = {}
+    for joints in CHAIN_JOINTS:
+        bench.log(f'chain of {joints} joints at real_time_factor 0')
+        urdf, controllers = chain_files(joints, bench.folder)
+        scaling[str(joints)] = bench.fast_steps_per_s(load_model(urdf, controllers),
+                                                      plan.chain_s)
+    return {
+        'raw_steps_per_s': raw,
+        'node_steps_per_s': node,
+        'x_real_time': node * bench.time_step,
+        'ratio_to_raw': node / raw,
+        **paced,
+        'startup_s': startup,
+        'scaling': scaling,
+    }
+
+
+def median_of(results: Sequence[dict]) -> dict:
+    """Return the median of every figure over several runs (nested dicts key by key)."""
+    merged = {}
+    for key, value in results[0].items():
+        if isinstance(value, dict):
+            merged[key] = median_of([result[key] for result in results])
+        else:
+            merged[key] = statistics.median(result[key] for result in results)
+    return merged
+
+
+def rounded(figures: dict) -> dict:
+    """Round figures for printing: 4 significant digits, steps/s as integers."""
+    out = {}
+    for key, value in figures.items():
+        if isinstance(value, dict):
+            out[key] = {k: round(v) for k, v in value.items()}
+        elif key.endswith('steps_per_s'):
+            out[key] = round(value)
+        else:
+            out[key] = float(f'{value:.4g}')
+    return out
+
+
+def default_domain_id() -> int:
+    """ROS_DOMAIN_ID from the environment, else one derived from this process's id."""
+    value = os.environ.get('ROS_DOMAIN_ID', '')
+    if value.isdigit():
+        return int(value)
+    return PID_DOMAIN_BASE + os.getpid() % PID_DOMAIN_COUNT
+
+
+def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
+    """Read the command line."""
+    parser = argparse.ArgumentParser(
+        prog='bench', description='Measure how fast sim_node runs; print one JSON object.')
+    parser.add_argument('--quick', action='store_true',
+                        help='a smoke run of a few seconds (all keys, timing meaningless)')
+    parser.add_argument('--runs', type=int, default=1,
+                        help='repeat everything N times and print the medians (default 1)')
+    parser.add_argument('--time-step', type=float, default=DEFAULT_TIME_STEP,
+                        help=f'physics step in s (default {DEFAULT_TIME_STEP})')
+    parser.add_argument('--domain-id', type=int, default=None,
+                        help='ROS domain of the nodes (default: $ROS_DOMAIN_ID, else from '
+                        'the process id)')
+    parser.add_argument('--description', type=pathlib.Path, default=None,
+                        help='robot description (default: the pan/tilt xacro)')
+    parser.add_argument('--controllers', type=pathlib.Path, default=None,
+                        help='controllers YAML (default: the pan/tilt controllers)')
+    parser.add_argument('--keep-logs', type=pathlib.Path, default=None,
+                        help="folder for the nodes' logs and generated chains (default: "
+                        'a temporary folder, removed afterwards)')
+    parser.add_argument('--verbose', action='store_true', help='say on stderr what runs')
+    args = parser.parse_args(argv)
+    if args.runs < 1:
+        parser.error('--runs must be at least 1')
+    if not 0.0 < args.time_step <= 0.1:
+        parser.error('--time-step must be > 0 and <= 0.1')
+    return args
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    """Run the benchmark and print its JSON object on stdout."""
+    args = parse_args(argv)
+    domain_id = args.domain_id if args.domain_id is not None else default_domain_id()
+    env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),
+               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    # The probe lives in this process: the same discovery range as the nodes.
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    share = package_share()
+
+    def log(text: str) -> None:
+        if args.verbose:
+            print(f'bench: {text}', file=sys.stderr, flush=True)
+
+    try:
+        model = load_model(args.description or share / DEFAULT_DESCRIPTION,
+                           args.controllers or share / DEFAULT_CONTROLLERS)
+    except ConfigurationError as err:
+        print(f'bench: error: {err}', file=sys.stderr)
+        sys.exit(EXIT_USAGE)
+    plan = QUICK_PLAN if args.quick else FULL_PLAN
+    probe = Probe(domain_id)
+    try:
+        with contextlib.ExitStack() as stack:
+            if args.keep_logs is not None:
+                args.keep_logs.mkdir(parents=True, exist_ok=True)
+                folder = args.keep_logs
+            else:
+                folder = pathlib.Path(stack.enter_context(
+                    tempfile.TemporaryDirectory(prefix='pan_tilt_bench_')))
+            bench = Bench(probe, env, folder, args.time_step, plan, log)
+            results = []
+            for run in range(args.runs):
+                log(f'run {run + 1} of {args.runs} (ROS domain {domain_id})')
+                results.append(run_once(bench, model))
+    except BenchError as err:
+        print(f'bench: error: {err}', file=sys.stderr)
+        sys.exit(EXIT_FAILURE)
+    finally:
+        probe.close()
+    print(json.dumps(rounded(median_of(results))), flush=True)
+
+
+if __name__ == '__main__':
+    main()

@@ -1,0 +1,133 @@
+"""The bench command: one JSON object with every figure; its helpers compute them right.
+
+No timing is asserted here: the figures come from running the command.
+"""
+
+import json
+import math
+import os
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+from pan_tilt_sim import bench
+from pan_tilt_sim.engine import make_simulation
+
+QUICK_TIMEOUT_S = 240
+REPO_ROOT = pathlib.Path(__file__).resolve().parents[1]
+FIGURES = {
+    'raw_steps_per_s': int,
+    'node_steps_per_s': int,
+    'x_real_time': float,
+    'ratio_to_raw': float,
+    'rtf_error': float,
+    'joint_states_p50_ms': float,
+    'joint_states_p99_ms': float,
+    'cpu_percent': float,
+    'startup_s': float,
+}
+
+
+@pytest.fixture(scope='module')
+def quick_run():
+    """Run ``python -m pan_tilt_sim.bench --quick`` once; return (stdout, stderr)."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [str(REPO_ROOT), *filter(None, [os.environ.get('PYTHONPATH')])]))
+    result = subprocess.run(
+        [sys.executable, '-m', 'pan_tilt_sim.bench', '--quick'], capture_output=True,
+        text=True, env=env, timeout=QUICK_TIMEOUT_S, check=False)
+    assert result.returncode == 0, result.stderr
+    return result.stdout, result.stderr
+
+
+@pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
+def test_quick_prints_exactly_one_json_object_with_every_figure(quick_run):
+    stdout, _ = quick_run
+    figures = json.loads(stdout)
+    assert set(figures) == {*FIGURES, 'scaling'}
+    for key, kind in FIGURES.items():
+        assert isinstance(figures[key], kind), (key, figures[key])
+        assert math.isfinite(figures[key]) and figures[key] >= 0, (key, figures[key])
+    assert figures['raw_steps_per_s'] > 0 and figures['node_steps_per_s'] > 0
+
+
+@pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
+def test_quick_reports_every_chain_length(quick_run):
+    scaling = json.loads(quick_run[0])['scaling']
+    assert set(scaling) == {str(joints) for joints in bench.CHAIN_JOINTS}
+    assert all(isinstance(rate, int) and rate > 0 for rate in scaling.values())
+
+
+@pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
+def test_quick_keeps_pybullet_and_node_output_off_stdout(quick_run):
+    stdout, _ = quick_run
+    assert stdout.count('\n') == 1 and stdout.lstrip().startswith('{')
+
+
+def test_rounded_gives_integer_rates_and_four_significant_digits():
+    figures = bench.rounded({'raw_steps_per_s': 123456.7, 'ratio_to_raw': 0.123456,
+                             'scaling': {'2': 9876.4}})
+    assert figures == {'raw_steps_per_s': 123457, 'ratio_to_raw': 0.1235,
+                       'scaling': {'2': 9876}}
+
+
+def test_windowed_rate_is_the_median_rate_over_windows():
+    # 10 units per second, with one window of 30 per second in the middle.
+    samples = [(0.0, 0.0), (0.5, 5.0), (1.0, 10.0), (1.5, 25.0), (2.0, 30.0), (2.5, 35.0)]
+    assert bench.windowed_rate(samples, 0.5) == pytest.approx(10.0)
+
+
+def test_windowed_rate_needs_two_samples():
+    with pytest.raises(bench.BenchError):
+        bench.windowed_rate([(0.0, 0.0)], 0.5)
+
+
+def test_slope_fits_a_line_through_jittered_samples():
+    samples = [(t * 0.02, t * 0.02 * 1.01 + (0.001 if t % 2 else -0.001)) for t in range(500)]
+    assert bench.slope(samples) == pytest.approx(1.01, abs=1e-4)
+
+
+def test_percentile_99_of_a_uniform_spread():
+    assert bench.percentile_99([float(v) for v in range(101)]) == pytest.approx(99.0)
+
+
+def test_median_of_runs_goes_into_nested_figures():
+    runs = [{'a': 1.0, 'scaling': {'2': 10.0}}, {'a': 3.0, 'scaling': {'2': 30.0}},
+            {'a': 2.0, 'scaling': {'2': 20.0}}]
+    assert bench.median_of(runs) == {'a': 2.0, 'scaling': {'2': 20.0}}
+
+
+def test_position_targets_sit_inside_the_limits():
+    low, high = bench.position_targets(-4.0, 0.0, limited=True)
+    assert -4.0 < low < high < 0.0
+    assert bench.position_targets(-math.inf, math.inf, limited=False) == (-1.0, 1.0)
+
+
+@pytest.mark.parametrize('joints', bench.CHAIN_JOINTS)
+def test_generated_chain_has_a_position_controller_per_joint(tmp_path, joints):
+    urdf, controllers = bench.chain_files(joints, tmp_path)
+    model = bench.load_model(urdf, controllers)
+    assert model.joint_states_topic == f'/chain_{joints}/joint_states'
+    assert len(model.commands) == joints
+    with make_simulation(str(urdf), str(controllers), 0.001) as simulation:
+        assert len(simulation.handles) == joints
+        simulation.advance(100)
+        # Held at zero by its controllers, the chain stays near straight.
+        assert max(abs(p) for p in simulation.joint_positions().values()) < 0.05
+
+
+def test_pan_tilt_model_commands_both_position_controllers(repo_root):
+    model = bench.load_model(repo_root / 'urdf' / 'pan_tilt.xacro',
+                             repo_root / 'config' / 'pan_tilt_control.yaml')
+    assert model.joint_states_topic == '/ex_urdf_pan_tilt/joint_states'
+    assert set(model.commands) == {
+        '/ex_urdf_pan_tilt/joint1_position_controller/command',
+        '/ex_urdf_pan_tilt/joint2_position_controller/command'}
+
+
+def test_fewer_than_one_run_is_a_usage_error():
+    with pytest.raises(SystemExit) as exit_info:
+        bench.parse_args(['--runs', '0'])
+    assert exit_info.value.code == 2
