@@ -70,6 +70,7 @@ class Simulation:
         self._time_step = time_step
         self._steps = 0
         self._states = self.physics.read_states()
+        self._physics_step = self.physics.stepper()
         for joint in self.physics.joints:
             if joint.initial_position != 0.0:
                 _LOG.info("joint '%s' starts at %g, its limit nearest to 0",
@@ -103,28 +104,27 @@ class Simulation:
 
     def advance(self, steps: int) -> None:
         """Run ``steps`` physics steps, updating every controller at each."""
+        # Everything the loop touches is a local: bound methods, the physics
+        # stepper, the handles.  Per step this costs ~1 us of Python for the
+        # pan/tilt against ~5 us inside PyBullet (see README, Performance).
         handles = self._handle_list
-        controllers = self.controllers
+        updates = [controller.update for controller in self.controllers]
         efforts = self._efforts
-        physics_step = self.physics.step
+        physics_step = self._physics_step
         dt = self._time_step
-        count = self._steps
         states = self._states
-        indices = range(len(handles))
-        for _ in range(steps):
-            for index in indices:
-                state = states[index]
-                handle = handles[index]
+        first = self._steps
+        for count in range(first, first + steps):
+            for handle, state in zip(handles, states, strict=True):
                 handle.position = state[STATE_POSITION]
                 handle.velocity = state[STATE_VELOCITY]
             time = count * dt
-            for controller in controllers:
-                controller.update(time, dt)
-            for index in indices:
-                efforts[index] = handles[index].effort
+            for update in updates:
+                update(time, dt)
+            for index, handle in enumerate(handles):
+                efforts[index] = handle.effort
             states = physics_step(efforts)
-            count += 1
-        self._steps = count
+        self._steps = first + steps
         self._states = states
 
     def reset(self, *, reset_time: bool = True) -> None:

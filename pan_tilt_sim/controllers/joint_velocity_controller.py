@@ -14,7 +14,7 @@ from typing import Any
 
 from pan_tilt_sim.controllers.base import CommandController, CommandResult, JointHandle
 from pan_tilt_sim.controllers.gains import gains_from_params
-from pan_tilt_sim.controllers.limits import check_velocity, clamp_effort
+from pan_tilt_sim.controllers.limits import check_velocity
 from pan_tilt_sim.controllers.pid import Pid, PidGains
 
 # Proportional-only by default: effort = 10 N*m per rad/s of error, a
@@ -66,6 +66,8 @@ class JointVelocityController(CommandController):
 
     def update(self, time: float, period: float) -> None:
         """Compute and clamp the effort for the present velocity error."""
+        # clamp_effort written out: this runs every physics step.
         handle = self._handle
         effort = self._pid.compute(self._command, handle.velocity, period)
-        handle.effort = clamp_effort(effort, self._effort_limit)
+        limit = self._effort_limit
+        handle.effort = limit if effort > limit else -limit if effort < -limit else effort
