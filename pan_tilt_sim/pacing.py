@@ -5,7 +5,12 @@ slower and runs, at each tick, as many steps as wall time asks for: at
 ``real_time_factor`` r, after w wall seconds the simulation should have
 run ``r * w / time_step`` steps.  When the machine cannot keep up, the debt
 is dropped rather than paid in a burst -- the simulation then runs slower
-than asked, as Gazebo does.  At factor 0 every tick runs a fixed batch.
+than asked, as Gazebo does.
+
+At factor 0 each tick runs as many steps as fill ``FAST_TICK_S`` of wall
+time, judged from the pace of the ticks before: the executor's fixed cost
+per tick (~0.1 ms) then stays a few percent whatever the robot costs per
+step, and commands and parameter changes are still taken within a few ms.
 """
 
 from __future__ import annotations
@@ -14,9 +19,13 @@ import math
 import time
 from collections.abc import Callable
 
-# Steps per tick at real_time_factor 0: large enough that the executor's
-# per-tick cost is small, small enough that commands are picked up often.
+# Wall seconds of stepping per tick at real_time_factor 0.
+FAST_TICK_S = 0.005
+# The first batch at real_time_factor 0, before the pace is known.
 FAST_BATCH_STEPS = 100
+# A batch at most doubles from one tick to the next, so one fast tick
+# (the clock jumping, a quiet moment) cannot make the next one long.
+MAX_BATCH_GROWTH = 2
 # Debt beyond this much wall time is dropped instead of caught up.
 MAX_CATCH_UP_S = 0.1
 # Wall clocks are floats: a step due "exactly now" must not round down.
@@ -51,12 +60,13 @@ class Pacer:
         """Forget the past: the next call starts a fresh wall-time reference."""
         self._start: float | None = None
         self._done = 0
+        self._batch = 0
 
     def steps_due(self) -> int:
         """Return the steps to run now; the caller runs exactly that many."""
-        if self.fast:
-            return FAST_BATCH_STEPS
         now = self._clock()
+        if self.fast:
+            return self._fast_batch(now)
         if self._start is None:
             self._start = now
         target = math.floor((now - self._start) * self._factor / self._time_step + STEP_EPSILON)
@@ -68,3 +78,17 @@ class Pacer:
             due = max_due
         self._done += max(due, 0)
         return max(due, 0)
+
+    def _fast_batch(self, now: float) -> int:
+        # Steps per wall second over the last tick (its batch and the executor's
+        # time since), scaled to fill FAST_TICK_S.
+        if self._start is None or self._batch == 0:
+            batch = FAST_BATCH_STEPS
+        else:
+            elapsed = now - self._start
+            batch = self._batch * MAX_BATCH_GROWTH
+            if elapsed > 0.0:
+                batch = max(1, min(batch, round(self._batch * FAST_TICK_S / elapsed)))
+        self._start = now
+        self._batch = batch
+        return batch

@@ -1,6 +1,6 @@
 """Pacing: steps per tick follow wall time times the real-time factor."""
 
-from pan_tilt_sim.pacing import FAST_BATCH_STEPS, MAX_CATCH_UP_S, Pacer
+from pan_tilt_sim.pacing import FAST_BATCH_STEPS, FAST_TICK_S, MAX_CATCH_UP_S, Pacer
 
 
 class FakeClock:
@@ -19,8 +19,40 @@ def _started(factor):
     return pacer, clock
 
 
-def test_factor_zero_runs_fixed_batches():
+def test_factor_zero_starts_with_a_fixed_batch():
     assert Pacer(0.0, 0.001).steps_due() == FAST_BATCH_STEPS
+
+
+def test_factor_zero_batches_grow_to_fill_a_tick_of_wall_time():
+    clock = FakeClock()
+    pacer = Pacer(0.0, 0.001, clock)
+    batches = [pacer.steps_due()]
+    for _ in range(6):
+        clock.now += batches[-1] / 100_000  # this machine runs 100k steps/s
+        batches.append(pacer.steps_due())
+    # Doubling at most per tick, up to what fits in FAST_TICK_S.
+    fitting = round(100_000 * FAST_TICK_S)
+    assert batches == [FAST_BATCH_STEPS, 2 * FAST_BATCH_STEPS, 4 * FAST_BATCH_STEPS,
+                       fitting, fitting, fitting, fitting]
+
+
+def test_factor_zero_batches_shrink_for_an_expensive_robot():
+    pacer, clock = _started(0.0)
+    clock.now += FAST_BATCH_STEPS / 1000  # 1000 steps/s
+    assert pacer.steps_due() == round(1000 * FAST_TICK_S)
+
+
+def test_factor_zero_runs_at_least_one_step_per_tick():
+    pacer, clock = _started(0.0)
+    clock.now += 60.0  # a long stall
+    assert pacer.steps_due() == 1
+
+
+def test_restart_at_factor_zero_starts_again_from_the_fixed_batch():
+    pacer, clock = _started(0.0)
+    clock.now += 10.0
+    pacer.restart()
+    assert pacer.steps_due() == FAST_BATCH_STEPS
 
 
 def test_real_time_runs_one_step_per_time_step_of_wall_time():
