@@ -11,7 +11,7 @@
   shell starts background jobs with SIGINT ignored (Python then leaves it
   ignored), and ``ros2 run`` does not forward signals -- Ctrl-C reaches the
   node through the terminal's process group.  rclpy chains its own handlers
-  (which shut the context down and so end ``rclpy.spin``) to these.  A signal
+  (which shut the context down and so end the spin) to these.  A signal
   while the node is being built aborts the build; while spinning it ends the
   spin; while the node is being destroyed it is only noted.
 * Importing rclpy and PyBullet takes about half a second, so this module
@@ -193,12 +193,14 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
                 node = make_node()
             import rclpy
 
+            from pan_tilt_sim import spinning
+
             if stop.received is None and rclpy.ok():
                 # Made while the context is alive: an executor whose construction
                 # a signal cuts short complains from __del__ with a traceback.
-                executor = rclpy.get_global_executor()
+                executor = spinning.make_executor()
                 node.get_logger().debug('started; spinning until SIGINT or SIGTERM')
-                rclpy.spin(node, executor)
+                spinning.spin(node, executor)
         except ConfigurationError as err:
             failure = err
         except KeyboardInterrupt:

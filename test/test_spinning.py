@@ -1,0 +1,63 @@
+"""The executor sim_node spins on, and spinning until shutdown."""
+
+import time
+
+import pytest
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+
+from pan_tilt_sim import spinning
+
+SPIN_BUDGET_S = 10.0
+
+
+@pytest.fixture
+def context():
+    context = Context()
+    rclpy.init(context=context)
+    yield context
+    rclpy.try_shutdown(context=context)
+
+
+def test_the_events_executor_is_the_default_where_rclpy_has_one(context, monkeypatch):
+    pytest.importorskip('rclpy.experimental')
+    monkeypatch.delenv(spinning.EXECUTOR_VARIABLE, raising=False)
+    executor = spinning.make_executor(context)
+    try:
+        assert not isinstance(executor, SingleThreadedExecutor)
+        assert type(executor).__name__ == 'EventsExecutor'
+    finally:
+        executor.shutdown()
+
+
+def test_the_environment_can_ask_for_the_single_threaded_executor(context, monkeypatch):
+    monkeypatch.setenv(spinning.EXECUTOR_VARIABLE, spinning.SINGLE_THREADED)
+    executor = spinning.make_executor(context)
+    try:
+        assert isinstance(executor, SingleThreadedExecutor)
+    finally:
+        executor.shutdown()
+
+
+@pytest.mark.parametrize('kind', [spinning.EVENTS, spinning.SINGLE_THREADED])
+def test_spin_runs_timers_and_returns_once_the_context_shuts_down(context, monkeypatch, kind):
+    monkeypatch.setenv(spinning.EXECUTOR_VARIABLE, kind)
+    node = rclpy.create_node('spinning_test', context=context)
+    ticks = []
+
+    def tick():
+        ticks.append(time.monotonic())
+        if len(ticks) == 5:
+            rclpy.try_shutdown(context=context)
+
+    node.create_timer(0.01, tick)
+    executor = spinning.make_executor(context)
+    started = time.monotonic()
+    try:
+        spinning.spin(node, executor)
+    finally:
+        node.destroy_node()
+        executor.shutdown()
+    assert len(ticks) == 5
+    assert time.monotonic() - started < SPIN_BUDGET_S
