@@ -115,7 +115,8 @@ class Simulation:
         states = self._states
         first = self._steps
         for count in range(first, first + steps):
-            for handle, state in zip(handles, states, strict=True):
+            # Equal lengths by construction; strict=True would cost ~0.2 us per step.
+            for handle, state in zip(handles, states, strict=False):
                 handle.position = state[STATE_POSITION]
                 handle.velocity = state[STATE_VELOCITY]
             time = count * dt
