@@ -226,7 +226,7 @@ def raw_steps_per_s(description_file: pathlib.Path, time_step: float, duration: 
         client = physics.client_id
         started = time.perf_counter()
         for _ in range(RAW_CALIBRATION_STEPS):
-            step(physicsClientId=client)
+            step(client)
         per_window = max(1, round(
             RAW_CALIBRATION_STEPS * RATE_WINDOW_S / (time.perf_counter() - started)))
         rates = []
@@ -234,7 +234,7 @@ def raw_steps_per_s(description_file: pathlib.Path, time_step: float, duration: 
         while not rates or time.perf_counter() < deadline:
             started = time.perf_counter()
             for _ in range(per_window):
-                step(physicsClientId=client)
+                step(client)
             rates.append(per_window / (time.perf_counter() - started))
     return statistics.median(rates)
 
@@ -543,7 +543,8 @@ def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     parser.add_argument('--keep-logs', type=pathlib.Path, default=None,
                         help="folder for the nodes' logs and generated chains (default: "
                         'a temporary folder, removed afterwards)')
-    parser.add_argument('--verbose', action='store_true', help='say on stderr what runs')
+    parser.add_argument('--verbose', action='store_true',
+                        help="say on stderr what runs, and each run's figures")
     args = parser.parse_args(argv)
     if args.runs < 1:
         parser.error('--runs must be at least 1')
@@ -587,6 +588,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             for run in range(args.runs):
                 log(f'run {run + 1} of {args.runs} (ROS domain {domain_id})')
                 results.append(run_once(bench, model))
+                log(f'run {run + 1}: {json.dumps(rounded(results[-1]))}')
     except BenchError as err:
         print(f'bench: error: {err}', file=sys.stderr)
         sys.exit(EXIT_FAILURE)
