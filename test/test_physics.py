@@ -44,3 +44,20 @@ def test_friction_holds_a_joint_against_a_torque_below_it(description):
         for _ in range(500):
             states = physics.step([0.9, 0.0])
         assert states[0][1] == pytest.approx(0.0, abs=1e-6)
+
+
+def test_the_stepper_applies_the_torques_the_keyword_call_applies(description):
+    # The stepper passes PyBullet's arguments by position (target and gain
+    # slots filled with zeros): the motion must be that of forces=... alone.
+    efforts = [50.0, -20.0]
+    with Physics(description, 0.001) as fast, Physics(description, 0.001) as reference:
+        step = fast.stepper()
+        indices = [reference.joint_index(joint.name) for joint in reference.joints]
+        for _ in range(300):
+            states = step(efforts)
+            pybullet.setJointMotorControlArray(
+                reference.body_id, indices, pybullet.TORQUE_CONTROL, forces=efforts,
+                physicsClientId=reference.client_id)
+            pybullet.stepSimulation(physicsClientId=reference.client_id)
+        assert states == reference.read_states()
+        assert states[0][1] > 0.5  # the pan turns under its 50 N*m
