@@ -1,9 +1,9 @@
 """sim_node's camera: parameters, ``image_raw`` and ``camera_info`` topics.
 
 A frame is due every ``1 / camera.rate`` seconds of sim time; it is taken
-after the first batch of physics steps that reaches the due time (at
-real_time_factor 1 a batch is ~10 ms of sim time, at 0 it is 0.1 s, so with
-the default 10 Hz the frames then fall exactly on the 0.1 s grid).  When
+after the first chunk of physics steps that reaches the due time (sim_node
+checks every /clock period, 10 ms of sim time, so with the default 10 Hz the
+frames fall exactly on the 0.1 s grid).  When
 someone subscribes to the image, the joint positions are snapshot and handed
 to the renderer (:mod:`pan_tilt_sim.camera`); the image is stamped with the
 sim time of the snapshot and published in the ``<link>_optical`` frame, with

@@ -1,7 +1,7 @@
 """What sim_node offers beyond the controllers: robot_description, TF and the camera.
 
 :class:`NodeFeatures` declares their parameters, creates their publishers and
-is told after each batch of physics steps; each feature then publishes
+is told every /clock period of physics steps; each feature then publishes
 whatever is due at the present sim time.  Topics (with the seed's files):
 
 * ``/ex_urdf_pan_tilt/robot_description`` -- std_msgs/String, transient local;
@@ -48,7 +48,7 @@ class NodeFeatures:
             raise
 
     def after_steps(self) -> None:
-        """Publish what is due at the present sim time (called after each batch of steps)."""
+        """Publish what is due at the present sim time (called every /clock period of steps)."""
         self.robot_state.update()
         if self.camera is not None:
             self.camera.update()
