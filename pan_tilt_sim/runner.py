@@ -196,11 +196,10 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
             from pan_tilt_sim import spinning
 
             if stop.received is None and rclpy.ok():
-                # Made while the context is alive: an executor whose construction
+                # Only while the context is alive: an executor whose construction
                 # a signal cuts short complains from __del__ with a traceback.
-                executor = spinning.make_executor()
                 node.get_logger().debug('started; spinning until SIGINT or SIGTERM')
-                spinning.spin(node, executor)
+                spinning.spin(node)
         except ConfigurationError as err:
             failure = err
         except KeyboardInterrupt:

@@ -52,12 +52,28 @@ def test_spin_runs_timers_and_returns_once_the_context_shuts_down(context, monke
             rclpy.try_shutdown(context=context)
 
     node.create_timer(0.01, tick)
-    executor = spinning.make_executor(context)
     started = time.monotonic()
     try:
-        spinning.spin(node, executor)
+        spinning.spin(node)
     finally:
         node.destroy_node()
-        executor.shutdown()
     assert len(ticks) == 5
     assert time.monotonic() - started < SPIN_BUDGET_S
+
+
+def test_spin_lets_keyboard_interrupt_through(context):
+    node = rclpy.create_node('spinning_test', context=context)
+
+    def interrupt():
+        raise KeyboardInterrupt
+
+    node.create_timer(0.01, interrupt)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            spinning.spin(node)
+        # The node is free again: another executor can take it.
+        executor = SingleThreadedExecutor(context=context)
+        assert executor.add_node(node)
+        executor.shutdown()
+    finally:
+        node.destroy_node()
