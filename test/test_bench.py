@@ -5,18 +5,16 @@ No timing is asserted here: the figures come from running the command.
 
 import json
 import math
-import os
-import pathlib
 import subprocess
 import sys
 
 import pytest
+import sim_process
 
 from pan_tilt_sim import bench
 from pan_tilt_sim.engine import make_simulation
 
 QUICK_TIMEOUT_S = 240
-REPO_ROOT = pathlib.Path(__file__).resolve().parents[1]
 FIGURES = {
     'raw_steps_per_s': int,
     'node_steps_per_s': int,
@@ -33,11 +31,9 @@ FIGURES = {
 @pytest.fixture(scope='module')
 def quick_run():
     """Run ``python -m pan_tilt_sim.bench --quick`` once; return (stdout, stderr)."""
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
-        [str(REPO_ROOT), *filter(None, [os.environ.get('PYTHONPATH')])]))
     result = subprocess.run(
         [sys.executable, '-m', 'pan_tilt_sim.bench', '--quick'], capture_output=True,
-        text=True, env=env, timeout=QUICK_TIMEOUT_S, check=False)
+        text=True, env=sim_process.environment(), timeout=QUICK_TIMEOUT_S, check=False)
     assert result.returncode == 0, result.stderr
     return result.stdout, result.stderr
 
