@@ -338,9 +338,11 @@ class Probe:
 class Bench:
     """One run of every measurement, sharing a probe, a ROS domain and a log folder."""
 
-    def __init__(self, probe: Probe, env: dict[str, str], folder: pathlib.Path,
-                 time_step: float, plan: Plan, log: Callable[[str], None]) -> None:
+    def __init__(self, probe: Probe, domain_id: int, env: dict[str, str],
+                 folder: pathlib.Path, time_step: float, plan: Plan,
+                 log: Callable[[str], None]) -> None:
         self.probe = probe
+        self.domain_id = domain_id
         self.env = env
         self.folder = folder
         self.time_step = time_step
@@ -363,14 +365,15 @@ class Bench:
             process.stop()
 
     def spin_until(self, node: NodeProcess, done: Callable[[], bool], timeout: float,
-                   what: str) -> None:
+                   what: str, probe: Probe | None = None) -> None:
         """Spin the probe until ``done()``; BenchError if the node dies or time runs out."""
+        probe = probe or self.probe
         deadline = time.monotonic() + timeout
         while not done():
             node.check_alive()
             if time.monotonic() > deadline:
                 raise BenchError(f'no {what} within {timeout} s')
-            self.probe.spin_once(SPIN_TIMEOUT_S)
+            probe.spin_once(SPIN_TIMEOUT_S)
 
     def fast_steps_per_s(self, model: Model, duration: float) -> float:
         """Measure sim_node's steps per wall second at factor 0, seen from this process."""
@@ -420,19 +423,29 @@ class Bench:
         }
 
     def startup_s(self, model: Model) -> float:
-        """Median wall time from starting sim_node's process to its first JointState here."""
+        """Median wall time from starting sim_node's process to its first JointState here.
+
+        Each run listens with a fresh probe: a DDS participant that saw the
+        previous run's node took ~2.5 s to match the next one in most runs
+        (the node itself is ready in ~0.3 s), which would measure discovery
+        of a restarted peer rather than start-up.
+        """
         times = []
         for _ in range(self.plan.startup_runs):
-            times.append(self._first_joint_state_after_start(model))
+            probe = Probe(self.domain_id)
+            try:
+                times.append(self._first_joint_state_after_start(probe, model))
+            finally:
+                probe.close()
         return statistics.median(times)
 
-    def _first_joint_state_after_start(self, model: Model) -> float:
+    def _first_joint_state_after_start(self, probe: Probe, model: Model) -> float:
         first: list[float] = []
-        with self.probe.joint_states(model.joint_states_topic, 1,
-                                     lambda wall, sim: first.append(wall)):
+        with probe.joint_states(model.joint_states_topic, 1,
+                                lambda wall, sim: first.append(wall)):
             with self.node(model, None) as node:
                 self.spin_until(node, lambda: bool(first), FIRST_MESSAGE_TIMEOUT_S,
-                                f'JointState on {model.joint_states_topic}')
+                                f'JointState on {model.joint_states_topic}', probe)
                 return first[0] - node.started
 
 
@@ -583,7 +596,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             else:
                 folder = pathlib.Path(stack.enter_context(
                     tempfile.TemporaryDirectory(prefix='pan_tilt_bench_')))
-            bench = Bench(probe, env, folder, args.time_step, plan, log)
+            bench = Bench(probe, domain_id, env, folder, args.time_step, plan, log)
             results = []
             for run in range(args.runs):
                 log(f'run {run + 1} of {args.runs} (ROS domain {domain_id})')
