@@ -6,32 +6,15 @@ first command the effort is zero.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
-
-from pan_tilt_sim.controllers.base import CommandController, CommandResult, JointHandle
+from pan_tilt_sim.controllers.base import CommandResult
 from pan_tilt_sim.controllers.limits import check_effort
+from pan_tilt_sim.controllers.single_joint import SingleJointController
 
 
-class JointEffortController(CommandController):
+class JointEffortController(SingleJointController):
     """Effort command -> effort."""
 
     type_names = ('effort_controllers/JointEffortController',)
-
-    def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
-        super().__init__(name, params, source)
-        self._joint_name = self.required_joint()
-        self._handle: JointHandle | None = None
-
-    @property
-    def joint_names(self) -> tuple[str, ...]:
-        """The one joint this controller drives."""
-        return (self._joint_name,)
-
-    def configure(self, joints: Mapping[str, JointHandle]) -> None:
-        """Bind the joint."""
-        self._handle = self.handle(joints, self._joint_name, 'joint')
-        self.reset()
 
     def reset(self) -> None:
         """Apply no effort until commanded."""

@@ -10,55 +10,33 @@ joint holds still.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
-
-from pan_tilt_sim.controllers.base import CommandController, CommandResult, JointHandle
-from pan_tilt_sim.controllers.gains import gains_from_params
+from pan_tilt_sim.controllers.base import CommandResult, JointHandle
 from pan_tilt_sim.controllers.limits import PositionLimits
-from pan_tilt_sim.controllers.pid import Pid, PidGains
+from pan_tilt_sim.controllers.pid import PidGains
+from pan_tilt_sim.controllers.single_joint import PidJointController
 
 # The seed's gains, used when the YAML gives none: with the seed's damping
 # they track critically damped or slower for link inertias up to ~10 kg m^2.
 DEFAULT_POSITION_GAINS = PidGains(p=100.0, i=0.01, d=10.0)
 
 
-class JointPositionController(CommandController):
+class JointPositionController(PidJointController):
     """Position setpoint -> effort, through a PID."""
 
     type_names = ('position_controllers/JointPositionController',
                   'effort_controllers/JointPositionController')
-
-    def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
-        super().__init__(name, params, source)
-        self._joint_name = self.required_joint()
-        self._gains = gains_from_params(self, DEFAULT_POSITION_GAINS)
-        self._handle: JointHandle | None = None
-
-    @property
-    def joint_names(self) -> tuple[str, ...]:
-        """The one joint this controller drives."""
-        return (self._joint_name,)
-
-    @property
-    def pid(self) -> Pid:
-        """The PID (its gains may be changed live)."""
-        return self._pid
+    default_gains = DEFAULT_POSITION_GAINS
 
     @property
     def setpoint(self) -> float:
         """The rate-limited position setpoint the PID tracks now."""
         return self._setpoint
 
-    def configure(self, joints: Mapping[str, JointHandle]) -> None:
-        """Bind the joint, its limits and a PID whose integral is bounded by the effort limit."""
-        handle = self.handle(joints, self._joint_name, 'joint')
-        self._handle = handle
+    def bind(self, handle: JointHandle) -> None:
+        """Take the joint's position limits and velocity limit, and build the PID."""
+        super().bind(handle)
         self._limits = PositionLimits(handle.spec)
         self._max_velocity = self._limits.max_velocity
-        self._effort_limit = handle.spec.effort_limit
-        self._pid = Pid(self._gains.with_default_clamp(self._effort_limit))
-        self.reset()
 
     def reset(self) -> None:
         """Hold the joint where it is; forget commands and the integral."""

@@ -9,48 +9,22 @@ velocity is zero.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
-
-from pan_tilt_sim.controllers.base import CommandController, CommandResult, JointHandle
-from pan_tilt_sim.controllers.gains import gains_from_params
+from pan_tilt_sim.controllers.base import CommandResult
 from pan_tilt_sim.controllers.limits import check_velocity
-from pan_tilt_sim.controllers.pid import Pid, PidGains
+from pan_tilt_sim.controllers.pid import PidGains
+from pan_tilt_sim.controllers.single_joint import PidJointController
 
 # Proportional-only by default: effort = 10 N*m per rad/s of error, a
 # first-order loop that is stable for any inertia and damping.
 DEFAULT_VELOCITY_GAINS = PidGains(p=10.0)
 
 
-class JointVelocityController(CommandController):
+class JointVelocityController(PidJointController):
     """Velocity command -> effort, through a PID."""
 
     type_names = ('velocity_controllers/JointVelocityController',
                   'effort_controllers/JointVelocityController')
-
-    def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
-        super().__init__(name, params, source)
-        self._joint_name = self.required_joint()
-        self._gains = gains_from_params(self, DEFAULT_VELOCITY_GAINS)
-        self._handle: JointHandle | None = None
-
-    @property
-    def joint_names(self) -> tuple[str, ...]:
-        """The one joint this controller drives."""
-        return (self._joint_name,)
-
-    @property
-    def pid(self) -> Pid:
-        """The PID (its gains may be changed live)."""
-        return self._pid
-
-    def configure(self, joints: Mapping[str, JointHandle]) -> None:
-        """Bind the joint and a PID whose integral is bounded by the effort limit."""
-        handle = self.handle(joints, self._joint_name, 'joint')
-        self._handle = handle
-        self._effort_limit = handle.spec.effort_limit
-        self._pid = Pid(self._gains.with_default_clamp(self._effort_limit))
-        self.reset()
+    default_gains = DEFAULT_VELOCITY_GAINS
 
     def reset(self) -> None:
         """Target zero velocity; forget the integral."""
