@@ -44,6 +44,30 @@ def test_the_setpoint_ramps_toward_the_command_at_the_velocity_limit():
     assert controller.setpoint == pytest.approx(0.1, abs=1e-9)
 
 
+def test_one_radian_takes_ten_seconds_no_step_faster_than_the_limit():
+    controller, _handle = _controller()
+    controller.set_command(1.0)
+    previous, steps = controller.setpoint, 0
+    while controller.setpoint < 1.0:
+        controller.update(steps * DT, DT)
+        assert controller.setpoint - previous <= 0.1 * DT + 1e-15
+        previous, steps = controller.setpoint, steps + 1
+    # 1 rad at 0.1 rad/s takes 10 s of sim time.
+    assert steps * DT == pytest.approx(10.0, abs=0.002)
+
+
+def test_the_ramp_lands_exactly_on_a_near_command_and_runs_both_ways():
+    controller, handle = _controller()
+    handle.position = 0.99995
+    controller.reset()
+    controller.set_command(1.0)
+    controller.update(0.0, DT)
+    assert controller.setpoint == 1.0
+    controller.set_command(-1.0)
+    controller.update(DT, DT)
+    assert controller.setpoint == pytest.approx(1.0 - 0.1 * DT)
+
+
 def test_effort_is_pid_on_position_error_with_damping_from_velocity():
     controller, handle = _controller()
     handle.position, handle.velocity = 0.0, 0.05

@@ -1,4 +1,4 @@
-"""Joint limits as joint_limits_interface applies them: clamp, ramp, saturate."""
+"""Joint limits as joint_limits_interface applies them: clamp and saturate."""
 
 import math
 
@@ -38,23 +38,6 @@ def test_non_finite_commands_are_rejected(value):
 
 def test_continuous_joints_have_no_position_clamp_and_are_not_wrapped():
     assert PositionLimits(WHEEL).check(12.5) == (12.5, CommandResult.ACCEPTED)
-
-
-def test_setpoint_ramps_no_faster_than_the_velocity_limit():
-    limits = PositionLimits(PAN)
-    setpoint, steps = 0.0, 0
-    while setpoint < 1.0:
-        new = limits.ramp(setpoint, 1.0, 0.001)
-        assert new - setpoint <= 0.1 * 0.001 + 1e-15
-        setpoint, steps = new, steps + 1
-    # 1 rad at 0.1 rad/s takes 10 s of sim time.
-    assert steps * 0.001 == pytest.approx(10.0, abs=0.002)
-
-
-def test_ramp_reaches_a_near_target_exactly_and_goes_both_ways():
-    limits = PositionLimits(PAN)
-    assert limits.ramp(0.99995, 1.0, 0.001) == 1.0
-    assert limits.ramp(0.0, -1.0, 0.001) == pytest.approx(-0.0001)
 
 
 def test_velocity_and_effort_commands_saturate_at_their_limits():

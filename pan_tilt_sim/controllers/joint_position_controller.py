@@ -53,7 +53,8 @@ class JointPositionController(PidJointController):
 
     def update(self, time: float, period: float) -> None:
         """Ramp the setpoint, then compute and clamp the effort."""
-        # PositionLimits.ramp and clamp_effort, written out: this runs every
+        # The ramp (at most max_velocity * period per step) and clamp_effort,
+        # written out: this runs every
         # physics step, and the two calls cost a third of it.
         handle = self._handle
         setpoint = self._setpoint

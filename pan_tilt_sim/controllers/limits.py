@@ -1,8 +1,9 @@
 """Joint limits as gazebo_ros_control's joint_limits_interface enforces them.
 
 * Position commands are clamped to the URDF [lower, upper] (not for
-  continuous joints), and the setpoint moves toward the command no faster
-  than the URDF velocity limit -- a "saturating" soft ramp.
+  continuous joints); the setpoint then moves toward the command no faster
+  than ``max_velocity`` (the URDF velocity limit) -- a "saturating" soft
+  ramp, which JointPositionController.update applies step by step.
 * Velocity commands are clamped to +-velocity limit.
 * Efforts are clamped to +-effort limit.
 """
@@ -30,15 +31,6 @@ class PositionLimits:
         """Clamp a position command into range; reject non-finite values."""
         return bounded_command(command, self.lower, self.upper)
 
-    def ramp(self, setpoint: float, target: float, dt: float) -> float:
-        """Move ``setpoint`` toward ``target`` by at most ``max_velocity * dt``."""
-        max_step = self.max_velocity * dt
-        delta = target - setpoint
-        if delta > max_step:
-            return setpoint + max_step
-        if delta < -max_step:
-            return setpoint - max_step
-        return target
 
 
 def check_velocity(joint: JointSpec, command: float) -> tuple[float, CommandResult]:
