@@ -26,7 +26,7 @@ import array
 from rclpy.node import Node
 from sensor_msgs.msg import CameraInfo, Image
 
-from pan_tilt_sim import extra_parameters as params
+from pan_tilt_sim import parameters as params
 from pan_tilt_sim.camera import (
     DEFAULT_FAR,
     DEFAULT_FOV_DEG,

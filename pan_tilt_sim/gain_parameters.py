@@ -25,15 +25,14 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Iterable, Sequence
 
-from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from pan_tilt_sim.controllers.base import Controller
 from pan_tilt_sim.controllers.pid import GainsError, Pid, PidGains
 from pan_tilt_sim.errors import ParameterError
-from pan_tilt_sim.extra_parameters import DOUBLE
-from pan_tilt_sim.parameters import coerce
+from pan_tilt_sim.parameters import DOUBLE, coerce, declare
 
 PID_PREFIX = 'pid'
 GAINS_PREFIX = 'gains'
@@ -141,9 +140,5 @@ class GainParameters:
 
     @staticmethod
     def _declare(node: Node, prefix: str, field: str, value: float) -> float:
-        name = f'{prefix}.{field}'
-        # Dynamic typing lets integers through; coerce() checks the type instead.
-        descriptor = ParameterDescriptor(
-            name=name, type=DOUBLE, description=f'{prefix}: {DESCRIPTIONS[field]}',
-            dynamic_typing=True)
-        return coerce(name, DOUBLE, node.declare_parameter(name, value, descriptor).value)
+        return declare(node, f'{prefix}.{field}', DOUBLE, value,
+                       f'{prefix}: {DESCRIPTIONS[field]}', read_only=False)

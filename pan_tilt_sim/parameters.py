@@ -27,6 +27,12 @@ from pan_tilt_sim.share import (  # noqa: F401 -- re-exported: the defaults live
     package_share,
 )
 
+BOOL = ParameterType.PARAMETER_BOOL
+INTEGER = ParameterType.PARAMETER_INTEGER
+DOUBLE = ParameterType.PARAMETER_DOUBLE
+STRING = ParameterType.PARAMETER_STRING
+STRING_ARRAY = ParameterType.PARAMETER_STRING_ARRAY
+
 DEFAULT_TIME_STEP = 0.001  # s, PyBullet's recommended range is 1/1000 .. 1/240
 MAX_TIME_STEP = 0.1  # s; beyond this the PID loop is meaningless
 DEFAULT_REAL_TIME_FACTOR = 1.0
@@ -92,23 +98,29 @@ class SimParameters:
 
 def declare_parameters(node: Node) -> SimParameters:
     """Declare every parameter on ``node`` and return their checked values."""
-    values = {}
-    for spec in _specs():
-        descriptor = ParameterDescriptor(
-            name=spec.name, type=spec.type, description=spec.description,
-            read_only=spec.read_only,
-            # rclpy's own type check would end start-up with an
-            # InvalidParameterTypeException traceback (and refuse integers for
-            # doubles): coerce() checks every type instead, naming what it wants.
-            dynamic_typing=True)
-        parameter = node.declare_parameter(spec.name, spec.default, descriptor)
-        values[spec.name] = coerce(spec.name, spec.type, parameter.value)
+    values = {spec.name: declare(node, spec.name, spec.type, spec.default, spec.description,
+                                 read_only=spec.read_only)
+              for spec in _specs()}
     values['xacro_args'] = tuple(values['xacro_args'])
     checked = SimParameters(**values)
     check_time_step(checked.time_step)
     check_real_time_factor(checked.real_time_factor)
     check_namespace('robot_namespace', checked.robot_namespace)
     return checked
+
+
+def declare(node: Node, name: str, wanted: int, default: Any, description: str, *,
+            read_only: bool = True) -> Any:
+    """Declare parameter ``name`` on ``node``; return its value, checked for type ``wanted``.
+
+    rclpy's own type check would end start-up with an
+    InvalidParameterTypeException traceback (and refuse integers for doubles):
+    the parameter is declared with dynamic typing and :func:`coerce` checks it.
+    """
+    descriptor = ParameterDescriptor(
+        name=name, type=wanted, description=description, read_only=read_only,
+        dynamic_typing=True)
+    return coerce(name, wanted, node.declare_parameter(name, default, descriptor).value)
 
 
 def coerce(name: str, wanted: int, value: Any) -> Any:
@@ -123,6 +135,7 @@ def coerce(name: str, wanted: int, value: Any) -> Any:
         return []  # declared without a value: not set
     ok = {
         ParameterType.PARAMETER_BOOL: lambda v: isinstance(v, bool),
+        ParameterType.PARAMETER_INTEGER: lambda v: isinstance(v, int) and not isinstance(v, bool),
         ParameterType.PARAMETER_DOUBLE: lambda v: isinstance(v, float),
         ParameterType.PARAMETER_STRING: lambda v: isinstance(v, str),
         ParameterType.PARAMETER_STRING_ARRAY: lambda v: isinstance(v, list | tuple) and all(

@@ -21,7 +21,7 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import String
 
-from pan_tilt_sim import extra_parameters as params
+from pan_tilt_sim import parameters as params
 from pan_tilt_sim.description import Mimic
 from pan_tilt_sim.engine import Simulation
 from pan_tilt_sim.kinematics import KinematicTree, Transform, parse_kinematics

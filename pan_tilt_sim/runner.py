@@ -198,8 +198,8 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
             if stop.received is None and rclpy.ok():
                 # Only while the context is alive: an executor whose construction
                 # a signal cuts short complains from __del__ with a traceback.
-                node.get_logger().debug('started; spinning until SIGINT or SIGTERM')
-                spinning.spin(node)
+                spinning.spin(node, on_ready=lambda: node.get_logger().debug(
+                    'started; spinning until SIGINT or SIGTERM'))
         except ConfigurationError as err:
             failure = err
         except KeyboardInterrupt:

@@ -1,19 +1,20 @@
-"""The executor sim_node spins on: rclpy's C++ EventsExecutor where rclpy has it.
+"""The executor sim_node spins on: rclpy's SingleThreadedExecutor, or the EventsExecutor.
 
 rclpy's Python executors rebuild a wait set of every entity on each wake-up:
-~0.2 ms of CPU for an idle node, ~0.35 ms for sim_node with its parameter
-services and QoS event handlers, cache misses included.  At
-real_time_factor 1 the node wakes 100 times a second, so that alone was
-~3.5 % of a core.  The EventsExecutor (``rclpy.experimental``, in Jazzy's
-rclpy since 7.1) reacts to events instead and costs ~0.05 ms per wake-up.
-
-Set ``PAN_TILT_SIM_EXECUTOR=single_threaded`` to use rclpy's
-SingleThreadedExecutor instead (as where the EventsExecutor is missing).
+~0.35 ms of CPU for sim_node with its parameter services and QoS event
+handlers, cache misses included.  sim_node therefore wakes only every 20 ms
+at real_time_factor 1 (see sim_node.TICK_PERIOD_S), which keeps it under 5 %
+of a core.  rclpy's C++ EventsExecutor (``rclpy.experimental``, in Jazzy's
+rclpy since 7.1) costs ~0.05 ms per wake-up, but it is experimental: in our
+signal tests it aborted the process (SIGABRT) now and then, even with the
+shut-down order :func:`spin` uses.  So it is opt-in:
+``PAN_TILT_SIM_EXECUTOR=events`` selects it where rclpy has it.
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 
 from rclpy.context import Context
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
@@ -29,8 +30,8 @@ SPIN_SLICE_S = 0.1
 
 
 def make_executor(context: Context | None = None) -> Executor:
-    """Return an EventsExecutor where rclpy has one and not told otherwise, else a plain one."""
-    if os.environ.get(EXECUTOR_VARIABLE, EVENTS) != SINGLE_THREADED:
+    """Return a SingleThreadedExecutor, or an EventsExecutor if asked for and available."""
+    if os.environ.get(EXECUTOR_VARIABLE, SINGLE_THREADED) == EVENTS:
         try:
             from rclpy.experimental import EventsExecutor
         except ImportError:
@@ -40,18 +41,28 @@ def make_executor(context: Context | None = None) -> Executor:
     return SingleThreadedExecutor(context=context)
 
 
-def spin(node: Node) -> None:
+def spin(node: Node, on_ready: Callable[[], None] | None = None) -> None:
     """Spin ``node`` on :func:`make_executor`'s executor until its context shuts down.
 
-    Ctrl-C raises KeyboardInterrupt as usual.  The executor is shut down and
-    released here, before the caller destroys the node: an EventsExecutor
-    destroyed after the node's timers and subscriptions aborted the process
-    (SIGABRT at exit, in 6 of 16 runs of test_signals' "SIGINT started
-    ignored" case; 0 of 200 runs of test_signals with this order).
+    ``on_ready`` is called once the executor exists, just before spinning
+    starts: a signal that shuts the context down while the executor is being
+    built leaves a half-built executor whose ``__del__`` prints a traceback,
+    so "running" is announced only after that window.  A shut-down during the
+    build ends the spin like any other.  Ctrl-C raises KeyboardInterrupt as
+    usual.  The executor is shut down and released here, before the caller
+    destroys the node (an EventsExecutor destroyed after the node's timers
+    and subscriptions aborted the process).
     """
-    executor = make_executor(node.context)
+    try:
+        executor = make_executor(node.context)
+    except Exception:
+        if node.context.ok():
+            raise
+        return  # a signal shut the context down while the executor was built
     executor.add_node(node)
     try:
+        if on_ready is not None:
+            on_ready()
         while node.context.ok():
             executor.spin_once(timeout_sec=SPIN_SLICE_S)
     except ExternalShutdownException:

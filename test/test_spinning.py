@@ -20,22 +20,22 @@ def context():
     rclpy.try_shutdown(context=context)
 
 
-def test_the_events_executor_is_the_default_where_rclpy_has_one(context, monkeypatch):
-    pytest.importorskip('rclpy.experimental')
+def test_the_single_threaded_executor_is_the_default(context, monkeypatch):
     monkeypatch.delenv(spinning.EXECUTOR_VARIABLE, raising=False)
     executor = spinning.make_executor(context)
     try:
-        assert not isinstance(executor, SingleThreadedExecutor)
-        assert type(executor).__name__ == 'EventsExecutor'
+        assert isinstance(executor, SingleThreadedExecutor)
     finally:
         executor.shutdown()
 
 
-def test_the_environment_can_ask_for_the_single_threaded_executor(context, monkeypatch):
-    monkeypatch.setenv(spinning.EXECUTOR_VARIABLE, spinning.SINGLE_THREADED)
+def test_the_environment_can_ask_for_the_events_executor(context, monkeypatch):
+    pytest.importorskip('rclpy.experimental')
+    monkeypatch.setenv(spinning.EXECUTOR_VARIABLE, spinning.EVENTS)
     executor = spinning.make_executor(context)
     try:
-        assert isinstance(executor, SingleThreadedExecutor)
+        assert not isinstance(executor, SingleThreadedExecutor)
+        assert type(executor).__name__ == 'EventsExecutor'
     finally:
         executor.shutdown()
 
