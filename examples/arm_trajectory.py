@@ -18,6 +18,7 @@ or ``--timeout`` wall seconds pass.
 
 import argparse
 import math
+import os
 import sys
 import time
 
@@ -82,6 +83,8 @@ def main(argv=None):
     parser.add_argument('--tolerance', type=float, default=0.02)
     parser.add_argument('--timeout', type=float, default=60.0, help='wall seconds')
     args = parser.parse_args(argv)
+    # Talk to a sim_node started by scripts/run_sim.sh, which keeps DDS on loopback.
+    os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     rclpy.init()
     node = Node('arm_trajectory')
     try:

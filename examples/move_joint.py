@@ -10,6 +10,7 @@ installed.  It stops when the joint is within ``--tolerance`` of the target, or 
 """
 
 import argparse
+import os
 import sys
 import time
 
@@ -34,6 +35,8 @@ def main(argv: list[str] | None = None) -> int:
     namespace = args.topic.rsplit('/', 2)[0]
     states_topic = args.joint_states or f'{namespace}/joint_states'
 
+    # Talk to a sim_node started by scripts/run_sim.sh, which keeps DDS on loopback.
+    os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     rclpy.init()
     node = Node('move_joint')
     latest = {}
