@@ -30,6 +30,8 @@ from std_msgs.msg import Float64
 from pan_tilt_sim.sim_node import SimNode
 
 SPIN_SLICE_S = 0.05
+# A service request still unanswered after this long is sent again (see call()).
+RESEND_AFTER_S = 2.0
 DEFAULT_BUDGET_S = 30.0
 QUEUE_DEPTH = 10
 # Deep queues: at real_time_factor 0 the node publishes faster than one
@@ -95,12 +97,24 @@ class NodeHarness:
 
     def call(self, service_type: type, name: str, request: Any = None,
              budget_s: float = DEFAULT_BUDGET_S) -> Any:
-        """Call service ``name`` from the probe once it is there; return the response."""
+        """Call service ``name`` from the probe once it is there; return the response.
+
+        Fast DDS may report the service ready before the server has matched the
+        client's response reader; the server then drops the response ("failed
+        to send response (timeout)").  So an unanswered request is sent again
+        after RESEND_AFTER_S -- the services tested here are idempotent.
+        """
         client = self.probe.create_client(service_type, name)
         try:
             assert self.spin_until(client.service_is_ready, budget_s), f'no service {name}'
-            future = client.call_async(service_type.Request() if request is None else request)
-            assert self.spin_until(future.done), f'{name} did not answer'
+            deadline = time.monotonic() + budget_s
+            while True:
+                future = client.call_async(
+                    service_type.Request() if request is None else request)
+                if self.spin_until(future.done, RESEND_AFTER_S):
+                    break
+                client.remove_pending_request(future)
+                assert time.monotonic() < deadline, f'{name} did not answer'
             response = future.result()
             assert response is not None, f'{name} failed: {future.exception()!r}'
             return response
