@@ -9,7 +9,6 @@ time is kept as a step count, so it never accumulates rounding error.
 
 from __future__ import annotations
 
-import logging
 from collections.abc import Sequence
 
 from pan_tilt_sim.controller_config import ControllersConfig
@@ -17,8 +16,6 @@ from pan_tilt_sim.controllers import CommandController, Controller, JointHandle,
 from pan_tilt_sim.description import JointSpec, RobotDescription
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.physics import STATE_POSITION, STATE_VELOCITY, Physics
-
-_LOG = logging.getLogger(__name__)
 
 
 def build_controllers(config: ControllersConfig, handles: dict[str, JointHandle],
@@ -71,10 +68,6 @@ class Simulation:
         self._steps = 0
         self._states = self.physics.read_states()
         self._physics_step = self.physics.stepper()
-        for joint in self.physics.joints:
-            if joint.initial_position != 0.0:
-                _LOG.info("joint '%s' starts at %g, its limit nearest to 0",
-                          joint.name, joint.initial_position)
 
     @property
     def time_step(self) -> float:

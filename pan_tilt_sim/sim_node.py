@@ -80,6 +80,11 @@ class SimNode(Node):
         self._timer = self.create_timer(self._tick_period(), self._on_tick)
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self._world_services = services.create_world_services(self)
+        for joint in self.simulation.physics.joints:
+            if joint.initial_position != 0.0:
+                self.get_logger().info(
+                    f"joint '{joint.name}' starts at {joint.initial_position:g}: 0 is outside "
+                    f'its limits [{joint.lower:g}, {joint.upper:g}]')
         self.get_logger().info(
             f"simulating '{description.name}' from {description.source} "
             f"with {len(self.simulation.controllers)} controllers; topics under "

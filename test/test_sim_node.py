@@ -147,3 +147,18 @@ def test_xacro_args_reach_xacro(repo_root, tmp_path):
     with sim_node(robot_description_file=str(path), xacro_args=['pan_limit:=0.25']) as sim:
         assert sim.node.settings.xacro_args == ('pan_limit:=0.25',)
         assert sim.simulation.description.joint('pan_joint').upper == 0.25
+
+
+def test_a_joint_starting_at_a_limit_is_logged_once_at_info():
+    from rcl_interfaces.msg import Log
+    from rclpy.qos import DurabilityPolicy, QoSProfile
+
+    # /rosout keeps its last messages for late subscribers (transient local).
+    late = QoSProfile(depth=1000, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    with sim_node() as sim:
+        log = sim.collect(Log, '/rosout', late)
+        assert sim.harness.spin_until(lambda: any('simulating' in m.msg for m in log))
+    starts = [m for m in log if m.name == 'sim_node' and 'starts at' in m.msg]
+    assert len(starts) == 1
+    assert starts[0].level == Log.INFO
+    assert "tilt_joint' starts at -1.5708" in starts[0].msg
