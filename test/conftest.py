@@ -41,3 +41,15 @@ def pytest_configure(config: pytest.Config) -> None:
     """Register the ``soak`` marker: minutes-long flood/soak tests, off unless asked for."""
     config.addinivalue_line(
         'markers', 'soak: flood and soak tests (minutes); run only with PAN_TILT_SIM_SLOW=1')
+
+
+@pytest.fixture
+def context():
+    """Return a fresh, initialised rclpy Context, shut down after the test."""
+    import rclpy
+    from rclpy.context import Context
+
+    context = Context()
+    rclpy.init(context=context)
+    yield context
+    rclpy.try_shutdown(context=context)

@@ -4,20 +4,11 @@ import time
 
 import pytest
 import rclpy
-from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 
 from pan_tilt_sim import spinning
 
 SPIN_BUDGET_S = 10.0
-
-
-@pytest.fixture
-def context():
-    context = Context()
-    rclpy.init(context=context)
-    yield context
-    rclpy.try_shutdown(context=context)
 
 
 def test_the_single_threaded_executor_is_the_default(context, monkeypatch):

@@ -14,9 +14,7 @@ import os
 import pathlib
 
 import pytest
-import rclpy
 import sim_process
-from rclpy.context import Context
 from rclpy.parameter import Parameter
 
 from pan_tilt_sim.errors import (
@@ -213,14 +211,6 @@ def files(tmp_path: pathlib.Path) -> pathlib.Path:
         else:
             path.write_text(content)
     return tmp_path
-
-
-@pytest.fixture
-def context():
-    context = Context()
-    rclpy.init(context=context)
-    yield context
-    rclpy.try_shutdown(context=context)
 
 
 def _fill(value, directory):

@@ -38,9 +38,9 @@ from pan_tilt_sim.controllers.gains import PID_FIELD, joint_gains_from_params
 from pan_tilt_sim.controllers.joint_effort_controller import JointEffortController
 from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
 from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
+from pan_tilt_sim.controllers.multi_joint import JOINTS_FIELD, MultiJointController
 
 INTERFACE_FIELD = 'interface_name'
-JOINTS_FIELD = 'joints'
 # The one-joint controller each command interface stands for.
 INTERFACE_CONTROLLERS: dict[str, type[CommandController]] = {
     'position': JointPositionController,
@@ -49,7 +49,7 @@ INTERFACE_CONTROLLERS: dict[str, type[CommandController]] = {
 }
 
 
-class ForwardCommandController(CommandController):
+class ForwardCommandController(MultiJointController):
     """A group of joints, commanded together through one interface."""
 
     type_names = ('forward_command_controller/ForwardCommandController',)
@@ -60,7 +60,6 @@ class ForwardCommandController(CommandController):
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
-        self._joint_names = self.joint_list(JOINTS_FIELD)
         interface = self.fixed_interface or params.get(INTERFACE_FIELD)
         if interface not in INTERFACE_CONTROLLERS:
             raise self.error(INTERFACE_FIELD, f"{interface!r} must be one of "
@@ -71,12 +70,6 @@ class ForwardCommandController(CommandController):
         self._members = tuple(
             member_type(name, {'joint': joint, PID_FIELD: gains.get(joint)}, source)
             for joint in self._joint_names)
-        self._problem = ''
-
-    @property
-    def joint_names(self) -> tuple[str, ...]:
-        """The joints, in the order of the command's elements."""
-        return self._joint_names
 
     @property
     def members(self) -> tuple[CommandController, ...]:
@@ -121,10 +114,6 @@ class ForwardCommandController(CommandController):
                              f"{', '.join(clamped)}; clamped")
             return CommandResult.CLAMPED
         return CommandResult.ACCEPTED
-
-    def command_problem(self, value: Any, result: CommandResult) -> str:
-        """Describe the last rejected or clamped command."""
-        return self._problem
 
     def update(self, time: float, period: float) -> None:
         """Update every joint's controller."""

@@ -34,7 +34,6 @@ from typing import Any
 
 from pan_tilt_sim.controllers.base import (
     MAX_COMMAND_MAGNITUDE,
-    CommandController,
     CommandKind,
     CommandResult,
     JointHandle,
@@ -43,6 +42,7 @@ from pan_tilt_sim.controllers.base import (
 from pan_tilt_sim.controllers.gains import feedforward_scales, joint_gains_from_params
 from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
 from pan_tilt_sim.controllers.limits import PositionLimits, clamp_effort
+from pan_tilt_sim.controllers.multi_joint import JOINTS_FIELD, MultiJointController
 from pan_tilt_sim.controllers.pid import Pid
 from pan_tilt_sim.controllers.trajectory import (
     JointTrajectory,
@@ -50,14 +50,13 @@ from pan_tilt_sim.controllers.trajectory import (
     TrajectoryPoint,
 )
 
-JOINTS_FIELD = 'joints'
 COMMAND_INTERFACES_FIELD = 'command_interfaces'
 COMMAND_INTERFACES = ('position', 'velocity', 'effort')
 # A knot this close after the start is taken as at the start (float stamps).
 TIME_EPSILON = 1e-9
 
 
-class JointTrajectoryController(CommandController):
+class JointTrajectoryController(MultiJointController):
     """Follows a joint trajectory with one PID per joint."""
 
     type_names = ('joint_trajectory_controller/JointTrajectoryController',)
@@ -66,7 +65,6 @@ class JointTrajectoryController(CommandController):
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
-        self._joint_names = self.joint_list(JOINTS_FIELD)
         interfaces = params.get(COMMAND_INTERFACES_FIELD, [])
         if not isinstance(interfaces, list | tuple) or any(
                 interface not in COMMAND_INTERFACES for interface in interfaces):
@@ -76,12 +74,6 @@ class JointTrajectoryController(CommandController):
         self._gains = [gains.get(joint, DEFAULT_POSITION_GAINS) for joint in self._joint_names]
         scales = feedforward_scales(self, self._joint_names)
         self._feedforward = [scales[joint] for joint in self._joint_names]
-        self._problem = ''
-
-    @property
-    def joint_names(self) -> tuple[str, ...]:
-        """The joints, in the order of every list this controller keeps."""
-        return self._joint_names
 
     @property
     def pids(self) -> tuple[Pid, ...]:
@@ -140,10 +132,6 @@ class JointTrajectoryController(CommandController):
                              "outside the joints' limits; clamped")
             return CommandResult.CLAMPED
         return CommandResult.ACCEPTED
-
-    def command_problem(self, value: Any, result: CommandResult) -> str:
-        """Describe the last rejected or clamped trajectory."""
-        return self._problem
 
     def update(self, time: float, period: float) -> None:
         """Start a due trajectory, sample the desired state, run the PIDs."""
