@@ -6,13 +6,14 @@ import sys
 
 import pytest
 
-# Keep DDS traffic on loopback and give each pytest process (xdist worker)
-# its own domain so parallel runs never hear each other.
+# Keep DDS traffic on loopback and give each pytest process (an xdist worker,
+# or a second test run on the same machine) its own domain, so concurrent runs
+# never hear each other's sim_nodes.  Child processes inherit it.  Fast DDS
+# takes domains 0..232; the tests use 100..199.  PAN_TILT_SIM_TEST_DOMAIN pins it.
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-_WORKER = os.environ.get('PYTEST_XDIST_WORKER', 'gw0')
-_DOMAIN_BASE = 40
-os.environ.setdefault(
-    'ROS_DOMAIN_ID', str(_DOMAIN_BASE + int(''.join(c for c in _WORKER if c.isdigit()) or 0)))
+_DOMAIN_BASE, _DOMAIN_SPAN = 100, 100
+os.environ['ROS_DOMAIN_ID'] = os.environ.get(
+    'PAN_TILT_SIM_TEST_DOMAIN', str(_DOMAIN_BASE + os.getpid() % _DOMAIN_SPAN))
 # ament index look-ups find the package installed into this environment.
 _prefixes = [p for p in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if p]
 if sys.prefix not in _prefixes:
