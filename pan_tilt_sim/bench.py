@@ -36,6 +36,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
+import itertools
 import json
 import math
 import os
@@ -293,10 +294,15 @@ class NodeProcess:
 class Probe:
     """The bench's own ROS node: listens to JointState and sends position commands."""
 
+    # Probes come and go within one process (a fresh one per start-up run);
+    # distinct names keep rcl from warning about a second /rosout publisher.
+    _created = itertools.count()
+
     def __init__(self, domain_id: int) -> None:
         self._context = Context()
         rclpy.init(args=[], context=self._context, domain_id=domain_id)
-        self.node = rclpy.create_node('sim_bench_probe', context=self._context)
+        self.node = rclpy.create_node(f'sim_bench_probe_{next(Probe._created)}',
+                                      context=self._context)
         self.executor = SingleThreadedExecutor(context=self._context)
         self.executor.add_node(self.node)
         self._publishers: dict[str, object] = {}
