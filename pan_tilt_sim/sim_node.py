@@ -202,7 +202,6 @@ class SimNode(Node):
 
     def _command_callback(self, controller: CommandController, extract):
         logger = self.get_logger()
-
         name = controller.name
 
         def store(message) -> None:
