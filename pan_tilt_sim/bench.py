@@ -64,13 +64,13 @@ from pan_tilt_sim.description import load_description
 from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.parameters import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
 from pan_tilt_sim.physics import Physics, pybullet
+from pan_tilt_sim.ros_interfaces import seconds
 
 DEFAULT_TIME_STEP = 0.001  # s, the issue's reference step
 CHAIN_JOINTS = (2, 8, 32)
 STARTUP_RUNS = 5
 EXIT_FAILURE = 1
 EXIT_USAGE = 2
-NANOSECONDS_PER_SECOND = 1e9
 MILLISECONDS_PER_SECOND = 1e3
 PERCENT = 100.0
 P99 = 98  # index of the 99th percentile among statistics.quantiles(n=100)
@@ -318,8 +318,7 @@ class Probe:
                      on_message: Callable[[float, float], None]) -> Iterator[None]:
         """Call ``on_message(arrival monotonic s, stamp s)`` for JointStates while open."""
         def callback(message: JointState) -> None:
-            stamp = message.header.stamp
-            on_message(time.monotonic(), stamp.sec + stamp.nanosec / NANOSECONDS_PER_SECOND)
+            on_message(time.monotonic(), seconds(message.header.stamp))
 
         subscription = self.node.create_subscription(
             JointState, topic, callback, QoSProfile(depth=depth))

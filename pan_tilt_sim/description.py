@@ -19,7 +19,7 @@ from collections.abc import Sequence
 from xml.parsers.expat import ExpatError
 
 from pan_tilt_sim import naming
-from pan_tilt_sim.errors import DescriptionError
+from pan_tilt_sim.errors import DescriptionError, one_line
 from pan_tilt_sim.resources import localize_meshes
 
 XACRO_SUFFIX = '.xacro'
@@ -143,10 +143,10 @@ def run_xacro(path: pathlib.Path, mappings: dict[str, str]) -> str:
         raise DescriptionError(
             f'{path}:{err.lineno}: not well-formed XML: {_expat_reason(err)}') from None
     except xacro.XacroException as err:
-        raise DescriptionError(f'{path}: xacro error: {_one_line(str(err))}') from None
+        raise DescriptionError(f'{path}: xacro error: {one_line(str(err))}') from None
     except Exception as err:  # xacro surfaces NameError, KeyError... from user expressions
         raise DescriptionError(
-            f'{path}: xacro error: {type(err).__name__}: {_one_line(str(err))}') from None
+            f'{path}: xacro error: {type(err).__name__}: {one_line(str(err))}') from None
     return document.toprettyxml(indent='  ')
 
 
@@ -284,7 +284,3 @@ def _plugin_namespace(root: ElementTree.Element) -> str | None:
 def _expat_reason(err: ExpatError) -> str:
     from xml.parsers.expat import ErrorString
     return ErrorString(err.code)
-
-
-def _one_line(text: str) -> str:
-    return ' '.join(text.split())

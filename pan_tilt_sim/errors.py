@@ -23,3 +23,8 @@ class ParameterError(ConfigurationError):
 
 class ArgumentError(ConfigurationError):
     """The command line's ROS arguments (``--ros-args ...``) cannot be parsed."""
+
+
+def one_line(text: str) -> str:
+    """Fold ``text`` (a wrapped or multi-line library message) into one line."""
+    return ' '.join(text.split())

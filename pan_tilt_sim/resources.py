@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
 
-from pan_tilt_sim.errors import DescriptionError
+from pan_tilt_sim.errors import DescriptionError, one_line
 
 PACKAGE_SCHEME = 'package://'
 FILE_SCHEME = 'file://'
@@ -125,7 +125,7 @@ def resolve_resource(uri: str, base_dir: pathlib.Path) -> pathlib.Path:
     try:
         return _resolve(uri, base_dir)
     except _UnusableError as exc:
-        raise DescriptionError(_one_line(f"resource '{uri}': {exc}")) from None
+        raise DescriptionError(one_line(f"resource '{uri}': {exc}")) from None
 
 
 def _resolve(uri: str, base_dir: pathlib.Path) -> pathlib.Path:
@@ -200,14 +200,14 @@ def localize_meshes(robot: ET.Element, base_dir: pathlib.Path,
         try:
             resolved = _resolve(uri, base_dir)
         except _UnusableError as exc:
-            raise DescriptionError(_one_line(f"{where} '{uri}': {exc}")) from None
+            raise DescriptionError(one_line(f"{where} '{uri}': {exc}")) from None
         try:
             _check_scale(mesh.get('scale'))
             if resolved not in done:
                 done[resolved] = _loadable_mesh(resolved, cache_dir)
         except _UnusableError as exc:
             raise DescriptionError(
-                _one_line(f"{where} '{uri}' (resolved to {resolved}): {exc}")) from None
+                one_line(f"{where} '{uri}' (resolved to {resolved}): {exc}")) from None
         mesh.set('filename', str(done[resolved]))
         localized.append(LocalizedMesh(link, role, uri, resolved, done[resolved]))
     return localized
@@ -218,10 +218,6 @@ def _mesh_elements(robot: ET.Element) -> Iterator[tuple[str, str, ET.Element]]:
         for role in MESH_ROLES:
             for mesh in link.findall(f'{role}/geometry/mesh'):
                 yield link.get('name', '?'), role, mesh
-
-
-def _one_line(message: str) -> str:
-    return ' '.join(message.split())
 
 
 def _check_scale(scale: str | None) -> None:

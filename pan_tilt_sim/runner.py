@@ -33,7 +33,7 @@ import traceback
 from collections.abc import Callable, Iterator, Sequence
 from typing import TYPE_CHECKING
 
-from pan_tilt_sim.errors import ArgumentError, ConfigurationError
+from pan_tilt_sim.errors import ArgumentError, ConfigurationError, one_line
 
 if TYPE_CHECKING:
     from rclpy.node import Node
@@ -142,7 +142,7 @@ def _rcl_reason(err: Exception, log: str) -> str:
                if match and _RCL_GENERIC_ERROR not in match['text']]
     if details:
         reason += ' (' + '; '.join(details) + ')'
-    reason = ' '.join(reason.split())
+    reason = one_line(reason)
     return reason[:1].lower() + reason[1:]
 
 
