@@ -71,7 +71,7 @@ setup(
     maintainer='pan_tilt_sim maintainers',
     maintainer_email='maintainers@users.noreply.h-seed-816557ff.example',
     description='Headless PyBullet stand-in for Gazebo + gazebo_ros_control.',
-    license='TODO: License declaration',
+    license='Apache-2.0',
     python_requires='>=3.10',
     entry_points={
         'console_scripts': [f'{name} = {target}' for name, target in EXECUTABLES.items()],

@@ -194,6 +194,14 @@ def test_package_xml_is_format_3_ament_python(repo_root):
     catkin_pkg.parse_package(str(repo_root / 'package.xml'))
 
 
+def test_licence_is_apache_2_everywhere(repo_root):
+    root = ElementTree.parse(repo_root / 'package.xml').getroot()
+    assert root.findtext('license') == 'Apache-2.0'
+    assert importlib.metadata.metadata(PACKAGE)['License'] == 'Apache-2.0'
+    text = (repo_root / 'LICENSE').read_text()
+    assert 'Apache License' in text and 'Version 2.0, January 2004' in text
+
+
 def test_launcher_runs_venv_python_when_venv_not_activated(prefix, tmp_path):
     report = _probe(prefix / 'lib' / PACKAGE / 'sim_node', tmp_path)
     assert pathlib.Path(report['prefix']).samefile(sys.prefix)
