@@ -23,14 +23,64 @@ def test_i_only_integrates_gain_times_error_over_time():
     assert pid.integral_term == pytest.approx(1.0)
 
 
-def test_integral_term_is_clamped_and_recovers_at_once_anti_windup():
-    pid = Pid(PidGains(i=10.0, i_clamp_min=-0.5, i_clamp_max=0.5))
+def test_with_antiwindup_the_accumulator_is_clamped_and_recovers_at_once():
+    pid = Pid(PidGains(i=10.0, i_clamp_min=-0.5, i_clamp_max=0.5, antiwindup=True))
     for _ in range(10_000):
         pid.compute(setpoint=1.0, measurement=0.0, dt=DT)
     assert pid.integral_term == pytest.approx(0.5)
     # Without windup one step of negative error already lowers the term.
     pid.compute(setpoint=-1.0, measurement=0.0, dt=DT)
     assert pid.integral_term < 0.5
+
+
+def test_without_antiwindup_the_contribution_is_clamped_but_the_accumulator_winds_up():
+    # control_toolbox's default: the output sees at most i_clamp_max, but the
+    # integral keeps growing (here to 10 * 1 * 10 s = 100) and must be unwound.
+    pid = Pid(PidGains(i=10.0, i_clamp_min=-0.5, i_clamp_max=0.5))
+    for _ in range(10_000):
+        output = pid.compute(setpoint=1.0, measurement=0.0, dt=DT)
+    assert output == pytest.approx(0.5)
+    assert pid.integral_term == pytest.approx(0.5)
+    for _ in range(9_000):  # 9 s of negative error: 100 - 90 = 10, still saturated
+        pid.compute(setpoint=-1.0, measurement=0.0, dt=DT)
+    assert pid.integral_term == pytest.approx(0.5)
+    for _ in range(1_000):  # one more second: 10 - 10 = 0
+        pid.compute(setpoint=-1.0, measurement=0.0, dt=DT)
+    assert pid.integral_term == pytest.approx(0.0, abs=1e-6)
+
+
+def test_antiwindup_comes_from_the_yaml_and_must_be_a_bool():
+    assert PidGains.from_mapping({'p': 1, 'antiwindup': True}).antiwindup is True
+    assert PidGains.from_mapping({'p': 1}).antiwindup is False
+    with pytest.raises(GainsError, match='antiwindup'):
+        PidGains.from_mapping({'p': 1, 'antiwindup': 'yes'})
+
+
+def test_a_zero_time_step_changes_nothing_and_returns_the_last_output():
+    pid = Pid(PidGains(p=2.0, i=1.0))
+    first = pid.compute(setpoint=1.0, measurement=0.0, dt=DT)
+    integral = pid.integral_term
+    assert pid.compute(setpoint=5.0, measurement=0.0, dt=0.0) == first
+    assert pid.integral_term == integral
+
+
+@pytest.mark.parametrize('dt', [-1.0, -DT, math.nan])
+def test_a_negative_or_nan_time_step_raises(dt):
+    pid = Pid(PidGains(p=1.0, i=1.0))
+    with pytest.raises(ValueError, match='dt'):
+        pid.compute(setpoint=1.0, measurement=0.0, dt=dt)
+    assert pid.integral_term == 0.0
+
+
+@pytest.mark.parametrize('setpoint, measurement, rate', [
+    (math.nan, 0.0, 0.0), (0.0, math.inf, 0.0), (1.0, 0.0, math.nan), (1.0, 0.0, -math.inf)])
+def test_a_non_finite_error_or_rate_gives_zero_and_leaves_the_integrator(setpoint, measurement,
+                                                                         rate):
+    pid = Pid(PidGains(p=1.0, i=1.0, d=1.0))
+    pid.compute(setpoint=1.0, measurement=0.0, dt=DT, measurement_rate=0.0)
+    integral = pid.integral_term
+    assert pid.compute(setpoint, measurement, DT, rate) == 0.0
+    assert pid.integral_term == integral
 
 
 def test_derivative_acts_on_the_measured_rate_not_the_error():

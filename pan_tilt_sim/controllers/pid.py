@@ -1,8 +1,16 @@
 """A PID controller (after control_toolbox::Pid), with gains as a validated value object.
 
 * The integral term ``i * integral(error dt)`` is kept already multiplied by
-  the gain and clamped to [i_clamp_min, i_clamp_max] every step (anti-windup):
-  changing gains live does not make the integral jump.
+  the gain, so changing gains live does not make it jump.  Its contribution
+  to the output is always limited to [i_clamp_min, i_clamp_max].  As in
+  control_toolbox, ``antiwindup`` says whether the accumulator itself is
+  held within those bounds (true: the term recovers as soon as the error
+  changes sign) or keeps integrating beyond them (false, control_toolbox's
+  default: the term stays saturated until the excess has been integrated
+  away).
+* As in control_toolbox: a step of ``dt == 0`` changes nothing and returns
+  the last output; ``dt < 0`` (or NaN) raises ValueError; a non-finite error
+  or rate returns 0 and leaves the integrator untouched.
 * The derivative acts on the measurement, not on the error, so a jump of the
   setpoint gives no derivative kick.  Callers that measure the rate directly
   (a joint's velocity for a position loop) pass it in; otherwise the rate is
@@ -18,6 +26,8 @@ from typing import Any
 
 GAIN_NAMES = ('p', 'i', 'd')
 CLAMP_NAMES = ('i_clamp', 'i_clamp_min', 'i_clamp_max')
+ANTIWINDUP = 'antiwindup'
+_INF = math.inf
 
 
 class GainsError(ValueError):
@@ -33,8 +43,11 @@ class PidGains:
     d: float = 0.0
     i_clamp_min: float = -math.inf
     i_clamp_max: float = math.inf
+    antiwindup: bool = False
 
     def __post_init__(self) -> None:
+        if not isinstance(self.antiwindup, bool):
+            raise GainsError(f'{ANTIWINDUP}: {self.antiwindup!r} must be true or false')
         for name in GAIN_NAMES:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int | float):
@@ -68,11 +81,11 @@ class PidGains:
 
         ``i_clamp`` bounds the integral term symmetrically; the explicit
         ``i_clamp_min``/``i_clamp_max`` win where both are given.  A missing
-        gain is zero.
+        gain is zero; ``antiwindup`` (a bool) defaults to false.
         """
         if not isinstance(values, Mapping):
             raise GainsError(f'expected a mapping of gains, got {values!r}')
-        known = set(GAIN_NAMES) | set(CLAMP_NAMES) | {'antiwindup'}
+        known = set(GAIN_NAMES) | set(CLAMP_NAMES) | {ANTIWINDUP}
         unknown = sorted(set(values) - known)
         if unknown:
             raise GainsError(f"unknown field '{unknown[0]}' (known: {', '.join(sorted(known))})")
@@ -83,7 +96,7 @@ class PidGains:
                 raise GainsError(f'i_clamp: {bound!r} must be a number >= 0')
             fields['i_clamp_min'] = -bound
             fields['i_clamp_max'] = bound
-        for name in ('i_clamp_min', 'i_clamp_max'):
+        for name in ('i_clamp_min', 'i_clamp_max', ANTIWINDUP):
             if name in values:
                 fields[name] = values[name]
         return cls(**fields)
@@ -98,13 +111,14 @@ class PidGains:
 class Pid:
     """PID on ``setpoint - measurement``; derivative on measurement."""
 
-    __slots__ = ('_p', '_i', '_d', '_i_min', '_i_max', '_gains', '_integral',
-                 '_last_measurement')
+    __slots__ = ('_p', '_i', '_d', '_i_min', '_i_max', '_antiwindup', '_gains', '_integral',
+                 '_last_measurement', '_output')
 
     def __init__(self, gains: PidGains) -> None:
         self.gains = gains
         self._integral = 0.0
         self._last_measurement = math.nan
+        self._output = 0.0
 
     @property
     def gains(self) -> PidGains:
@@ -117,27 +131,39 @@ class Pid:
         self._gains = gains
         self._p, self._i, self._d = gains.p, gains.i, gains.d
         self._i_min, self._i_max = gains.i_clamp_min, gains.i_clamp_max
+        self._antiwindup = gains.antiwindup
 
     @property
     def integral_term(self) -> float:
-        """The integral term's present contribution to the output."""
-        return self._integral
+        """The integral term's present contribution to the output (within the clamp)."""
+        integral = self._integral
+        return self._i_min if integral < self._i_min else (
+            self._i_max if integral > self._i_max else integral)
 
     def reset(self) -> None:
-        """Zero the integral and forget the last measurement."""
+        """Zero the integral and the last output, and forget the last measurement."""
         self._integral = 0.0
         self._last_measurement = math.nan
+        self._output = 0.0
 
     def compute(self, setpoint: float, measurement: float, dt: float,
                 measurement_rate: float | None = None) -> float:
         """Return the control output for one step of ``dt`` seconds."""
+        if not dt > 0.0:
+            if dt == 0.0:
+                return self._output
+            raise ValueError(f'PID step dt must be >= 0 s, got {dt}')
         error = setpoint - measurement
-        integral = self._integral + self._i * error * dt
-        integral = self._i_min if integral < self._i_min else (
-            self._i_max if integral > self._i_max else integral)
-        self._integral = integral
         if measurement_rate is None:
             last = self._last_measurement
-            measurement_rate = 0.0 if last != last or dt <= 0.0 else (measurement - last) / dt
+            measurement_rate = 0.0 if last != last else (measurement - last) / dt
             self._last_measurement = measurement
-        return self._p * error + integral - self._d * measurement_rate
+        if not (-_INF < error < _INF and -_INF < measurement_rate < _INF):
+            return 0.0  # NaN fails both comparisons: the integrator is left as it was
+        integral = self._integral + self._i * error * dt
+        low, high = self._i_min, self._i_max
+        term = low if integral < low else high if integral > high else integral
+        self._integral = term if self._antiwindup else integral
+        output = self._p * error + term - self._d * measurement_rate
+        self._output = output
+        return output
