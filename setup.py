@@ -20,7 +20,7 @@ from setuptools import find_packages, setup
 
 PACKAGE = 'pan_tilt_sim'
 EXECUTABLES = {
-    'sim_node': 'pan_tilt_sim.runner:sim_node_main',  # signals handled before rclpy loads
+    'sim_node': 'pan_tilt_sim.__main__:main',  # signals handled before rclpy loads
     'bench': 'pan_tilt_sim.bench:main',
     'step_response': 'pan_tilt_sim.step_response:main',
 }

@@ -62,9 +62,9 @@ from pan_tilt_sim.controllers import create_controller
 from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
 from pan_tilt_sim.description import load_description
 from pan_tilt_sim.errors import ConfigurationError
-from pan_tilt_sim.parameters import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
-from pan_tilt_sim.physics import Physics, pybullet
+from pan_tilt_sim.physics import Physics
 from pan_tilt_sim.ros_interfaces import seconds
+from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
 
 DEFAULT_TIME_STEP = 0.001  # s, the issue's reference step
 CHAIN_JOINTS = (2, 8, 32)
@@ -134,7 +134,7 @@ def load_model(description_file: pathlib.Path, controllers_file: pathlib.Path) -
     for spec in config.controllers:
         controller = create_controller(spec.name, spec.type, spec.params, str(config.source))
         if isinstance(controller, JointPositionController):
-            joint = description.joint(controller.joint_names[0])
+            joint = description.model.joint(controller.joint_names[0])
             topic = naming.join(namespace, controller.name, controller.command_topic)
             commands[topic] = position_targets(joint.lower, joint.upper,
                                                joint.has_position_limits)
@@ -223,11 +223,10 @@ def slope(samples: Sequence[tuple[float, float]]) -> float:
 def raw_steps_per_s(description_file: pathlib.Path, time_step: float, duration: float) -> float:
     """Time bare ``stepSimulation()`` on the model; median over windows of RATE_WINDOW_S."""
     with Physics(load_description(description_file), time_step) as physics:
-        step = pybullet.stepSimulation
-        client = physics.client_id
+        step = physics.bare_stepper()
         started = time.perf_counter()
         for _ in range(RAW_CALIBRATION_STEPS):
-            step(client)
+            step()
         per_window = max(1, round(
             RAW_CALIBRATION_STEPS * RATE_WINDOW_S / (time.perf_counter() - started)))
         rates = []
@@ -235,7 +234,7 @@ def raw_steps_per_s(description_file: pathlib.Path, time_step: float, duration: 
         while not rates or time.perf_counter() < deadline:
             started = time.perf_counter()
             for _ in range(per_window):
-                step(client)
+                step()
             rates.append(per_window / (time.perf_counter() - started))
     return statistics.median(rates)
 
@@ -259,7 +258,7 @@ class NodeProcess:
                  log_file: pathlib.Path) -> None:
         arguments = {'robot_description_file': str(model.description_file),
                      'controllers_file': str(model.controllers_file), **parameters}
-        command = [sys.executable, '-m', 'pan_tilt_sim.sim_node', '--ros-args']
+        command = [sys.executable, '-m', 'pan_tilt_sim', '--ros-args']
         for name, value in arguments.items():
             command += ['-p', f'{name}:={value}']
         self._log_file = log_file

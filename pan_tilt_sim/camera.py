@@ -14,10 +14,11 @@ square, so ``fx = fy = (width / 2) / tan(fov / 2)``, and the principal
 point is the image centre in OpenCV's convention (pixel centres at integer
 coordinates): ``cx = (width - 1) / 2``, ``cy = (height - 1) / 2``.
 
-:class:`Renderer` keeps its own PyBullet client holding a copy of the robot
-and the scenery (:mod:`pan_tilt_sim.world`).  It renders from a snapshot of
-the joint positions, so the physics client is never touched by rendering and
-the scenery can never slow or disturb the physics.
+:class:`Renderer` renders in the simulation's own PyBullet client -- one
+client per simulation -- between batches of physics steps, so every frame
+shows the robot (and anything else in the world) exactly as the physics has
+it.  Rendering only reads the world; the scenery it shows
+(:mod:`pan_tilt_sim.world`) is visual only and never touches the physics.
 """
 
 from __future__ import annotations
@@ -28,18 +29,12 @@ from collections.abc import Mapping, Sequence
 
 import numpy
 
-from pan_tilt_sim.description import RobotDescription
+from pan_tilt_sim.bullet import pybullet
 from pan_tilt_sim.errors import ParameterError
-from pan_tilt_sim.kinematics import (
-    Transform,
-    Vector,
-    link_reach,
-    parse_kinematics,
-    quaternion_from_matrix,
-    rotate,
-)
-from pan_tilt_sim.physics import Physics, pybullet
-from pan_tilt_sim.world import DEFAULT_WORLD, GROUND_RGB, build_world, has_ground
+from pan_tilt_sim.physics import BASE_LINK_INDEX, Physics
+from pan_tilt_sim.robot_model import RobotModel
+from pan_tilt_sim.transforms import Transform, Vector, quaternion_from_matrix, rotate
+from pan_tilt_sim.world import DEFAULT_WORLD, GROUND_RGB, has_ground
 
 DEFAULT_LINK = 'tilt_link'
 DEFAULT_WIDTH = 320
@@ -53,14 +48,11 @@ OPTICAL_SUFFIX = '_optical'
 RGBA_CHANNELS = 4
 RGB_CHANNELS = 3
 BACKGROUND_DEPTH = 1.0  # OpenGL depth where nothing was drawn (the far plane)
-BASE_LINK_INDEX = -1  # PyBullet's index of a body's base link
 # Link axes that may serve as the camera's "up" (perpendicular to its +z view axis).
 UP_CANDIDATES: tuple[Vector, ...] = ((1.0, 0.0, 0.0), (-1.0, 0.0, 0.0),
                                      (0.0, 1.0, 0.0), (0.0, -1.0, 0.0))
 FORWARD: Vector = (0.0, 0.0, 1.0)
 WORLD_UP: Vector = (0.0, 0.0, 1.0)
-# The scene copy is never stepped; any valid time step will do.
-SCENE_TIME_STEP = 0.001
 
 
 @dataclasses.dataclass(frozen=True)
@@ -140,7 +132,7 @@ def vertical_fov_deg(settings: CameraSettings) -> float:
     return math.degrees(2.0 * half)
 
 
-def camera_mount(urdf_xml: str, link: str,
+def camera_mount(model: RobotModel, link: str,
                  initial_positions: Mapping[str, float]) -> Transform:
     """Return the pose of the optical frame in ``link``'s frame.
 
@@ -148,8 +140,8 @@ def camera_mount(urdf_xml: str, link: str,
     link's +z, the optical y (image down) is minus the link axis that points
     most nearly up in the initial pose, and optical x = y cross z (image right).
     """
-    reach = link_reach(urdf_xml, link)
-    poses = parse_kinematics(urdf_xml).link_poses(initial_positions)
+    reach = model.link(link).reach()
+    poses = model.link_poses(initial_positions)
     link_pose = poses.get(link, Transform())
     up = max(UP_CANDIDATES,
              key=lambda axis: _dot(rotate(link_pose.rotation, axis), WORLD_UP))
@@ -160,38 +152,32 @@ def camera_mount(urdf_xml: str, link: str,
 
 
 class Renderer:
-    """Renders the camera's view of the robot, posed from a joint snapshot, in its scenery."""
+    """Renders the camera's view from the simulation's PyBullet client, as it is now."""
 
-    def __init__(self, description: RobotDescription, settings: CameraSettings,
+    def __init__(self, physics: Physics, model: RobotModel, settings: CameraSettings,
                  world: str = DEFAULT_WORLD) -> None:
         self.settings = settings
-        self._scene = Physics(description, SCENE_TIME_STEP)
+        self._client = physics.client_id
         try:
-            self._client = self._scene.client_id
-            self._body = self._scene.body_id
-            self._link_index = self._find_link(settings.link)
-            build_world(world, self._client)
-            self._ground = has_ground(world)
-            camera = intrinsics(settings)
-            # Each pixel's viewing ray in optical axes: ((u - cx) / fx, (v - cy) / fy, 1).
-            self._ray_x = (numpy.arange(settings.width) - camera.cx) / camera.fx
-            self._ray_y = (numpy.arange(settings.height) - camera.cy) / camera.fy
-            initial = {joint.name: joint.initial_position for joint in self._scene.joints}
-            self.mount = camera_mount(description.urdf_xml, settings.link, initial)
-            self._projection = pybullet.computeProjectionMatrixFOV(
-                vertical_fov_deg(settings), settings.width / settings.height,
-                settings.near, settings.far, physicsClientId=self._client)
-        except BaseException:
-            self._scene.close()
-            raise
-        self.joint_names = tuple(joint.name for joint in self._scene.joints)
+            self._link_index = physics.link_index(settings.link)
+        except KeyError:
+            raise ParameterError(
+                f"parameter 'camera.link': '{settings.link}' is not a link of the robot "
+                f"(links: {', '.join(model.link_names)})") from None
+        self._body = physics.body_id
+        self._ground = has_ground(world)
+        camera = intrinsics(settings)
+        # Each pixel's viewing ray in optical axes: ((u - cx) / fx, (v - cy) / fy, 1).
+        self._ray_x = (numpy.arange(settings.width) - camera.cx) / camera.fx
+        self._ray_y = (numpy.arange(settings.height) - camera.cy) / camera.fy
+        initial = {joint.name: joint.initial_position for joint in physics.joints}
+        self.mount = camera_mount(model, settings.link, initial)
+        self._projection = pybullet.computeProjectionMatrixFOV(
+            vertical_fov_deg(settings), settings.width / settings.height,
+            settings.near, settings.far, physicsClientId=self._client)
 
-    def render(self, positions: Sequence[float]) -> bytes:
-        """Return an rgb8 image (rows top first) with the joints at ``positions``.
-
-        ``positions`` are in :attr:`joint_names` order (the physics layer's order).
-        """
-        self._scene.reset_joints(positions)
+    def render(self) -> bytes:
+        """Return an rgb8 image (rows top first) of the world as the physics has it now."""
         eye, forward, up = self.optical_axes()
         target = [e + f for e, f in zip(eye, forward, strict=True)]
         view = pybullet.computeViewMatrix(eye, target, up, physicsClientId=self._client)
@@ -234,24 +220,6 @@ class Renderer:
                                           physicsClientId=self._client)
             position, orientation = state[4], state[5]  # the URDF link frame
         return Transform(tuple(position), tuple(orientation))
-
-    def close(self) -> None:
-        """Release the scene's PyBullet client."""
-        self._scene.close()
-
-    def _find_link(self, link: str) -> int:
-        client, body = self._client, self._body
-        base = pybullet.getBodyInfo(body, physicsClientId=client)[0].decode('utf-8')
-        if link == base:
-            return BASE_LINK_INDEX
-        names = [base]
-        for index in range(pybullet.getNumJoints(body, physicsClientId=client)):
-            child = pybullet.getJointInfo(body, index, physicsClientId=client)[12]
-            names.append(child.decode('utf-8'))
-            if names[-1] == link:
-                return index
-        raise ParameterError(f"parameter 'camera.link': '{link}' is not a link of the robot "
-                             f"(links: {', '.join(names)})")
 
 
 def _dot(a: Sequence[float], b: Sequence[float]) -> float:

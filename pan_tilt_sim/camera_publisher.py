@@ -1,13 +1,15 @@
 """sim_node's camera: parameters, ``image_raw`` and ``camera_info`` topics.
 
-A frame is due every ``1 / camera.rate`` seconds of sim time; it is taken
-after the first chunk of physics steps that reaches the due time (sim_node
-checks every /clock period, 10 ms of sim time, so with the default 10 Hz the
-frames fall exactly on the 0.1 s grid).  When
-someone subscribes to the image, the joint positions are snapshot and handed
-to the renderer (:mod:`pan_tilt_sim.camera`); the image is stamped with the
-sim time of the snapshot and published in the ``<link>_optical`` frame, with
-a CameraInfo whose K and P follow from ``camera.fov_deg`` and the image size.
+A frame is due every ``1 / camera.rate`` seconds of sim time
+(:class:`~pan_tilt_sim.schedule.PeriodicSchedule`); it is taken after the
+first chunk of physics steps that reaches the due time (sim_node checks
+every /clock period, 10 ms of sim time, so with the default 10 Hz the frames
+fall exactly on the 0.1 s grid).  When someone subscribes to the image, the
+renderer (:mod:`pan_tilt_sim.camera`) draws the world as the physics has it
+now; the image is stamped with the sim time and published in the
+``<link>_optical`` frame, with a CameraInfo whose K and P follow from
+``camera.fov_deg`` and the image size.  A reset of the simulation starts the
+schedule again (:meth:`CameraPublisher.reset`).
 
 Rendering runs on the physics thread, between batches of steps: a 320x240
 TinyRenderer frame of the seed in the targets world costs ~3 ms (measured by
@@ -22,6 +24,7 @@ while nobody subscribes to ``image_raw``, so the camera then costs nothing.
 from __future__ import annotations
 
 import array
+from collections.abc import Callable, Sequence
 
 from rclpy.node import Node
 from sensor_msgs.msg import CameraInfo, Image
@@ -40,10 +43,10 @@ from pan_tilt_sim.camera import (
     Renderer,
     intrinsics,
 )
-from pan_tilt_sim.engine import Simulation
 from pan_tilt_sim.errors import ParameterError
-from pan_tilt_sim.kinematics import Transform, link_names
 from pan_tilt_sim.ros_interfaces import stamp
+from pan_tilt_sim.schedule import PeriodicSchedule
+from pan_tilt_sim.transforms import Transform
 from pan_tilt_sim.world import DEFAULT_WORLD, WORLDS, check_world
 
 IMAGE_ENCODING = 'rgb8'
@@ -52,8 +55,6 @@ DISTORTION_MODEL = 'plumb_bob'
 NO_DISTORTION = [0.0] * 5
 IDENTITY_3X3 = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
 QUEUE_DEPTH = 5
-# Tolerance on "frame due" so float sim times do not skip a frame.
-DUE_EPSILON = 1e-9
 
 
 def declare_world(node: Node) -> str:
@@ -64,11 +65,14 @@ def declare_world(node: Node) -> str:
         'targets). Visual only: it never touches the physics.'))
 
 
-def declare_camera(node: Node, urdf_xml: str) -> CameraSettings | None:
-    """Declare the ``camera.*`` parameters; return the settings, or None when it is off."""
+def declare_camera(node: Node, links: Sequence[str]) -> CameraSettings | None:
+    """Declare the ``camera.*`` parameters; return the settings, or None when it is off.
+
+    ``links`` are the robot's link names (the camera is on by default when it
+    has ``camera.link``).
+    """
     link = params.declare(node, 'camera.link', params.STRING, DEFAULT_LINK,
                           'Link carrying the camera, at its tip, looking along its +z.')
-    links = link_names(urdf_xml)
     enabled = params.declare(
         node, 'camera.enabled', params.BOOL, link in links,
         'Render and publish camera images (default: true when the robot has camera.link).')
@@ -111,11 +115,13 @@ def camera_info_message(camera: Intrinsics, frame_id: str) -> CameraInfo:
 class CameraPublisher:
     """Renders the camera when a frame is due and publishes it with its CameraInfo."""
 
-    def __init__(self, node: Node, simulation: Simulation, settings: CameraSettings,
-                 world: str, image_topic: str, info_topic: str) -> None:
-        self._simulation = simulation
+    def __init__(self, node: Node, renderer: Renderer, clock: Callable[[], float],
+                 image_topic: str, info_topic: str) -> None:
+        settings = renderer.settings
+        self._renderer = renderer
+        self._clock = clock
         self.settings = settings
-        self._renderer = Renderer(simulation.description, settings, world)
+        self._schedule = PeriodicSchedule(settings.period)
         self._image_publisher = node.create_publisher(Image, image_topic, QUEUE_DEPTH)
         self._info_publisher = node.create_publisher(CameraInfo, info_topic, QUEUE_DEPTH)
         self._info = camera_info_message(intrinsics(settings), settings.optical_frame)
@@ -124,7 +130,6 @@ class CameraPublisher:
                             step=settings.width * BYTES_PER_PIXEL)
         self._image.header.frame_id = settings.optical_frame
         self._frames = 0
-        self._next_due = 0.0
 
     @property
     def mount(self) -> Transform:
@@ -138,17 +143,12 @@ class CameraPublisher:
 
     def update(self) -> None:
         """Publish a frame if one is due at the present sim time (render it if watched)."""
-        now = self._simulation.time
-        if now + DUE_EPSILON < self._next_due:
+        now = self._clock()
+        if not self._schedule.take(now):
             return
-        period = self.settings.period
-        # Count periods from zero, so no rounding error accumulates.
-        self._next_due = (int((now + DUE_EPSILON) / period) + 1) * period
         stamp(now, self._info.header.stamp)
         if self._image_publisher.get_subscription_count() > 0:
-            positions = self._simulation.joint_positions()
-            pixels = self._renderer.render(
-                [positions[name] for name in self._renderer.joint_names])
+            pixels = self._renderer.render()
             image = self._image
             stamp(now, image.header.stamp)
             image.data = array.array('B', pixels)
@@ -157,6 +157,6 @@ class CameraPublisher:
         if self._info_publisher.get_subscription_count() > 0:
             self._info_publisher.publish(self._info)
 
-    def close(self) -> None:
-        """Release the renderer."""
-        self._renderer.close()
+    def reset(self) -> None:
+        """Start the frame schedule again (after sim time was reset or moved)."""
+        self._schedule.reset()

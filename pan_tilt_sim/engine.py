@@ -13,9 +13,10 @@ from collections.abc import Sequence
 
 from pan_tilt_sim.controller_config import ControllersConfig
 from pan_tilt_sim.controllers import CommandController, Controller, JointHandle, create_controller
-from pan_tilt_sim.description import JointSpec, RobotDescription
+from pan_tilt_sim.description import RobotDescription
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.physics import STATE_POSITION, STATE_VELOCITY, Physics
+from pan_tilt_sim.robot_model import JointSpec
 
 
 def build_controllers(config: ControllersConfig, handles: dict[str, JointHandle],

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 from rclpy.node import Node
 
+from pan_tilt_sim import naming
+from pan_tilt_sim.camera import Renderer
 from pan_tilt_sim.camera_publisher import CameraPublisher, declare_camera, declare_world
 from pan_tilt_sim.engine import Simulation
 from pan_tilt_sim.robot_state import RobotStatePublisher
@@ -21,31 +23,34 @@ from pan_tilt_sim.world import build_world
 
 
 class NodeFeatures:
-    """robot_description, TF and camera of one simulated robot.
+    """robot_description, TF and camera of one simulated robot, on ``node``.
 
-    ``node`` is sim_node's SimNode: it has ``simulation`` and ``topic(*names)``.
+    Topics go under ``robot_namespace``; the simulation gives the model, the
+    sim time, the joint positions and the PyBullet client the camera renders in.
     """
 
-    def __init__(self, node: Node, *, gui: bool = False) -> None:
-        simulation: Simulation = node.simulation
+    def __init__(self, node: Node, simulation: Simulation, robot_namespace: str, *,
+                 gui: bool = False) -> None:
+        description = simulation.description
+        model = description.model
         world = declare_world(node)
-        settings = declare_camera(node, simulation.description.urdf_xml)
-        if gui:
-            # Show the scenery in the PyBullet window too (visual only: no physics cost).
-            build_world(world, simulation.physics.client_id, ground=True)
+        settings = declare_camera(node, model.link_names)
+        if settings is not None or gui:
+            # The scenery lives in the simulation's client: visual only, no physics cost.
+            build_world(world, simulation.physics.client_id, ground=gui)
         self.camera: CameraPublisher | None = None
         static = []
         if settings is not None:
+            renderer = Renderer(simulation.physics, model, settings, world)
             self.camera = CameraPublisher(
-                node, simulation, settings, world,
-                node.topic('camera', 'image_raw'), node.topic('camera', 'camera_info'))
+                node, renderer, lambda: simulation.time,
+                naming.join(robot_namespace, 'camera', 'image_raw'),
+                naming.join(robot_namespace, 'camera', 'camera_info'))
             static.append((settings.link, settings.optical_frame, self.camera.mount))
-        try:
-            self.robot_state = RobotStatePublisher(
-                node, simulation, node.topic('robot_description'), static)
-        except BaseException:
-            self.close()
-            raise
+        self.robot_state = RobotStatePublisher(
+            node, model, description.urdf_xml,
+            naming.join(robot_namespace, 'robot_description'),
+            lambda: simulation.time, simulation.joint_positions, static)
 
     def after_steps(self) -> None:
         """Publish what is due at the present sim time (called every /clock period of steps)."""
@@ -53,8 +58,8 @@ class NodeFeatures:
         if self.camera is not None:
             self.camera.update()
 
-    def close(self) -> None:
-        """Release the camera's renderer."""
+    def reset(self) -> None:
+        """Start every schedule again: sim time was reset, or the world put back."""
+        self.robot_state.reset()
         if self.camera is not None:
-            self.camera.close()
-            self.camera = None
+            self.camera.reset()

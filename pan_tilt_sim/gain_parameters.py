@@ -1,95 +1,72 @@
-"""Live PID tuning: every PID gain is a node parameter, as dynamic_reconfigure made it.
+"""Live PID tuning: every PID gain is a node parameter, as control_toolbox's PidROS makes it.
 
-For each PID, ``<prefix>.p``, ``.i``, ``.d`` and ``.i_clamp`` are declared
-from the gains in effect (the YAML's, or the controller's defaults).  The
-prefix follows the YAML the gains come from:
+For each PID, the same six parameters are declared, from the gains in
+effect (the YAML's, or the controller's defaults): ``<prefix>.p``, ``.i``,
+``.d``, ``.i_clamp_max``, ``.i_clamp_min`` (doubles) and ``.antiwindup``
+(bool), whatever the YAML wrote (its ``i_clamp: x`` is
+``i_clamp_min = -x``, ``i_clamp_max = x``).  The prefix follows the YAML the
+gains come from (:attr:`Controller.gains_field`):
 
 * ``<controller>.pid`` for a one-joint controller (ROS 1 style, as the seed's
   ``joint1_position_controller.pid.p``);
 * ``<controller>.gains.<joint>`` for each joint of a multi-joint controller
   (ros2_controllers style, as ``arm_controller.gains.shoulder_joint.p``).
-  ``ros2 param set /sim_node
-joint1_position_controller.pid.p 50`` changes the gain at the next physics
-step; the integral term is kept (:class:`~pan_tilt_sim.controllers.pid.Pid`
-stores it already multiplied by ``i``).  Invalid values -- negative, not
-finite, not a number -- are refused with a reason and change nothing.
-Integers are accepted for these doubles.
 
-``i_clamp`` bounds the integral term symmetrically, as in the YAML.  A
-controller whose YAML gives an asymmetric ``i_clamp_min``/``i_clamp_max``
-gets those two parameters instead.
+``ros2 param set /sim_node joint1_position_controller.pid.p 50`` changes the
+gain at the next physics step; the integral term is kept
+(:class:`~pan_tilt_sim.controllers.pid.Pid` stores it already multiplied by
+``i``).  Changes are checked in the node's on-set callback and applied in
+its post-set callback, so a refused change -- negative, not finite, not a
+number, or refused by another callback of the same atomic set -- changes
+nothing.  Integers are accepted for the doubles.
 """
 
 from __future__ import annotations
 
 import dataclasses
 from collections.abc import Iterable, Sequence
+from typing import Any
 
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from pan_tilt_sim.controllers.base import Controller
-from pan_tilt_sim.controllers.pid import GainsError, Pid, PidGains
+from pan_tilt_sim.controllers.gains import PID_FIELD
+from pan_tilt_sim.controllers.pid import ANTIWINDUP, GainsError, Pid, PidGains
 from pan_tilt_sim.errors import ParameterError
-from pan_tilt_sim.parameters import DOUBLE, coerce, declare
+from pan_tilt_sim.parameters import BOOL, DOUBLE, coerce, declare
 
-PID_PREFIX = 'pid'
-GAINS_PREFIX = 'gains'
-SYMMETRIC_FIELDS = ('p', 'i', 'd', 'i_clamp')
-ASYMMETRIC_FIELDS = ('p', 'i', 'd', 'i_clamp_min', 'i_clamp_max')
+FIELDS = ('p', 'i', 'd', 'i_clamp_max', 'i_clamp_min', ANTIWINDUP)
+FIELD_TYPES = {field: DOUBLE for field in FIELDS} | {ANTIWINDUP: BOOL}
 DESCRIPTIONS = {
     'p': 'Proportional gain.',
     'i': 'Integral gain.',
     'd': 'Derivative gain (on the measured rate).',
-    'i_clamp': 'Bound of the integral term, +-i_clamp (same unit as the effort).',
+    'i_clamp_max': 'Upper bound of the integral term (same unit as the effort).',
     'i_clamp_min': 'Lower bound of the integral term.',
-    'i_clamp_max': 'Upper bound of the integral term.',
+    ANTIWINDUP: 'Hold the integrator itself within the clamp (else only its contribution).',
 }
 
 
-def gain_fields(gains: PidGains) -> tuple[str, ...]:
-    """Return the parameter fields that describe ``gains`` (symmetric clamp or not)."""
-    if gains.i_clamp_min == -gains.i_clamp_max:
-        return SYMMETRIC_FIELDS
-    return ASYMMETRIC_FIELDS
-
-
-def field_values(gains: PidGains, fields: Sequence[str]) -> dict[str, float]:
-    """Return the value of each parameter field for ``gains``."""
+def field_values(gains: PidGains) -> dict[str, Any]:
+    """Return the value of each gain parameter field for ``gains``."""
     values = dataclasses.asdict(gains)
-    values['i_clamp'] = gains.i_clamp_max
-    return {field: values[field] for field in fields}
+    return {field: values[field] for field in FIELDS}
 
 
-def apply_fields(gains: PidGains, updates: dict[str, float]) -> PidGains:
+def apply_fields(gains: PidGains, updates: dict[str, Any]) -> PidGains:
     """Return ``gains`` with the fields in ``updates`` replaced; GainsError if invalid."""
-    changes = dict(updates)
-    if 'i_clamp' in changes:
-        bound = changes.pop('i_clamp')
-        if not bound >= 0.0:  # also refuses NaN
-            raise GainsError(f'i_clamp: {bound!r} must be a number >= 0')
-        changes['i_clamp_min'], changes['i_clamp_max'] = -bound, bound
-    return dataclasses.replace(gains, **changes)
+    return dataclasses.replace(gains, **updates)
 
 
-def controller_pids(controller: Controller) -> dict[str, Pid]:
-    """Return the PIDs of ``controller`` by parameter prefix (none for PID-less types)."""
-    pid = getattr(controller, 'pid', None)
-    if isinstance(pid, Pid):
-        return {f'{controller.name}.{PID_PREFIX}': pid}
-    pids = {}
-    members = getattr(controller, 'members', None)
-    if members is not None:  # a group: one one-joint controller per joint
-        for member in members:
-            member_pid = getattr(member, 'pid', None)
-            if isinstance(member_pid, Pid):
-                pids[f'{controller.name}.{GAINS_PREFIX}.{member.joint_names[0]}'] = member_pid
-    joint_pids = getattr(controller, 'pids', None)
-    if joint_pids is not None:  # one PID per joint, in joint order
-        for joint, joint_pid in zip(controller.joint_names, joint_pids, strict=True):
-            pids[f'{controller.name}.{GAINS_PREFIX}.{joint}'] = joint_pid
-    return pids
+def parameter_prefixes(controller: Controller) -> dict[str, Pid]:
+    """Return the PIDs of ``controller`` by the prefix of their gain parameters."""
+    pids = controller.pids()
+    if controller.gains_field == PID_FIELD:
+        return {f'{controller.name}.{PID_FIELD}': pid for pid in pids.values()}
+    return {f'{controller.name}.{controller.gains_field}.{joint}': pid
+            for joint, pid in pids.items()}
 
 
 class GainParameters:
@@ -98,47 +75,52 @@ class GainParameters:
     def __init__(self, node: Node, controllers: Iterable[Controller]) -> None:
         self._pids: dict[str, Pid] = {}
         for controller in controllers:
-            self._pids.update(controller_pids(controller))
-        self._fields = {prefix: gain_fields(pid.gains) for prefix, pid in self._pids.items()}
+            self._pids.update(parameter_prefixes(controller))
         # Declare before listening; values given at start-up (-p ...) pass the same check.
         for prefix, pid in self._pids.items():
             declared = {field: self._declare(node, prefix, field, value)
-                        for field, value in field_values(pid.gains, self._fields[prefix]).items()}
+                        for field, value in field_values(pid.gains).items()}
             pid.gains = self._checked(prefix, declared)
         node.add_on_set_parameters_callback(self.on_set_parameters)
+        node.add_post_set_parameters_callback(self.on_parameters_set)
 
     def parameter_names(self) -> list[str]:
         """Return the names of every gain parameter."""
-        return [f'{prefix}.{field}' for prefix, fields in self._fields.items() for field in fields]
+        return [f'{prefix}.{field}' for prefix in self._pids for field in FIELDS]
 
-    def on_set_parameters(self, changed: list[Parameter]) -> SetParametersResult:
-        """Validate and apply the gain parameters among ``changed``; ignore the rest."""
-        updates: dict[str, dict[str, float]] = {}
+    def on_set_parameters(self, changed: Sequence[Parameter]) -> SetParametersResult:
+        """Check the gain parameters among ``changed`` (the rest are not ours); apply nothing."""
         try:
-            for parameter in changed:
-                prefix, _, field = parameter.name.rpartition('.')
-                if field not in self._fields.get(prefix, ()):
-                    continue
-                updates.setdefault(prefix, {})[field] = coerce(
-                    parameter.name, DOUBLE, parameter.value)
-            new_gains = {prefix: self._checked(prefix, fields)
-                         for prefix, fields in updates.items()}
+            self._new_gains(changed)
         except ParameterError as err:
             return SetParametersResult(successful=False, reason=str(err))
-        for prefix, gains in new_gains.items():
-            self._pids[prefix].gains = gains
         return SetParametersResult(successful=True)
 
-    def _checked(self, prefix: str, fields: dict[str, float]) -> PidGains:
+    def on_parameters_set(self, changed: Sequence[Parameter]) -> None:
+        """Apply the gain parameters among ``changed``, which the on-set check accepted."""
+        for prefix, gains in self._new_gains(changed).items():
+            self._pids[prefix].gains = gains
+
+    def _new_gains(self, changed: Sequence[Parameter]) -> dict[str, PidGains]:
+        updates: dict[str, dict[str, Any]] = {}
+        for parameter in changed:
+            prefix, _, field = parameter.name.rpartition('.')
+            if prefix not in self._pids or field not in FIELD_TYPES:
+                continue
+            updates.setdefault(prefix, {})[field] = coerce(
+                parameter.name, FIELD_TYPES[field], parameter.value)
+        return {prefix: self._checked(prefix, fields) for prefix, fields in updates.items()}
+
+    def _checked(self, prefix: str, fields: dict[str, Any]) -> PidGains:
         try:
             return apply_fields(self._pids[prefix].gains, fields)
         except GainsError as err:
             field, _, problem = str(err).partition(': ')
-            if field in self._fields[prefix]:
+            if field in FIELDS:
                 raise ParameterError(f"parameter '{prefix}.{field}': {problem}") from None
             raise ParameterError(f"parameters '{prefix}.*': {err}") from None
 
     @staticmethod
-    def _declare(node: Node, prefix: str, field: str, value: float) -> float:
-        return declare(node, f'{prefix}.{field}', DOUBLE, value,
+    def _declare(node: Node, prefix: str, field: str, value: Any) -> Any:
+        return declare(node, f'{prefix}.{field}', FIELD_TYPES[field], value,
                        f'{prefix}: {DESCRIPTIONS[field]}', read_only=False)

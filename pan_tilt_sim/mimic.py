@@ -15,8 +15,8 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 
-from pan_tilt_sim.description import JointSpec
 from pan_tilt_sim.errors import DescriptionError
+from pan_tilt_sim.robot_model import JointSpec
 
 
 @dataclasses.dataclass(frozen=True)

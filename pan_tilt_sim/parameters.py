@@ -20,12 +20,7 @@ from rclpy.parameter import Parameter
 
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.naming import check_namespace
-from pan_tilt_sim.share import (  # noqa: F401 -- re-exported: the defaults live there
-    DEFAULT_CONTROLLERS,
-    DEFAULT_DESCRIPTION,
-    PACKAGE_NAME,
-    package_share,
-)
+from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
 
 BOOL = ParameterType.PARAMETER_BOOL
 INTEGER = ParameterType.PARAMETER_INTEGER

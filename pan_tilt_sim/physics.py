@@ -15,15 +15,16 @@ constraint (see :mod:`pan_tilt_sim.mimic`).
 from __future__ import annotations
 
 import contextlib
-import os
 import pathlib
 import tempfile
 import weakref
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 
-from pan_tilt_sim.description import JointSpec, RobotDescription
+from pan_tilt_sim.bullet import pybullet, quiet_native_output
+from pan_tilt_sim.description import RobotDescription
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.mimic import follow_leaders, mimic_couplings
+from pan_tilt_sim.robot_model import JointSpec
 
 STANDARD_GRAVITY = 9.81  # m/s^2, along -z as in Gazebo's default world
 URDF_FILE_NAME = 'robot.urdf'
@@ -34,27 +35,7 @@ STATE_VELOCITY = 1
 # the share of the position error corrected per step (1 would be all at once).
 MIMIC_MAX_FORCE = 1e9
 MIMIC_ERROR_REDUCTION = 0.8
-
-
-@contextlib.contextmanager
-def quiet_native_output() -> Iterator[None]:
-    """Silence C-level stdout/stderr (PyBullet's build banner and loader chatter)."""
-    saved = []
-    try:
-        with open(os.devnull, 'wb') as devnull:
-            for fd in (1, 2):
-                saved.append((fd, os.dup(fd)))
-                os.dup2(devnull.fileno(), fd)
-            yield
-    finally:
-        for fd, copy in saved:
-            os.dup2(copy, fd)
-            os.close(copy)
-
-
-# PyBullet prints its build banner on stderr when imported; users see one line.
-with quiet_native_output():
-    import pybullet  # noqa: E402
+BASE_LINK_INDEX = -1  # PyBullet's index of a body's base link
 
 
 def _disconnect(client: int) -> None:
@@ -85,7 +66,7 @@ class Physics:
             self.close()
             raise
         self._joints = description.actuated_joints
-        index_of = self._joint_indices()
+        index_of, self._link_indices = self._joint_and_link_indices()
         self._indices = [index_of[joint.name] for joint in self._joints]
         self._mimics = mimic_couplings(self._joints, description.source)
         self._configure_motors()
@@ -116,6 +97,10 @@ class Physics:
     def joint_index(self, name: str) -> int:
         """PyBullet's index of the joint called ``name``."""
         return self._indices[[joint.name for joint in self._joints].index(name)]
+
+    def link_index(self, name: str) -> int:
+        """PyBullet's index of the link called ``name`` (-1: the base); KeyError if none."""
+        return self._link_indices[name]
 
     def read_states(self) -> list:
         """``pybullet.getJointStates`` for the actuated joints: (position, velocity, ...)."""
@@ -148,6 +133,17 @@ class Physics:
             return get_states(body, indices, client)
         return step
 
+    def bare_stepper(self) -> Callable[[], None]:
+        """Return ``stepSimulation`` bound to this client: a step that applies no efforts.
+
+        For measuring PyBullet alone (the benchmark's raw figure).
+        """
+        step_simulation, client = pybullet.stepSimulation, self._client
+
+        def step() -> None:
+            step_simulation(client)
+        return step
+
     def reset_joints(self, positions: Sequence[float]) -> None:
         """Put every actuated joint at ``positions`` (mimic joints by their leader), at rest."""
         if self._mimics:
@@ -175,7 +171,7 @@ class Physics:
         pybullet.setGravity(0.0, 0.0, -STANDARD_GRAVITY, physicsClientId=client)
         pybullet.setTimeStep(self._time_step, physicsClientId=client)
         urdf_path = pathlib.Path(self._workdir.name) / URDF_FILE_NAME
-        urdf_path.write_text(description.urdf_xml, encoding='utf-8')
+        urdf_path.write_text(description.physics_urdf, encoding='utf-8')
         try:
             with quiet_native_output():
                 return pybullet.loadURDF(
@@ -185,13 +181,15 @@ class Physics:
             raise DescriptionError(
                 f'{description.source}: PyBullet cannot load the robot: {err}') from None
 
-    def _joint_indices(self) -> dict[str, int]:
-        count = pybullet.getNumJoints(self._body, physicsClientId=self._client)
-        names = {}
-        for index in range(count):
-            info = pybullet.getJointInfo(self._body, index, physicsClientId=self._client)
-            names[info[1].decode('utf-8')] = index
-        return names
+    def _joint_and_link_indices(self) -> tuple[dict[str, int], dict[str, int]]:
+        client = self._client
+        base = pybullet.getBodyInfo(self._body, physicsClientId=client)[0].decode('utf-8')
+        joints, links = {}, {base: BASE_LINK_INDEX}
+        for index in range(pybullet.getNumJoints(self._body, physicsClientId=client)):
+            info = pybullet.getJointInfo(self._body, index, physicsClientId=client)
+            joints[info[1].decode('utf-8')] = index
+            links[info[12].decode('utf-8')] = index  # a joint's child link has its index
+        return joints, links
 
     def _configure_motors(self) -> None:
         # Velocity motors at zero speed: force 0 switches PyBullet's default motors

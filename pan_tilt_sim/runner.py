@@ -15,8 +15,9 @@
   while the node is being built aborts the build; while spinning it ends the
   spin; while the node is being destroyed it is only noted.
 * Importing rclpy and PyBullet takes about half a second, so this module
-  imports neither until the handlers are in place: :func:`sim_node_main` is
-  the entry point that covers a Ctrl-C from the very start.
+  imports neither until the handlers are in place, and knows no node: the
+  program (``pan_tilt_sim.__main__``) hands :func:`run` a factory that
+  imports its node only when called.
 """
 
 from __future__ import annotations
@@ -38,7 +39,6 @@ from pan_tilt_sim.errors import ArgumentError, ConfigurationError, one_line
 if TYPE_CHECKING:
     from rclpy.node import Node
 
-SIM_NODE_PROGRAM = 'sim_node'
 EXIT_OK = 0
 EXIT_CONFIGURATION_ERROR = 2
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -221,15 +221,9 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
     return EXIT_OK
 
 
-def _make_sim_node() -> Node:
-    from pan_tilt_sim.sim_node import SimNode  # slow: imports rclpy and PyBullet
-
-    return SimNode()
-
-
-def sim_node_main(args: list[str] | None = None,
-                  make_node: Callable[[], Node] = _make_sim_node) -> None:
-    """Run the sim_node program; exit 0 when stopped by a signal, 2 on a configuration error."""
-    status = run(make_node, args, program=SIM_NODE_PROGRAM)
+def main(make_node: Callable[[], Node], args: list[str] | None = None, *,
+         program: str) -> None:
+    """Run a node program; exit 0 when stopped by a signal, 2 on a configuration error."""
+    status = run(make_node, args, program=program)
     if status != EXIT_OK:
         sys.exit(status)

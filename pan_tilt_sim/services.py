@@ -19,13 +19,11 @@ exclusive) callback group, so a reset never lands inside a batch of steps.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Callable
 
+from rclpy.node import Node
 from rclpy.service import Service
 from std_srvs.srv import Empty
-
-if TYPE_CHECKING:
-    from pan_tilt_sim.sim_node import SimNode
 
 RESET_SIMULATION = 'reset_simulation'
 RESET_WORLD = 'reset_world'
@@ -33,24 +31,29 @@ PAUSE_PHYSICS = 'pause_physics'
 UNPAUSE_PHYSICS = 'unpause_physics'
 
 
-def create_world_services(node: SimNode) -> list[Service]:
-    """Offer ``reset_simulation``, ``reset_world``, ``pause_physics``, ``unpause_physics``."""
+def create_world_services(node: Node, *, reset: Callable[..., None],
+                          set_paused: Callable[[bool], None]) -> list[Service]:
+    """Offer ``reset_simulation``, ``reset_world``, ``pause_physics``, ``unpause_physics``.
 
-    def reset(reset_time: bool):
+    ``reset(reset_time=...)`` puts the world back; ``set_paused(bool)`` holds or
+    releases the physics.
+    """
+
+    def resetting(reset_time: bool):
         def serve(request: Empty.Request, response: Empty.Response) -> Empty.Response:
-            node.reset(reset_time=reset_time)
+            reset(reset_time=reset_time)
             return response
         return serve
 
-    def pause(paused: bool):
+    def pausing(paused: bool):
         def serve(request: Empty.Request, response: Empty.Response) -> Empty.Response:
-            node.set_paused(paused)
+            set_paused(paused)
             return response
         return serve
 
     return [
-        node.create_service(Empty, RESET_SIMULATION, reset(reset_time=True)),
-        node.create_service(Empty, RESET_WORLD, reset(reset_time=False)),
-        node.create_service(Empty, PAUSE_PHYSICS, pause(paused=True)),
-        node.create_service(Empty, UNPAUSE_PHYSICS, pause(paused=False)),
+        node.create_service(Empty, RESET_SIMULATION, resetting(reset_time=True)),
+        node.create_service(Empty, RESET_WORLD, resetting(reset_time=False)),
+        node.create_service(Empty, PAUSE_PHYSICS, pausing(paused=True)),
+        node.create_service(Empty, UNPAUSE_PHYSICS, pausing(paused=False)),
     ]

@@ -18,7 +18,7 @@ from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
-from pan_tilt_sim import naming, parameters, runner, services
+from pan_tilt_sim import naming, parameters, services
 from pan_tilt_sim.controller_config import load_controllers_config
 from pan_tilt_sim.controllers import CommandController, CommandResult
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
@@ -36,7 +36,6 @@ from pan_tilt_sim.ros_interfaces import (
 )
 
 NODE_NAME = 'sim_node'
-EXIT_CONFIGURATION_ERROR = runner.EXIT_CONFIGURATION_ERROR
 # Wall seconds between ticks when paced to real time: one JointState (50 Hz)
 # per tick, and each wake-up of rclpy's executor (~0.35 ms) costs < 2 % CPU.
 TICK_PERIOD_S = 0.02
@@ -71,15 +70,20 @@ class SimNode(Node):
         self._wire_controllers()
         try:
             self.gain_parameters = GainParameters(self, self.simulation.controllers)
-            self.features = NodeFeatures(self, gui=self.settings.gui)
+            self.features = NodeFeatures(
+                self, self.simulation, self.robot_namespace, gui=self.settings.gui)
         except BaseException:
             self.simulation.close()
             raise
         self._publish_clock()
         self.features.after_steps()  # their first samples at t = 0, as /clock's
         self._timer = self.create_timer(self._tick_period(), self._on_tick)
-        self.add_on_set_parameters_callback(self._on_set_parameters)
-        self._world_services = services.create_world_services(self)
+        # Checked in the on-set callback, applied in the post-set one: a change
+        # that any callback refuses is applied nowhere.
+        self.add_on_set_parameters_callback(self._check_parameters)
+        self.add_post_set_parameters_callback(self._apply_parameters)
+        self._world_services = services.create_world_services(
+            self, reset=self.reset, set_paused=self.set_paused)
         for joint in self.simulation.physics.joints:
             if joint.initial_position != 0.0:
                 self.get_logger().info(
@@ -130,6 +134,11 @@ class SimNode(Node):
         """Whether the physics is held."""
         return self._paused
 
+    @property
+    def real_time_factor(self) -> float:
+        """The pace the physics runs at now: sim seconds per wall second (0: flat out)."""
+        return self._pacer.real_time_factor
+
     def set_paused(self, paused: bool) -> None:
         """Hold or release the physics (topics stay alive); the ``paused`` parameter follows."""
         result, = self.set_parameters([Parameter(PAUSED, value=paused)])
@@ -143,15 +152,19 @@ class SimNode(Node):
             self._retime()
 
     def reset(self, *, reset_time: bool = True) -> None:
-        """Put the robot back to its initial state; sim time to 0 if asked (/clock says so)."""
+        """Put the robot back to its initial state; sim time to 0 if asked (/clock says so).
+
+        Every periodic publication (joint states, TF, camera) starts again from now.
+        """
         self.simulation.reset(reset_time=reset_time)
         self._pacer.restart()
         self._publish_clock()
+        self.features.reset()
+        self.features.after_steps()
 
     def destroy_node(self) -> None:
         """Stop ticking and release PyBullet."""
         self._timer.cancel()
-        self.features.close()
         self.simulation.close()
         logger = self.get_logger()
         super().destroy_node()
@@ -213,26 +226,26 @@ class SimNode(Node):
                                throttle_duration_sec=WARNING_THROTTLE_S)
         return store
 
-    def _on_set_parameters(self, changed: list[Parameter]) -> SetParametersResult:
+    @staticmethod
+    def _own_updates(changed: list[Parameter]) -> dict:
+        """Return the node's own parameters among ``changed``, coerced and checked."""
+        updates = {p.name: parameters.runtime_value(p) for p in changed
+                   if p.name in _OWN_PARAMETERS}  # other callbacks own the rest
+        if 'real_time_factor' in updates:
+            parameters.check_real_time_factor(updates['real_time_factor'])
+        return updates
+
+    def _check_parameters(self, changed: list[Parameter]) -> SetParametersResult:
         try:
-            updates = {p.name: parameters.runtime_value(p) for p in changed
-                       if p.name in _OWN_PARAMETERS}  # other callbacks own the rest
-            if 'real_time_factor' in updates:
-                parameters.check_real_time_factor(updates['real_time_factor'])
+            self._own_updates(changed)
         except ConfigurationError as err:
             return SetParametersResult(successful=False, reason=str(err))
+        return SetParametersResult(successful=True)
+
+    def _apply_parameters(self, changed: list[Parameter]) -> None:
+        updates = self._own_updates(changed)  # accepted by _check_parameters
         if PAUSED in updates:
             self._apply_paused(updates[PAUSED])
         if 'real_time_factor' in updates:
             self._pacer.real_time_factor = updates['real_time_factor']
             self._retime()
-        return SetParametersResult(successful=True)
-
-
-def main(args: list[str] | None = None) -> None:
-    """Run sim_node until SIGINT/SIGTERM (exit 0); a configuration error exits with code 2."""
-    runner.sim_node_main(args, SimNode)
-
-
-if __name__ == '__main__':
-    main()

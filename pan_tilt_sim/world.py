@@ -1,10 +1,9 @@
 """Scenery for the camera: a ground plane and a few coloured targets, or nothing.
 
 The world is built from PyBullet primitives (no ``pybullet_data`` files) and
-is visual only: its bodies have no collision shapes, so they cost the physics
-nothing and can never touch the robot.  It lives in the camera's own PyBullet
-client (see :mod:`pan_tilt_sim.camera`), and in the physics client only when
-a GUI window should show it too.
+is visual only: its bodies have no collision shapes, so they can never touch
+the robot.  It lives in the simulation's PyBullet client, where the camera
+renders (see :mod:`pan_tilt_sim.camera`) and a GUI window shows it.
 
 The ground is the plane z = 0.  TinyRenderer's cost grows with the pixels it
 shades, and a ground body covers half of every horizontal view (measured: 9 ms
@@ -25,8 +24,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
+from pan_tilt_sim.bullet import pybullet
 from pan_tilt_sim.errors import ParameterError
-from pan_tilt_sim.physics import pybullet
 
 EMPTY = 'empty'
 TARGETS = 'targets'

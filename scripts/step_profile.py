@@ -40,7 +40,7 @@ def per_step_us(run: Callable[[int], None], steps: int) -> float:
 
 def pybullet_figures(simulation) -> dict[str, float]:
     """Time the PyBullet calls alone on the simulation's own client."""
-    from pan_tilt_sim.physics import pybullet
+    from pan_tilt_sim.bullet import pybullet
 
     client = simulation.physics.client_id
     stepper = simulation.physics.stepper()
@@ -117,7 +117,7 @@ def main() -> None:
     if args.executor:
         os.environ['PAN_TILT_SIM_EXECUTOR'] = args.executor
     from pan_tilt_sim.engine import make_simulation
-    from pan_tilt_sim.parameters import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
+    from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
 
     share = package_share()
     with make_simulation(str(share / DEFAULT_DESCRIPTION), str(share / DEFAULT_CONTROLLERS),

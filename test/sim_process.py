@@ -1,6 +1,6 @@
 """sim_node as a program in its own process, started from the package the tests import.
 
-``python -m pan_tilt_sim.sim_node`` with this package first on PYTHONPATH:
+``python -m pan_tilt_sim`` with this package first on PYTHONPATH:
 the source tree under test, installed or not.  The child inherits the test
 process's ROS_DOMAIN_ID and ROS_AUTOMATIC_DISCOVERY_RANGE (see conftest.py).
 """
@@ -15,9 +15,8 @@ import sys
 import pan_tilt_sim
 
 PACKAGE_ROOT = pathlib.Path(pan_tilt_sim.__file__).resolve().parents[1]
-MODULE_ENTRY = ('-m', 'pan_tilt_sim.sim_node')
-# The entry point that handles signals from its very first import (see runner.py).
-RUNNER_ENTRY = ('-c', 'from pan_tilt_sim.runner import sim_node_main; sim_node_main()')
+# The program's one entry (the console script calls the same main()).
+MODULE_ENTRY = ('-m', 'pan_tilt_sim')
 
 
 def environment() -> dict[str, str]:

@@ -6,6 +6,7 @@ import numpy
 import pytest
 from node_harness import sim_node
 from sensor_msgs.msg import CameraInfo, Image
+from std_srvs.srv import Empty
 
 from pan_tilt_sim.camera import (
     CameraSettings,
@@ -16,9 +17,10 @@ from pan_tilt_sim.camera import (
 )
 from pan_tilt_sim.description import load_description
 from pan_tilt_sim.errors import ParameterError
-from pan_tilt_sim.kinematics import rotate
+from pan_tilt_sim.physics import Physics
 from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
-from pan_tilt_sim.world import GROUND_RGB, TARGET_SET, Target
+from pan_tilt_sim.transforms import rotate
+from pan_tilt_sim.world import GROUND_RGB, TARGET_SET, Target, build_world
 
 HORIZONTAL_TILT = -math.pi / 2  # the seed's tilt start: the camera looks horizontally
 PAN_LIMIT = 3.14
@@ -35,12 +37,33 @@ def seed_description():
     return load_description(package_share() / DEFAULT_DESCRIPTION)
 
 
+class Scene:
+    """The seed robot in its own simulation, its camera, the world around it."""
+
+    def __init__(self, description, world: str = 'targets') -> None:
+        self.physics = Physics(description, 0.001)
+        build_world(world, self.physics.client_id)
+        self.settings = CameraSettings()
+        self.renderer = Renderer(self.physics, description.model, self.settings, world)
+
+    def render(self, positions) -> bytes:
+        """Put the joints at ``positions`` (pan, tilt) and render."""
+        self.physics.reset_joints(positions)
+        return self.renderer.render()
+
+    def optical_axes(self):
+        return self.renderer.optical_axes()
+
+    def close(self) -> None:
+        self.physics.close()
+
+
 @pytest.fixture(scope='module')
 def renderer(seed_description):
-    """Return a renderer of the default camera in the default (targets) world."""
-    renderer = Renderer(seed_description, CameraSettings())
-    yield renderer
-    renderer.close()
+    """Return the default camera in the default (targets) world."""
+    scene = Scene(seed_description)
+    yield scene
+    scene.close()
 
 
 def as_array(pixels: bytes, settings: CameraSettings) -> numpy.ndarray:
@@ -107,7 +130,7 @@ def test_bad_camera_settings_name_the_parameter(field, value, parameter):
 # --- mounting -------------------------------------------------------------------
 
 def test_the_camera_sits_at_the_tip_of_the_tilt_link_looking_along_its_z(seed_description):
-    mount = camera_mount(seed_description.urdf_xml, 'tilt_link',
+    mount = camera_mount(seed_description.model, 'tilt_link',
                          {'pan_joint': 0.0, 'tilt_joint': HORIZONTAL_TILT})
     assert mount.translation == pytest.approx((0.0, 0.0, 0.2))  # half the 0.4 m cylinder
     # REP-103 optical frame in link axes: z forward = link z, y down = -link x
@@ -197,7 +220,7 @@ def test_a_target_appears_where_the_camera_info_intrinsics_project_it(renderer):
 
 
 def test_an_empty_world_shows_only_the_robot(seed_description):
-    renderer = Renderer(seed_description, CameraSettings(), world='empty')
+    renderer = Scene(seed_description, world='empty')
     try:
         image = as_array(renderer.render([0.0, HORIZONTAL_TILT]), renderer.settings)
     finally:
@@ -215,7 +238,7 @@ def test_images_and_camera_info_arrive_at_the_camera_rate_in_sim_time():
         harness.wait_for_subscribers(topic)
         start = harness.simulation.time
         harness.run_until_sim_time(start + 2.0)
-        harness.spin_until(lambda: len(images) >= 20 and len(infos) >= 20, budget_s=5.0)
+        assert harness.spin_until(lambda: len(images) >= 20 and len(infos) >= 20, budget_s=5.0)
     stamps = [m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 for m in images]
     in_window = [s for s in stamps if start + 0.05 <= s < start + 1.05]
     assert len(in_window) == 10  # 10 Hz of sim time
@@ -247,6 +270,25 @@ def test_panning_through_the_node_brings_a_target_in_and_out_of_view():
         assert harness.spin_until(lambda: len(images) > count)
         last = numpy.frombuffer(images[-1].data, numpy.uint8).reshape(240, 320, 3)
     assert not colour_mask(last, blue.rgba).any()
+
+
+def test_frames_keep_coming_after_reset_simulation():
+    # Sim time goes back to 0: the camera's schedule must start again, not
+    # wait until sim time passes the frame that was due before the reset.
+    with sim_node(**{'camera.rate': 10.0}) as harness:
+        topic = harness.node.topic('camera', 'image_raw')
+        images = harness.collect(Image, topic)
+        harness.wait_for_subscribers(topic)
+        harness.run_until_sim_time(2.0)
+        harness.node.set_paused(True)
+        harness.call(Empty, 'reset_simulation')
+        assert harness.simulation.time == 0.0
+        harness.drain()
+        count = len(images)
+        harness.node.set_paused(False)
+        harness.run_for(1.2)
+        stamps = [m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 for m in images[count:]]
+    assert len([s for s in stamps if s <= 1.2 + 1e-6]) >= 12, stamps  # ~12 frames at 10 Hz
 
 
 def test_nothing_is_rendered_while_nobody_watches():

@@ -4,8 +4,9 @@ import math
 
 import pytest
 
-from pan_tilt_sim.description import JointKind, load_description, parse_xacro_args
+from pan_tilt_sim.description import load_description, parse_xacro_args
 from pan_tilt_sim.errors import DescriptionError
+from pan_tilt_sim.robot_model import JointKind
 
 
 def _facts(description):
@@ -16,7 +17,7 @@ def test_our_pan_tilt_xacro_has_the_seeds_joints_limits_and_dynamics(repo_root):
     description = load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
     assert description.name == 'ex_urdf_pan_tilt'
     assert description.plugin_namespace == '/ex_urdf_pan_tilt'
-    pan, tilt = description.joint('pan_joint'), description.joint('tilt_joint')
+    pan, tilt = description.model.joint('pan_joint'), description.model.joint('tilt_joint')
     assert (pan.kind, pan.lower, pan.upper) == (JointKind.REVOLUTE, -3.14, 3.14)
     assert (tilt.lower, tilt.upper) == (-4.71239, -1.570796)
     for joint in (pan, tilt):
@@ -60,8 +61,8 @@ def test_our_xacro_keeps_the_seeds_links_geometry_and_inertia(seeds_dir, repo_ro
 
 def test_initial_position_is_zero_or_the_nearest_limit(repo_root):
     description = load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
-    assert description.joint('pan_joint').initial_position == 0.0
-    assert description.joint('tilt_joint').initial_position == -1.570796
+    assert description.model.joint('pan_joint').initial_position == 0.0
+    assert description.model.joint('tilt_joint').initial_position == -1.570796
 
 
 def test_xacro_args_are_mappings(tmp_path):
@@ -72,8 +73,8 @@ def test_xacro_args_are_mappings(tmp_path):
         '<link name="a"/><link name="b"/>'
         '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
         '<limit lower="0" upper="$(arg reach)" effort="1" velocity="1"/></joint></robot>')
-    assert load_description(path).joint('j').upper == 1.0
-    assert load_description(path, ['reach:=2.5']).joint('j').upper == 2.5
+    assert load_description(path).model.joint('j').upper == 1.0
+    assert load_description(path, ['reach:=2.5']).model.joint('j').upper == 2.5
 
 
 def test_a_continuous_joint_has_no_position_limits(tmp_path):
@@ -82,7 +83,7 @@ def test_a_continuous_joint_has_no_position_limits(tmp_path):
         '<robot name="w"><link name="a"/><link name="b"/>'
         '<joint name="wheel" type="continuous"><parent link="a"/><child link="b"/>'
         '<limit effort="5" velocity="2"/></joint></robot>')
-    wheel = load_description(path).joint('wheel')
+    wheel = load_description(path).model.joint('wheel')
     assert not wheel.has_position_limits
     assert (wheel.lower, wheel.upper) == (-math.inf, math.inf)
     assert wheel.clamp_position(100.0) == 100.0

@@ -1,14 +1,15 @@
-"""Live PID tuning: <controller>.pid.p|i|d|i_clamp parameters, set through the service."""
+"""Live PID tuning: <controller>.pid.{p,i,d,i_clamp_max,i_clamp_min,antiwindup} parameters."""
 
 import math
 import re
 
 import pytest
 from node_harness import sim_node
+from rclpy.parameter import Parameter
 
 from pan_tilt_sim.controllers.pid import GainsError, PidGains
 from pan_tilt_sim.errors import ParameterError
-from pan_tilt_sim.gain_parameters import apply_fields, field_values, gain_fields
+from pan_tilt_sim.gain_parameters import FIELDS, apply_fields, field_values
 
 PAN = 'joint1_position_controller'
 TILT = 'joint2_position_controller'
@@ -28,25 +29,22 @@ def ramp_lag(p: float) -> float:
 
 # --- pure -----------------------------------------------------------------------
 
-def test_symmetric_clamps_are_one_i_clamp_parameter():
-    gains = PidGains(p=1.0, i_clamp_min=-3.0, i_clamp_max=3.0)
-    assert gain_fields(gains) == ('p', 'i', 'd', 'i_clamp')
-    assert field_values(gains, gain_fields(gains)) == {'p': 1.0, 'i': 0.0, 'd': 0.0,
-                                                       'i_clamp': 3.0}
-
-
-def test_asymmetric_clamps_keep_their_two_parameters():
-    gains = PidGains(i_clamp_min=-1.0, i_clamp_max=2.0)
-    assert gain_fields(gains) == ('p', 'i', 'd', 'i_clamp_min', 'i_clamp_max')
-
-
-def test_setting_i_clamp_bounds_the_integral_both_ways():
-    gains = apply_fields(PidGains(p=1.0), {'i_clamp': 5.0, 'p': 2.0})
-    assert (gains.p, gains.i_clamp_min, gains.i_clamp_max) == (2.0, -5.0, 5.0)
+@pytest.mark.parametrize('gains', [PidGains(p=1.0, i_clamp_min=-3.0, i_clamp_max=3.0),
+                                   PidGains(i_clamp_min=-1.0, i_clamp_max=2.0),
+                                   PidGains(p=2.0, antiwindup=True)])
+def test_every_pid_has_the_same_six_parameters_whatever_its_gains(gains):
+    # As control_toolbox's PidROS: the names never depend on the values.
+    values = field_values(gains)
+    assert tuple(values) == FIELDS == ('p', 'i', 'd', 'i_clamp_max', 'i_clamp_min',
+                                       'antiwindup')
+    assert (values['i_clamp_min'], values['i_clamp_max']) == (gains.i_clamp_min,
+                                                               gains.i_clamp_max)
+    assert apply_fields(PidGains(), values) == gains
 
 
 @pytest.mark.parametrize('updates', [{'p': -1.0}, {'d': math.nan}, {'i': math.inf},
-                                     {'i_clamp': -0.5}, {'i_clamp': math.nan}])
+                                     {'i_clamp_min': 1.0, 'i_clamp_max': -1.0},
+                                     {'i_clamp_max': math.nan}, {'antiwindup': 1.0}])
 def test_invalid_gains_are_refused(updates):
     with pytest.raises(GainsError):
         apply_fields(PidGains(), updates)
@@ -57,13 +55,12 @@ def test_invalid_gains_are_refused(updates):
 def test_gains_are_parameters_initialised_from_the_yaml():
     with sim_node() as harness:
         node = harness.node
-        values = {field: node.get_parameter(f'{PAN}.pid.{field}').value
-                  for field in ('p', 'i', 'd', 'i_clamp')}
+        values = {field: node.get_parameter(f'{PAN}.pid.{field}').value for field in FIELDS}
         assert sorted(harness.node.gain_parameters.parameter_names()) == sorted(
-            f'{controller}.pid.{field}' for controller in (PAN, TILT)
-            for field in ('p', 'i', 'd', 'i_clamp'))
+            f'{controller}.pid.{field}' for controller in (PAN, TILT) for field in FIELDS)
     # The YAML gives p, i, d; the integral is bounded by the URDF effort limit (300).
-    assert values == {'p': 100.0, 'i': 0.01, 'd': 10.0, 'i_clamp': 300.0}
+    assert values == {'p': 100.0, 'i': 0.01, 'd': 10.0, 'i_clamp_max': 300.0,
+                      'i_clamp_min': -300.0, 'antiwindup': False}
 
 
 def test_a_gain_set_live_changes_the_step_response_as_computed_by_hand():
@@ -107,7 +104,8 @@ def test_a_live_change_keeps_the_integral_term():
 @pytest.mark.parametrize(('field', 'value', 'reason'), [
     ('p', -1.0, r"'joint1_position_controller.pid.p'.*>= 0"),
     ('d', -3, r"'joint1_position_controller.pid.d'.*>= 0"),
-    ('i_clamp', -2.0, r"'joint1_position_controller.pid.i_clamp'.*>= 0"),
+    ('i_clamp_max', -400.0, r"'joint1_position_controller.pid.\*'.*greater than"),
+    ('antiwindup', 'yes', r"'joint1_position_controller.pid.antiwindup' must be a bool"),
     ('i', 'fast', r"'joint1_position_controller.pid.i' must be a double"),
     ('p', math.nan, r"'joint1_position_controller.pid.p'.*finite"),
 ])
@@ -120,7 +118,31 @@ def test_invalid_values_are_refused_with_a_reason_and_change_nothing(field, valu
         assert re.search(reason, results[0].reason), results[0].reason
         assert controller.pid.gains == before
         assert harness.node.get_parameter(f'{PAN}.pid.{field}').value == field_values(
-            before, (field,))[field]
+            before)[field]
+
+
+@pytest.mark.parametrize('own', [{'paused': True}, {'real_time_factor': 0.5}])
+def test_a_refused_atomic_change_applies_nothing_not_even_the_valid_part(own):
+    # The gain is refused, so `paused` / `real_time_factor` must not change
+    # either: in the node, in its pacing and in the parameter.
+    with sim_node() as harness:
+        node = harness.node
+        name, value = next(iter(own.items()))
+        before = node.get_parameter(name).value
+        result = node.set_parameters_atomically([
+            Parameter(name, value=value), Parameter(f'{PAN}.pid.p', value=-1.0)])
+        assert not result.successful
+        assert node.get_parameter(name).value == before
+        assert node.paused is False
+        assert node.real_time_factor == 0.0
+        assert harness.simulation.controller(PAN).pid.gains.p == 100.0
+        accepted = node.set_parameters_atomically([
+            Parameter(name, value=value), Parameter(f'{PAN}.pid.p', value=60.0)])
+        assert accepted.successful
+        assert node.get_parameter(name).value == value
+        assert (node.paused, node.real_time_factor) == (
+            own.get('paused', False), own.get('real_time_factor', 0.0))
+        assert harness.simulation.controller(PAN).pid.gains.p == 60.0
 
 
 def test_the_core_runtime_parameters_still_work_beside_the_gains():
@@ -149,13 +171,14 @@ def test_multi_joint_controllers_get_one_set_of_gains_per_joint(repo_root):
     with sim_node(robot_description_file=model, controllers_file=controllers) as harness:
         node = harness.node
         assert node.get_parameter('arm_controller.gains.shoulder_joint.p').value == 100.0
-        assert node.get_parameter('arm_controller.gains.wrist_joint.i_clamp').value == 0.5
+        assert node.get_parameter('arm_controller.gains.wrist_joint.i_clamp_max').value == 0.5
+        assert node.get_parameter('arm_controller.gains.wrist_joint.i_clamp_min').value == -0.5
         assert node.get_parameter('gripper_controller.gains.left_finger_joint.p').value == 400.0
         results = harness.set_parameters(**{'arm_controller.gains.extend_joint.d': 50.0,
                                             'gripper_controller.gains.left_finger_joint.i': 2})
         assert all(result.successful for result in results)
         arm = harness.simulation.controller('arm_controller')
-        assert [pid.gains.d for pid in arm.pids] == [10.0, 50.0, 0.3]
+        assert [pid.gains.d for pid in arm.pids().values()] == [10.0, 50.0, 0.3]
         gripper = harness.simulation.controller('gripper_controller')
         assert gripper.members[0].pid.gains.i == 2.0
         refused = harness.set_parameters(**{'arm_controller.gains.wrist_joint.p': -1.0})

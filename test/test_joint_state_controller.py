@@ -3,8 +3,8 @@
 import pytest
 
 from pan_tilt_sim.controllers import JointHandle, create_controller
-from pan_tilt_sim.description import JointKind, JointSpec
 from pan_tilt_sim.errors import ControllerConfigError
+from pan_tilt_sim.robot_model import JointKind, JointSpec
 
 TYPE = 'joint_state_controller/JointStateController'
 DT = 0.001

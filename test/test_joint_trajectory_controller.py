@@ -12,9 +12,9 @@ import pytest
 from pan_tilt_sim.controllers import CommandKind, CommandResult, JointHandle, create_controller
 from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
 from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPlan, TrajectoryPoint
-from pan_tilt_sim.description import JointKind, JointSpec
 from pan_tilt_sim.engine import make_simulation
 from pan_tilt_sim.errors import ControllerConfigError
+from pan_tilt_sim.robot_model import JointKind, JointSpec
 
 DT = 0.001
 JTC = 'joint_trajectory_controller/JointTrajectoryController'
@@ -257,7 +257,7 @@ def test_effort_is_pid_on_position_with_derivative_on_velocity_error():
     # Desired 0.1 rad moving at 1 rad/s; measured 0 rad at 0.25 rad/s.
     expected = 50.0 * 0.1 + 5.0 * (1.0 - 0.25) + 2.0 * 1.0
     assert handles['a'].effort == pytest.approx(expected)
-    assert controller.pids[1].gains == DEFAULT_POSITION_GAINS.with_default_clamp(1000.0)
+    assert controller.pids()['b'].gains == DEFAULT_POSITION_GAINS.with_default_clamp(1000.0)
 
 
 @pytest.mark.parametrize(('params', 'field'), [

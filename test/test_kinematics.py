@@ -1,24 +1,25 @@
 """The kinematic tree from a URDF matches what PyBullet computes, without ROS."""
 
 import math
+import pathlib
 
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from pan_tilt_sim.bullet import pybullet
 from pan_tilt_sim.description import load_description
-from pan_tilt_sim.kinematics import (
+from pan_tilt_sim.physics import Physics
+from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.transforms import (
     Transform,
-    link_reach,
-    parse_kinematics,
     quaternion_from_axis_angle,
     quaternion_from_matrix,
     quaternion_from_rpy,
     rotate,
     rotation_matrix,
 )
-from pan_tilt_sim.physics import Physics, pybullet
-from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.urdf import parse_urdf
 
 # A chain with every joint kind the tree handles, offsets and rotated origins.
 ARM_URDF = """<robot name="arm">
@@ -79,26 +80,34 @@ def test_a_transform_composes_rotation_then_translation():
     assert twice.apply((1.0, 0.0, 0.0)) == pytest.approx((0.0, 1.0, 0.0), abs=1e-12)
 
 
+def seed_model():
+    return load_description(package_share() / DEFAULT_DESCRIPTION).model
+
+
+def arm_model():
+    return parse_urdf(ARM_URDF, pathlib.Path('arm.urdf'))
+
+
 def test_the_seed_has_two_moving_joints_and_no_fixed_ones():
-    tree = parse_kinematics(load_description(package_share() / DEFAULT_DESCRIPTION).urdf_xml)
+    tree = seed_model()
     assert tree.root == 'base_link'
     assert [joint.name for joint in tree.moving_joints] == ['pan_joint', 'tilt_joint']
     assert tree.fixed_joints == ()
 
 
 def test_the_seed_tilt_link_is_0_3_m_up_and_turned_by_the_tilt():
-    tree = parse_kinematics(load_description(package_share() / DEFAULT_DESCRIPTION).urdf_xml)
+    tree = seed_model()
     pose = tree.link_poses({'pan_joint': 0.0, 'tilt_joint': -math.pi / 2})['tilt_link']
     assert pose.translation == pytest.approx((0.0, 0.0, 0.3))
     assert rotate(pose.rotation, (0, 0, 1)) == pytest.approx((-1.0, 0.0, 0.0), abs=1e-12)
 
 
 def test_link_reach_is_the_far_end_of_the_visual_along_z():
-    urdf = load_description(package_share() / DEFAULT_DESCRIPTION).urdf_xml
-    assert link_reach(urdf, 'tilt_link') == pytest.approx(0.2)  # 0.4 m cylinder, centred
-    assert link_reach(urdf, 'pan_link') == pytest.approx(0.29)  # offset 0.09 + 0.2
-    assert link_reach(ARM_URDF, 'upper') == pytest.approx(0.5)  # box from 0 to 0.5
-    assert link_reach(ARM_URDF, 'base') == 0.0  # no visual
+    seed, arm = seed_model(), arm_model()
+    assert seed.link('tilt_link').reach() == pytest.approx(0.2)  # 0.4 m cylinder, centred
+    assert seed.link('pan_link').reach() == pytest.approx(0.29)  # offset 0.09 + 0.2
+    assert arm.link('upper').reach() == pytest.approx(0.5)  # box from 0 to 0.5
+    assert arm.link('base').reach() == 0.0  # no visual
 
 
 @pytest.fixture
@@ -129,7 +138,7 @@ def pybullet_link_poses(physics):
 def test_link_poses_agree_with_pybullet(arm_physics, yaw, pitch, extend):
     positions = {'yaw': yaw, 'pitch': pitch, 'extend': extend}
     arm_physics.reset_joints([positions[joint.name] for joint in arm_physics.joints])
-    ours = parse_kinematics(ARM_URDF).link_poses(positions)
+    ours = arm_model().link_poses(positions)
     for link, (position, orientation) in pybullet_link_poses(arm_physics).items():
         assert ours[link].translation == pytest.approx(position, abs=1e-5), link
         assert close_rotation(ours[link].rotation, orientation, 1e-5), link

@@ -2,9 +2,9 @@
 
 import pytest
 
-from pan_tilt_sim.description import JointKind, JointSpec, Mimic
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.mimic import MimicCoupling, follow_leaders, mimic_couplings
+from pan_tilt_sim.robot_model import JointKind, JointSpec, Mimic
 
 
 def joint(name, mimic=None):

@@ -103,10 +103,6 @@ def _node_env(tmp_path: pathlib.Path) -> dict:
             'ROS_DOMAIN_ID': os.environ.get('ROS_DOMAIN_ID', '0')}
 
 
-def _node_written() -> bool:
-    return importlib.util.find_spec(f'{PACKAGE}.sim_node') is not None
-
-
 # --- pip layout (this venv) -------------------------------------------------
 
 def test_ament_index_finds_this_venv(prefix):
@@ -142,7 +138,7 @@ def test_ros2_run_sees_exactly_the_entry_points(prefix):
     expected = {name: f'{PACKAGE}.{name}:main' for name in EXECUTABLES}
     # sim_node starts through the runner, which installs its signal handlers
     # before rclpy and PyBullet are imported (a Ctrl-C during start-up is clean).
-    expected['sim_node'] = f'{PACKAGE}.runner:sim_node_main'
+    expected['sim_node'] = f'{PACKAGE}.__main__:main'
     assert entry_points == expected
     # `ros2 run` offers every executable file in lib/<package>/.
     lib = prefix / 'lib' / PACKAGE
@@ -207,7 +203,6 @@ def test_launcher_runs_venv_python_when_venv_not_activated(prefix, tmp_path):
     assert pathlib.Path(report['prefix']).samefile(sys.prefix)
 
 
-@pytest.mark.skipif(not _node_written(), reason='pan_tilt_sim.sim_node is not written yet')
 def test_sim_node_starts_through_the_launcher(prefix, tmp_path):
     # A bad parameter ends start-up with exit code 2 before any simulation.
     proc = subprocess.run(
@@ -262,11 +257,10 @@ def test_colcon_build_layout(repo_root, tmp_path, mode):
     report = _probe(install / 'lib' / PACKAGE / 'sim_node', tmp_path)
     assert pathlib.Path(report['prefix']).samefile(sys.prefix)
 
-    if _node_written():
-        # As `ros2 run` after sourcing the workspace: the colcon-built module.
-        proc = subprocess.run(
-            ['bash', '-c', 'source install/setup.bash && exec "$@"', 'bash',
-             str(install / 'lib' / PACKAGE / 'sim_node'), '--ros-args', '-p', 'time_step:=-1'],
-            cwd=tmp_path / 'ws', env=_node_env(tmp_path), capture_output=True, text=True,
-            timeout=120)
-        assert proc.returncode == 2, proc.stdout + proc.stderr
+    # As `ros2 run` after sourcing the workspace: the colcon-built module.
+    proc = subprocess.run(
+        ['bash', '-c', 'source install/setup.bash && exec "$@"', 'bash',
+         str(install / 'lib' / PACKAGE / 'sim_node'), '--ros-args', '-p', 'time_step:=-1'],
+        cwd=tmp_path / 'ws', env=_node_env(tmp_path), capture_output=True, text=True,
+        timeout=120)
+    assert proc.returncode == 2, proc.stdout + proc.stderr

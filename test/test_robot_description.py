@@ -2,27 +2,26 @@
 
 import importlib.util
 import math
+import os
+import pathlib
 
+import mesh_fixtures as mf
 import pytest
 from geometry_msgs.msg import TransformStamped
-from node_harness import sim_node
+from node_harness import sim_node, stamp_s
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from std_msgs.msg import String
+from std_msgs.msg import Float64MultiArray, String
 
-from pan_tilt_sim.description import Mimic, load_description
-from pan_tilt_sim.kinematics import (
-    Transform,
-    parse_kinematics,
-    quaternion_from_axis_angle,
-    rotate,
-)
+from pan_tilt_sim import robot_state
+from pan_tilt_sim.description import load_description
 from pan_tilt_sim.robot_state import (
-    joint_position,
     moving_transforms,
     static_transforms,
     transform_message,
 )
 from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.transforms import Transform, quaternion_from_axis_angle, rotate
+from pan_tilt_sim.urdf import parse_urdf
 
 HAS_TF2_MSGS = importlib.util.find_spec('tf2_msgs') is not None
 LATE_SUBSCRIBER_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
@@ -42,8 +41,54 @@ def test_robot_description_reaches_a_subscriber_that_comes_late():
     assert '<robot name="ex_urdf_pan_tilt"' in urdf and 'xacro:' not in urdf
 
 
+MESH_ROBOT = """<robot name="meshy">
+  <link name="base"><visual><geometry>
+    <mesh filename="package://meshy_pkg/meshes/base.dae" scale="0.001 0.001 0.001"/>
+  </geometry><material name="orange"><color rgba="1 0.5 0 1"/></material></visual></link>
+  <link name="arm"><inertial><mass value="1"/>
+      <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><mesh filename="package://meshy_pkg/meshes/arm.stl"/></geometry>
+    </collision></link>
+  <joint name="hinge" type="revolute"><parent link="base"/><child link="arm"/>
+    <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+</robot>
+"""
+JOINT_STATE_ONLY = 'jsb:\n  type: joint_state_broadcaster/JointStateBroadcaster\n'
+
+
+@pytest.fixture
+def mesh_robot(tmp_path, monkeypatch):
+    """A robot whose meshes are package:// URIs of a package in a temporary ament prefix."""
+    prefix = mf.make_ament_prefix(tmp_path, 'meshy_pkg', {
+        'meshes/base.dae': mf.dae_text((100.0, 100.0, 100.0)),
+        'meshes/arm.stl': mf.binary_stl_bytes((0.1, 0.1, 0.5)),
+        'urdf/meshy.urdf': MESH_ROBOT,
+        'config/controllers.yaml': JOINT_STATE_ONLY})
+    monkeypatch.setenv('AMENT_PREFIX_PATH', os.pathsep.join(
+        [str(prefix), os.environ.get('AMENT_PREFIX_PATH', '')]))
+    monkeypatch.setenv('XDG_CACHE_HOME', str(tmp_path / 'cache'))
+    return prefix / 'share' / 'meshy_pkg'
+
+
+def test_robot_description_is_the_urdf_as_written_and_pybullet_gets_local_files(mesh_robot):
+    # RViz and robot_state_publisher need the package:// URIs (and the DAE's
+    # colours); only PyBullet's own copy points at loadable local files.
+    with sim_node(robot_description_file=str(mesh_robot / 'urdf' / 'meshy.urdf'),
+                  controllers_file=str(mesh_robot / 'config' / 'controllers.yaml')) as harness:
+        received = harness.collect(String, harness.node.topic('robot_description'),
+                                   LATE_SUBSCRIBER_QOS)
+        assert harness.spin_until(lambda: received, budget_s=10.0)
+        description = harness.simulation.description
+    assert received[0].data == MESH_ROBOT
+    assert description.urdf_xml == MESH_ROBOT
+    assert 'package://' not in description.physics_urdf
+    local = [pathlib.Path(part.split('"')[0]) for part in
+             description.physics_urdf.split('filename="')[1:]]
+    assert len(local) == 2 and all(path.is_file() for path in local), local
+
+
 def test_tf_has_one_edge_per_moving_joint_following_the_joint_positions():
-    tree = parse_kinematics(load_description(package_share() / DEFAULT_DESCRIPTION).urdf_xml)
+    tree = load_description(package_share() / DEFAULT_DESCRIPTION).model
     frames = moving_transforms(tree, {'pan_joint': math.pi / 2, 'tilt_joint': -math.pi})
     assert [(parent, child) for parent, child, _ in frames] == [
         ('base_link', 'pan_link'), ('pan_link', 'tilt_link')]
@@ -55,12 +100,12 @@ def test_tf_has_one_edge_per_moving_joint_following_the_joint_positions():
 
 
 def test_tf_static_has_the_fixed_joints_and_the_extra_frames():
-    tree = parse_kinematics("""<robot name="r"><link name="a"/><link name="b"/><link name="c"/>
+    tree = parse_urdf("""<robot name="r"><link name="a"/><link name="b"/><link name="c"/>
       <joint name="bolt" type="fixed"><parent link="a"/><child link="b"/>
         <origin xyz="1 2 3"/></joint>
       <joint name="hinge" type="revolute"><parent link="b"/><child link="c"/>
         <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
-    </robot>""")
+    </robot>""", pathlib.Path('r.urdf'))
     optical = ('c', 'c_optical', Transform((0.0, 0.0, 0.5)))
     frames = static_transforms(tree, [optical])
     assert [(parent, child) for parent, child, _ in frames] == [('a', 'b'), ('c', 'c_optical')]
@@ -68,9 +113,82 @@ def test_tf_static_has_the_fixed_joints_and_the_extra_frames():
 
 
 def test_a_mimic_joint_follows_its_leader_in_tf():
-    mimics = {'finger_right': Mimic('finger_left', multiplier=-1.0, offset=0.1)}
-    assert joint_position({'finger_left': 0.3}, 'finger_right', mimics) == pytest.approx(-0.2)
-    assert joint_position({'finger_left': 0.3}, 'finger_left', mimics) == 0.3
+    model = parse_urdf("""<robot name="r"><link name="a"/><link name="l"/><link name="r"/>
+      <joint name="finger_left" type="prismatic"><parent link="a"/><child link="l"/>
+        <limit lower="0" upper="1" effort="1" velocity="1"/></joint>
+      <joint name="finger_right" type="prismatic"><parent link="a"/><child link="r"/>
+        <limit lower="-1" upper="1" effort="1" velocity="1"/>
+        <mimic joint="finger_left" multiplier="-1" offset="0.1"/></joint>
+    </robot>""", pathlib.Path('r.urdf'))
+    frames = {child: transform for _, child, transform in
+              moving_transforms(model, {'finger_left': 0.3})}
+    assert frames['l'].translation == pytest.approx((0.3, 0.0, 0.0))
+    assert frames['r'].translation == pytest.approx((-0.2, 0.0, 0.0))
+
+
+class RecordingTfSink:
+    """A stand-in for the /tf and /tf_static publishers (tf2_msgs is not on PyPI)."""
+
+    def __init__(self) -> None:
+        self.tf_messages: list[list[TransformStamped]] = []
+        self.static_messages: list[list[TransformStamped]] = []
+
+    def tf(self, transforms):
+        self.tf_messages.append([_copy(t) for t in transforms])
+
+    def tf_static(self, transforms):
+        self.static_messages.append([_copy(t) for t in transforms])
+
+
+def _copy(transform: TransformStamped) -> tuple:
+    t, r = transform.transform.translation, transform.transform.rotation
+    return (stamp_s(transform), transform.header.frame_id, transform.child_frame_id,
+            (t.x, t.y, t.z), (r.x, r.y, r.z, r.w))
+
+
+@pytest.fixture
+def tf_sink(monkeypatch):
+    """Make the node publish TF into a recording stand-in."""
+    sink = RecordingTfSink()
+    monkeypatch.setattr(robot_state, 'create_tf_sink', lambda node: sink)
+    return sink
+
+
+def test_tf_edges_match_forward_kinematics_after_commands_mimic_included(tf_sink):
+    arm = package_share() / 'urdf' / 'three_joint_arm.xacro'
+    with sim_node(robot_description_file=str(arm), controllers_file=str(
+            package_share() / 'config' / 'three_joint_arm_controllers.yaml')) as harness:
+        harness.command('gripper_controller', Float64MultiArray(data=[0.02]))
+        harness.run_for(1.0)
+        positions = harness.simulation.joint_positions()
+        last = tf_sink.tf_messages[-1]
+        model = harness.simulation.description.model
+    assert tf_sink.static_messages, 'nothing on /tf_static'
+    assert {child for _, _, child, _, _ in last} == {j.child for j in model.moving_joints}
+    assert positions['right_finger_joint'] == pytest.approx(-0.02, abs=1e-3)  # the mimic
+    expected = {joint.child: joint.transform(model.joint_position(positions, joint.name))
+                for joint in model.moving_joints}
+    for _, parent, child, translation, rotation in last:
+        assert parent == model.joint(next(j.name for j in model.moving_joints
+                                          if j.child == child)).parent
+        # The last /tf is at most one TF period (20 ms) older than `positions`.
+        assert translation == pytest.approx(expected[child].translation, abs=2e-3), child
+        dot = abs(sum(a * b for a, b in zip(rotation, expected[child].rotation, strict=True)))
+        assert dot == pytest.approx(1.0, abs=1e-4), child
+
+
+def test_tf_keeps_coming_after_reset_simulation(tf_sink):
+    with sim_node() as harness:
+        harness.run_until_sim_time(1.0)
+        harness.node.set_paused(True)
+        before = len(tf_sink.tf_messages)
+        harness.node.reset(reset_time=True)
+        harness.node.set_paused(False)
+        harness.run_until_sim_time(1.0)
+        stamps = [message[0][0] for message in tf_sink.tf_messages[before:]]
+    # 50 Hz over 1 s of sim time from 0 again (the first one at the reset itself).
+    assert len(stamps) >= 50, stamps
+    assert stamps[0] == 0.0
 
 
 def test_the_node_puts_the_camera_optical_frame_on_tf_static():

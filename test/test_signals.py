@@ -119,7 +119,7 @@ def _catches_sigterm(pid: int) -> bool:
 def test_a_signal_during_start_up_stops_it_cleanly(signum):
     # The runner entry point installs its handlers before importing rclpy and
     # PyBullet (~0.5 s): signal as soon as the handler is there, mid-import.
-    process = sim_process.start(*DEBUG_ARGS, entry=sim_process.RUNNER_ENTRY)
+    process = sim_process.start(*DEBUG_ARGS)
     deadline = time.monotonic() + STARTUP_BUDGET_S
     while not _catches_sigterm(process.pid):
         assert time.monotonic() < deadline and process.poll() is None

@@ -146,7 +146,7 @@ def test_xacro_args_reach_xacro(repo_root, tmp_path):
         'lower="-3.14" upper="3.14"', 'lower="-3.14" upper="$(arg pan_limit)"'))
     with sim_node(robot_description_file=str(path), xacro_args=['pan_limit:=0.25']) as sim:
         assert sim.node.settings.xacro_args == ('pan_limit:=0.25',)
-        assert sim.simulation.description.joint('pan_joint').upper == 0.25
+        assert sim.simulation.description.model.joint('pan_joint').upper == 0.25
 
 
 def test_a_joint_starting_at_a_limit_is_logged_once_at_info():

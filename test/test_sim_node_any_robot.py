@@ -20,7 +20,7 @@ from std_msgs.msg import Float64, Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from pan_tilt_sim.ros_interfaces import stamp
-from pan_tilt_sim.sim_node import EXIT_CONFIGURATION_ERROR
+from pan_tilt_sim.runner import EXIT_CONFIGURATION_ERROR
 
 STARTUP_BUDGET_S = 30.0
 
@@ -68,7 +68,7 @@ def test_seed2_missing_mesh_ends_start_up_with_code_2_naming_the_uri(seed2_packa
     environment = dict(os.environ, PYTHONPATH=os.pathsep.join(
         [str(pathlib.Path(__file__).resolve().parents[1]), os.environ.get('PYTHONPATH', '')]))
     result = subprocess.run(
-        [sys.executable, '-m', 'pan_tilt_sim.sim_node', '--ros-args',
+        [sys.executable, '-m', 'pan_tilt_sim', '--ros-args',
          '-p', f'robot_description_file:={seed2_package / mf.SEED2_URDF_RELPATH}',
          '-p', f"controllers_file:={seed2_package / 'config' / 'joint_controllers.yaml'}"],
         capture_output=True, text=True, env=environment, timeout=STARTUP_BUDGET_S)

@@ -81,7 +81,7 @@ def test_two_namespaced_sims_keep_to_their_own_topics_services_and_clocks(two_si
     right_count = len(clocks['right'])
     harness.call(Empty, '/left/reset_simulation', budget_s=STARTUP_BUDGET_S)
     assert harness.spin_until(lambda: stamp_s(clocks['left'][-1]) == 0.0)
-    harness.spin_until(lambda: len(clocks['right']) > right_count + 10, STARTUP_BUDGET_S)
+    assert harness.spin_until(lambda: len(clocks['right']) > right_count + 10, STARTUP_BUDGET_S)
     right_times = [stamp_s(message) for message in clocks['right']]
     assert right_times == sorted(right_times)
     assert global_clock == []

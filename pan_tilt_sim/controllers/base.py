@@ -16,8 +16,9 @@ import math
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
-from pan_tilt_sim.description import JointSpec
+from pan_tilt_sim.controllers.pid import Pid
 from pan_tilt_sim.errors import ControllerConfigError
+from pan_tilt_sim.robot_model import JointSpec
 
 # Largest command magnitude taken on a side without a limit (rad, m, rad/s, N*m...):
 # far beyond any real joint, small enough that PID arithmetic on it stays finite.
@@ -67,6 +68,9 @@ class Controller(abc.ABC):
     """Base of every controller type; subclasses list their YAML ``type`` strings."""
 
     type_names: ClassVar[tuple[str, ...]] = ()
+    # The YAML section the PID gains come from: 'pid' (ROS 1, one joint) or
+    # 'gains' (ros2_controllers, per joint); the gain parameters follow it.
+    gains_field: ClassVar[str] = 'gains'
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         self.name = name
@@ -88,6 +92,10 @@ class Controller(abc.ABC):
 
     def reset(self) -> None:  # noqa: B027 -- stateless controllers need no reset
         """Forget commands and internal state, as after a fresh start."""
+
+    def pids(self) -> dict[str, Pid]:
+        """Return the PIDs of this controller by joint (gains may change live); none here."""
+        return {}
 
     def error(self, field: str, problem: str) -> ControllerConfigError:
         """Return an error naming this controller's field in the controllers file."""
@@ -148,6 +156,15 @@ class CommandController(Controller):
     @abc.abstractmethod
     def set_command(self, value: Any) -> CommandResult:
         """Store the latest command (called from subscriptions; must be cheap)."""
+
+    @abc.abstractmethod
+    def setpoints(self) -> dict[str, float]:
+        """Return what each joint is driven toward now, by joint, in its interface's unit.
+
+        For a position loop the rate-limited setpoint, for a velocity or
+        effort command the (clamped) command, for a trajectory the desired
+        position sampled at the present sim time.
+        """
 
     def command_problem(self, value: Any, result: CommandResult) -> str:
         """Describe what was wrong with ``value``, which ``set_command`` rejected or clamped."""

@@ -39,6 +39,7 @@ from pan_tilt_sim.controllers.joint_effort_controller import JointEffortControll
 from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
 from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
 from pan_tilt_sim.controllers.multi_joint import JOINTS_FIELD, MultiJointController
+from pan_tilt_sim.controllers.pid import Pid
 
 INTERFACE_FIELD = 'interface_name'
 # The one-joint controller each command interface stands for.
@@ -75,6 +76,15 @@ class ForwardCommandController(MultiJointController):
     def members(self) -> tuple[CommandController, ...]:
         """The one-joint controller of each joint (their PIDs may be tuned live)."""
         return self._members
+
+    def pids(self) -> dict[str, Pid]:
+        """Return each joint's PID (none for the effort interface)."""
+        return {joint: pid for member in self._members for joint, pid in member.pids().items()}
+
+    def setpoints(self) -> dict[str, float]:
+        """Return each joint's one-joint controller's setpoint."""
+        return {joint: value for member in self._members
+                for joint, value in member.setpoints().items()}
 
     def configure(self, joints: Mapping[str, JointHandle]) -> None:
         """Bind every joint (named in errors as an entry of ``joints``)."""

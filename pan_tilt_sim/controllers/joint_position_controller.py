@@ -29,7 +29,7 @@ class JointPositionController(PidJointController):
 
     @property
     def setpoint(self) -> float:
-        """The rate-limited position setpoint the PID tracks now."""
+        """Return the rate-limited position setpoint the PID tracks now."""
         return self._setpoint
 
     def bind(self, handle: JointHandle) -> None:
@@ -37,6 +37,10 @@ class JointPositionController(PidJointController):
         super().bind(handle)
         self._limits = PositionLimits(handle.spec)
         self._max_velocity = self._limits.max_velocity
+
+    def setpoints(self) -> dict[str, float]:
+        """Return the rate-limited position setpoint the PID tracks now."""
+        return {self._joint_name: self._setpoint}
 
     def reset(self) -> None:
         """Hold the joint where it is; forget commands and the integral."""

@@ -75,10 +75,13 @@ class JointTrajectoryController(MultiJointController):
         scales = feedforward_scales(self, self._joint_names)
         self._feedforward = [scales[joint] for joint in self._joint_names]
 
-    @property
-    def pids(self) -> tuple[Pid, ...]:
+    def pids(self) -> dict[str, Pid]:
         """One PID per joint (their gains may be changed live)."""
-        return tuple(self._pids)
+        return dict(zip(self._joint_names, self._pids, strict=True))
+
+    def setpoints(self) -> dict[str, float]:
+        """Return the desired positions the PIDs track now."""
+        return dict(zip(self._joint_names, self._desired_positions, strict=True))
 
     @property
     def desired_positions(self) -> list[float]:

@@ -13,12 +13,14 @@ from collections.abc import Mapping
 from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.base import CommandController, JointHandle
-from pan_tilt_sim.controllers.gains import gains_from_params
+from pan_tilt_sim.controllers.gains import PID_FIELD, gains_from_params
 from pan_tilt_sim.controllers.pid import Pid, PidGains
 
 
 class SingleJointController(CommandController):
     """A command controller driving the one joint its ``joint`` parameter names."""
+
+    gains_field = PID_FIELD
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
@@ -40,6 +42,10 @@ class SingleJointController(CommandController):
     def bind(self, handle: JointHandle) -> None:  # noqa: B027 -- optional hook
         """Take what the controller needs from the joint's handle (limits, say)."""
 
+    def setpoints(self) -> dict[str, float]:
+        """Return the joint's present command (see :meth:`CommandController.setpoints`)."""
+        return {self._joint_name: self._command}
+
 
 class PidJointController(SingleJointController):
     """A one-joint controller whose effort comes from a PID."""
@@ -54,6 +60,10 @@ class PidJointController(SingleJointController):
     def pid(self) -> Pid:
         """The PID (its gains may be changed live)."""
         return self._pid
+
+    def pids(self) -> dict[str, Pid]:
+        """Return the one joint's PID."""
+        return {self._joint_name: self._pid}
 
     def bind(self, handle: JointHandle) -> None:
         """Build the PID, its integral bounded by the effort limit unless clamped in the YAML."""

@@ -1,0 +1,284 @@
+"""The one model of the robot: links, joints, limits, inertials, origins, mimic, plugins.
+
+Parsed once from the URDF (:mod:`pan_tilt_sim.urdf`); physics, controllers,
+kinematics, camera, TF and the tools all read this model, never the XML.
+Plain values, no ROS, no PyBullet.
+
+Kinematics is what robot_state_publisher computes: each joint's transform
+from its parent link to its child link is the joint's ``<origin>`` followed
+by the joint's motion (a rotation about ``<axis>`` for revolute and
+continuous joints, a translation along it for prismatic ones).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import functools
+import math
+from collections.abc import Mapping
+
+from pan_tilt_sim.transforms import (
+    Transform,
+    Vector,
+    quaternion_from_axis_angle,
+    rotation_matrix,
+)
+
+DEFAULT_AXIS: Vector = (1.0, 0.0, 0.0)  # URDF's default joint axis
+
+
+class JointKind(enum.Enum):
+    """URDF joint types the simulator distinguishes."""
+
+    REVOLUTE = 'revolute'
+    CONTINUOUS = 'continuous'
+    PRISMATIC = 'prismatic'
+    FIXED = 'fixed'
+    FLOATING = 'floating'
+    PLANAR = 'planar'
+
+    @property
+    def is_actuated(self) -> bool:
+        """Whether a one-degree-of-freedom motor can drive this kind of joint."""
+        return self in (JointKind.REVOLUTE, JointKind.CONTINUOUS, JointKind.PRISMATIC)
+
+    @property
+    def rotates(self) -> bool:
+        """Whether the joint's position is an angle about its axis."""
+        return self in (JointKind.REVOLUTE, JointKind.CONTINUOUS)
+
+
+@dataclasses.dataclass(frozen=True)
+class Mimic:
+    """A ``<mimic>`` element: position = multiplier * leader + offset."""
+
+    joint: str
+    multiplier: float = 1.0
+    offset: float = 0.0
+
+
+@dataclasses.dataclass(frozen=True)
+class Inertial:
+    """A link's ``<inertial>``: mass (kg), centre of mass frame, inertia tensor (kg m^2)."""
+
+    mass: float = 0.0
+    origin: Transform = Transform()
+    ixx: float = 0.0
+    ixy: float = 0.0
+    ixz: float = 0.0
+    iyy: float = 0.0
+    iyz: float = 0.0
+    izz: float = 0.0
+
+
+@dataclasses.dataclass(frozen=True)
+class Geometry:
+    """A ``<geometry>``: a box (``size``), cylinder (``radius``, ``length``), sphere or mesh."""
+
+    kind: str
+    size: Vector = (0.0, 0.0, 0.0)
+    radius: float = 0.0
+    length: float = 0.0
+    filename: str = ''
+
+    def half_extents(self) -> Vector | None:
+        """Half-size of the shape's bounding box in its own frame; None for meshes."""
+        if self.kind == 'box':
+            sx, sy, sz = self.size
+            return (sx / 2.0, sy / 2.0, sz / 2.0)
+        if self.kind == 'cylinder':
+            return (self.radius, self.radius, self.length / 2.0)
+        if self.kind == 'sphere':
+            return (self.radius, self.radius, self.radius)
+        return None
+
+
+@dataclasses.dataclass(frozen=True)
+class Shape:
+    """A ``<visual>`` or ``<collision>``: geometry placed by ``origin`` in the link frame."""
+
+    origin: Transform
+    geometry: Geometry
+
+
+@dataclasses.dataclass(frozen=True)
+class Link:
+    """A ``<link>``; ``inertial`` is None when the URDF gives none (a massless frame)."""
+
+    name: str
+    inertial: Inertial | None = None
+    visuals: tuple[Shape, ...] = ()
+    collisions: tuple[Shape, ...] = ()
+
+    def reach(self) -> float:
+        """How far the link's visual geometry reaches along the link's +z (0 if none).
+
+        Boxes, cylinders and spheres count (a cylinder as its bounding box);
+        meshes, whose size is not known here, are ignored.
+        """
+        reach = 0.0
+        for visual in self.visuals:
+            half = visual.geometry.half_extents()
+            if half is None:
+                continue
+            # Half-extent of the rotated box along the link's z: |R[2,:]| . half.
+            row = rotation_matrix(visual.origin.rotation)[2]
+            extent = sum(abs(r) * h for r, h in zip(row, half, strict=True))
+            reach = max(reach, visual.origin.translation[2] + extent)
+        return reach
+
+
+@dataclasses.dataclass(frozen=True)
+class JointSpec:
+    """What the URDF says about one joint.
+
+    Limits that the URDF does not give are infinite.  A non-positive effort or
+    velocity limit is taken as "no limit", since a zero limit would make the
+    joint impossible to move and is almost always a placeholder.
+    """
+
+    name: str
+    kind: JointKind
+    lower: float = -math.inf
+    upper: float = math.inf
+    effort_limit: float = math.inf
+    velocity_limit: float = math.inf
+    damping: float = 0.0
+    friction: float = 0.0
+    mimic: Mimic | None = None
+    parent: str = ''
+    child: str = ''
+    origin: Transform = Transform()
+    axis: Vector = DEFAULT_AXIS
+
+    @property
+    def has_position_limits(self) -> bool:
+        """Whether the position is bounded (not for continuous joints)."""
+        return self.kind is not JointKind.CONTINUOUS and self.lower <= self.upper and (
+            math.isfinite(self.lower) or math.isfinite(self.upper))
+
+    def clamp_position(self, position: float) -> float:
+        """Return ``position`` clamped into the joint's position limits."""
+        if not self.has_position_limits:
+            return position
+        return min(max(position, self.lower), self.upper)
+
+    @property
+    def initial_position(self) -> float:
+        """Zero, or the nearest limit when zero lies outside the limits."""
+        return self.clamp_position(0.0)
+
+    @property
+    def moves(self) -> bool:
+        """Whether the joint's transform follows a joint position (else it is constant)."""
+        return self.kind.is_actuated
+
+    def transform(self, position: float = 0.0) -> Transform:
+        """Return the parent-to-child transform at joint ``position`` (rad or m)."""
+        if self.kind.rotates:
+            return self.origin.then(
+                Transform(rotation=quaternion_from_axis_angle(self.axis, position)))
+        if self.kind is JointKind.PRISMATIC:
+            ax, ay, az = self.axis
+            return self.origin.then(Transform(translation=(ax * position, ay * position,
+                                                           az * position)))
+        return self.origin
+
+
+@dataclasses.dataclass(frozen=True)
+class RobotModel:
+    """A robot as its URDF describes it (after xacro)."""
+
+    name: str
+    links: tuple[Link, ...]
+    joints: tuple[JointSpec, ...]
+    plugin_namespace: str | None = None
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Names of all joints, in file order."""
+        return tuple(joint.name for joint in self.joints)
+
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        """Names of all links, in file order."""
+        return tuple(link.name for link in self.links)
+
+    @property
+    def actuated_joints(self) -> tuple[JointSpec, ...]:
+        """Joints a one-degree-of-freedom controller can drive (non-fixed), in file order."""
+        return tuple(joint for joint in self.joints if joint.kind.is_actuated)
+
+    def joint(self, name: str) -> JointSpec:
+        """Return the joint called ``name``; KeyError if there is none."""
+        return self._joints_by_name[name]
+
+    def link(self, name: str) -> Link:
+        """Return the link called ``name``; KeyError if there is none."""
+        return self._links_by_name[name]
+
+    @functools.cached_property
+    def _joints_by_name(self) -> dict[str, JointSpec]:
+        return {joint.name: joint for joint in self.joints}
+
+    @functools.cached_property
+    def _links_by_name(self) -> dict[str, Link]:
+        return {link.name: link for link in self.links}
+
+    @functools.cached_property
+    def root(self) -> str:
+        """The root link: the first link that is no joint's child."""
+        children = {joint.child for joint in self.joints}
+        roots = [link.name for link in self.links if link.name not in children]
+        return (roots or [link.name for link in self.links] or [''])[0]
+
+    @functools.cached_property
+    def tree_joints(self) -> tuple[JointSpec, ...]:
+        """The joints reachable from the root, parents before children."""
+        children: dict[str, list[JointSpec]] = {}
+        for joint in self.joints:
+            children.setdefault(joint.parent, []).append(joint)
+        ordered = []
+        pending = [self.root]
+        while pending:
+            link = pending.pop(0)
+            for joint in children.get(link, ()):
+                ordered.append(joint)
+                pending.append(joint.child)
+        return tuple(ordered)
+
+    @property
+    def fixed_joints(self) -> tuple[JointSpec, ...]:
+        """Joints of the tree whose transform is constant (for /tf_static)."""
+        return tuple(joint for joint in self.tree_joints if not joint.moves)
+
+    @property
+    def moving_joints(self) -> tuple[JointSpec, ...]:
+        """Joints of the tree whose transform follows a joint position (for /tf)."""
+        return tuple(joint for joint in self.tree_joints if joint.moves)
+
+    @functools.cached_property
+    def mimics(self) -> dict[str, Mimic]:
+        """The ``<mimic>`` of every joint that has one, by joint name."""
+        return {joint.name: joint.mimic for joint in self.joints if joint.mimic is not None}
+
+    def joint_position(self, positions: Mapping[str, float], joint: str) -> float:
+        """Return ``joint``'s position: from ``positions``, else by its mimic, else 0."""
+        if joint in positions:
+            return positions[joint]
+        mimic = self.mimics.get(joint)
+        if mimic is None:
+            return 0.0
+        return mimic.multiplier * self.joint_position(positions, mimic.joint) + mimic.offset
+
+    def link_poses(self, positions: Mapping[str, float]) -> dict[str, Transform]:
+        """Return every link's pose in the root link's frame at joint ``positions``.
+
+        Joints missing from ``positions`` follow their mimic, else stand at 0.
+        """
+        poses = {self.root: Transform()}
+        for joint in self.tree_joints:  # parents come first
+            poses[joint.child] = poses[joint.parent].then(
+                joint.transform(self.joint_position(positions, joint.name)))
+        return poses
