@@ -21,8 +21,8 @@ from setuptools import find_packages, setup
 PACKAGE = 'pan_tilt_sim'
 EXECUTABLES = {
     'sim_node': 'pan_tilt_sim.__main__:main',  # signals handled before rclpy loads
-    'bench': 'pan_tilt_sim.bench:main',
-    'step_response': 'pan_tilt_sim.step_response:main',
+    'bench': 'pan_tilt_sim.tools.bench:main',
+    'step_response': 'pan_tilt_sim.tools.step_response:main',
 }
 HERE = os.path.dirname(os.path.abspath(__file__))
 SHARE = os.path.join('share', PACKAGE)

@@ -17,7 +17,7 @@ from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
-from pan_tilt_sim.launch_support import (
+from pan_tilt_sim.tools.launch_support import (
     robot_setup,
     robot_state_publisher_parameters,
     sim_node_parameters,

@@ -21,9 +21,9 @@ import os
 import statistics
 import time
 
-from pan_tilt_sim.camera import CameraSettings, Renderer
-from pan_tilt_sim.engine import make_simulation
 from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.sim.camera import CameraSettings, Renderer
+from pan_tilt_sim.sim.engine import make_simulation
 
 FRAMES = 50
 ENGINE_STEPS = 50_000
@@ -74,7 +74,7 @@ def node_run(camera: bool, seconds: float, factor: float = 1.0,
     from rclpy.parameter import Parameter
     from sensor_msgs.msg import Image
 
-    from pan_tilt_sim.sim_node import SimNode
+    from pan_tilt_sim.ros.sim_node import SimNode
 
     rclpy.init()
     node = SimNode(parameter_overrides=[Parameter('camera.enabled', value=camera),
@@ -124,7 +124,7 @@ def main() -> None:
                         help='wall seconds per node run (default 10)')
     args = parser.parse_args()
     share = package_share()
-    from pan_tilt_sim.description import load_description
+    from pan_tilt_sim.model.description import load_description
 
     description = load_description(share / DEFAULT_DESCRIPTION)
     result = {

@@ -40,7 +40,7 @@ def per_step_us(run: Callable[[int], None], steps: int) -> float:
 
 def pybullet_figures(simulation) -> dict[str, float]:
     """Time the PyBullet calls alone on the simulation's own client."""
-    from pan_tilt_sim.bullet import pybullet
+    from pan_tilt_sim.sim.bullet import pybullet
 
     client = simulation.physics.client_id
     stepper = simulation.physics.stepper()
@@ -63,8 +63,8 @@ def node_figures(seconds: float) -> dict[str, float]:
     import rclpy
     from rclpy.parameter import Parameter
 
-    from pan_tilt_sim import spinning
-    from pan_tilt_sim.sim_node import SimNode
+    from pan_tilt_sim.ros import spinning
+    from pan_tilt_sim.ros.sim_node import SimNode
 
     rclpy.init()
     node = SimNode(parameter_overrides=[Parameter('real_time_factor', value=0.0)])
@@ -116,8 +116,8 @@ def main() -> None:
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     if args.executor:
         os.environ['PAN_TILT_SIM_EXECUTOR'] = args.executor
-    from pan_tilt_sim.engine import make_simulation
     from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
+    from pan_tilt_sim.sim.engine import make_simulation
 
     share = package_share()
     with make_simulation(str(share / DEFAULT_DESCRIPTION), str(share / DEFAULT_CONTROLLERS),

@@ -10,7 +10,7 @@ import pytest
 # or a second test run on the same machine) its own domain, so concurrent runs
 # never hear each other's sim_nodes.  Child processes inherit it.  The tests
 # take 30..129, clear of the low ids people use by hand and of the bench's own
-# pid-derived range (pan_tilt_sim.bench.PID_DOMAIN_BASE, 150..229).
+# pid-derived range (pan_tilt_sim.tools.bench.PID_DOMAIN_BASE, 150..229).
 # PAN_TILT_SIM_TEST_DOMAIN pins it.
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 _DOMAIN_BASE, _DOMAIN_SPAN = 30, 100

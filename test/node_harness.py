@@ -27,7 +27,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
-from pan_tilt_sim.sim_node import SimNode
+from pan_tilt_sim.ros.sim_node import SimNode
 
 SPIN_SLICE_S = 0.05
 # A service request still unanswered after this long is sent again (see call()).

@@ -11,8 +11,8 @@ import sys
 import pytest
 import sim_process
 
-from pan_tilt_sim import bench
-from pan_tilt_sim.engine import make_simulation
+from pan_tilt_sim.sim.engine import make_simulation
+from pan_tilt_sim.tools import bench
 
 QUICK_TIMEOUT_S = 240
 FIGURES = {
@@ -30,9 +30,9 @@ FIGURES = {
 
 @pytest.fixture(scope='module')
 def quick_run():
-    """Run ``python -m pan_tilt_sim.bench --quick`` once; return (stdout, stderr)."""
+    """Run ``python -m pan_tilt_sim.tools.bench --quick`` once; return (stdout, stderr)."""
     result = subprocess.run(
-        [sys.executable, '-m', 'pan_tilt_sim.bench', '--quick'], capture_output=True,
+        [sys.executable, '-m', 'pan_tilt_sim.tools.bench', '--quick'], capture_output=True,
         text=True, env=sim_process.environment(), timeout=QUICK_TIMEOUT_S, check=False)
     assert result.returncode == 0, result.stderr
     return result.stdout, result.stderr

@@ -8,19 +8,19 @@ from node_harness import sim_node
 from sensor_msgs.msg import CameraInfo, Image
 from std_srvs.srv import Empty
 
-from pan_tilt_sim.camera import (
+from pan_tilt_sim.errors import ParameterError
+from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.model.transforms import rotate
+from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.sim.camera import (
     CameraSettings,
     Renderer,
     camera_mount,
     intrinsics,
     vertical_fov_deg,
 )
-from pan_tilt_sim.description import load_description
-from pan_tilt_sim.errors import ParameterError
-from pan_tilt_sim.physics import Physics
-from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
-from pan_tilt_sim.transforms import rotate
-from pan_tilt_sim.world import GROUND_RGB, TARGET_SET, Target, build_world
+from pan_tilt_sim.sim.physics import Physics
+from pan_tilt_sim.sim.world import GROUND_RGB, TARGET_SET, Target, build_world
 
 HORIZONTAL_TILT = -math.pi / 2  # the seed's tilt start: the camera looks horizontally
 PAN_LIMIT = 3.14

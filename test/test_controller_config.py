@@ -5,9 +5,9 @@ import textwrap
 
 import pytest
 
-from pan_tilt_sim.controller_config import DEFAULT_UPDATE_RATE, load_controllers_config
-from pan_tilt_sim.engine import make_simulation
 from pan_tilt_sim.errors import ControllerConfigError
+from pan_tilt_sim.model.controller_config import DEFAULT_UPDATE_RATE, load_controllers_config
+from pan_tilt_sim.sim.engine import make_simulation
 
 
 @pytest.fixture

@@ -4,9 +4,9 @@ import math
 
 import pytest
 
-from pan_tilt_sim.description import load_description, parse_xacro_args
 from pan_tilt_sim.errors import DescriptionError
-from pan_tilt_sim.robot_model import JointKind
+from pan_tilt_sim.model.description import load_description, parse_xacro_args
+from pan_tilt_sim.model.robot import JointKind
 
 
 def _facts(description):

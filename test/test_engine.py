@@ -2,10 +2,10 @@
 
 import pytest
 
-from pan_tilt_sim.controller_config import ControllersConfig, ControllerSpec
-from pan_tilt_sim.description import load_description
-from pan_tilt_sim.engine import Simulation, make_simulation
 from pan_tilt_sim.errors import ControllerConfigError
+from pan_tilt_sim.model.controller_config import ControllersConfig, ControllerSpec
+from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.sim.engine import Simulation, make_simulation
 
 DT = 0.001
 STEPS_PER_SECOND = 1000

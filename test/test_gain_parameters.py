@@ -9,7 +9,7 @@ from rclpy.parameter import Parameter
 
 from pan_tilt_sim.controllers.pid import GainsError, PidGains
 from pan_tilt_sim.errors import ParameterError
-from pan_tilt_sim.gain_parameters import FIELDS, apply_fields, field_values
+from pan_tilt_sim.ros.gain_parameters import FIELDS, apply_fields, field_values
 
 PAN = 'joint1_position_controller'
 TILT = 'joint2_position_controller'

@@ -20,9 +20,9 @@ from pan_tilt_sim.controllers import CommandKind, CommandResult, JointHandle, cr
 from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
 from pan_tilt_sim.controllers.joint_velocity_controller import DEFAULT_VELOCITY_GAINS
 from pan_tilt_sim.controllers.pid import PidGains
-from pan_tilt_sim.engine import make_simulation
 from pan_tilt_sim.errors import ControllerConfigError
-from pan_tilt_sim.robot_model import JointKind, JointSpec, Mimic
+from pan_tilt_sim.model.robot import JointKind, JointSpec, Mimic
+from pan_tilt_sim.sim.engine import make_simulation
 
 DT = 0.001
 GROUP_TYPES = {

@@ -6,8 +6,8 @@ import pytest
 from robot_fixtures import LINK_MASS, JointDef, star_robot_urdf, write_text
 
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
-from pan_tilt_sim.engine import make_simulation
 from pan_tilt_sim.errors import ControllerConfigError, DescriptionError
+from pan_tilt_sim.sim.engine import make_simulation
 
 DT = 0.001
 

@@ -5,7 +5,7 @@ import math
 import pytest
 
 from pan_tilt_sim.controllers import CommandResult, JointHandle, create_controller
-from pan_tilt_sim.robot_model import JointKind, JointSpec
+from pan_tilt_sim.model.robot import JointKind, JointSpec
 
 DT = 0.001
 PAN = JointSpec('pan_joint', JointKind.REVOLUTE, lower=-3.14, upper=3.14,

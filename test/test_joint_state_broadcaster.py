@@ -3,11 +3,11 @@
 import pytest
 from robot_fixtures import write_text
 
-from pan_tilt_sim.controller_config import load_controllers_config
 from pan_tilt_sim.controllers import JointHandle, create_controller
 from pan_tilt_sim.controllers.joint_state_controller import DEFAULT_PUBLISH_RATE
 from pan_tilt_sim.errors import ControllerConfigError
-from pan_tilt_sim.robot_model import JointKind, JointSpec, Mimic
+from pan_tilt_sim.model.controller_config import load_controllers_config
+from pan_tilt_sim.model.robot import JointKind, JointSpec, Mimic
 
 BROADCASTER = 'joint_state_broadcaster/JointStateBroadcaster'
 

@@ -4,7 +4,7 @@ import pytest
 
 from pan_tilt_sim.controllers import JointHandle, create_controller
 from pan_tilt_sim.errors import ControllerConfigError
-from pan_tilt_sim.robot_model import JointKind, JointSpec
+from pan_tilt_sim.model.robot import JointKind, JointSpec
 
 TYPE = 'joint_state_controller/JointStateController'
 DT = 0.001

@@ -12,9 +12,9 @@ import pytest
 from pan_tilt_sim.controllers import CommandKind, CommandResult, JointHandle, create_controller
 from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
 from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPlan, TrajectoryPoint
-from pan_tilt_sim.engine import make_simulation
 from pan_tilt_sim.errors import ControllerConfigError
-from pan_tilt_sim.robot_model import JointKind, JointSpec
+from pan_tilt_sim.model.robot import JointKind, JointSpec
+from pan_tilt_sim.sim.engine import make_simulation
 
 DT = 0.001
 JTC = 'joint_trajectory_controller/JointTrajectoryController'

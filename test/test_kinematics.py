@@ -7,11 +7,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from pan_tilt_sim.bullet import pybullet
-from pan_tilt_sim.description import load_description
-from pan_tilt_sim.physics import Physics
-from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
-from pan_tilt_sim.transforms import (
+from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.model.transforms import (
     Transform,
     quaternion_from_axis_angle,
     quaternion_from_matrix,
@@ -19,7 +16,10 @@ from pan_tilt_sim.transforms import (
     rotate,
     rotation_matrix,
 )
-from pan_tilt_sim.urdf import parse_urdf
+from pan_tilt_sim.model.urdf import parse_urdf
+from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.sim.bullet import pybullet
+from pan_tilt_sim.sim.physics import Physics
 
 # A chain with every joint kind the tree handles, offsets and rotated origins.
 ARM_URDF = """<robot name="arm">

@@ -6,7 +6,7 @@ import importlib.util
 
 import pytest
 
-from pan_tilt_sim.launch_support import (
+from pan_tilt_sim.tools.launch_support import (
     robot_setup,
     robot_state_publisher_parameters,
     sim_node_parameters,

@@ -11,7 +11,7 @@ from pan_tilt_sim.controllers.limits import (
     check_velocity,
     clamp_effort,
 )
-from pan_tilt_sim.robot_model import JointKind, JointSpec
+from pan_tilt_sim.model.robot import JointKind, JointSpec
 
 PAN = JointSpec('pan_joint', JointKind.REVOLUTE, lower=-3.14, upper=3.14,
                 effort_limit=300.0, velocity_limit=0.1, damping=50.0, friction=1.0)

@@ -18,7 +18,7 @@ from pan_tilt_sim.controllers.base import CommandResult, JointHandle
 from pan_tilt_sim.controllers.joint_effort_controller import JointEffortController
 from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
 from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
-from pan_tilt_sim.robot_model import JointKind, JointSpec
+from pan_tilt_sim.model.robot import JointKind, JointSpec
 
 PROPERTY_SETTINGS = settings(max_examples=200, deadline=None)
 LIMIT_RANGE = 1e6  # |lower|, |upper|: metres or radians, generously

@@ -3,8 +3,8 @@
 import pytest
 
 from pan_tilt_sim.errors import DescriptionError
-from pan_tilt_sim.mimic import MimicCoupling, follow_leaders, mimic_couplings
-from pan_tilt_sim.robot_model import JointKind, JointSpec, Mimic
+from pan_tilt_sim.model.mimic import MimicCoupling, follow_leaders, mimic_couplings
+from pan_tilt_sim.model.robot import JointKind, JointSpec, Mimic
 
 
 def joint(name, mimic=None):

@@ -3,7 +3,7 @@
 import pytest
 
 from pan_tilt_sim.errors import ParameterError
-from pan_tilt_sim.naming import check_namespace, join, resolve_robot_namespace
+from pan_tilt_sim.model.naming import check_namespace, join, resolve_robot_namespace
 
 
 def test_node_namespace_wins_over_everything():

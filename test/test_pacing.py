@@ -1,6 +1,6 @@
 """Pacing: steps per tick follow wall time times the real-time factor."""
 
-from pan_tilt_sim.pacing import FAST_BATCH_STEPS, FAST_TICK_S, MAX_CATCH_UP_S, Pacer
+from pan_tilt_sim.ros.pacing import FAST_BATCH_STEPS, FAST_TICK_S, MAX_CATCH_UP_S, Pacer
 
 
 class FakeClock:

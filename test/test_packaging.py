@@ -135,7 +135,7 @@ def test_ros2_run_sees_exactly_the_entry_points(prefix):
     entry_points = {
         ep.name: ep.value for ep in importlib.metadata.entry_points(group='console_scripts')
         if ep.dist is not None and ep.dist.name.replace('-', '_') == PACKAGE}
-    expected = {name: f'{PACKAGE}.{name}:main' for name in EXECUTABLES}
+    expected = {name: f'{PACKAGE}.tools.{name}:main' for name in EXECUTABLES}
     # sim_node starts through the runner, which installs its signal handlers
     # before rclpy and PyBullet are imported (a Ctrl-C during start-up is clean).
     expected['sim_node'] = f'{PACKAGE}.__main__:main'

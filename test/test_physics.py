@@ -2,8 +2,8 @@
 
 import pytest
 
-from pan_tilt_sim.description import load_description
-from pan_tilt_sim.physics import Physics, pybullet
+from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.sim.physics import Physics, pybullet
 
 
 @pytest.fixture

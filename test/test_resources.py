@@ -19,7 +19,7 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from pan_tilt_sim.errors import DescriptionError
-from pan_tilt_sim.resources import (
+from pan_tilt_sim.model.resources import (
     LocalizedMesh,
     localize_meshes,
     read_ascii_stl,

@@ -12,16 +12,16 @@ from node_harness import sim_node, stamp_s
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64MultiArray, String
 
-from pan_tilt_sim import robot_state
-from pan_tilt_sim.description import load_description
-from pan_tilt_sim.robot_state import (
+from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.model.transforms import Transform, quaternion_from_axis_angle, rotate
+from pan_tilt_sim.model.urdf import parse_urdf
+from pan_tilt_sim.ros import robot_state
+from pan_tilt_sim.ros.robot_state import (
     moving_transforms,
     static_transforms,
     transform_message,
 )
 from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
-from pan_tilt_sim.transforms import Transform, quaternion_from_axis_angle, rotate
-from pan_tilt_sim.urdf import parse_urdf
 
 HAS_TF2_MSGS = importlib.util.find_spec('tf2_msgs') is not None
 LATE_SUBSCRIBER_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,

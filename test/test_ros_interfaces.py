@@ -9,7 +9,7 @@ from trajectory_msgs.msg import JointTrajectoryPoint
 
 from pan_tilt_sim.controllers import CommandKind
 from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
-from pan_tilt_sim.ros_interfaces import COMMAND_MESSAGES, joint_trajectory, seconds
+from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES, joint_trajectory, seconds
 
 
 def test_every_command_kind_has_a_message_type():

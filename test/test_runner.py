@@ -13,7 +13,7 @@ import signal
 import pytest
 
 from pan_tilt_sim.errors import ArgumentError
-from pan_tilt_sim.runner import StopRequested, StopSignals, debug_requested, init_ros
+from pan_tilt_sim.ros.runner import StopRequested, StopSignals, debug_requested, init_ros
 
 
 def _python_call() -> None:

@@ -23,8 +23,8 @@ import sim_process
 from rclpy.context import Context
 from rclpy.parameter import Parameter
 
-from pan_tilt_sim.physics import pybullet
-from pan_tilt_sim.sim_node import SimNode
+from pan_tilt_sim.ros.sim_node import SimNode
+from pan_tilt_sim.sim.physics import pybullet
 
 STARTUP_BUDGET_S = 30.0
 STOP_BUDGET_S = 2.0

@@ -19,8 +19,8 @@ from robot_fixtures import JointDef, write_star_robot, write_text
 from std_msgs.msg import Float64, Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from pan_tilt_sim.ros_interfaces import stamp
-from pan_tilt_sim.runner import EXIT_CONFIGURATION_ERROR
+from pan_tilt_sim.ros.ros_interfaces import stamp
+from pan_tilt_sim.ros.runner import EXIT_CONFIGURATION_ERROR
 
 STARTUP_BUDGET_S = 30.0
 

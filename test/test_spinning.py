@@ -6,7 +6,7 @@ import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 
-from pan_tilt_sim import spinning
+from pan_tilt_sim.ros import spinning
 
 SPIN_BUDGET_S = 10.0
 

@@ -23,8 +23,8 @@ from pan_tilt_sim.errors import (
     DescriptionError,
     ParameterError,
 )
+from pan_tilt_sim.ros.sim_node import SimNode
 from pan_tilt_sim.share import package_share
-from pan_tilt_sim.sim_node import SimNode
 
 EXIT_CONFIGURATION_ERROR = 2
 PAN_TILT_URDF = package_share() / 'urdf' / 'pan_tilt.xacro'

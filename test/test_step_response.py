@@ -7,8 +7,8 @@ import sys
 
 import pytest
 
-from pan_tilt_sim import step_response
-from pan_tilt_sim.step_response import (
+from pan_tilt_sim.tools import step_response
+from pan_tilt_sim.tools.step_response import (
     StepRecord,
     overshoot_percent,
     rise_time,
@@ -102,7 +102,7 @@ def test_a_setpoint_that_jumps_means_the_velocity_limit_was_not_active():
 def pan_step():
     """Return the JSON the tool prints for the seed's pan stepped from 0 to 1 rad."""
     completed = subprocess.run(
-        [sys.executable, '-c', 'import sys; from pan_tilt_sim import step_response; '
+        [sys.executable, '-c', 'import sys; from pan_tilt_sim.tools import step_response; '
          "step_response.main(sys.argv[1:]); assert 'rclpy' not in sys.modules, 'rclpy'",
          '--joint', 'pan_joint', '--target', '1.0'],
         capture_output=True, text=True, timeout=120, check=False)

@@ -18,7 +18,7 @@ from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.pid import Pid
 from pan_tilt_sim.errors import ControllerConfigError
-from pan_tilt_sim.robot_model import JointSpec
+from pan_tilt_sim.model.robot import JointSpec
 
 # Largest command magnitude taken on a side without a limit (rad, m, rad/s, N*m...):
 # far beyond any real joint, small enough that PID arithmetic on it stays finite.

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 
 from pan_tilt_sim.controllers.base import CommandResult, bounded_command, clamp
-from pan_tilt_sim.robot_model import JointSpec
+from pan_tilt_sim.model.robot import JointSpec
 
 
 class PositionLimits:

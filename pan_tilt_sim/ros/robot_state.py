@@ -26,11 +26,11 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import String
 
-from pan_tilt_sim import parameters as params
-from pan_tilt_sim.robot_model import RobotModel
-from pan_tilt_sim.ros_interfaces import stamp
+from pan_tilt_sim.model.robot import RobotModel
+from pan_tilt_sim.model.transforms import Transform
+from pan_tilt_sim.ros import parameters as params
+from pan_tilt_sim.ros.ros_interfaces import stamp
 from pan_tilt_sim.schedule import PeriodicSchedule
-from pan_tilt_sim.transforms import Transform
 
 TF_PERIOD_S = 0.02  # sim seconds between /tf messages (50 Hz, the joint_states rate)
 TF_TOPIC = '/tf'

@@ -13,9 +13,9 @@ import dataclasses
 from collections.abc import Sequence
 from typing import Any
 
-from pan_tilt_sim import naming
-from pan_tilt_sim.controller_config import load_controllers_config
-from pan_tilt_sim.description import load_description
+from pan_tilt_sim.model import naming
+from pan_tilt_sim.model.controller_config import load_controllers_config
+from pan_tilt_sim.model.description import load_description
 
 ROOT_NAMESPACE = '/'
 

@@ -51,8 +51,8 @@ from typing import Any
 
 import yaml
 
-from pan_tilt_sim import naming
 from pan_tilt_sim.errors import ControllerConfigError
+from pan_tilt_sim.model import naming
 
 TYPE_FIELD = 'type'
 ROS2_PARAMETERS = 'ros__parameters'

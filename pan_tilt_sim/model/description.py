@@ -2,9 +2,9 @@
 
 Nothing here knows about PyBullet or ROS: it reads the file (running xacro
 with the user's mappings when the file is a xacro), parses it once into the
-robot model (:mod:`pan_tilt_sim.urdf`), and makes PyBullet's copy of the
+robot model (:mod:`pan_tilt_sim.model.urdf`), and makes PyBullet's copy of the
 URDF, whose meshes are local files PyBullet can load
-(:mod:`pan_tilt_sim.resources`).
+(:mod:`pan_tilt_sim.model.resources`).
 """
 
 from __future__ import annotations
@@ -17,9 +17,9 @@ from collections.abc import Sequence
 from xml.parsers.expat import ExpatError
 
 from pan_tilt_sim.errors import DescriptionError, one_line
-from pan_tilt_sim.resources import localize_meshes
-from pan_tilt_sim.robot_model import JointSpec, RobotModel
-from pan_tilt_sim.urdf import parse_xml, read_model
+from pan_tilt_sim.model.resources import localize_meshes
+from pan_tilt_sim.model.robot import JointSpec, RobotModel
+from pan_tilt_sim.model.urdf import parse_xml, read_model
 
 XACRO_SUFFIX = '.xacro'
 MAPPING_SEPARATOR = ':='

@@ -14,12 +14,12 @@ from __future__ import annotations
 
 from rclpy.node import Node
 
-from pan_tilt_sim import naming
-from pan_tilt_sim.camera import Renderer
-from pan_tilt_sim.camera_publisher import CameraPublisher, declare_camera, declare_world
-from pan_tilt_sim.engine import Simulation
-from pan_tilt_sim.robot_state import RobotStatePublisher
-from pan_tilt_sim.world import build_world
+from pan_tilt_sim.model import naming
+from pan_tilt_sim.ros.camera_publisher import CameraPublisher, declare_camera, declare_world
+from pan_tilt_sim.ros.robot_state import RobotStatePublisher
+from pan_tilt_sim.sim.camera import Renderer
+from pan_tilt_sim.sim.engine import Simulation
+from pan_tilt_sim.sim.world import build_world
 
 
 class NodeFeatures:

@@ -18,7 +18,7 @@ coordinates): ``cx = (width - 1) / 2``, ``cy = (height - 1) / 2``.
 client per simulation -- between batches of physics steps, so every frame
 shows the robot (and anything else in the world) exactly as the physics has
 it.  Rendering only reads the world; the scenery it shows
-(:mod:`pan_tilt_sim.world`) is visual only and never touches the physics.
+(:mod:`pan_tilt_sim.sim.world`) is visual only and never touches the physics.
 """
 
 from __future__ import annotations
@@ -29,12 +29,12 @@ from collections.abc import Mapping, Sequence
 
 import numpy
 
-from pan_tilt_sim.bullet import pybullet
 from pan_tilt_sim.errors import ParameterError
-from pan_tilt_sim.physics import BASE_LINK_INDEX, Physics
-from pan_tilt_sim.robot_model import RobotModel
-from pan_tilt_sim.transforms import Transform, Vector, quaternion_from_matrix, rotate
-from pan_tilt_sim.world import DEFAULT_WORLD, GROUND_RGB, has_ground
+from pan_tilt_sim.model.robot import RobotModel
+from pan_tilt_sim.model.transforms import Transform, Vector, quaternion_from_matrix, rotate
+from pan_tilt_sim.sim.bullet import pybullet
+from pan_tilt_sim.sim.physics import BASE_LINK_INDEX, Physics
+from pan_tilt_sim.sim.world import DEFAULT_WORLD, GROUND_RGB, has_ground
 
 DEFAULT_LINK = 'tilt_link'
 DEFAULT_WIDTH = 320

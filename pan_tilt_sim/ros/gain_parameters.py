@@ -35,7 +35,7 @@ from pan_tilt_sim.controllers.base import Controller
 from pan_tilt_sim.controllers.gains import PID_FIELD
 from pan_tilt_sim.controllers.pid import ANTIWINDUP, GainsError, Pid, PidGains
 from pan_tilt_sim.errors import ParameterError
-from pan_tilt_sim.parameters import BOOL, DOUBLE, coerce, declare
+from pan_tilt_sim.ros.parameters import BOOL, DOUBLE, coerce, declare
 
 FIELDS = ('p', 'i', 'd', 'i_clamp_max', 'i_clamp_min', ANTIWINDUP)
 FIELD_TYPES = {field: DOUBLE for field in FIELDS} | {ANTIWINDUP: BOOL}

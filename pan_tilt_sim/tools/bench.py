@@ -1,6 +1,6 @@
 """bench: how fast sim_node runs, printed as one JSON object.
 
-``ros2 run pan_tilt_sim bench`` (or ``python -m pan_tilt_sim.bench``) runs the
+``ros2 run pan_tilt_sim bench`` (or ``python -m pan_tilt_sim.tools.bench``) runs the
 seed's pan/tilt model and prints, measured in one run so that ratios hold on
 a noisy machine:
 
@@ -56,15 +56,15 @@ from rclpy.qos import QoSProfile
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
-from pan_tilt_sim import naming
-from pan_tilt_sim.controller_config import load_controllers_config
 from pan_tilt_sim.controllers import create_controller
 from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
-from pan_tilt_sim.description import load_description
 from pan_tilt_sim.errors import ConfigurationError
-from pan_tilt_sim.physics import Physics
-from pan_tilt_sim.ros_interfaces import seconds
+from pan_tilt_sim.model import naming
+from pan_tilt_sim.model.controller_config import load_controllers_config
+from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.ros.ros_interfaces import seconds
 from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.sim.physics import Physics
 
 DEFAULT_TIME_STEP = 0.001  # s, the issue's reference step
 CHAIN_JOINTS = (2, 8, 32)

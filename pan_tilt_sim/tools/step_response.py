@@ -35,10 +35,10 @@ from collections.abc import Sequence
 
 from pan_tilt_sim.controllers import CommandResult
 from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
-from pan_tilt_sim.engine import Simulation, make_simulation
 from pan_tilt_sim.errors import ConfigurationError
-from pan_tilt_sim.robot_model import JointKind
+from pan_tilt_sim.model.robot import JointKind
 from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.sim.engine import Simulation, make_simulation
 
 PROGRAM = 'step_response'
 EXIT_CONFIGURATION_ERROR = 2

@@ -16,7 +16,7 @@ import dataclasses
 from collections.abc import Sequence
 
 from pan_tilt_sim.errors import DescriptionError
-from pan_tilt_sim.robot_model import JointSpec
+from pan_tilt_sim.model.robot import JointSpec
 
 
 @dataclasses.dataclass(frozen=True)

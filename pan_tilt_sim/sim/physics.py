@@ -9,7 +9,7 @@ viscous torque; URDF ``friction`` is modelled as Coulomb friction by a
 velocity motor held at zero speed whose force is capped at the friction
 value, which also gives the static friction Gazebo users know.  A
 ``<mimic>`` joint is held at ``multiplier * leader + offset`` by a gear
-constraint (see :mod:`pan_tilt_sim.mimic`).
+constraint (see :mod:`pan_tilt_sim.model.mimic`).
 """
 
 from __future__ import annotations
@@ -20,11 +20,11 @@ import tempfile
 import weakref
 from collections.abc import Callable, Sequence
 
-from pan_tilt_sim.bullet import pybullet, quiet_native_output
-from pan_tilt_sim.description import RobotDescription
 from pan_tilt_sim.errors import DescriptionError
-from pan_tilt_sim.mimic import follow_leaders, mimic_couplings
-from pan_tilt_sim.robot_model import JointSpec
+from pan_tilt_sim.model.description import RobotDescription
+from pan_tilt_sim.model.mimic import follow_leaders, mimic_couplings
+from pan_tilt_sim.model.robot import JointSpec
+from pan_tilt_sim.sim.bullet import pybullet, quiet_native_output
 
 STANDARD_GRAVITY = 9.81  # m/s^2, along -z as in Gazebo's default world
 URDF_FILE_NAME = 'robot.urdf'

@@ -19,7 +19,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from pan_tilt_sim.errors import ParameterError
-from pan_tilt_sim.naming import check_namespace
+from pan_tilt_sim.model.naming import check_namespace
 from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
 
 BOOL = ParameterType.PARAMETER_BOOL

@@ -193,7 +193,7 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
                 node = make_node()
             import rclpy
 
-            from pan_tilt_sim import spinning
+            from pan_tilt_sim.ros import spinning
 
             if stop.received is None and rclpy.ok():
                 # Only while the context is alive: an executor whose construction

@@ -1,4 +1,4 @@
-"""URDF text to :class:`~pan_tilt_sim.robot_model.RobotModel`: the one parser. No ROS.
+"""URDF text to :class:`~pan_tilt_sim.model.robot.RobotModel`: the one parser. No ROS.
 
 Everything the simulator reads from a URDF is read here, once, with one
 error policy: anything malformed that the simulator would use -- a number,
@@ -13,9 +13,9 @@ import math
 import pathlib
 import xml.etree.ElementTree as ElementTree
 
-from pan_tilt_sim import naming
 from pan_tilt_sim.errors import DescriptionError
-from pan_tilt_sim.robot_model import (
+from pan_tilt_sim.model import naming
+from pan_tilt_sim.model.robot import (
     DEFAULT_AXIS,
     Geometry,
     Inertial,
@@ -26,7 +26,7 @@ from pan_tilt_sim.robot_model import (
     RobotModel,
     Shape,
 )
-from pan_tilt_sim.transforms import ZERO_VECTOR, Transform, Vector, quaternion_from_rpy
+from pan_tilt_sim.model.transforms import ZERO_VECTOR, Transform, Vector, quaternion_from_rpy
 
 URDF_ROOT_TAG = 'robot'
 # Gazebo plugins whose namespace element names the robot's topic namespace.

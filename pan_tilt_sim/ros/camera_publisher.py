@@ -5,7 +5,7 @@ A frame is due every ``1 / camera.rate`` seconds of sim time
 first chunk of physics steps that reaches the due time (sim_node checks
 every /clock period, 10 ms of sim time, so with the default 10 Hz the frames
 fall exactly on the 0.1 s grid).  When someone subscribes to the image, the
-renderer (:mod:`pan_tilt_sim.camera`) draws the world as the physics has it
+renderer (:mod:`pan_tilt_sim.sim.camera`) draws the world as the physics has it
 now; the image is stamped with the sim time and published in the
 ``<link>_optical`` frame, with a CameraInfo whose K and P follow from
 ``camera.fov_deg`` and the image size.  A reset of the simulation starts the
@@ -29,8 +29,12 @@ from collections.abc import Callable, Sequence
 from rclpy.node import Node
 from sensor_msgs.msg import CameraInfo, Image
 
-from pan_tilt_sim import parameters as params
-from pan_tilt_sim.camera import (
+from pan_tilt_sim.errors import ParameterError
+from pan_tilt_sim.model.transforms import Transform
+from pan_tilt_sim.ros import parameters as params
+from pan_tilt_sim.ros.ros_interfaces import stamp
+from pan_tilt_sim.schedule import PeriodicSchedule
+from pan_tilt_sim.sim.camera import (
     DEFAULT_FAR,
     DEFAULT_FOV_DEG,
     DEFAULT_HEIGHT,
@@ -43,11 +47,7 @@ from pan_tilt_sim.camera import (
     Renderer,
     intrinsics,
 )
-from pan_tilt_sim.errors import ParameterError
-from pan_tilt_sim.ros_interfaces import stamp
-from pan_tilt_sim.schedule import PeriodicSchedule
-from pan_tilt_sim.transforms import Transform
-from pan_tilt_sim.world import DEFAULT_WORLD, WORLDS, check_world
+from pan_tilt_sim.sim.world import DEFAULT_WORLD, WORLDS, check_world
 
 IMAGE_ENCODING = 'rgb8'
 BYTES_PER_PIXEL = 3

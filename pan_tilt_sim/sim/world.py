@@ -3,7 +3,7 @@
 The world is built from PyBullet primitives (no ``pybullet_data`` files) and
 is visual only: its bodies have no collision shapes, so they can never touch
 the robot.  It lives in the simulation's PyBullet client, where the camera
-renders (see :mod:`pan_tilt_sim.camera`) and a GUI window shows it.
+renders (see :mod:`pan_tilt_sim.sim.camera`) and a GUI window shows it.
 
 The ground is the plane z = 0.  TinyRenderer's cost grows with the pixels it
 shades, and a ground body covers half of every horizontal view (measured: 9 ms
@@ -24,8 +24,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from pan_tilt_sim.bullet import pybullet
 from pan_tilt_sim.errors import ParameterError
+from pan_tilt_sim.sim.bullet import pybullet
 
 EMPTY = 'empty'
 TARGETS = 'targets'

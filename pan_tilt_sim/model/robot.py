@@ -1,6 +1,6 @@
 """The one model of the robot: links, joints, limits, inertials, origins, mimic, plugins.
 
-Parsed once from the URDF (:mod:`pan_tilt_sim.urdf`); physics, controllers,
+Parsed once from the URDF (:mod:`pan_tilt_sim.model.urdf`); physics, controllers,
 kinematics, camera, TF and the tools all read this model, never the XML.
 Plain values, no ROS, no PyBullet.
 
@@ -18,7 +18,7 @@ import functools
 import math
 from collections.abc import Mapping
 
-from pan_tilt_sim.transforms import (
+from pan_tilt_sim.model.transforms import (
     Transform,
     Vector,
     quaternion_from_axis_angle,

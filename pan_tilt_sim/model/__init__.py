@@ -1,0 +1,1 @@
+"""The robot as its files describe it: no rclpy, no PyBullet."""

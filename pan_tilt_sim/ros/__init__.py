@@ -1,0 +1,1 @@
+"""The ROS adapter: everything that imports rclpy."""

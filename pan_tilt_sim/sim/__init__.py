@@ -1,0 +1,1 @@
+"""The simulation: the only layer that imports PyBullet (one client per simulation)."""

@@ -1,0 +1,1 @@
+"""Tools around the simulator: step_response, bench, launch-file helpers."""
