@@ -56,3 +56,29 @@ def context():
     rclpy.init(context=context)
     yield context
     rclpy.try_shutdown(context=context)
+
+
+@pytest.fixture
+def client():
+    """Yield a private PyBullet DIRECT client id; disconnect it afterwards."""
+    import pybullet
+
+    client_id = pybullet.connect(pybullet.DIRECT)
+    yield client_id
+    pybullet.disconnect(physicsClientId=client_id)
+
+
+@pytest.fixture
+def cache_dir(tmp_path):
+    """Return a cache folder for converted meshes (not created yet)."""
+    return tmp_path / 'cache'
+
+
+@pytest.fixture
+def seed2(tmp_path, monkeypatch, seeds_dir):
+    """Install the seed-2 package into a temporary prefix; return its share folder."""
+    import mesh_fixtures as mf
+
+    prefix = mf.make_seed2_package(tmp_path, seeds_dir / 'my_robot.urdf')
+    monkeypatch.setenv('AMENT_PREFIX_PATH', str(prefix))
+    return prefix / 'share' / mf.SEED2_PACKAGE

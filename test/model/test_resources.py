@@ -1,8 +1,8 @@
 """Resource resolution and mesh localization: what the description layer relies on.
 
-Every PyBullet test uses its own DIRECT client (never the default one) and
-disconnects it.  PyBullet prints loader warnings on stdout from C; tests read
-them with ``capfd`` to prove a localized mesh loads without any.
+Localized meshes are loaded into PyBullet to prove they load, quietly
+(see mesh_loading.py).  What PyBullet itself does with meshes is pinned in
+test/dependencies/.
 """
 
 import os
@@ -14,9 +14,20 @@ import mesh_fixtures as mf
 import numpy as np
 import pybullet
 import pytest
-import xacro
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
+from mesh_loading import (
+    BOX_123,
+    FLOAT32_TOLERANCE,
+    MILLI_SCALE,
+    MM,
+    assert_quiet,
+    collision_extent,
+    load,
+    mesh_robot,
+    mesh_xml,
+    one_link_robot,
+)
 
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.resources import (
@@ -27,73 +38,6 @@ from pan_tilt_sim.model.resources import (
     resolve_resource,
     write_binary_stl,
 )
-
-MM = 0.001
-MILLI_SCALE = '0.001 0.001 0.001'
-FLOAT32_TOLERANCE = 1e-6
-BOX_123: mf.Size = (1.0, 2.0, 3.0)
-INERTIAL = ('<inertial><mass value="1"/>'
-            '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>')
-PRIMITIVE_COLLISION = '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>'
-
-
-@pytest.fixture
-def client():
-    """Yield a private PyBullet DIRECT client id; disconnect it afterwards."""
-    client_id = pybullet.connect(pybullet.DIRECT)
-    yield client_id
-    pybullet.disconnect(physicsClientId=client_id)
-
-
-@pytest.fixture
-def cache_dir(tmp_path):
-    """Return a cache folder for converted meshes (not created yet)."""
-    return tmp_path / 'cache'
-
-
-def mesh_xml(uri: str, scale: str | None = None) -> str:
-    """Return a ``<geometry><mesh>`` snippet."""
-    scale_attr = f' scale="{scale}"' if scale is not None else ''
-    return f'<geometry><mesh filename="{uri}"{scale_attr}/></geometry>'
-
-
-def one_link_robot(visual: str = '', collision: str = '') -> ET.Element:
-    """Return a parsed one-link URDF whose link ``m`` holds the given snippets."""
-    return ET.fromstring(f'<robot name="t"><link name="m">{visual}{collision}{INERTIAL}'
-                         '</link></robot>')
-
-
-def mesh_robot(uri: str, role: str, scale: str | None = None) -> ET.Element:
-    """Return a one-link URDF with ``uri`` as its visual or collision mesh.
-
-    A visual mesh gets a primitive collision box beside it.
-    """
-    snippet = f'<{role}>{mesh_xml(uri, scale)}</{role}>'
-    if role == 'visual':
-        return one_link_robot(visual=snippet, collision=PRIMITIVE_COLLISION)
-    return one_link_robot(collision=snippet)
-
-
-def load(client_id: int, robot: ET.Element, folder: pathlib.Path) -> int:
-    """Write ``robot`` to a file in ``folder``, load it into PyBullet and return the body."""
-    path = folder / f'{robot.get("name")}-loaded.urdf'
-    path.write_bytes(ET.tostring(robot))
-    return pybullet.loadURDF(str(path), physicsClientId=client_id)
-
-
-def collision_extent(client_id: int, body: int, link: int = -1) -> np.ndarray:
-    """Return the size of a link's collision mesh as PyBullet holds it (scale applied)."""
-    _, vertices = pybullet.getMeshData(body, link, physicsClientId=client_id)
-    points = np.array(vertices)
-    return points.max(axis=0) - points.min(axis=0)
-
-
-def assert_quiet(capfd: pytest.CaptureFixture[str]) -> None:
-    """Fail if PyBullet printed a loader warning or error."""
-    out, err = capfd.readouterr()
-    assert 'b3Warning' not in out + err
-    assert 'b3Error' not in out + err
-
 
 # --- resolve_resource -------------------------------------------------------
 
@@ -351,34 +295,10 @@ def test_visual_mesh_loads_quietly(tmp_path, cache_dir, client, capfd, name):
     assert_quiet(capfd)
 
 
-def test_pybullet_alone_silently_drops_an_ascii_stl(tmp_path, client, capfd):
-    """Why ASCII STL is converted: PyBullet loads the link without a shape and only prints."""
-    mf.write_ascii_stl(tmp_path / 'ascii.stl')
-    body = load(client, mesh_robot(str(tmp_path / 'ascii.stl'), 'collision'), tmp_path)
-    assert pybullet.getCollisionShapeData(body, -1, physicsClientId=client) == ()
-    assert 'cannot extract mesh' in capfd.readouterr().out
 
 
-def test_scale_shrinks_a_one_metre_box_to_one_millimetre(tmp_path, cache_dir, client):
-    """PyBullet applies scale="0.001 0.001 0.001" itself: a 1 m box becomes 1 mm."""
-    mf.write_binary_stl(tmp_path / 'box.stl')
-    robot = mesh_robot('box.stl', 'collision', MILLI_SCALE)
-    localize_meshes(robot, tmp_path, cache_dir)
-    body = load(client, robot, tmp_path)
-    lower, upper = pybullet.getAABB(body, -1, physicsClientId=client)
-    aabb_size = np.subtract(upper, lower)
-    collision_margin = 2 * 0.002  # Bullet pads convex hulls by 2 mm on each side.
-    np.testing.assert_allclose(aabb_size, MM + collision_margin, rtol=FLOAT32_TOLERANCE)
-    np.testing.assert_allclose(collision_extent(client, body), [MM] * 3, rtol=FLOAT32_TOLERANCE)
 
 
-def test_pybullet_honours_anisotropic_scale(tmp_path, cache_dir, client):
-    """PyBullet applies a per-axis scale as given."""
-    mf.write_binary_stl(tmp_path / 'box.stl')
-    robot = mesh_robot('box.stl', 'collision', '2 3 4')
-    localize_meshes(robot, tmp_path, cache_dir)
-    body = load(client, robot, tmp_path)
-    np.testing.assert_allclose(collision_extent(client, body), [2, 3, 4], rtol=FLOAT32_TOLERANCE)
 
 
 def test_collada_node_transforms_are_applied(tmp_path, cache_dir, client):
@@ -579,12 +499,7 @@ def test_collada_reference_cycle_is_an_error(tmp_path, cache_dir):
 # --- the seed-2 robot -----------------------------------------------------
 
 
-@pytest.fixture
-def seed2(tmp_path, monkeypatch, seeds_dir):
-    """Install the seed-2 package into a temporary prefix; return its share folder."""
-    prefix = mf.make_seed2_package(tmp_path, seeds_dir / 'my_robot.urdf')
-    monkeypatch.setenv('AMENT_PREFIX_PATH', str(prefix))
-    return prefix / 'share' / mf.SEED2_PACKAGE
+
 
 
 def test_seed2_urdf_loads_with_both_links_and_their_sizes(seed2, tmp_path, cache_dir, client,
@@ -629,43 +544,7 @@ def test_seed2_missing_visual_names_uri_and_resolved_path(seed2, cache_dir):
 
 # --- xacro $(find PKG) ----------------------------------------------------
 
-XACRO_MAIN = '''<?xml version="1.0"?>
-<robot xmlns:xacro="http://www.ros.org/wiki/xacro" name="x">
-  <xacro:arg name="mesh" default="base"/>
-  <xacro:include filename="$(find my_robot_pkg)/urdf/arm.xacro"/>
-  <link name="base_link"><collision><geometry>
-    <mesh filename="$(find my_robot_pkg)/meshes/collision/$(arg mesh).stl"/>
-  </geometry></collision></link>
-  <xacro:arm/>
-</robot>
-'''
-XACRO_ARM = '''<?xml version="1.0"?>
-<robot xmlns:xacro="http://www.ros.org/wiki/xacro">
-  <xacro:macro name="arm"><link name="arm_link"><collision><geometry>
-    <mesh filename="package://my_robot_pkg/meshes/collision/arm.stl"/>
-  </geometry></collision></link></xacro:macro>
-</robot>
-'''
 
 
-def test_xacro_find_uses_the_ament_index(seed2, tmp_path, cache_dir):
-    """Xacro resolves $(find PKG) through AMENT_PREFIX_PATH, in includes too."""
-    (seed2 / 'urdf' / 'arm.xacro').write_text(XACRO_ARM)
-    main = tmp_path / 'main.xacro'
-    main.write_text(XACRO_MAIN)
-    document = xacro.process_file(str(main), mappings={'mesh': 'base'})
-    robot = ET.fromstring(document.toxml())
-    assert robot.find('link/collision/geometry/mesh').get('filename') == str(
-        seed2 / 'meshes' / 'collision' / 'base.stl')
-    done = localize_meshes(robot, main.parent, cache_dir)
-    assert [m.loadable for m in done] == [seed2 / mf.SEED2_MESHES['base_collision'],
-                                          seed2 / mf.SEED2_MESHES['arm_collision']]
 
 
-def test_xacro_find_of_an_unknown_package_raises_xacro_exception(tmp_path, monkeypatch):
-    """Xacro reports an unknown $(find) package as XacroException (the caller maps it)."""
-    monkeypatch.setenv('AMENT_PREFIX_PATH', str(tmp_path))
-    main = tmp_path / 'main.xacro'
-    main.write_text(XACRO_MAIN)
-    with pytest.raises(xacro.XacroException, match="package 'my_robot_pkg' not found"):
-        xacro.process_file(str(main))

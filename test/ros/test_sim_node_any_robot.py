@@ -9,10 +9,10 @@ import contextlib
 import os
 import pathlib
 import subprocess
-import sys
 
 import mesh_fixtures as mf
 import pytest
+import sim_process
 from builtin_interfaces.msg import Duration
 from node_harness import sim_node, stamp_s
 from robot_fixtures import JointDef, write_star_robot, write_text
@@ -65,13 +65,12 @@ def test_seed2_arm_joint_reaches_its_command_under_the_plugin_namespace(seed2_pa
 def test_seed2_missing_mesh_ends_start_up_with_code_2_naming_the_uri(seed2_package, tmp_path):
     missing = seed2_package / mf.SEED2_MESHES['arm_collision']
     missing.unlink()
-    environment = dict(os.environ, PYTHONPATH=os.pathsep.join(
-        [str(pathlib.Path(__file__).resolve().parents[1]), os.environ.get('PYTHONPATH', '')]))
     result = subprocess.run(
-        [sys.executable, '-m', 'pan_tilt_sim', '--ros-args',
-         '-p', f'robot_description_file:={seed2_package / mf.SEED2_URDF_RELPATH}',
-         '-p', f"controllers_file:={seed2_package / 'config' / 'joint_controllers.yaml'}"],
-        capture_output=True, text=True, env=environment, timeout=STARTUP_BUDGET_S)
+        sim_process.command(
+            '-p', f'robot_description_file:={seed2_package / mf.SEED2_URDF_RELPATH}',
+            '-p', f"controllers_file:={seed2_package / 'config' / 'joint_controllers.yaml'}"),
+        capture_output=True, text=True, env=sim_process.environment(),
+        timeout=STARTUP_BUDGET_S)
     assert result.returncode == EXIT_CONFIGURATION_ERROR
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1, result.stderr

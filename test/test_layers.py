@@ -1,0 +1,126 @@
+"""The package's layers: data flows one way, PyBullet and rclpy stay in their layer, no cycles.
+
+model -> controllers -> sim -> ros -> tools; ``errors``, ``schedule`` and
+``share`` are shared by all.  Read from the installed package's source with
+``ast`` (every import, also those inside functions), and checked once more by
+importing: loading model/ and controllers/ pulls in neither rclpy nor PyBullet.
+"""
+
+import ast
+import pathlib
+import subprocess
+import sys
+
+import pytest
+import sim_process
+
+import pan_tilt_sim
+
+PACKAGE = pathlib.Path(pan_tilt_sim.__file__).resolve().parent
+SHARED = {'errors', 'schedule', 'share'}
+# What each layer may import from the package, besides itself and SHARED.
+ALLOWED = {
+    'model': set(),
+    'controllers': {'model'},
+    'sim': {'model', 'controllers'},
+    'ros': {'model', 'controllers', 'sim'},
+    'tools': {'model', 'controllers', 'sim', 'ros'},
+}
+ROS_PACKAGE_SUFFIXES = ('_msgs', '_srvs', '_interfaces')
+ROS_PACKAGES = {'rclpy', 'builtin_interfaces'}
+
+
+def modules() -> dict[str, pathlib.Path]:
+    """Return every module of the package by dotted name."""
+    found = {}
+    for path in PACKAGE.rglob('*.py'):
+        parts = path.relative_to(PACKAGE.parent).with_suffix('').parts
+        name = '.'.join(parts[:-1] if parts[-1] == '__init__' else parts)
+        found[name] = path
+    return found
+
+
+def imports(path: pathlib.Path) -> set[str]:
+    """Return every module ``path`` imports, anywhere in it (top-level names and dotted)."""
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names.add(node.module)
+            names.update(f'{node.module}.{alias.name}' for alias in node.names)
+    return names
+
+
+def layer(module: str) -> str:
+    """Return the layer of a package module: its first sub-package, or '' at the top."""
+    parts = module.split('.')
+    return parts[1] if len(parts) > 2 else ''
+
+
+MODULES = modules()
+
+
+def test_the_package_has_the_layer_folders():
+    assert set(ALLOWED) <= {path.name for path in PACKAGE.iterdir() if path.is_dir()}
+
+
+@pytest.mark.parametrize('module', sorted(MODULES))
+def test_pybullet_is_imported_only_in_the_sim_layer(module):
+    uses_pybullet = any(name.split('.')[0] == 'pybullet' for name in imports(MODULES[module]))
+    assert not uses_pybullet or layer(module) == 'sim', module
+
+
+@pytest.mark.parametrize('module', sorted(MODULES))
+def test_rclpy_and_ros_messages_are_imported_only_in_ros_and_tools(module):
+    ros = sorted(name for name in imports(MODULES[module])
+                 if name.split('.')[0] in ROS_PACKAGES
+                 or name.split('.')[0].endswith(ROS_PACKAGE_SUFFIXES))
+    if layer(module) in ('ros', 'tools') or module == 'pan_tilt_sim.sim_node':
+        return  # the top-level sim_node only re-exports the node
+    assert not ros, f'{module} imports {ros}'
+
+
+@pytest.mark.parametrize('module', sorted(m for m in MODULES if layer(m) in ALLOWED))
+def test_each_layer_imports_only_the_layers_below_it(module):
+    own = layer(module)
+    for name in imports(MODULES[module]):
+        if not name.startswith('pan_tilt_sim.'):
+            continue
+        target = name.split('.')[1]
+        if target in SHARED or target == own:
+            continue
+        assert target in ALLOWED[own], f'{module} ({own}) imports {name} ({target})'
+
+
+def test_no_module_imports_one_that_imports_it_back():
+    graph = {name: {dep for dep in imports(path) if dep in MODULES and dep != name}
+             for name, path in MODULES.items()}
+    cycles = []
+
+    def reaches(start: str, goal: str) -> bool:
+        seen, pending = set(), [start]
+        while pending:
+            current = pending.pop()
+            if current == goal:
+                return True
+            if current not in seen:
+                seen.add(current)
+                pending.extend(graph[current])
+        return False
+
+    for module, deps in graph.items():
+        cycles.extend((module, dep) for dep in deps if reaches(dep, module))
+    assert cycles == []
+
+
+def test_importing_model_and_controllers_pulls_in_neither_rclpy_nor_pybullet():
+    names = sorted(m for m in MODULES if layer(m) in ('model', 'controllers'))
+    code = '; '.join([*(f'import {name}' for name in names),
+                      'import sys',
+                      "print(sorted(m for m in ('rclpy', 'pybullet') if m in sys.modules))"])
+    result = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                            env=sim_process.environment(), timeout=60, check=False)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == '[]'
+    assert len(names) > 20  # every module of both layers was imported
