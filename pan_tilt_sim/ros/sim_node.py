@@ -10,6 +10,7 @@ latest command, and only the tick writes to the simulation.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
@@ -47,6 +48,16 @@ _OWN_PARAMETERS = {field.name for field in dataclasses.fields(parameters.SimPara
 PAUSED = 'paused'  # the parameter; services and set_paused() go through it
 
 
+def clock_period_steps(time_step: float) -> int:
+    """Return the physics steps between /clock messages: the whole number nearest 10 ms.
+
+    /clock stamps stay on the step grid, so with a time step that does not
+    divide 10 ms the period is the nearest whole number of steps (halves
+    round up): 9 ms at 0.003 s, 12 ms at 0.004 s, every step from 0.02 s on.
+    """
+    return max(1, math.floor(CLOCK_PERIOD_S / time_step + 0.5 + 1e-9))
+
+
 class SimNode(Node):
     """Loads the robot and its controllers, and runs them in PyBullet."""
 
@@ -65,7 +76,7 @@ class SimNode(Node):
         # Commands taken per controller (ignored ones included): a cheap health figure.
         self.commands_received = {c.name: 0 for c in self.simulation.command_controllers()}
         self._pacer = Pacer(self.settings.real_time_factor, self.settings.time_step)
-        self._clock_every = max(1, round(CLOCK_PERIOD_S / self.settings.time_step))
+        self._clock_every = clock_period_steps(self.settings.time_step)
         self._clock_publisher = self.create_publisher(Clock, '/clock', QUEUE_DEPTH)
         self._clock_message = Clock()
         self._wire_controllers()
@@ -90,6 +101,11 @@ class SimNode(Node):
                 self.get_logger().info(
                     f"joint '{joint.name}' starts at {joint.initial_position:g}: 0 is outside "
                     f'its limits [{joint.lower:g}, {joint.upper:g}]')
+        clock_period = self._clock_every * self.settings.time_step
+        if abs(clock_period - CLOCK_PERIOD_S) > 1e-9:
+            self.get_logger().info(
+                f'/clock every {self._clock_every} steps ({clock_period * 1e3:g} ms of sim '
+                f'time): the nearest whole number of time_step to 10 ms')
         self.get_logger().info(
             f"simulating '{description.name}' from {description.source} "
             f"with {len(self.simulation.controllers)} controllers; topics under "

@@ -286,19 +286,3 @@ def test_effort_group_drives_its_joints_with_the_efforts(tmp_path, type_name):
         assert velocities[joint] == pytest.approx(expected, rel=0.03)
 
 
-@pytest.mark.parametrize(('interface', 'type_name', 'extra'), KINDS, ids=KIND_IDS)
-def test_wrong_length_command_leaves_the_motion_unchanged(tmp_path, interface, type_name, extra):
-    runs = []
-    for send_bad in (False, True):
-        folder = tmp_path / str(send_bad)
-        folder.mkdir()
-        with star_simulation(folder, type_name, **extra) as sim:
-            controller = sim.controller('group')
-            controller.set_command([0.3, 0.1])
-            sim.advance(200)
-            if send_bad:
-                assert controller.set_command([1.0, 1.0, 1.0]) is CommandResult.REJECTED
-            sim.advance(300)
-            runs.append(sim.joint_positions())
-    assert runs[0] == runs[1]
-    assert runs[0]['pan'] != 0.0

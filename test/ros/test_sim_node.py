@@ -11,6 +11,8 @@ from node_harness import PROBE_QUEUE, sim_node, stamp_s
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
 
+from pan_tilt_sim.ros.sim_node import clock_period_steps
+
 NS = '/ex_urdf_pan_tilt'
 PAN = 'joint1_position_controller'
 TILT = 'joint2_position_controller'
@@ -92,6 +94,23 @@ def test_clock_publishes_sim_time_every_10_ms(pan_tilt):
                for a, b in zip(times, times[1:], strict=False))
 
 
+@pytest.mark.parametrize(('time_step', 'steps'), [
+    (0.001, 10), (0.0005, 20), (0.003, 3), (0.004, 3), (1 / 240, 2), (0.02, 1), (0.1, 1)])
+def test_the_clock_period_is_the_whole_number_of_steps_nearest_10_ms(time_step, steps):
+    assert clock_period_steps(time_step) == steps
+
+
+def test_with_a_3_ms_step_clock_comes_every_9_ms_and_says_so_once(capfd):
+    with sim_node(time_step=0.003) as sim:
+        clock = sim.collect(Clock, '/clock', PROBE_QUEUE)
+        sim.run_for(0.5)
+    times = [stamp_s(m) for m in clock]
+    assert len(times) >= 50
+    assert all(b - a == pytest.approx(0.009, abs=1e-9)
+               for a, b in zip(times, times[1:], strict=False))
+    assert capfd.readouterr().err.count('/clock every 3 steps (9 ms of sim time)') == 1
+
+
 def test_an_effort_controller_meets_damping_and_friction(tmp_path):
     config = tmp_path / 'effort.yaml'
     config.write_text(
@@ -145,7 +164,6 @@ def test_xacro_args_reach_xacro(repo_root, tmp_path):
         '<xacro:property name="base_link_length" value="0.01"/>').replace(
         'lower="-3.14" upper="3.14"', 'lower="-3.14" upper="$(arg pan_limit)"'))
     with sim_node(robot_description_file=str(path), xacro_args=['pan_limit:=0.25']) as sim:
-        assert sim.node.settings.xacro_args == ('pan_limit:=0.25',)
         assert sim.simulation.description.model.joint('pan_joint').upper == 0.25
 
 
@@ -162,3 +180,20 @@ def test_a_joint_starting_at_a_limit_is_logged_once_at_info():
     assert len(starts) == 1
     assert starts[0].level == Log.INFO
     assert "tilt_joint' starts at -1.5708" in starts[0].msg
+
+
+def test_the_same_commands_from_a_reset_give_the_same_joint_states_to_the_last_bit(pan_tilt):
+    runs = []
+    for _ in range(2):
+        pan_tilt.node.set_paused(True)
+        pan_tilt.node.reset(reset_time=True)
+        pan_tilt.drain()
+        first = len(pan_tilt.states)
+        pan_tilt.command(PAN, Float64(data=0.7))  # taken while held: acts from t = 0
+        pan_tilt.command(TILT, Float64(data=-2.2))
+        pan_tilt.node.set_paused(False)
+        pan_tilt.run_for(3.0)
+        runs.append([(stamp_s(m), tuple(m.position), tuple(m.velocity), tuple(m.effort))
+                     for m in pan_tilt.states[first:] if stamp_s(m) <= 3.0])
+    assert len(runs[0]) == 151  # 0 .. 3 s at 50 Hz
+    assert runs[0] == runs[1]

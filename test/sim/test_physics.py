@@ -30,20 +30,44 @@ def test_the_base_is_fixed_and_gravity_points_down(description):
         assert position == pytest.approx((0.0, 0.0, 0.0))
 
 
-def test_without_torque_no_motor_drives_the_joints(description):
-    with Physics(description, 0.001) as physics:
-        physics.reset_joints([0.5, -2.0])
+# A 2 kg point-like mass 0.5 m from its hinge: I = 2 * 0.5^2 + 0.001 kg m^2.
+ARM_MASS, ARM_LENGTH, ARM_OWN_INERTIA = 2.0, 0.5, 0.001
+ARM_INERTIA = ARM_MASS * ARM_LENGTH ** 2 + ARM_OWN_INERTIA
+
+
+def one_arm(tmp_path, axis: str, friction: float = 0.0):
+    """Return the description of one arm on a hinge about ``axis``, with URDF friction."""
+    path = tmp_path / 'arm.urdf'
+    path.write_text(f"""<robot name="arm"><link name="base"/>
+      <link name="arm"><inertial><origin xyz="{ARM_LENGTH} 0 0"/><mass value="{ARM_MASS}"/>
+        <inertia ixx="{ARM_OWN_INERTIA}" iyy="{ARM_OWN_INERTIA}" izz="{ARM_OWN_INERTIA}"
+                 ixy="0" ixz="0" iyz="0"/></inertial></link>
+      <joint name="hinge" type="continuous"><parent link="base"/><child link="arm"/>
+        <axis xyz="{axis}"/><limit effort="100" velocity="100"/>
+        <dynamics friction="{friction}"/></joint></robot>""")
+    return load_description(path)
+
+
+def test_without_torque_the_arm_falls_freely_no_motor_holds_it(tmp_path):
+    # PyBullet's default velocity motors would hold the arm still: they are off.
+    with Physics(one_arm(tmp_path, '0 1 0'), 0.001) as physics:
+        for _ in range(50):
+            (state,) = physics.step([0.0])
+    # Horizontal at the start: angular acceleration m g L / I (gravity pulls it down).
+    expected = ARM_MASS * 9.81 * ARM_LENGTH / ARM_INERTIA * 0.05
+    assert state[1] == pytest.approx(expected, rel=0.01)
+
+
+def test_friction_holds_below_its_value_and_only_resists_above_it(tmp_path):
+    # A vertical hinge: no gravity torque.  URDF friction 1 N*m.
+    with Physics(one_arm(tmp_path, '0 0 1', friction=1.0), 0.001) as physics:
         for _ in range(200):
-            states = physics.step([0.0, 0.0])
-        # Only gravity acts: the horizontal-axis tilt may sag, the vertical pan cannot move.
-        assert states[0][0] == pytest.approx(0.5, abs=1e-6)
-
-
-def test_friction_holds_a_joint_against_a_torque_below_it(description):
-    with Physics(description, 0.001) as physics:
-        for _ in range(500):
-            states = physics.step([0.9, 0.0])
-        assert states[0][1] == pytest.approx(0.0, abs=1e-6)
+            (held,) = physics.step([0.9])
+        for _ in range(100):
+            (moving,) = physics.step([3.0])
+    assert held[1] == pytest.approx(0.0, abs=1e-6)
+    # (3 - 1) N*m over I for 0.1 s: friction resists, nothing else does.
+    assert moving[1] == pytest.approx((3.0 - 1.0) / ARM_INERTIA * 0.1, rel=0.01)
 
 
 def test_the_stepper_applies_the_torques_the_keyword_call_applies(description):
