@@ -216,9 +216,9 @@ class SimUnderTest:
         The command landed at most one batch of steps before that time.
         """
         taken = self.simulation.controller(controller)
-        before = taken.setpoint
+        before = taken.setpoints()
         self.command(controller, Float64(data=value))
-        assert self.spin_until(lambda: taken.setpoint != before), (
+        assert self.spin_until(lambda: taken.setpoints() != before), (
             f'command {value} to {controller} never moved the setpoint')
         return self.simulation.time
 
@@ -260,7 +260,7 @@ class SimUnderTest:
     def setpoints(self, controller: str) -> list[float]:
         """Return the controller's setpoints, one per joint."""
         found = self.simulation.controller(controller)
-        return [member.setpoint for member in getattr(found, 'members', (found,))]
+        return list(found.setpoints().values())
 
 
 @contextlib.contextmanager
