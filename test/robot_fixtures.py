@@ -96,3 +96,30 @@ def write_text(folder: pathlib.Path, name: str, text: str) -> pathlib.Path:
     path = folder / name
     path.write_text(textwrap.dedent(text), encoding='utf-8')
     return path
+
+
+# A chain with every joint kind the kinematic tree handles, offsets and rotated origins;
+# its tip link hangs on a fixed joint.
+ARM_URDF = """<robot name="arm">
+  <link name="base"/>
+  <link name="shoulder"><inertial><mass value="1"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="upper"><inertial><mass value="1"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><origin xyz="0 0 0.25" rpy="0 0 0"/><geometry><box size="0.1 0.1 0.5"/></geometry>
+    </visual></link>
+  <link name="slider"><inertial><mass value="1"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="tool"><inertial><mass value="1"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="yaw" type="continuous"><parent link="base"/><child link="shoulder"/>
+    <origin xyz="0.1 0 0.2" rpy="0 0 0.3"/><axis xyz="0 0 1"/></joint>
+  <joint name="pitch" type="revolute"><parent link="shoulder"/><child link="upper"/>
+    <origin xyz="0 0.05 0.1" rpy="0.2 -0.4 0.1"/><axis xyz="0 1 1"/>
+    <limit lower="-2" upper="2" effort="10" velocity="1"/></joint>
+  <joint name="extend" type="prismatic"><parent link="upper"/><child link="slider"/>
+    <origin xyz="0 0 0.5" rpy="0 0 0"/><axis xyz="1 0 0"/>
+    <limit lower="-0.3" upper="0.3" effort="10" velocity="1"/></joint>
+  <joint name="flange" type="fixed"><parent link="slider"/><child link="tool"/>
+    <origin xyz="0.02 0 0.07" rpy="1.5707963 0 0"/></joint>
+</robot>"""
