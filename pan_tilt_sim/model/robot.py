@@ -187,13 +187,79 @@ class JointSpec:
 
 
 @dataclasses.dataclass(frozen=True)
+class ControlInterface:
+    """A ``<command_interface>`` or ``<state_interface>`` of a ros2_control joint."""
+
+    name: str
+    params: Mapping[str, str] = dataclasses.field(default_factory=dict)
+
+
+@dataclasses.dataclass(frozen=True)
+class ControlJoint:
+    """A ``<joint>`` of a ``<ros2_control>`` block: its interfaces and parameters."""
+
+    name: str
+    command_interfaces: tuple[ControlInterface, ...] = ()
+    state_interfaces: tuple[ControlInterface, ...] = ()
+    params: Mapping[str, str] = dataclasses.field(default_factory=dict)
+    initial_position: float | None = None  # the position state interface's initial_value
+
+    @property
+    def command_interface_names(self) -> tuple[str, ...]:
+        """Names of the command interfaces (position, velocity, effort...), in file order."""
+        return tuple(interface.name for interface in self.command_interfaces)
+
+    @property
+    def state_interface_names(self) -> tuple[str, ...]:
+        """Names of the state interfaces, in file order."""
+        return tuple(interface.name for interface in self.state_interfaces)
+
+
+@dataclasses.dataclass(frozen=True)
+class ControlSystem:
+    """A ``<ros2_control>`` block: its hardware plugin, the plugin's parameters, its joints."""
+
+    name: str
+    type: str = 'system'
+    plugin: str = ''
+    hardware_params: Mapping[str, str] = dataclasses.field(default_factory=dict)
+    joints: tuple[ControlJoint, ...] = ()
+
+
+@dataclasses.dataclass(frozen=True)
+class ControlPlugin:
+    """A Gazebo plugin that runs the robot's controllers, as the URDF's ``<gazebo>`` names it.
+
+    gazebo_ros_control (ROS 1: ``robotNamespace``), gazebo_ros2_control and
+    gz_ros2_control (``<ros><namespace>``, ``<parameters>`` controller files).
+    """
+
+    filename: str
+    name: str = ''
+    namespace: str | None = None
+    parameters: tuple[str, ...] = ()  # controller YAML files, as written (after xacro)
+
+
+@dataclasses.dataclass(frozen=True)
 class RobotModel:
     """A robot as its URDF describes it (after xacro)."""
 
     name: str
     links: tuple[Link, ...]
     joints: tuple[JointSpec, ...]
-    plugin_namespace: str | None = None
+    ros2_control: tuple[ControlSystem, ...] = ()
+    control_plugins: tuple[ControlPlugin, ...] = ()
+
+    @property
+    def plugin_namespace(self) -> str | None:
+        """The namespace the first control plugin gives the robot's topics, if any."""
+        return next((plugin.namespace for plugin in self.control_plugins if plugin.namespace),
+                    None)
+
+    def control_joint(self, name: str) -> ControlJoint | None:
+        """Return the ``<ros2_control>`` entry of joint ``name``, or None if it has none."""
+        return next((joint for system in self.ros2_control for joint in system.joints
+                     if joint.name == name), None)
 
     @property
     def joint_names(self) -> tuple[str, ...]:

@@ -17,6 +17,10 @@ from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.robot import (
     DEFAULT_AXIS,
+    ControlInterface,
+    ControlJoint,
+    ControlPlugin,
+    ControlSystem,
     Geometry,
     Inertial,
     JointKind,
@@ -29,8 +33,12 @@ from pan_tilt_sim.model.robot import (
 from pan_tilt_sim.model.transforms import ZERO_VECTOR, Transform, Vector, quaternion_from_rpy
 
 URDF_ROOT_TAG = 'robot'
-# Gazebo plugins whose namespace element names the robot's topic namespace.
-GAZEBO_ROS_CONTROL_PLUGINS = ('libgazebo_ros_control.so', 'libgazebo_ros2_control.so')
+# Gazebo plugins that run the robot's controllers (ROS 1, Gazebo classic ROS 2, gz).
+GAZEBO_ROS_CONTROL_PLUGINS = ('libgazebo_ros_control.so', 'libgazebo_ros2_control.so',
+                              'gz_ros2_control-system', 'libgz_ros2_control-system.so',
+                              'ign_ros2_control-system', 'libign_ros2_control-system.so')
+INITIAL_VALUE = 'initial_value'
+POSITION = 'position'
 INERTIA_FIELDS = ('ixx', 'ixy', 'ixz', 'iyy', 'iyz', 'izz')
 SHAPE_ROLES = ('visual', 'collision')
 
@@ -65,13 +73,22 @@ def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
             raise DescriptionError(
                 f"{source}: joint '{joint.name}' mimics '{joint.mimic.joint}', "
                 'which is not a joint of this robot')
-    plugin_namespace = _plugin_namespace(root)
-    if plugin_namespace and not naming.is_valid_namespace(naming.normalize(plugin_namespace)):
-        raise DescriptionError(
-            f"{source}: the gazebo_ros_control plugin's namespace '{plugin_namespace}' is not a "
-            f'valid ROS namespace ({naming.NAMESPACE_RULE})')
+    plugins = _control_plugins(root)
+    for plugin in plugins:
+        namespace = plugin.namespace
+        if namespace and not naming.is_valid_namespace(naming.normalize(namespace)):
+            raise DescriptionError(
+                f"{source}: the gazebo_ros_control plugin's namespace '{namespace}' is not a "
+                f'valid ROS namespace ({naming.NAMESPACE_RULE})')
+    systems = tuple(reader.control_system(element) for element in root.findall('ros2_control'))
+    for system in systems:
+        for joint in system.joints:
+            if joint.name not in joint_names:
+                raise DescriptionError(
+                    f"{source}: <ros2_control name=\"{system.name}\">: joint '{joint.name}' is "
+                    'not a joint of this robot')
     return RobotModel(name=root.get('name', ''), links=links, joints=joints,
-                      plugin_namespace=plugin_namespace)
+                      ros2_control=systems, control_plugins=plugins)
 
 
 def parse_urdf(urdf_xml: str, source: pathlib.Path) -> RobotModel:
@@ -159,6 +176,41 @@ class _Reader:
             return Shape(origin, Geometry('mesh', filename=shape.get('filename', '')))
         return Shape(origin, Geometry(shape.tag))
 
+    def control_system(self, element: ElementTree.Element) -> ControlSystem:
+        name = element.get('name', '')
+        hardware = element.find('hardware')
+        joints = tuple(self.control_joint(joint, name) for joint in element.findall('joint'))
+        return ControlSystem(
+            name=name, type=element.get('type', 'system'),
+            plugin=(hardware.findtext('plugin') or '').strip() if hardware is not None else '',
+            hardware_params=_params(hardware) if hardware is not None else {},
+            joints=joints)
+
+    def control_joint(self, element: ElementTree.Element, system: str) -> ControlJoint:
+        name = element.get('name', '')
+        if not name:
+            raise DescriptionError(f'{self.source}: <ros2_control name="{system}">: a <joint> '
+                                   'has no name')
+        commands = tuple(ControlInterface(child.get('name', ''), _params(child))
+                         for child in element.findall('command_interface'))
+        states = tuple(ControlInterface(child.get('name', ''), _params(child))
+                       for child in element.findall('state_interface'))
+        initial = None
+        for state in states:
+            text = state.params.get(INITIAL_VALUE)
+            if state.name != POSITION or text is None:
+                continue
+            try:
+                initial = float(text)
+            except ValueError:
+                initial = math.nan
+            if not math.isfinite(initial):
+                raise DescriptionError(
+                    f"{self.source}: <ros2_control name=\"{system}\">: joint '{name}': "
+                    f'<param name="{INITIAL_VALUE}">{text}</param> is not a number')
+        return ControlJoint(name=name, command_interfaces=commands, state_interfaces=states,
+                            params=_params(element), initial_position=initial)
+
     def joint(self, element: ElementTree.Element) -> JointSpec:
         name = element.get('name')
         if not name:
@@ -204,12 +256,26 @@ def _positive_or_inf(value: float) -> float:
     return value if value > 0.0 else math.inf
 
 
-def _plugin_namespace(root: ElementTree.Element) -> str | None:
+def _params(element: ElementTree.Element) -> dict[str, str]:
+    """Return the ``<param name="...">value</param>`` children of ``element``."""
+    return {param.get('name', ''): (param.text or '').strip()
+            for param in element.findall('param')}
+
+
+def _control_plugins(root: ElementTree.Element) -> tuple[ControlPlugin, ...]:
+    plugins = []
     for plugin in root.iterfind('gazebo/plugin'):
-        if plugin.get('filename') not in GAZEBO_ROS_CONTROL_PLUGINS:
+        filename = plugin.get('filename', '')
+        if filename not in GAZEBO_ROS_CONTROL_PLUGINS:
             continue
+        namespace = None
         for path in ('robotNamespace', 'ros/namespace'):
-            namespace = plugin.findtext(path)
-            if namespace and namespace.strip():
-                return namespace.strip()
-    return None
+            text = plugin.findtext(path)
+            if text and text.strip():
+                namespace = text.strip()
+                break
+        parameters = tuple(text.strip() for text in (
+            element.text for element in plugin.findall('parameters')) if text and text.strip())
+        plugins.append(ControlPlugin(filename=filename, name=plugin.get('name', ''),
+                                     namespace=namespace, parameters=parameters))
+    return tuple(plugins)

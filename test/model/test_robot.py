@@ -79,3 +79,62 @@ def test_a_malformed_value_is_an_error_naming_the_element_not_a_silent_default(o
     with pytest.raises(DescriptionError) as caught:
         parse_urdf(ARM_URDF.replace(old, new), pathlib.Path('arm.urdf'))
     assert str(caught.value) == f'arm.urdf: {message}'
+
+
+# --- <ros2_control> and the Gazebo control plugins ---------------------------------
+
+CONTROLLED = """<robot name="c"><link name="a"/><link name="b"/><link name="f"/>
+  <joint name="j" type="revolute"><parent link="a"/><child link="b"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <joint name="g" type="prismatic"><parent link="b"/><child link="f"/>
+    <limit lower="0" upper="1" effort="1" velocity="1"/></joint>
+  <ros2_control name="Sys" type="system">
+    <hardware><plugin>gz_ros2_control/GazeboSimSystem</plugin>
+      <param name="position_proportional_gain">0.5</param></hardware>
+    <joint name="j">
+      <command_interface name="position"><param name="min">-1</param></command_interface>
+      <command_interface name="velocity"/>
+      <state_interface name="position"><param name="initial_value">0.25</param></state_interface>
+      <state_interface name="velocity"/>
+    </joint>
+    <joint name="g"><command_interface name="effort"/><state_interface name="position"/></joint>
+  </ros2_control>
+  <gazebo><plugin filename="gz_ros2_control-system"
+                  name="gz_ros2_control::GazeboSimROS2ControlPlugin">
+    <parameters>/ws/share/c/config/controllers.yaml</parameters>
+    <ros><namespace>/arm</namespace></ros></plugin></gazebo>
+</robot>"""
+
+
+def test_the_ros2_control_block_gives_interfaces_initial_values_and_hardware_params():
+    model = parse_urdf(CONTROLLED, pathlib.Path('c.urdf'))
+    (system,) = model.ros2_control
+    assert (system.name, system.plugin) == ('Sys', 'gz_ros2_control/GazeboSimSystem')
+    assert system.hardware_params == {'position_proportional_gain': '0.5'}
+    joint = model.control_joint('j')
+    assert joint.command_interface_names == ('position', 'velocity')
+    assert joint.command_interfaces[0].params == {'min': '-1'}
+    assert joint.state_interface_names == ('position', 'velocity')
+    assert joint.initial_position == 0.25
+    assert model.control_joint('g').initial_position is None
+    assert model.control_joint('nothing') is None
+
+
+def test_the_control_plugin_names_its_controllers_file_and_namespace():
+    (plugin,) = parse_urdf(CONTROLLED, pathlib.Path('c.urdf')).control_plugins
+    assert plugin.filename == 'gz_ros2_control-system'
+    assert plugin.parameters == ('/ws/share/c/config/controllers.yaml',)
+    assert plugin.namespace == '/arm'
+
+
+@pytest.mark.parametrize(('old', 'new', 'message'), [
+    ('<param name="initial_value">0.25</param>', '<param name="initial_value">zero</param>',
+     '<ros2_control name="Sys">: joint \'j\': <param name="initial_value">zero</param> '
+     'is not a number'),
+    ('<joint name="g"><command_interface', '<joint name="h"><command_interface',
+     '<ros2_control name="Sys">: joint \'h\' is not a joint of this robot'),
+])
+def test_a_bad_ros2_control_block_is_an_error_naming_it(old, new, message):
+    with pytest.raises(DescriptionError) as caught:
+        parse_urdf(CONTROLLED.replace(old, new), pathlib.Path('c.urdf'))
+    assert str(caught.value) == f'c.urdf: {message}'
