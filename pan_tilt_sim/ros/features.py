@@ -58,6 +58,10 @@ class NodeFeatures:
         if self.camera is not None:
             self.camera.update()
 
+    def refresh_readers(self) -> None:
+        """Ask, once per batch of steps, whether anybody reads what is published periodically."""
+        self.robot_state.refresh_readers()
+
     def reset(self) -> None:
         """Start every schedule again: sim time was reset, or the world put back."""
         self.robot_state.reset()
