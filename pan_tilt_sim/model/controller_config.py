@@ -217,7 +217,10 @@ def controllers_files_for(given: str, description: RobotDescription, *,
     exists).  Else, for the shipped pan/tilt model, its shipped controllers.
     """
     if given:
-        return (resolve_resource(given, pathlib.Path.cwd()),)
+        try:
+            return (resolve_resource(given, pathlib.Path.cwd()),)
+        except ConfigurationError as err:
+            raise ControllerConfigError(f'{given_as}: {err}') from None
     named = []
     for plugin in description.model.control_plugins:
         for text in plugin.parameters:

@@ -545,3 +545,16 @@ def test_the_shipped_arm_names_its_controllers_in_its_plugin(repo_root):
     description = load_description(repo_root / 'urdf' / 'three_joint_arm.xacro')
     assert controllers_files_for('', description) == (
         package_share() / 'config' / 'three_joint_arm_controllers.yaml',)
+
+
+def test_a_given_controllers_file_may_be_a_package_uri_and_a_bad_one_names_the_parameter(
+        tmp_path):
+    description = _description(tmp_path)
+    assert controllers_files_for('package://pan_tilt_sim/config/pan_tilt_control.yaml',
+                                 description) == (
+        package_share() / 'config' / 'pan_tilt_control.yaml',)
+    with pytest.raises(ControllerConfigError,
+                       match=r"^the parameter 'controllers_file': resource "
+                             r"'package://no_such_package_here/c.yaml': package "
+                             r"'no_such_package_here' is not in the ament index"):
+        controllers_files_for('package://no_such_package_here/c.yaml', description)
