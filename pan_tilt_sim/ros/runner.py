@@ -15,11 +15,12 @@
   while the node is being built aborts the build; while spinning it ends the
   spin; while the node is being destroyed it is only noted.
 * Started by a launch file, the program must not outlive it: when
-  ``PAN_TILT_SIM_PARENT_PID`` names the parent's pid, the program stops
-  (SIGTERM, so as cleanly as on Ctrl-C) when that parent dies -- at once
-  if it is already gone.  Linux's ``PR_SET_PDEATHSIG`` does it, elsewhere a
-  watcher thread.  A plain ``sim_node &`` or ``nohup sim_node`` without the
-  variable keeps running after its shell, as any program does.
+  ``PAN_TILT_SIM_PARENT_PID`` names the launch process's pid, the program
+  stops (SIGTERM, so as cleanly as on Ctrl-C) when that process dies -- at
+  once if it is already gone.  Linux's ``PR_SET_PDEATHSIG`` does it when
+  the launch process is the parent; a watcher thread when something stands
+  between them (``--launch-prefix``) or off Linux.  Without the variable
+  (``nohup sim_node &``) the program outlives its shell, as any program does.
 * Importing rclpy and PyBullet takes about half a second, so this module
   imports neither until the handlers are in place, and knows no node: the
   program (``pan_tilt_sim.__main__``) hands :func:`run` a factory that
@@ -116,20 +117,26 @@ class StopSignals:
 
 
 def stop_with_parent(environ: dict[str, str] | None = None) -> bool:
-    """Arrange for SIGTERM when the parent named by ``PAN_TILT_SIM_PARENT_PID`` dies.
+    """Arrange for SIGTERM when the process named by ``PAN_TILT_SIM_PARENT_PID`` dies.
 
-    Returns whether a parent is watched.  If the parent died already (this
-    process has another parent by now), SIGTERM is sent at once.
+    Returns whether a process is watched.  When it is this process's parent,
+    Linux's parent-death signal does it; when something stands between them
+    (a launch prefix such as gdb), or off Linux, a watcher thread polls.  If
+    the process is already gone, SIGTERM is sent at once.
     """
     text = (os.environ if environ is None else environ).get(PARENT_PID_VARIABLE, '').strip()
     if not text.isdigit():
         return False
     parent = int(text)
-    if not _parent_death_signal(signal.SIGTERM):
-        threading.Thread(target=_watch_parent, args=(parent,), daemon=True,
-                         name='parent-watch').start()
-    if os.getppid() != parent:  # gone before the request took effect
+    if os.getppid() == parent and _parent_death_signal(signal.SIGTERM):
+        if os.getppid() != parent:  # it died before the request took effect
+            os.kill(os.getpid(), signal.SIGTERM)
+        return True
+    if not _is_alive(parent):
         os.kill(os.getpid(), signal.SIGTERM)
+        return True
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True,
+                     name='parent-watch').start()
     return True
 
 
@@ -144,8 +151,18 @@ def _parent_death_signal(signum: int) -> bool:
         return False
 
 
+def _is_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # someone else's process: it exists
+        return True
+    return True
+
+
 def _watch_parent(parent: int) -> None:
-    while os.getppid() == parent:
+    while _is_alive(parent):
         time.sleep(PARENT_POLL_S)
     os.kill(os.getpid(), signal.SIGTERM)
 

@@ -33,8 +33,11 @@ PARENT = textwrap.dedent('''
     env = dict(os.environ)
     if sys.argv[2] != 'plain':
         env[sys.argv[3]] = str(os.getpid())
+    command = sys.argv[4:]
+    if sys.argv[2] == 'prefixed':  # a launch prefix: a shell between us and sim_node
+        command = ['sh', '-c', '"$@"; exit $?', 'sh', *command]
     with open(sys.argv[1], 'wb') as log:
-        child = subprocess.Popen(sys.argv[4:], env=env, stdout=subprocess.DEVNULL, stderr=log)
+        child = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=log)
     print(child.pid, flush=True)
     if sys.argv[2] == 'exit-at-once':
         os._exit(0)
@@ -99,6 +102,18 @@ def test_sim_node_stops_when_its_parent_died_before_it_got_going(tmp_path, clean
     parent.wait()
     assert wait_for(lambda: not is_running(child), BUDGET_S), 'sim_node was orphaned'
     assert STARTED_LINE not in log.read_bytes()
+
+
+@pytest.mark.skipif(not sys.platform.startswith('linux'), reason='reads /proc')
+def test_sim_node_under_a_launch_prefix_stops_when_the_launch_process_dies(tmp_path, cleanup):
+    parent, shell, log = start_under_parent(tmp_path, 'prefixed')
+    cleanup.append(shell)
+    assert wait_for(lambda: STARTED_LINE in log.read_bytes(), BUDGET_S), log.read_text()
+    (child,) = map(int, pathlib.Path(f'/proc/{shell}/task/{shell}/children').read_text().split())
+    cleanup.append(child)
+    parent.kill()
+    parent.wait()
+    assert wait_for(lambda: not is_running(child), GONE_BUDGET_S), 'sim_node was orphaned'
 
 
 @pytest.mark.skipif(not sys.platform.startswith('linux'), reason='reads /proc')
