@@ -17,6 +17,7 @@ from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.robot import (
     DEFAULT_AXIS,
+    POSITION_PROPORTIONAL_GAIN,
     ControlInterface,
     ControlJoint,
     ControlPlugin,
@@ -87,8 +88,28 @@ def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
                 raise DescriptionError(
                     f"{source}: <ros2_control name=\"{system.name}\">: joint '{joint.name}' is "
                     'not a joint of this robot')
+    _check_position_gain(plugins, systems, source)
     return RobotModel(name=root.get('name', ''), links=links, joints=joints,
                       ros2_control=systems, control_plugins=plugins)
+
+
+def _check_position_gain(plugins: tuple[ControlPlugin, ...], systems: tuple[ControlSystem, ...],
+                         source: pathlib.Path) -> None:
+    """``position_proportional_gain``, wherever given, must be a number > 0."""
+    places = [(f"the {plugin.filename} plugin's <{POSITION_PROPORTIONAL_GAIN}>",
+               plugin.settings.get(POSITION_PROPORTIONAL_GAIN)) for plugin in plugins]
+    places += [(f'<ros2_control name="{system.name}">: <hardware> <param '
+                f'name="{POSITION_PROPORTIONAL_GAIN}">',
+                system.hardware_params.get(POSITION_PROPORTIONAL_GAIN)) for system in systems]
+    for place, text in places:
+        if text is None:
+            continue
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not (math.isfinite(value) and value > 0.0):
+            raise DescriptionError(f"{source}: {place}: '{text}' must be a number > 0")
 
 
 def parse_urdf(urdf_xml: str, source: pathlib.Path) -> RobotModel:
@@ -276,6 +297,9 @@ def _control_plugins(root: ElementTree.Element) -> tuple[ControlPlugin, ...]:
                 break
         parameters = tuple(text.strip() for text in (
             element.text for element in plugin.findall('parameters')) if text and text.strip())
+        settings = {child.tag: (child.text or '').strip() for child in plugin
+                    if child.tag != 'parameters' and not len(child)}
         plugins.append(ControlPlugin(filename=filename, name=plugin.get('name', ''),
-                                     namespace=namespace, parameters=parameters))
+                                     namespace=namespace, parameters=parameters,
+                                     settings=settings))
     return tuple(plugins)
