@@ -27,7 +27,7 @@ import numpy
 from pan_tilt_sim.model.robot import JointSpec
 from pan_tilt_sim.model.sensors import CHILD, PARENT_TO_CHILD, SENSOR, SensorSpec
 from pan_tilt_sim.model.transforms import Transform, rotation_matrix
-from pan_tilt_sim.sim.bullet import pybullet
+from pan_tilt_sim.sim.bullet import pybullet, quiet_native_output
 from pan_tilt_sim.sim.physics import Physics
 from pan_tilt_sim.sim.sensors.mount import LinkReader
 from pan_tilt_sim.sim.sensors.noise import NoiseModel
@@ -66,8 +66,9 @@ class ForceTorque:
         # The point the moment is taken about, in the child link frame.
         point = numpy.array(sensor.pose.translation) if frame == SENSOR else numpy.zeros(3)
         self._com_from_point = numpy.array(inertial.translation) - point
-        pybullet.enableJointForceTorqueSensor(self._body, self._index, True,
-                                              physicsClientId=self._client)
+        with quiet_native_output():  # a second sensor on the joint: PyBullet warns on stdout
+            pybullet.enableJointForceTorqueSensor(self._body, self._index, True,
+                                                  physicsClientId=self._client)
 
     def read(self) -> Wrench:
         """Return the wrench of the step just taken, as the sensor reports it."""
