@@ -74,7 +74,7 @@ def colour_image(rgb: numpy.ndarray, gazebo_format: str, frame_id: str, time: fl
     message.encoding = encoding
     message.is_bigendian = 0
     message.step = message.width * channels
-    message.data = array.array('B', numpy.ascontiguousarray(pixels, numpy.uint8).tobytes())
+    message.data = byte_array(numpy.ascontiguousarray(pixels, numpy.uint8))
     return message
 
 
@@ -96,15 +96,15 @@ def depth_image(depth: numpy.ndarray, frame_id: str, time: float,
     message.encoding = DEPTH_ENCODING
     message.is_bigendian = 0
     message.step = message.width * FLOAT_BYTES
-    message.data = array.array('B', numpy.ascontiguousarray(depth, '<f4').tobytes())
+    message.data = byte_array(numpy.ascontiguousarray(depth, '<f4'))
     return message
 
 
 def pack_rgb(rgb: numpy.ndarray) -> numpy.ndarray:
     """Return PCL's packed colour: uint32 0x00RRGGBB of each pixel, viewed as float32."""
-    colour = rgb.astype(numpy.uint32)
-    packed = (colour[..., 0] << 16) | (colour[..., 1] << 8) | colour[..., 2]
-    return packed.view(numpy.float32)
+    packed = numpy.zeros(rgb.shape[:2] + (4,), numpy.uint8)
+    packed[..., :3] = rgb[..., ::-1]  # little endian: the bytes of 0x00RRGGBB are B, G, R, 0
+    return packed.view('<f4')[..., 0]
 
 
 def point_cloud(xyz: numpy.ndarray, frame_id: str, time: float,
@@ -115,12 +115,11 @@ def point_cloud(xyz: numpy.ndarray, frame_id: str, time: float,
     ``extra`` adds one float32 field (``rgb`` or ``intensity``) after z.
     """
     rows, columns = xyz.shape[:2]
-    names = ['x', 'y', 'z']
-    channels = [xyz.astype(numpy.float32)]
+    names = ['x', 'y', 'z'] + ([extra[0]] if extra is not None else [])
+    points = numpy.empty((rows, columns, len(names)), '<f4')
+    points[..., :3] = xyz
     if extra is not None:
-        names.append(extra[0])
-        channels.append(extra[1].astype(numpy.float32, copy=False)[..., numpy.newaxis])
-    points = numpy.concatenate(channels, axis=-1)
+        points[..., 3] = extra[1]
     message = PointCloud2() if into is None else into
     stamp(time, message.header.stamp)
     message.header.frame_id = frame_id
@@ -130,17 +129,28 @@ def point_cloud(xyz: numpy.ndarray, frame_id: str, time: float,
     message.is_bigendian = False
     message.point_step = FLOAT_BYTES * len(names)
     message.row_step = message.point_step * columns
-    message.is_dense = bool(numpy.isfinite(xyz).all())
-    message.data = array.array('B', numpy.ascontiguousarray(points, '<f4').tobytes())
+    message.is_dense = bool(numpy.isfinite(points[..., 2]).all())
+    message.data = byte_array(points)
     return message
+
+
+def byte_array(values: numpy.ndarray) -> array.array:
+    """Return the bytes of a numpy array as the ``array('B')`` messages hold (one copy)."""
+    data = array.array('B')
+    data.frombytes(memoryview(numpy.ascontiguousarray(values)).cast('B'))
+    return data
 
 
 def depth_points(depth: numpy.ndarray, ray_x: numpy.ndarray,
                  ray_y: numpy.ndarray) -> numpy.ndarray:
     """Return the optical-frame points of a ranged depth image (NaN where not finite)."""
-    valid = numpy.isfinite(depth)
-    z = numpy.where(valid, depth, numpy.nan)
-    return numpy.stack([ray_x * z, ray_y * z, z], axis=-1)
+    points = numpy.empty(depth.shape + (3,), numpy.float32)
+    z = points[..., 2]
+    z[...] = depth
+    z[~numpy.isfinite(depth)] = numpy.nan
+    numpy.multiply(ray_x, z, out=points[..., 0])
+    numpy.multiply(ray_y, z, out=points[..., 1])
+    return points
 
 
 def laser_scan(ranges: numpy.ndarray, angle_min: float, angle_max: float, increment: float,

@@ -77,6 +77,7 @@ class SensorPublisher:
         self.period = 1.0 / interface.rate if interface.rate > 0.0 else simulation.time_step
         self._schedule = PeriodicSchedule(self.period)
         self._publishers = []
+        self._topic_types: list[tuple[str, type]] = []
         self.messages = 0  # measurements published
         self.cost_s = 0.0  # wall time spent measuring, building and publishing them
         self._node = node
@@ -91,7 +92,12 @@ class SensorPublisher:
             return None
         created = self._node.create_publisher(message_type, topic, QUEUE_DEPTH)
         self._publishers.append(created)
+        self._topic_types.append((topic, message_type))
         return created
+
+    def topic_types(self) -> list[tuple[str, type]]:
+        """Return (topic, message type) of every topic the sensor publishes."""
+        return list(self._topic_types)
 
     @staticmethod
     def watched(publisher) -> bool:

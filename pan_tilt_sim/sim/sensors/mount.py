@@ -29,7 +29,11 @@ class LinkState:
 
     def point_velocity(self, point: numpy.ndarray) -> numpy.ndarray:
         """Velocity (world) of a world ``point`` fixed to the link."""
-        return self.linear_velocity + numpy.cross(self.angular_velocity, point - self.com)
+        wx, wy, wz = self.angular_velocity
+        rx, ry, rz = point - self.com
+        # omega x r, written out: numpy.cross costs ~20 us on 3-vectors.
+        return self.linear_velocity + numpy.array((wy * rz - wz * ry, wz * rx - wx * rz,
+                                                   wx * ry - wy * rx))
 
 
 def inverse(transform: Transform) -> Transform:

@@ -130,14 +130,13 @@ class VisionSensor:
         depth = linear_depth(buffer.astype(numpy.float64), self.near, self.far)
         empty = buffer >= BACKGROUND
         depth[empty] = math.inf
-        if self._ground:
-            # World z of each pixel's ray (optical (x, y, 1)), and where it meets z = 0.
+        if self._ground and empty.any():
+            # World z of each pixel's ray (optical (x, y, 1)), and where it meets z = 0:
+            # at depth -eye_z / ray_z, for rays pointing towards the plane.
             ray_z = rows[2, 0] * self.ray_x + rows[2, 1] * self.ray_y + rows[2, 2]
-            with numpy.errstate(divide='ignore', invalid='ignore'):
-                ground = -eye[2] / ray_z
-            sees_ground = empty & (ground > 0.0)
+            sees_ground = empty & (ray_z * eye[2] < 0.0)
             rgb[sees_ground] = GROUND_RGB
-            depth[sees_ground] = ground[sees_ground]
+            depth[sees_ground] = -eye[2] / ray_z[sees_ground]
         if self._noise is not None and self._noise.active:
             noisy = self._noise.apply(rgb.astype(numpy.float64) / BYTE_MAX)
             rgb = numpy.clip(numpy.rint(noisy * BYTE_MAX), 0, BYTE_MAX).astype(numpy.uint8)
