@@ -282,8 +282,21 @@ class WrenchPublisher(SensorPublisher):
         self._publisher = self.publisher(WrenchStamped, 'wrench')
         self._message = WrenchStamped()
 
+    def update(self) -> None:
+        """Measure when due and watched; switch PyBullet's joint feedback off when unwatched."""
+        super().update()
+        if not self._watched and self.force_torque.enabled:
+            self.force_torque.enable(False)
+
     def measure_and_publish(self, now: float) -> bool:
-        """Read the joint's wrench (of the step just taken) and publish."""
+        """Read the joint's wrench (of the step just taken) and publish.
+
+        The joint feedback is switched on at the first due time someone listens;
+        that step's wrench was not computed, so the first sample is skipped.
+        """
+        if not self.force_torque.enabled:
+            self.force_torque.enable(True)
+            return False
         wrench = self.force_torque.read()
         self._publisher.publish(messages.wrench_message(
             wrench.force, wrench.torque, self.interface.frame_id, now, self._message))
@@ -364,7 +377,7 @@ class SensorSet:
         reader = ForceTorque(physics, sensor, model.joint(sensor.joint),
                              frame=interface.wrench_frame,
                              measure_direction=interface.measure_direction,
-                             noise=NoiseModel(noises, rng, extra))
+                             noise=NoiseModel(noises, rng, extra), enabled=False)
         return WrenchPublisher(node, interface, simulation, reader)
 
     def update(self) -> None:

@@ -50,7 +50,7 @@ class ForceTorque:
 
     def __init__(self, physics: Physics, sensor: SensorSpec, joint: JointSpec, *,
                  frame: str = CHILD, measure_direction: str = PARENT_TO_CHILD,
-                 noise: NoiseModel | None = None) -> None:
+                 noise: NoiseModel | None = None, enabled: bool = True) -> None:
         self.sensor = sensor
         self._client = physics.client_id
         self._body = physics.body_id
@@ -66,12 +66,25 @@ class ForceTorque:
         # The point the moment is taken about, in the child link frame.
         point = numpy.array(sensor.pose.translation) if frame == SENSOR else numpy.zeros(3)
         self._com_from_point = numpy.array(inertial.translation) - point
+        self.enabled = False
+        self.enable(enabled)
+
+    def enable(self, on: bool) -> None:
+        """Switch PyBullet's joint feedback on or off.
+
+        It costs every physics step while on (Bullet runs a second articulated-body
+        pass to compute the joint forces), so the ROS layer keeps it off while
+        nobody listens; a reading is valid from the step after it was switched on.
+        """
+        if on == self.enabled:
+            return
         with quiet_native_output():  # a second sensor on the joint: PyBullet warns on stdout
-            pybullet.enableJointForceTorqueSensor(self._body, self._index, True,
+            pybullet.enableJointForceTorqueSensor(self._body, self._index, on,
                                                   physicsClientId=self._client)
+        self.enabled = on
 
     def read(self) -> Wrench:
-        """Return the wrench of the step just taken, as the sensor reports it."""
+        """Return the wrench of the step just taken, as the sensor reports it (if enabled)."""
         reaction = pybullet.getJointState(self._body, self._index,
                                           physicsClientId=self._client)[REACTION]
         force = self._inertial_rotation @ numpy.array(reaction[:3])  # child link axes
