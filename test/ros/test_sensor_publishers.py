@@ -176,3 +176,15 @@ def test_reset_starts_every_sensor_schedule_again(rig):
     restart = next(index for index in range(1, len(stamps)) if stamps[index] < stamps[index - 1])
     assert stamps[restart] == pytest.approx(0.0, abs=SAME_TIME)
     assert stamps[restart + 1] == pytest.approx(0.02, abs=SAME_TIME)
+
+
+def test_force_torque_feedback_is_switched_off_when_the_last_listener_leaves(rig):
+    force_torque = next(p for p in rig.node.features.sensors.publishers
+                        if p.sensor.name == 'ft').force_torque
+    received = []
+    subscription = rig.probe.create_subscription(WrenchStamped, TOPICS['wrench'],
+                                                 received.append, PROBE_QUEUE)
+    assert rig.spin_until(lambda: len(received) > 2), 'no wrench arrived'
+    assert force_torque.enabled
+    rig.probe.destroy_subscription(subscription)
+    assert rig.spin_until(lambda: not force_torque.enabled), 'feedback stayed on'
