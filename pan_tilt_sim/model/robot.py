@@ -18,6 +18,7 @@ import functools
 import math
 from collections.abc import Mapping
 
+from pan_tilt_sim.model.sensors import SensorSpec
 from pan_tilt_sim.model.transforms import (
     Transform,
     Vector,
@@ -252,6 +253,10 @@ class RobotModel:
     joints: tuple[JointSpec, ...]
     ros2_control: tuple[ControlSystem, ...] = ()
     control_plugins: tuple[ControlPlugin, ...] = ()
+    # <gazebo reference="..."><sensor> tags the simulator models, and one line
+    # per sensor tag it skipped (unsupported type, plugin or reference).
+    sensors: tuple[SensorSpec, ...] = ()
+    sensor_warnings: tuple[str, ...] = ()
 
     @property
     def plugin_namespace(self) -> str | None:

@@ -92,8 +92,12 @@ class SimNode(Node):
         self._wire_controllers()
         try:
             self.gain_parameters = GainParameters(self, self.simulation.controllers)
+            # Sensors follow an explicit namespace (the node's, or robot_namespace) the
+            # way Gazebo's spawn -robot_namespace moves every plugin; else their plugins'.
             self.features = NodeFeatures(
-                self, self.simulation, self.robot_namespace, gui=self.settings.gui)
+                self, self.simulation, self.robot_namespace, gui=self.settings.gui,
+                sensor_namespace=naming.normalize(self.get_namespace())
+                or naming.normalize(self.settings.robot_namespace))
         except BaseException:
             self.simulation.close()
             raise
@@ -150,6 +154,9 @@ class SimNode(Node):
         simulation = self.simulation
         while steps > 0:
             chunk = min(steps, self._clock_every - simulation.steps % self._clock_every)
+            sensor_due = self.features.steps_until_due(simulation.steps)
+            if sensor_due is not None:  # a watched sensor samples between /clock messages
+                chunk = min(chunk, sensor_due)
             simulation.advance(chunk)
             steps -= chunk
             if simulation.steps % self._clock_every == 0:

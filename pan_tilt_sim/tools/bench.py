@@ -19,7 +19,10 @@ a noisy machine:
   of ``STARTUP_RUNS``;
 * ``scaling``: node_steps_per_s at real_time_factor 0 for generated serial
   chains of 2, 8 and 32 revolute joints, each with a position controller
-  (keys are the joint counts).
+  (keys are the joint counts);
+* ``sensor_us_per_message``: wall microseconds sim_node spends per message
+  of each sensor of ``urdf/pan_tilt_sensors.xacro`` with every topic watched
+  (:mod:`pan_tilt_sim.tools.sensor_cost`, in this process).
 
 Rates are medians over windows of ``RATE_WINDOW_S``.  ``--runs N`` repeats
 everything and prints the median of each figure; ``--quick`` is a smoke run
@@ -65,6 +68,7 @@ from pan_tilt_sim.model.description import load_description
 from pan_tilt_sim.ros.ros_interfaces import seconds
 from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
 from pan_tilt_sim.sim.physics import Physics
+from pan_tilt_sim.tools.sensor_cost import sensor_costs
 
 DEFAULT_TIME_STEP = 0.001  # s, the reference step
 CHAIN_JOINTS = (2, 8, 32)
@@ -101,12 +105,13 @@ class Plan:
     paced_s: float
     startup_runs: int
     chain_s: float
+    sensor_sim_s: float = 2.0  # sim seconds with every sensor watched
 
 
 FULL_PLAN = Plan(raw_s=3.0, warmup_s=1.0, fast_s=5.0, paced_s=10.0,
                  startup_runs=STARTUP_RUNS, chain_s=3.0)
 QUICK_PLAN = Plan(raw_s=0.3, warmup_s=0.2, fast_s=0.6, paced_s=0.6, startup_runs=1,
-                  chain_s=0.4)
+                  chain_s=0.4, sensor_sim_s=0.3)
 
 
 class BenchError(RuntimeError):
@@ -497,6 +502,9 @@ def run_once(bench: Bench, model: Model) -> dict:
         urdf, controllers = chain_files(joints, bench.folder)
         scaling[str(joints)] = bench.fast_steps_per_s(load_model(urdf, controllers),
                                                       plan.chain_s)
+    bench.log('sensors, every topic watched')
+    sensors = {name: figures['us_per_message'] for name, figures in sensor_costs(
+        sim_seconds=plan.sensor_sim_s, domain_id=bench.domain_id).items()}
     return {
         'raw_steps_per_s': raw,
         'node_steps_per_s': node,
@@ -505,6 +513,7 @@ def run_once(bench: Bench, model: Model) -> dict:
         **paced,
         'startup_s': startup,
         'scaling': scaling,
+        'sensor_us_per_message': sensors,
     }
 
 

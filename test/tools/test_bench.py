@@ -42,7 +42,7 @@ def quick_run():
 def test_quick_prints_exactly_one_json_object_with_every_figure(quick_run):
     stdout, _ = quick_run
     figures = json.loads(stdout)
-    assert set(figures) == {*FIGURES, 'scaling'}
+    assert set(figures) == {*FIGURES, 'scaling', 'sensor_us_per_message'}
     for key, kind in FIGURES.items():
         assert isinstance(figures[key], kind), (key, figures[key])
         assert math.isfinite(figures[key]) and figures[key] >= 0, (key, figures[key])
@@ -54,6 +54,13 @@ def test_quick_reports_every_chain_length(quick_run):
     scaling = json.loads(quick_run[0])['scaling']
     assert set(scaling) == {str(joints) for joints in bench.CHAIN_JOINTS}
     assert all(isinstance(rate, int) and rate > 0 for rate in scaling.values())
+
+
+@pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
+def test_quick_reports_the_cost_of_each_sensor_per_message(quick_run):
+    costs = json.loads(quick_run[0])['sensor_us_per_message']
+    assert set(costs) == {'depth_camera', 'lidar', 'tilt_imu', 'tilt_ft'}
+    assert all(isinstance(cost, int) and cost > 0 for cost in costs.values()), costs
 
 
 @pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
