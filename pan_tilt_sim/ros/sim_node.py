@@ -23,8 +23,14 @@ from pan_tilt_sim.controllers import CommandController, CommandResult
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
 from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.model import naming
-from pan_tilt_sim.model.controller_config import load_controllers_config
-from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.model.controller_config import (
+    CONTROLLERS_ARGS,
+    ControllersConfig,
+    controllers_files_for,
+    load_controllers_config,
+    parse_controllers_args,
+)
+from pan_tilt_sim.model.description import RobotDescription, load_description
 from pan_tilt_sim.ros import parameters, services
 from pan_tilt_sim.ros.features import NodeFeatures
 from pan_tilt_sim.ros.gain_parameters import GainParameters
@@ -72,12 +78,16 @@ class SimNode(Node):
         self.settings = parameters.declare_parameters(self)
         description = load_description(
             self.settings.robot_description_file, self.settings.xacro_args)
-        controllers = load_controllers_config(self.settings.controllers_file)
+        controllers = load_controllers_config(
+            controllers_files_for(self.settings.controllers_file, description),
+            parse_controllers_args(self.settings.controllers_args,
+                                   f"parameter '{CONTROLLERS_ARGS}'"))
         self.robot_namespace = naming.resolve_robot_namespace(
             self.get_namespace(), self.settings.robot_namespace,
             controllers.namespace, description.plugin_namespace)
         self.simulation = Simulation(
-            description, controllers, self.settings.time_step, gui=self.settings.gui)
+            description, controllers, self.settings.time_step, gui=self.settings.gui,
+            active_controllers=self.settings.active_controllers)
         self._paused = self.settings.paused
         # Commands taken per controller (ignored ones included): a cheap health figure.
         self.commands_received = {c.name: 0 for c in self.simulation.command_controllers()}
@@ -91,8 +101,12 @@ class SimNode(Node):
         self._wire_controllers()
         try:
             self.gain_parameters = GainParameters(self, self.simulation.controllers)
+            # Sensors follow an explicit namespace (the node's, or robot_namespace) the
+            # way Gazebo's spawn -robot_namespace moves every plugin; else their plugins'.
             self.features = NodeFeatures(
-                self, self.simulation, self.robot_namespace, gui=self.settings.gui)
+                self, self.simulation, self.robot_namespace, gui=self.settings.gui,
+                sensor_namespace=naming.normalize(self.get_namespace())
+                or naming.normalize(self.settings.robot_namespace))
         except BaseException:
             self.simulation.close()
             raise
@@ -105,6 +119,7 @@ class SimNode(Node):
         self.add_post_set_parameters_callback(self._apply_parameters)
         self._world_services = services.create_world_services(
             self, reset=self.reset, set_paused=self.set_paused)
+        self._log_controllers(description, controllers)
         for joint in self.simulation.physics.joints:
             if joint.initial_position != 0.0:
                 self.get_logger().info(
@@ -117,7 +132,8 @@ class SimNode(Node):
                 f'time): the nearest whole number of time_step to 10 ms')
         self.get_logger().info(
             f"simulating '{description.name}' from {description.source} "
-            f"with {len(self.simulation.controllers)} controllers; topics under "
+            f"with {len(self.simulation.manager.active)} active controllers from "
+            f"{controllers.label}; topics under "
             f"'{self.robot_namespace or '/'}', time_step {self.settings.time_step} s, "
             f'real_time_factor {self._pacer.real_time_factor}')
 
@@ -159,6 +175,9 @@ class SimNode(Node):
         allow_clock = self._clock_throttle.allow
         while steps > 0:
             chunk = min(steps, every - simulation.steps % every)
+            sensor_due = self.features.steps_until_due(simulation.steps)
+            if sensor_due is not None:  # a watched sensor samples between /clock messages
+                chunk = min(chunk, sensor_due)
             simulation.advance(chunk)
             steps -= chunk
             if simulation.steps % every == 0 and clock_wanted:
@@ -267,6 +286,31 @@ class SimNode(Node):
                     message_type, self.topic(controller.name, controller.command_topic),
                     self._command_callback(controller, extract), QUEUE_DEPTH)
 
+    def _log_controllers(self, description: RobotDescription,
+                         controllers: ControllersConfig) -> None:
+        """Say once what xacro warned about, and what is skipped, inactive or missing."""
+        logger = self.get_logger()
+        for warning in description.warnings:
+            logger.warning(warning)
+        manager = self.simulation.manager
+        for skipped in manager.skipped:
+            logger.info(f"controller '{skipped.name}' (type '{skipped.type}') skipped: "
+                        f'{skipped.reason}')
+        inactive = [c.name for c in manager.controllers if not manager.is_active(c.name)]
+        if inactive:
+            logger.info(f"loaded but inactive (not in 'active_controllers'): "
+                        f"{', '.join(inactive)}")
+        broadcasters = [c for c in manager.controllers if isinstance(c, JointStateController)]
+        topic = self.topic('joint_states')
+        if not broadcasters:
+            logger.warning(
+                f'no joint_state_broadcaster in {controllers.label}: nothing will '
+                f'be published on {topic}')
+        elif not any(manager.is_active(c.name) for c in broadcasters):
+            logger.warning(
+                f"{', '.join(c.name for c in broadcasters)}: inactive (not in "
+                f"'active_controllers'): nothing will be published on {topic}")
+
     @staticmethod
     def _joint_state_sink(publisher, names):
         message = JointState()
@@ -281,8 +325,15 @@ class SimNode(Node):
         logger = self.get_logger()
         name = controller.name
 
+        is_active = self.simulation.manager.is_active
+
         def store(message) -> None:
             self.commands_received[name] += 1
+            if not is_active(name):
+                logger.warning(f'{name}: ignored a command: the controller is inactive '
+                               "(not in 'active_controllers')",
+                               throttle_duration_sec=WARNING_THROTTLE_S)
+                return
             value = extract(message)
             result = controller.set_command(value)
             if result is not CommandResult.ACCEPTED:

@@ -34,6 +34,9 @@ than wall time):
 * ``scaling``: serial chains of 2, 8 and 32 revolute joints, each with a
   position controller, at real_time_factor 0 with no subscriber:
   ``steps_per_s`` and ``node_cpu_us_per_step`` (keys are the joint counts).
+* ``sensor_us_per_message``: wall microseconds sim_node spends per message
+  of each sensor of ``urdf/pan_tilt_sensors.xacro`` with every topic watched
+  (:mod:`pan_tilt_sim.tools.sensor_cost`, in this process).
 
 ``--runs N`` repeats everything and prints the median of each figure;
 ``--quick`` is a smoke run of a few seconds (every key present, no timing
@@ -81,6 +84,7 @@ from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package
 from pan_tilt_sim.sim.engine import Simulation, make_simulation
 from pan_tilt_sim.sim.physics import Physics
 from pan_tilt_sim.sim.profiling import pybullet_step_cost
+from pan_tilt_sim.tools.sensor_cost import sensor_costs
 
 DEFAULT_TIME_STEP = 0.001  # s, the issue's reference step
 CHAIN_JOINTS = (2, 8, 32)
@@ -123,12 +127,13 @@ class Plan:
     paced_s: float
     startup_runs: int
     chain_s: float
+    sensor_sim_s: float = 2.0  # sim seconds with every sensor watched
 
 
 FULL_PLAN = Plan(raw_s=3.0, raw_sim_s=RAW_SIM_S, warmup_s=1.0, fast_s=5.0, paced_s=10.0,
                  startup_runs=STARTUP_RUNS, chain_s=3.0)
 QUICK_PLAN = Plan(raw_s=0.3, raw_sim_s=QUICK_RAW_SIM_S, warmup_s=0.2, fast_s=0.6, paced_s=0.6,
-                  startup_runs=1, chain_s=0.4)
+                  startup_runs=1, chain_s=0.4, sensor_sim_s=0.3)
 
 
 class BenchError(RuntimeError):
@@ -625,12 +630,16 @@ def run_once(bench: Bench, model: Model) -> dict:
         bench.log(f'chain of {joints} joints at real_time_factor 0')
         urdf, controllers = chain_files(joints, bench.folder)
         scaling[str(joints)] = bench.fast(load_model(urdf, controllers), plan.chain_s)
+    bench.log('sensors, every topic watched')
+    sensors = {name: figures['us_per_message'] for name, figures in sensor_costs(
+        sim_seconds=plan.sensor_sim_s, domain_id=bench.domain_id).items()}
     return {
         'raw': raw,
         'factor_0': factor_0,
         'factor_1': paced,
         'startup_s': startup,
         'scaling': scaling,
+        'sensor_us_per_message': sensors,
     }
 
 

@@ -51,7 +51,8 @@ def quick_run():
 @pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
 def test_quick_prints_exactly_one_json_object_with_every_figure(quick_run):
     figures = json.loads(quick_run[0])
-    assert set(figures) == {'raw', 'factor_0', 'factor_1', 'startup_s', 'scaling'}
+    assert set(figures) == {'raw', 'factor_0', 'factor_1', 'startup_s', 'scaling',
+                            'sensor_us_per_message'}
     assert set(figures['raw']) == RAW
     assert {case: set(values) for case, values in figures['factor_0'].items()} == FACTOR_0
     assert set(figures['factor_1']) == FACTOR_1
@@ -62,6 +63,13 @@ def test_quick_prints_exactly_one_json_object_with_every_figure(quick_run):
         assert math.isfinite(value) and value >= 0, (key, value)
     assert figures['raw']['steps_per_s'] > 0
     assert all(case['steps_per_s'] > 0 for case in figures['factor_0'].values())
+
+
+@pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
+def test_quick_reports_the_cost_of_each_sensor_per_message(quick_run):
+    costs = json.loads(quick_run[0])['sensor_us_per_message']
+    assert set(costs) == {'depth_camera', 'lidar', 'tilt_imu', 'tilt_ft'}
+    assert all(isinstance(cost, float) and cost > 0 for cost in costs.values()), costs
 
 
 @pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
