@@ -70,6 +70,10 @@ class NodeFeatures:
         """Return how many steps after ``step`` a watched sensor must see the world (or None)."""
         return self.sensors.steps_until_due(step)
 
+    def refresh_readers(self) -> None:
+        """Ask, once per batch of steps, whether anybody reads what is published periodically."""
+        self.robot_state.refresh_readers()
+
     def reset(self) -> None:
         """Start every schedule again: sim time was reset, or the world put back."""
         self.robot_state.reset()
