@@ -9,17 +9,17 @@ and installs them into the venv itself, the prefix the ROS wheels use:
 ``<venv>/lib`` for the libraries, the venv's site-packages for the Python
 modules, ``<venv>/share`` for the definitions and the ament index.
 
-A package is left alone, built or not, when anything but this script
-already provides it: a prefix on AMENT_PREFIX_PATH other than the venv (a
-ROS install or workspace), a folder on PYTHONPATH, or a package in the venv
-that this script did not install.  Its definitions are never installed over
-someone else's.
+A package is not built when anything but this script already provides
+it: a prefix on AMENT_PREFIX_PATH other than the venv (a ROS install or
+workspace), a module this interpreter imports from elsewhere (PYTHONPATH),
+or a package in the venv that this script did not install.  Its
+definitions are never installed over someone else's.
 
 Each built package has a stamp: a hash of its folder, interfaces/cmake/,
-this script's RECIPE number, the generator selection, the Python version and
-the versions of the rosidl wheels.  A package whose stamp matches is not rebuilt; --force
-rebuilds anyway.  Before a rebuild the files of the previous build (its
-CMake install manifest) are removed.
+this script's RECIPE number, the generator selection, the Python version
+and the versions of the rosidl wheels.  A package whose stamp matches is
+not rebuilt; --force rebuilds anyway.  Before a rebuild the files of the
+previous build (its CMake install manifest) are removed.
 
 State, under ``<venv>/share/pan_tilt_sim_interfaces/``: ``status.json``
 (``{"packages": {name: {"state": "built"|"provided", ...}}}``), and per
@@ -174,8 +174,11 @@ def remove_manifest(manifest: pathlib.Path, prefix: pathlib.Path) -> None:
             path.unlink()
         folders.update(p for p in path.parents if _within(p, prefix) and p != prefix)
     for folder in sorted(folders, key=lambda p: len(p.parts), reverse=True):
-        for cache in folder.glob('__pycache__'):
-            shutil.rmtree(cache, ignore_errors=True)
+        if not folder.is_dir():
+            continue
+        # A folder left with nothing but byte code of the removed modules goes too.
+        if [entry.name for entry in folder.iterdir()] == ['__pycache__']:
+            shutil.rmtree(folder / '__pycache__', ignore_errors=True)
         try:
             folder.rmdir()
         except OSError:
@@ -314,7 +317,7 @@ def main(argv: list[str] | None = None) -> int:
             say(f'{package.name}: provided by {provider}; not built here')
             continue
         if decision == 'up to date':
-            status['packages'][package.name] = status['packages'].get(package.name) or built
+            status['packages'][package.name] = built
             continue
         say(f'building {package.name} {package.version} into {prefix} '
             f'({args.generators} generators, {args.jobs} jobs)')
