@@ -12,13 +12,15 @@
 #   directory.  At the end of the configure step each such directory is
 #   replaced by this interpreter's headers or NumPy's.
 # * PAN_TILT_SIM_INTERFACES_GENERATORS=python (what the build script passes)
-#   runs only the generators that rclpy over rmw_fastrtps_cpp loads the
-#   output of: the type descriptions (RIHS01 hashes), the C structs, the
-#   Fast DDS C type support, the C type support with that one implementation
-#   linked in directly (so it dlopen()s nothing by name), and the Python
-#   bindings.  No C++ headers or type supports, no introspection: nothing in
-#   the venv compiles against them or loads them.  "default" runs every
-#   generator rosidl_default_generators registered, as upstream does.
+#   runs only the generators whose output rclpy over rmw_fastrtps_cpp loads:
+#   the type descriptions (RIHS01 hashes), the C structs, the Fast DDS C type
+#   support (serialisation), the C introspection type support (Fast DDS
+#   builds its type object from it: without it creating a publisher fails
+#   with "failed to register type object"), the C type support that
+#   dispatches to those two, and the Python bindings.  No C++ headers or
+#   type supports: nothing in the venv compiles against them or loads them.
+#   "default" runs every generator rosidl_default_generators registered, as
+#   upstream does.
 
 set(PAN_TILT_SIM_INTERFACES_GENERATORS "default" CACHE STRING
   "python: only what rclpy with rmw_fastrtps_cpp needs; default: all of rosidl_default_generators")
