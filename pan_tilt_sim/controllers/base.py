@@ -103,8 +103,15 @@ class Controller(abc.ABC):
         """
         return {}
 
+    def state_interfaces(self) -> dict[str, tuple[str, ...]]:
+        """Return the state interfaces this controller reads, by joint (none here)."""
+        return {}
+
     def reset(self) -> None:  # noqa: B027 -- stateless controllers need no reset
         """Forget commands and internal state, as after a fresh start."""
+
+    def deactivate(self) -> None:  # noqa: B027 -- most controllers have nothing to end
+        """End what the controller was doing for someone (its updates stop after this)."""
 
     def pids(self) -> dict[str, Pid]:
         """Return the PIDs of this controller by joint (gains may change live); none here."""

@@ -25,14 +25,15 @@ class Simulation:
 
     def __init__(self, description: RobotDescription, controllers: ControllersConfig,
                  time_step: float, *, gui: bool = False,
-                 active_controllers: Sequence[str] | None = None) -> None:
+                 active_controllers: Sequence[str] | None = None,
+                 autostart_controllers: bool = True) -> None:
         self.description = description
         self.physics = Physics(description, time_step, gui=gui)
         try:
             self.handles = {joint.name: JointHandle(joint) for joint in self.physics.joints}
             self.manager = ControllerManager(controllers, self.handles, description.model,
-                                             active=active_controllers)
-            self.controllers = self.manager.controllers
+                                             active=active_controllers,
+                                             autostart=autostart_controllers)
         except BaseException:
             self.physics.close()
             raise
@@ -58,16 +59,18 @@ class Simulation:
         """Sim time in seconds."""
         return self._steps * self._time_step
 
+    @property
+    def controllers(self) -> list[Controller]:
+        """The loaded controllers (the manager's; they change as controllers are loaded)."""
+        return self.manager.controllers
+
     def command_controllers(self) -> list[CommandController]:
         """Return the (loaded) controllers that take commands from topics."""
         return [c for c in self.controllers if isinstance(c, CommandController)]
 
     def controller(self, name: str) -> Controller:
-        """Return the controller called ``name``; KeyError if there is none."""
-        for controller in self.controllers:
-            if controller.name == name:
-                return controller
-        raise KeyError(name)
+        """Return the loaded controller called ``name``; KeyError if there is none."""
+        return self.manager.controller(name)
 
     def advance(self, steps: int) -> None:
         """Run ``steps`` physics steps, updating every active controller at each."""
@@ -101,7 +104,7 @@ class Simulation:
             handle.reset()
         self.physics.reset_joints([handle.position for handle in self._handle_list])
         self._states = self.physics.read_states()
-        for controller in self.controllers:
+        for controller in self.manager.configured:
             controller.reset()
         if reset_time:
             self._steps = 0
