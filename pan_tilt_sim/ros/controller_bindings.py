@@ -57,6 +57,8 @@ class ControllerBindings:
         self._joint_state_sinks: list[tuple[JointStateController, Any, Any]] = []
         self._trajectory_controllers: list[JointTrajectoryController] = []
         self.actions: dict[str, TrajectoryActionServer] = {}
+        # Wakes the executor when a goal ended or feedback is due (see after_steps).
+        self._attention = node.create_guard_condition(self.serve_actions)
         for controller in self._manager.configured:
             self._bind(controller)
 
@@ -93,18 +95,30 @@ class ControllerBindings:
         try:
             return self._manager.switch(activate, deactivate, strict=strict)
         finally:
-            self.after_steps()
+            self.serve_actions()  # the goals of deactivated controllers end now
 
     # --- called by the node --------------------------------------------------------------------
 
     def after_steps(self) -> None:
-        """Finish the goals that ended, send feedback, log what the controllers noticed."""
-        for action in self.actions.values():
-            action.poll()
+        """After a batch of steps: log what controllers noticed; wake the executor for goals.
+
+        Runs wherever the physics runs (sim_node's physics thread, or a timer
+        on the executor); the goals' rclpy side is served on the executor, by
+        :meth:`serve_actions`, through a guard condition.
+        """
         for controller in self._trajectory_controllers:
             notices = controller.notices
             while notices:
                 self._logger.warning(f'{controller.name}: {notices.pop(0)}')
+        for action in self.actions.values():
+            if action.needs_attention():
+                self._attention.trigger()
+                return
+
+    def serve_actions(self) -> None:
+        """Deliver the results of goals that ended and the feedback that is due (executor)."""
+        for action in self.actions.values():
+            action.poll()
 
     def refresh_readers(self) -> None:
         """Sample joint states only for broadcasters someone listens to."""
@@ -116,6 +130,7 @@ class ControllerBindings:
         for action in self.actions.values():
             action.destroy()
         self.actions.clear()
+        self._node.destroy_guard_condition(self._attention)
 
     # --- entities ------------------------------------------------------------------------------
 

@@ -13,10 +13,13 @@ controller's, :mod:`pan_tilt_sim.controllers.joint_trajectory_controller`):
 * accepted callback: the controller starts the goal at once (which aborts
   the one running: preempted), then the goal executes;
 * execute callback: a coroutine that awaits a Future, so it never blocks
-  the executor; the node completes that Future after the physics step in
-  which the goal ended (:meth:`TrajectoryActionServer.poll`, called after
-  every batch of steps and after every callback that may end a goal), and
-  the coroutine then sets the terminal state and returns the result;
+  the executor; once a batch of physics steps has ended the goal
+  (:meth:`TrajectoryActionServer.needs_attention`, asked after every batch,
+  also in sim_node's physics thread), the node wakes the executor with a
+  guard condition and :meth:`TrajectoryActionServer.poll` completes the
+  Future there; the coroutine then sets the terminal state and returns the
+  result.  Callbacks that end a goal themselves (cancel, preemption, a
+  switch) poll at once;
 * cancel callback: the running goal is canceled at once (the joints hold
   where they are) and ACCEPTED; a goal that has already ended is REJECTED;
 * feedback (desired, actual, error) goes out at the controller's
@@ -134,10 +137,24 @@ class TrajectoryActionServer:
 
     # --- called by the node ---------------------------------------------------------------------
 
+    def needs_attention(self) -> bool:
+        """Whether :meth:`poll` has something to do: a goal ended, or feedback is due.
+
+        Cheap, and touches no rclpy entity: asked after every batch of steps,
+        from whichever thread runs the physics.
+        """
+        if not self._running:
+            return False
+        if any(goal.done for goal in self._running):
+            return True
+        return self._controller.goal is not None and (
+            self._now() - self._last_feedback >= self._controller.monitor_period - 1e-9)
+
     def poll(self) -> None:
         """Complete the Futures of goals that have ended; send feedback of the running one.
 
-        Cheap when nothing runs; called after every batch of physics steps.
+        Runs on the executor (between batches of steps): after
+        :meth:`needs_attention` said so, and after callbacks that end goals.
         """
         if not self._running:
             return
