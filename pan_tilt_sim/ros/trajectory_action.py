@@ -147,7 +147,7 @@ class TrajectoryActionServer:
             return False
         if any(goal.done for goal in self._running):
             return True
-        return self._controller.goal is not None and (
+        return self._controller.goal is not None and self._controller.following and (
             self._now() - self._last_feedback >= self._controller.monitor_period - 1e-9)
 
     def poll(self) -> None:
@@ -163,7 +163,7 @@ class TrajectoryActionServer:
                 del self._running[goal]
                 future.set_result(goal.status)
         goal = self._controller.goal
-        if goal is None or goal not in self._running:
+        if goal is None or goal not in self._running or not self._controller.following:
             return
         now = self._now()
         if now - self._last_feedback < self._controller.monitor_period - 1e-9:
