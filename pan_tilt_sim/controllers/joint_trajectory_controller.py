@@ -166,6 +166,11 @@ class JointTrajectoryController(MultiJointController):
         """The goal being executed, if any (None once it has ended)."""
         return self._goal
 
+    @property
+    def following(self) -> bool:
+        """Whether the latest trajectory has started (not waiting for its stamp or next step)."""
+        return self._pending is None
+
     def pids(self) -> dict[str, Pid]:
         """One PID per joint (their gains may be changed live)."""
         return dict(zip(self._joint_names, self._pids, strict=True))
