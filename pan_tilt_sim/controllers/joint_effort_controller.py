@@ -6,7 +6,7 @@ first command the effort is zero.
 
 from __future__ import annotations
 
-from pan_tilt_sim.controllers.base import CommandResult
+from pan_tilt_sim.controllers.base import Actuator, ActuatorKind, CommandResult, JointHandle
 from pan_tilt_sim.controllers.limits import check_effort
 from pan_tilt_sim.controllers.single_joint import SingleJointController
 
@@ -15,6 +15,10 @@ class JointEffortController(SingleJointController):
     """Effort command -> effort."""
 
     type_names = ('effort_controllers/JointEffortController',)
+
+    def bind(self, handle: JointHandle) -> None:
+        """Have the physics apply the commanded effort to the joint."""
+        handle.actuator = Actuator(ActuatorKind.EFFORT, self.name)
 
     def reset(self) -> None:
         """Apply no effort until commanded."""

@@ -1,10 +1,13 @@
 """The shared part of the one-joint command controllers.
 
 :class:`SingleJointController` names its joint with the ``joint`` parameter
-and binds that joint's handle at configure time; :class:`PidJointController`
-adds a PID whose gains come from the ``pid`` section (or the subclass's
-defaults) and whose integral term is bounded by the joint's effort limit
-unless the YAML gives a clamp.
+and binds that joint's handle at configure time.  :class:`PidJointController`
+drives its joint by a PID on effort when gains are given for it -- its
+``pid`` section, else ``gazebo_ros_control/pid_gains/<joint>`` -- and
+otherwise by the ideal actuator (:mod:`pan_tilt_sim.controllers.actuator`);
+the ``effort_controllers/`` types always use a PID, with the subclass's
+default gains when none are given.  The PID's integral term is bounded by
+the joint's effort limit unless the YAML gives a clamp.
 """
 
 from __future__ import annotations
@@ -12,9 +15,25 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
-from pan_tilt_sim.controllers.base import CommandController, JointHandle
-from pan_tilt_sim.controllers.gains import PID_FIELD, gains_from_params
+from pan_tilt_sim.controllers.base import (
+    Actuator,
+    ActuatorKind,
+    CommandController,
+    Controller,
+    JointHandle,
+)
+from pan_tilt_sim.controllers.gains import PID_FIELD, choose_gains, gains_from_params
 from pan_tilt_sim.controllers.pid import Pid, PidGains
+
+# The controller types that command effort: their PID is the controller itself.
+EFFORT_TYPE_PREFIX = 'effort_controllers/'
+TYPE_FIELD = 'type'
+
+
+def commands_effort(controller: Controller) -> bool:
+    """Whether ``controller``'s YAML ``type`` is an ``effort_controllers/`` type."""
+    type_name = controller.params.get(TYPE_FIELD)
+    return isinstance(type_name, str) and type_name.startswith(EFFORT_TYPE_PREFIX)
 
 
 class SingleJointController(CommandController):
@@ -48,24 +67,41 @@ class SingleJointController(CommandController):
 
 
 class PidJointController(SingleJointController):
-    """A one-joint controller whose effort comes from a PID."""
+    """A one-joint controller: a PID on effort when it has gains, else the ideal actuator."""
 
     default_gains: ClassVar[PidGains]
+    pid_kind: ClassVar[ActuatorKind]
+    ideal_kind: ClassVar[ActuatorKind]
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
-        self._gains = gains_from_params(self, self.default_gains)
+        self._own_gains = gains_from_params(self, None)
+        self._pid: Pid | None = None
+        # Where the own gains are written (a group controller names its ``gains.<joint>``).
+        self.gains_origin = f'{name}.{PID_FIELD}'
 
     @property
-    def pid(self) -> Pid:
-        """The PID (its gains may be changed live)."""
+    def pid(self) -> Pid | None:
+        """The PID (its gains may be changed live); None when the ideal actuator drives."""
         return self._pid
 
+    @property
+    def ideal(self) -> bool:
+        """Whether the ideal actuator drives the joint (no PID gains for it)."""
+        return self._pid is None
+
     def pids(self) -> dict[str, Pid]:
-        """Return the one joint's PID."""
-        return {self._joint_name: self._pid}
+        """Return the one joint's PID, if it has one."""
+        return {} if self._pid is None else {self._joint_name: self._pid}
 
     def bind(self, handle: JointHandle) -> None:
-        """Build the PID, its integral bounded by the effort limit unless clamped in the YAML."""
+        """Choose PID or ideal actuator; a PID's integral is bounded by the effort limit."""
         self._effort_limit = handle.spec.effort_limit
-        self._pid = Pid(self._gains.with_default_clamp(self._effort_limit))
+        default = self.default_gains if commands_effort(self) else None
+        gains, source = choose_gains(self._own_gains, self.gains_origin, handle, default)
+        if gains is None:
+            self._pid = None
+            handle.actuator = Actuator(self.ideal_kind, self.name)
+        else:
+            self._pid = Pid(gains.with_default_clamp(self._effort_limit))
+            handle.actuator = Actuator(self.pid_kind, self.name, self._pid, source)

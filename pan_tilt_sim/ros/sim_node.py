@@ -71,7 +71,8 @@ class SimNode(Node):
             self.get_namespace(), self.settings.robot_namespace,
             controllers.namespace, description.plugin_namespace)
         self.simulation = Simulation(
-            description, controllers, self.settings.time_step, gui=self.settings.gui)
+            description, controllers, self.settings.time_step, gui=self.settings.gui,
+            initial_positions=self.settings.initial_positions, logger=self.get_logger())
         self._paused = self.settings.paused
         # Commands taken per controller (ignored ones included): a cheap health figure.
         self.commands_received = {c.name: 0 for c in self.simulation.command_controllers()}
@@ -96,11 +97,8 @@ class SimNode(Node):
         self.add_post_set_parameters_callback(self._apply_parameters)
         self._world_services = services.create_world_services(
             self, reset=self.reset, set_paused=self.set_paused)
-        for joint in self.simulation.physics.joints:
-            if joint.initial_position != 0.0:
-                self.get_logger().info(
-                    f"joint '{joint.name}' starts at {joint.initial_position:g}: 0 is outside "
-                    f'its limits [{joint.lower:g}, {joint.upper:g}]')
+        # Actuators, start positions, PyBullet's load messages, unstable gains.
+        self.simulation.report_startup()
         clock_period = self._clock_every * self.settings.time_step
         if abs(clock_period - CLOCK_PERIOD_S) > 1e-9:
             self.get_logger().info(

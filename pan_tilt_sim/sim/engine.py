@@ -1,22 +1,61 @@
 """The simulation loop: physics and controllers, stepped together, no ROS.
 
 Each step is ros2_control's read / update / write around one physics step:
-the measured joint states go into the joint handles, every controller
+the measured joint states go into the joint handles (and, for joints an
+ideal actuator drives, the effort its motor applied), every controller
 updates (command controllers first, so broadcasters sample fresh efforts),
-the efforts go to PyBullet, and PyBullet advances one ``time_step``.  Sim
-time is kept as a step count, so it never accumulates rounding error.
+the efforts and velocity targets go to PyBullet, and PyBullet advances one
+``time_step``.  Sim time is kept as a step count, so it never accumulates
+rounding error.
+
+At start-up the simulation says, through the logger it is given, which
+actuator drives each joint and why, where each joint starts, what PyBullet
+said while loading the robot, and which PID gains are too high for their
+joint's inertia at this time step (:mod:`pan_tilt_sim.sim.stability`).
+While running, a joint at PyBullet's speed cap or with a non-finite state
+gets a warning (at most one per joint per second).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import logging
+import math
+import time as wall_time
+from collections.abc import Mapping, Sequence
+from typing import Protocol
 
 from pan_tilt_sim.controllers import CommandController, Controller, JointHandle, create_controller
+from pan_tilt_sim.controllers.base import Drive
+from pan_tilt_sim.controllers.gains import plugin_gains
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription
+from pan_tilt_sim.model.initial_positions import FROM_DEFAULT, StartPosition, start_positions
 from pan_tilt_sim.model.robot import JointSpec
-from pan_tilt_sim.sim.physics import STATE_POSITION, STATE_VELOCITY, Physics
+from pan_tilt_sim.sim.physics import (
+    STATE_MOTOR_TORQUE,
+    STATE_POSITION,
+    STATE_VELOCITY,
+    Physics,
+    health_problem,
+)
+from pan_tilt_sim.sim.stability import pid_stability_warnings
+
+LOGGER_NAME = 'pan_tilt_sim'
+# A joint this close to PyBullet's speed cap is riding it.
+AT_CAP = 0.99
+WARNING_THROTTLE_S = 1.0  # wall seconds between two warnings about one joint
+INFO, WARNING = 'info', 'warning'
+
+
+class Logger(Protocol):
+    """What the simulation logs through: rclpy's node logger and logging.Logger both fit."""
+
+    def info(self, message: str) -> object:
+        """Log ``message`` as information."""
+
+    def warning(self, message: str) -> object:
+        """Log ``message`` as a warning."""
 
 
 def build_controllers(config: ControllersConfig, handles: dict[str, JointHandle],
@@ -50,25 +89,83 @@ def build_controllers(config: ControllersConfig, handles: dict[str, JointHandle]
 
 
 class Simulation:
-    """One robot in PyBullet, driven by its controllers, advanced step by step."""
+    """One robot in PyBullet, driven by its controllers, advanced step by step.
+
+    ``initial_positions`` (joint name -> position) override the URDF's
+    ``initial_value`` (see :mod:`pan_tilt_sim.model.initial_positions`).
+    What the simulation has to say at start-up waits in
+    :attr:`startup_report` until :meth:`report_startup` logs it (the node
+    does that once it is completely built, so that a start-up error stays
+    the only line); run-time warnings go to ``logger`` at once.
+    """
 
     def __init__(self, description: RobotDescription, controllers: ControllersConfig,
-                 time_step: float, *, gui: bool = False) -> None:
+                 time_step: float, *, gui: bool = False,
+                 initial_positions: Mapping[str, float] | None = None,
+                 logger: Logger | None = None) -> None:
         self.description = description
-        self.physics = Physics(description, time_step, gui=gui)
+        self._logger: Logger = logger or logging.getLogger(LOGGER_NAME)
+        starts = start_positions(description.model, initial_positions)
+        movable = [joint.name for joint in description.actuated_joints]
+        gains = plugin_gains(controllers.pid_gains, movable, str(controllers.source))
+        load_messages: list[str] = []
+        self.physics = Physics(
+            description, time_step, gui=gui,
+            initial_positions=[starts[joint].position for joint in movable],
+            warn=load_messages.append)
         try:
-            self.handles = {joint.name: JointHandle(joint) for joint in self.physics.joints}
+            self.handles = {
+                joint.name: JointHandle(joint, position, gains.get(joint.name))
+                for joint, position in zip(self.physics.joints,
+                                           self.physics.initial_positions, strict=True)}
             self.controllers = build_controllers(
                 controllers, self.handles, description.joints)
         except BaseException:
             self.physics.close()
             raise
         self._handle_list = list(self.handles.values())
-        self._efforts = [0.0] * len(self._handle_list)
+        velocity_driven = [handle.drive is Drive.VELOCITY for handle in self._handle_list]
+        self.physics.set_drives(velocity_driven)
+        self._effort_handles = [handle for handle, driven in zip(
+            self._handle_list, velocity_driven, strict=True) if not driven]
+        self._velocity_handles = [handle for handle, driven in zip(
+            self._handle_list, velocity_driven, strict=True) if driven]
+        self._velocity_slots = [slot for slot, driven in enumerate(velocity_driven) if driven]
+        self._efforts = [0.0] * len(self._effort_handles)
+        self._targets = [0.0] * len(self._velocity_handles)
         self._time_step = time_step
         self._steps = 0
         self._states = self.physics.read_states()
         self._physics_step = self.physics.stepper()
+        self._speed_limit = AT_CAP * self.physics.velocity_cap
+        self._last_warning: dict[str, float] = {}
+        self.startup_report = self._startup_report(description, starts, load_messages)
+
+    def report_startup(self) -> None:
+        """Log :attr:`startup_report` (info and warnings), once."""
+        for level, message in self.startup_report:
+            # One call site per severity: rclpy's logger insists on it.
+            if level == WARNING:
+                self._logger.warning(message)
+            else:
+                self._logger.info(message)
+        self.startup_report = []
+
+    def _startup_report(self, description: RobotDescription, starts: Mapping[str, StartPosition],
+                        load_messages: Sequence[str]) -> list[tuple[str, str]]:
+        report = [(WARNING, message) for message in (*description.warnings, *load_messages)]
+        for handle in self._handle_list:
+            report.append((INFO, f"joint '{handle.name}': "
+                                 f'{handle.actuator.describe(handle.spec)}'))
+        for handle in self._handle_list:
+            start = starts[handle.name]
+            line = start.describe(handle.spec.lower, handle.spec.upper)
+            if line:
+                report.append((WARNING if start.clamped and start.source != FROM_DEFAULT
+                               else INFO, line))
+        report.extend((WARNING, message) for message in pid_stability_warnings(
+            self.physics, self._handle_list, self._time_step))
+        return report
 
     @property
     def time_step(self) -> float:
@@ -103,7 +200,9 @@ class Simulation:
         # pan/tilt against ~5 us inside PyBullet (see README, Performance).
         handles = self._handle_list
         updates = [controller.update for controller in self.controllers]
-        efforts = self._efforts
+        effort_handles, efforts = self._effort_handles, self._efforts
+        velocity_handles, targets = self._velocity_handles, self._targets
+        readback = list(zip(velocity_handles, self._velocity_slots, strict=True))
         physics_step = self._physics_step
         dt = self._time_step
         states = self._states
@@ -113,14 +212,34 @@ class Simulation:
             for handle, state in zip(handles, states, strict=False):
                 handle.position = state[STATE_POSITION]
                 handle.velocity = state[STATE_VELOCITY]
+            for handle, slot in readback:  # what the ideal actuators applied
+                handle.effort = states[slot][STATE_MOTOR_TORQUE]
             time = count * dt
             for update in updates:
                 update(time, dt)
-            for index, handle in enumerate(handles):
+            for index, handle in enumerate(effort_handles):
                 efforts[index] = handle.effort
-            states = physics_step(efforts)
+            for index, handle in enumerate(velocity_handles):
+                targets[index] = handle.velocity_target
+            states = physics_step(efforts, targets)
         self._steps = first + steps
         self._states = states
+        self._check_health(states)
+
+    def _check_health(self, states: Sequence[Sequence[float]]) -> None:
+        """Warn about any joint at PyBullet's speed cap or with a non-finite state."""
+        limit = self._speed_limit
+        for handle, state in zip(self._handle_list, states, strict=False):
+            velocity = state[STATE_VELOCITY]
+            if -limit < velocity < limit and math.isfinite(state[STATE_POSITION]):
+                continue
+            now = wall_time.monotonic()
+            if now - self._last_warning.get(handle.name, -math.inf) < WARNING_THROTTLE_S:
+                continue
+            self._last_warning[handle.name] = now
+            self._logger.warning(
+                f'at sim time {self.time:.3f} s: '
+                f'{health_problem(handle.name, state, self.physics.velocity_cap)}')
 
     def reset(self, *, reset_time: bool = True) -> None:
         """Joints back to their initial state, controllers reset; sim time to 0 if asked."""
@@ -155,10 +274,15 @@ class Simulation:
 
 
 def make_simulation(description_file: str, controllers_file: str, time_step: float, *,
-                    xacro_args: Sequence[str] = (), gui: bool = False) -> Simulation:
-    """Load both files and build a :class:`Simulation` (for tools and tests)."""
+                    xacro_args: Sequence[str] = (), gui: bool = False,
+                    initial_positions: Mapping[str, float] | None = None,
+                    logger: Logger | None = None) -> Simulation:
+    """Load both files and build a :class:`Simulation` (for tools and tests); log its report."""
     from pan_tilt_sim.model.controller_config import load_controllers_config
     from pan_tilt_sim.model.description import load_description
 
-    return Simulation(load_description(description_file, xacro_args),
-                      load_controllers_config(controllers_file), time_step, gui=gui)
+    simulation = Simulation(load_description(description_file, xacro_args),
+                            load_controllers_config(controllers_file), time_step, gui=gui,
+                            initial_positions=initial_positions, logger=logger)
+    simulation.report_startup()
+    return simulation
