@@ -124,3 +124,20 @@ def test_largest_stable_time_step_solves_the_rule():
     dt = largest_stable_time_step(p, d, inertia)
     assert d * dt / 2 + p * dt * dt / 4 == pytest.approx(inertia)
     assert largest_stable_time_step(0.0, 4.0, 0.002) == pytest.approx(0.001)
+
+
+@pytest.mark.parametrize('factor', [0.9, 1.1])
+def test_a_stiff_p_alone_is_held_to_p_dt_squared_over_4_below_the_inertia(tmp_path, factor):
+    log = Log()
+    p = factor * 4 * STAR_INERTIA / DT ** 2  # ~1e5: the p term of the rule decides alone
+    with star(tmp_path, f'{{p: {p}}}', log) as sim:
+        sim.controller('pos').set_command(0.01)
+        sim.advance(1000)
+        speed = abs(sim.joint_velocities()['hinge'])
+    startup = [line for line in log.warnings if 'is unstable at time_step' in line]
+    if factor < 1:
+        assert speed < 5.0 and startup == []
+    else:
+        assert speed > 50.0
+        assert len(startup) == 1 and f'use p < {4 * STAR_INERTIA / DT ** 2:.3g} and a ' \
+                                      'smaller d' in startup[0]
