@@ -26,10 +26,14 @@ import math
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
+from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
 from pan_tilt_sim.controllers.pid import Pid, PidGains
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.model.robot import JointKind, JointSpec
 
+# The command interface a ros2_control controller package's controllers claim.
+PACKAGE_INTERFACES = {'position_controllers': 'position', 'velocity_controllers': 'velocity',
+                      'effort_controllers': 'effort'}
 # Largest command magnitude taken on a side without a limit (rad, m, rad/s, N*m...):
 # far beyond any real joint, small enough that PID arithmetic on it stays finite.
 MAX_COMMAND_MAGNITUDE = 1e12
@@ -45,7 +49,7 @@ class Drive(enum.Enum):
 class ActuatorKind(enum.Enum):
     """What drives a joint, and through which :class:`Drive`."""
 
-    PASSIVE = ('passive: no controller', Drive.EFFORT)
+    PASSIVE = ('passive: no active controller', Drive.EFFORT)
     MIMIC = ('mimic: follows its leader', Drive.EFFORT)
     EFFORT = ('effort command', Drive.EFFORT)
     POSITION_PID = ('position PID on effort', Drive.EFFORT)
@@ -97,26 +101,36 @@ class Actuator:
         return f'{self.kind.label}{owner}'
 
 
+def idle_actuator(spec: JointSpec) -> Actuator:
+    """Return what drives a joint no active controller claims: nothing, or its mimic leader."""
+    return Actuator(ActuatorKind.MIMIC if spec.mimic is not None else ActuatorKind.PASSIVE)
+
+
 class JointHandle:
     """State and command of one joint, shared by simulation and controllers.
 
     ``initial_position`` is where the joint starts and resets to;
     ``plugin_gains`` are the joint's ``gazebo_ros_control/pid_gains`` (None
     if the YAML gives none), which a position or velocity controller without
-    gains of its own uses, as gazebo_ros_control does.
+    gains of its own uses, as gazebo_ros_control does; ``tracking_gain`` is
+    the share of its position error an ideal position actuator closes per
+    step (gz_ros2_control's ``position_proportional_gain``).  ``actuator``
+    is what drives the joint now: the simulation sets it from the active
+    controllers (:meth:`Controller.actuators`).
     """
 
     __slots__ = ('spec', 'position', 'velocity', 'effort', 'velocity_target',
-                 'initial_position', 'plugin_gains', 'actuator')
+                 'initial_position', 'plugin_gains', 'tracking_gain', 'actuator')
 
     def __init__(self, spec: JointSpec, initial_position: float | None = None,
-                 plugin_gains: PidGains | None = None) -> None:
+                 plugin_gains: PidGains | None = None,
+                 tracking_gain: float = TRACKING_GAIN) -> None:
         self.spec = spec
         self.initial_position = (spec.initial_position if initial_position is None
                                  else initial_position)
         self.plugin_gains = plugin_gains
-        self.actuator = Actuator(ActuatorKind.MIMIC if spec.mimic is not None
-                                 else ActuatorKind.PASSIVE)
+        self.tracking_gain = tracking_gain
+        self.actuator = idle_actuator(spec)
         self.position = self.initial_position
         self.velocity = 0.0
         self.effort = 0.0
@@ -160,6 +174,8 @@ class Controller(abc.ABC):
     """Base of every controller type; subclasses list their YAML ``type`` strings."""
 
     type_names: ClassVar[tuple[str, ...]] = ()
+    # The YAML type this controller was created from (the registry sets it).
+    type_name: str = ''
     # The YAML section the PID gains come from: 'pid' (ROS 1, one joint) or
     # 'gains' (ros2_controllers, per joint); the gain parameters follow it.
     gains_field: ClassVar[str] = 'gains'
@@ -182,11 +198,23 @@ class Controller(abc.ABC):
     def update(self, time: float, period: float) -> None:
         """Run one control step at sim ``time`` (s), ``period`` s after the previous one."""
 
+    def command_interfaces(self) -> dict[str, tuple[str, ...]]:
+        """Return the command interfaces this controller claims, by joint (ros2_control's claim).
+
+        ``position``, ``velocity`` or ``effort``: a joint whose ``<ros2_control>``
+        block lacks one of them cannot be driven by this controller.
+        """
+        return {}
+
     def reset(self) -> None:  # noqa: B027 -- stateless controllers need no reset
         """Forget commands and internal state, as after a fresh start."""
 
     def pids(self) -> dict[str, Pid]:
         """Return the PIDs of this controller by joint (gains may change live); none here."""
+        return {}
+
+    def actuators(self) -> dict[str, Actuator]:
+        """Return what drives each of this controller's joints while it is active; none here."""
         return {}
 
     def error(self, field: str, problem: str) -> ControllerConfigError:

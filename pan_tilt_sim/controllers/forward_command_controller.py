@@ -29,6 +29,7 @@ from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.base import (
     MAX_COMMAND_MAGNITUDE,
+    Actuator,
     CommandController,
     CommandKind,
     CommandResult,
@@ -82,9 +83,18 @@ class ForwardCommandController(MultiJointController):
         """The one-joint controller of each joint (their PIDs may be tuned live)."""
         return self._members
 
+    def command_interfaces(self) -> dict[str, tuple[str, ...]]:
+        """Return ``interface_name`` for every joint."""
+        return {joint: (self.interface_name,) for joint in self._joint_names}
+
     def pids(self) -> dict[str, Pid]:
-        """Return each joint's PID (none for the effort interface)."""
+        """Return each joint's PID (none for the effort interface or the ideal actuator)."""
         return {joint: pid for member in self._members for joint, pid in member.pids().items()}
+
+    def actuators(self) -> dict[str, Actuator]:
+        """Return what drives each joint while this controller is active."""
+        return {joint: actuator for member in self._members
+                for joint, actuator in member.actuators().items()}
 
     def setpoints(self) -> dict[str, float]:
         """Return each joint's one-joint controller's setpoint."""

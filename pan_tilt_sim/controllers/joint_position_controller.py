@@ -17,12 +17,7 @@ start, so the joint holds still.  What follows the setpoint:
 
 from __future__ import annotations
 
-from pan_tilt_sim.controllers.actuator import (
-    ARRIVED,
-    SETPOINT_ACCELERATION,
-    TRACKING_GAIN,
-    ramp,
-)
+from pan_tilt_sim.controllers.actuator import ARRIVED, SETPOINT_ACCELERATION, ramp
 from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult, JointHandle
 from pan_tilt_sim.controllers.limits import PositionLimits
 from pan_tilt_sim.controllers.pid import PidGains
@@ -89,7 +84,7 @@ class JointPositionController(PidJointController):
                 setpoint, rate = ramp(setpoint, rate, command, period, max_velocity,
                                       SETPOINT_ACCELERATION)
                 self._setpoint, self._rate = setpoint, rate
-            target = rate + TRACKING_GAIN / period * (setpoint - handle.position)
+            target = rate + self._tracking_gain / period * (setpoint - handle.position)
             handle.velocity_target = (max_velocity if target > max_velocity else
                                       -max_velocity if target < -max_velocity else target)
             return

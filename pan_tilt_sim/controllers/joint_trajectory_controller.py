@@ -35,7 +35,6 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
 from pan_tilt_sim.controllers.base import (
     MAX_COMMAND_MAGNITUDE,
     Actuator,
@@ -83,15 +82,24 @@ class JointTrajectoryController(MultiJointController):
             raise self.error(COMMAND_INTERFACES_FIELD, f'{interfaces!r} must be a list of '
                              f"{', '.join(COMMAND_INTERFACES)}")
         self._effort_interface = EFFORT_INTERFACE in interfaces
+        self._command_interfaces = tuple(interfaces)
         gains = joint_gains_from_params(self, self._joint_names)
         self._gains = [gains.get(joint) for joint in self._joint_names]
         scales = feedforward_scales(self, self._joint_names)
         self._feedforward = [scales[joint] for joint in self._joint_names]
 
+    def command_interfaces(self) -> dict[str, tuple[str, ...]]:
+        """Return the ``command_interfaces`` listed, for every joint."""
+        return {joint: self._command_interfaces for joint in self._joint_names}
+
     def pids(self) -> dict[str, Pid]:
         """Return the PID of every joint that has one (their gains may be changed live)."""
         return {joint: pid for joint, pid in zip(self._joint_names, self._pids, strict=True)
                 if pid is not None}
+
+    def actuators(self) -> dict[str, Actuator]:
+        """Return what drives each joint while this controller is active."""
+        return dict(zip(self._joint_names, self._actuators, strict=True))
 
     def setpoints(self) -> dict[str, float]:
         """Return the desired positions the PIDs track now."""
@@ -108,19 +116,22 @@ class JointTrajectoryController(MultiJointController):
         self._limits = [PositionLimits(handle.spec) for handle in self._handles]
         self._effort_limits = [handle.spec.effort_limit for handle in self._handles]
         self._max_velocities = [handle.spec.velocity_limit for handle in self._handles]
+        self._tracking_gains = [handle.tracking_gain for handle in self._handles]
         default = DEFAULT_POSITION_GAINS if self._effort_interface else None
         self._pids: list[Pid | None] = []
+        self._actuators: list[Actuator] = []
         for handle, own, limit in zip(self._handles, self._gains, self._effort_limits,
                                       strict=True):
             gains, source = choose_gains(own, f'{self.name}.{GAINS_FIELD}.{handle.name}',
                                          handle, default)
             if gains is None:
                 self._pids.append(None)
-                handle.actuator = Actuator(ActuatorKind.IDEAL_POSITION, self.name)
+                self._actuators.append(Actuator(ActuatorKind.IDEAL_POSITION, self.name))
             else:
                 pid = Pid(gains.with_default_clamp(limit))
                 self._pids.append(pid)
-                handle.actuator = Actuator(ActuatorKind.POSITION_PID, self.name, pid, source)
+                self._actuators.append(
+                    Actuator(ActuatorKind.POSITION_PID, self.name, pid, source))
         count = len(self._handles)
         self._desired_positions = [0.0] * count
         self._desired_velocities = [0.0] * count
@@ -176,14 +187,14 @@ class JointTrajectoryController(MultiJointController):
             self._plan.sample(time, desired_positions, desired_velocities)
         handles, pids = self._handles, self._pids
         feedforward, effort_limits = self._feedforward, self._effort_limits
-        max_velocities = self._max_velocities
-        gain = TRACKING_GAIN / period
+        max_velocities, tracking_gains = self._max_velocities, self._tracking_gains
         for index in self._indices:
             handle = handles[index]
             desired_velocity = desired_velocities[index]
             pid = pids[index]
             if pid is None:  # the ideal actuator: track the desired state
-                target = desired_velocity + gain * (desired_positions[index] - handle.position)
+                target = desired_velocity + tracking_gains[index] / period * (
+                    desired_positions[index] - handle.position)
                 limit = max_velocities[index]
                 handle.velocity_target = (limit if target > limit else
                                           -limit if target < -limit else target)

@@ -32,6 +32,7 @@ class JointVelocityController(PidJointController):
     default_gains = DEFAULT_VELOCITY_GAINS
     pid_kind = ActuatorKind.VELOCITY_PID
     ideal_kind = ActuatorKind.IDEAL_VELOCITY
+    default_interface = 'velocity'
 
     def reset(self) -> None:
         """Target zero velocity; forget the integral."""

@@ -5,9 +5,10 @@ and binds that joint's handle at configure time.  :class:`PidJointController`
 drives its joint by a PID on effort when gains are given for it -- its
 ``pid`` section, else ``gazebo_ros_control/pid_gains/<joint>`` -- and
 otherwise by the ideal actuator (:mod:`pan_tilt_sim.controllers.actuator`);
-the ``effort_controllers/`` types always use a PID, with the subclass's
-default gains when none are given.  The PID's integral term is bounded by
-the joint's effort limit unless the YAML gives a clamp.
+on the effort interface (the ``effort_controllers/`` types) it always uses a
+PID, with the subclass's default gains when none are given.  The PID's
+integral term is bounded by the joint's effort limit unless the YAML gives a
+clamp.
 """
 
 from __future__ import annotations
@@ -16,30 +17,24 @@ from collections.abc import Mapping
 from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.base import (
+    PACKAGE_INTERFACES,
     Actuator,
     ActuatorKind,
     CommandController,
-    Controller,
     JointHandle,
 )
 from pan_tilt_sim.controllers.gains import PID_FIELD, choose_gains, gains_from_params
 from pan_tilt_sim.controllers.pid import Pid, PidGains
 
-# The controller types that command effort: their PID is the controller itself.
-EFFORT_TYPE_PREFIX = 'effort_controllers/'
-TYPE_FIELD = 'type'
-
-
-def commands_effort(controller: Controller) -> bool:
-    """Whether ``controller``'s YAML ``type`` is an ``effort_controllers/`` type."""
-    type_name = controller.params.get(TYPE_FIELD)
-    return isinstance(type_name, str) and type_name.startswith(EFFORT_TYPE_PREFIX)
+EFFORT_INTERFACE = 'effort'
 
 
 class SingleJointController(CommandController):
     """A command controller driving the one joint its ``joint`` parameter names."""
 
     gains_field = PID_FIELD
+    # The interface claimed unless the type's package says (effort_controllers/...).
+    default_interface: ClassVar[str] = 'position'
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
@@ -50,6 +45,16 @@ class SingleJointController(CommandController):
     def joint_names(self) -> tuple[str, ...]:
         """The one joint this controller drives."""
         return (self._joint_name,)
+
+    @property
+    def interface(self) -> str:
+        """The command interface: the type's package's, else the controller's own."""
+        package = self.type_name.partition('/')[0]
+        return PACKAGE_INTERFACES.get(package, self.default_interface)
+
+    def command_interfaces(self) -> dict[str, tuple[str, ...]]:
+        """Return the one joint's interface (see :attr:`interface`)."""
+        return {self._joint_name: (self.interface,)}
 
     def configure(self, joints: Mapping[str, JointHandle]) -> None:
         """Bind the joint's handle (and what :meth:`bind` derives from it), then reset."""
@@ -77,6 +82,7 @@ class PidJointController(SingleJointController):
         super().__init__(name, params, source)
         self._own_gains = gains_from_params(self, None)
         self._pid: Pid | None = None
+        self._actuator = Actuator()
         # Where the own gains are written (a group controller names its ``gains.<joint>``).
         self.gains_origin = f'{name}.{PID_FIELD}'
 
@@ -94,14 +100,19 @@ class PidJointController(SingleJointController):
         """Return the one joint's PID, if it has one."""
         return {} if self._pid is None else {self._joint_name: self._pid}
 
+    def actuators(self) -> dict[str, Actuator]:
+        """Return what drives the joint while this controller is active."""
+        return {self._joint_name: self._actuator}
+
     def bind(self, handle: JointHandle) -> None:
         """Choose PID or ideal actuator; a PID's integral is bounded by the effort limit."""
         self._effort_limit = handle.spec.effort_limit
-        default = self.default_gains if commands_effort(self) else None
+        self._tracking_gain = handle.tracking_gain
+        default = self.default_gains if self.interface == EFFORT_INTERFACE else None
         gains, source = choose_gains(self._own_gains, self.gains_origin, handle, default)
         if gains is None:
             self._pid = None
-            handle.actuator = Actuator(self.ideal_kind, self.name)
+            self._actuator = Actuator(self.ideal_kind, self.name)
         else:
             self._pid = Pid(gains.with_default_clamp(self._effort_limit))
-            handle.actuator = Actuator(self.pid_kind, self.name, self._pid, source)
+            self._actuator = Actuator(self.pid_kind, self.name, self._pid, source)

@@ -10,7 +10,9 @@ are explicitly massless (:mod:`pan_tilt_sim.model.inertials`).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import io
 import os
 import pathlib
 import xml.etree.ElementTree as ElementTree
@@ -25,6 +27,8 @@ from pan_tilt_sim.model.urdf import parse_xml, read_model
 
 XACRO_SUFFIX = '.xacro'
 MAPPING_SEPARATOR = ':='
+# Lines xacro adds after a warning to say where it was.
+XACRO_LOCATION_PREFIXES = ('when processing file:', 'included from:')
 # Converted meshes are kept between runs (keyed on content) under the user cache.
 MESH_CACHE_SUBDIR = pathlib.Path('pan_tilt_sim', 'meshes')
 
@@ -37,14 +41,16 @@ class RobotDescription:
     still ``package://...``): what robot_description publishes and
     robot_state_publisher and RViz read.  ``physics_urdf`` is PyBullet's
     copy, whose meshes point at loadable local files and whose massless
-    links say so; ``warnings`` are what making that copy had to change
-    beyond that (one line each, for the log).
+    links say so.
     """
 
     model: RobotModel
     urdf_xml: str
     physics_urdf: str
     source: pathlib.Path
+    # What xacro warned about while expanding the file ("redefining global
+    # symbol: pi"...) and what making PyBullet's copy had to change (a frozen
+    # joint's massless links), one line each, for the caller to log once.
     warnings: tuple[str, ...] = ()
 
     @property
@@ -80,12 +86,19 @@ def parse_xacro_args(xacro_args: Sequence[str]) -> dict[str, str]:
     return mappings
 
 
-def run_xacro(path: pathlib.Path, mappings: dict[str, str]) -> str:
-    """Expand a xacro file with ``mappings``; errors name the file and line."""
+def run_xacro(path: pathlib.Path, mappings: dict[str, str]) -> tuple[str, tuple[str, ...]]:
+    """Expand a xacro file with ``mappings``; return the URDF and xacro's warnings.
+
+    xacro prints its warnings on stderr; they are captured instead, so that
+    a failed start-up prints only its one error line and a good one can log
+    them through the node's logger.  Errors name the file and line.
+    """
     import xacro  # deferred: only xacro files need it
 
+    captured = io.StringIO()
     try:
-        document = xacro.process_file(str(path), mappings=mappings)
+        with contextlib.redirect_stderr(captured):
+            document = xacro.process_file(str(path), mappings=mappings)
     except ExpatError as err:
         raise DescriptionError(
             f'{path}:{err.lineno}: not well-formed XML: {_expat_reason(err)}') from None
@@ -94,11 +107,32 @@ def run_xacro(path: pathlib.Path, mappings: dict[str, str]) -> str:
     except Exception as err:  # xacro surfaces NameError, KeyError... from user expressions
         raise DescriptionError(
             f'{path}: xacro error: {type(err).__name__}: {one_line(str(err))}') from None
-    return document.toprettyxml(indent='  ')
+    return document.toprettyxml(indent='  '), xacro_warnings(path, captured.getvalue())
 
 
-def read_description_xml(path: pathlib.Path, xacro_args: Sequence[str] = ()) -> str:
-    """Return the URDF text of a .urdf or .xacro file."""
+def xacro_warnings(path: pathlib.Path, text: str) -> tuple[str, ...]:
+    """Fold what xacro printed into one line per warning, each naming the file once.
+
+    xacro follows a warning with the file it was processing ("when
+    processing file: ...", "included from: ..."); that is kept only where it
+    names another file than ``path`` (an included one).
+    """
+    warnings: list[str] = []
+    for line in text.splitlines():
+        line = line.strip()
+        if not line:
+            continue
+        if line.startswith(XACRO_LOCATION_PREFIXES) and warnings:
+            if line.partition(':')[2].strip() != str(path):
+                warnings[-1] += f' ({line})'
+            continue
+        warnings.append(f'{path}: xacro: {line}')
+    return tuple(dict.fromkeys(warnings))
+
+
+def read_description_xml(path: pathlib.Path,
+                         xacro_args: Sequence[str] = ()) -> tuple[str, tuple[str, ...]]:
+    """Return the URDF text of a .urdf or .xacro file, and xacro's warnings."""
     if path.is_dir():
         raise DescriptionError(f'robot description file {path}: is a directory, not a file')
     if not path.is_file():
@@ -113,13 +147,13 @@ def read_description_xml(path: pathlib.Path, xacro_args: Sequence[str] = ()) -> 
     if 'xmlns:xacro' in text and '<xacro:' in text:
         # A URDF-named file that uses xacro macros: expand it, as `xacro` would.
         return run_xacro(path, mappings)
-    return text
+    return text, ()
 
 
 def load_description(path: pathlib.Path | str, xacro_args: Sequence[str] = ()) -> RobotDescription:
     """Read a .urdf/.xacro file into a :class:`RobotDescription` (parsed once)."""
     path = pathlib.Path(path).expanduser().resolve()
-    urdf_xml = read_description_xml(path, xacro_args)
+    urdf_xml, warnings = read_description_xml(path, xacro_args)
     root = parse_xml(urdf_xml, path)
     model = read_model(root, path)
     if not model.actuated_joints:
@@ -131,7 +165,7 @@ def load_description(path: pathlib.Path | str, xacro_args: Sequence[str] = ()) -
         localize_meshes(root, path.parent, mesh_cache_dir())
     except DescriptionError as err:
         raise DescriptionError(f'{path}: {err}') from None
-    warnings = complete_inertials(root, model)
+    warnings += complete_inertials(root, model)
     # One element per line: PyBullet's reader fails on some long one-line files
     # ("Cannot load URDF file."), which minified URDFs would be.
     ElementTree.indent(root)

@@ -2,11 +2,15 @@
 
 Each step is ros2_control's read / update / write around one physics step:
 the measured joint states go into the joint handles (and, for joints an
-ideal actuator drives, the effort its motor applied), every controller
-updates (command controllers first, so broadcasters sample fresh efforts),
-the efforts and velocity targets go to PyBullet, and PyBullet advances one
-``time_step``.  Sim time is kept as a step count, so it never accumulates
-rounding error.
+ideal actuator drives, the effort its motor applied), every active
+controller updates (command controllers first, so broadcasters sample fresh
+efforts), the efforts and velocity targets go to PyBullet, and PyBullet
+advances one ``time_step``.  Sim time is kept as a step count, so it never
+accumulates rounding error.  Which controllers are loaded and which are
+active is the :class:`~pan_tilt_sim.controllers.manager.ControllerManager`'s
+business; the active ones say how each of their joints is driven
+(:meth:`~pan_tilt_sim.controllers.base.Controller.actuators`), and a joint no
+active controller claims is passive -- it keeps the last effort applied.
 
 At start-up the simulation says, through the logger it is given, which
 actuator drives each joint and why, where each joint starts, what PyBullet
@@ -24,14 +28,14 @@ import time as wall_time
 from collections.abc import Mapping, Sequence
 from typing import Protocol
 
-from pan_tilt_sim.controllers import CommandController, Controller, JointHandle, create_controller
-from pan_tilt_sim.controllers.base import Drive
+from pan_tilt_sim.controllers import CommandController, Controller, JointHandle
+from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
+from pan_tilt_sim.controllers.base import Drive, idle_actuator
 from pan_tilt_sim.controllers.gains import plugin_gains
-from pan_tilt_sim.errors import ControllerConfigError
+from pan_tilt_sim.controllers.manager import ControllerManager
 from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.initial_positions import FROM_DEFAULT, StartPosition, start_positions
-from pan_tilt_sim.model.robot import JointSpec
 from pan_tilt_sim.sim.physics import (
     STATE_MOTOR_TORQUE,
     STATE_POSITION,
@@ -58,36 +62,6 @@ class Logger(Protocol):
         """Log ``message`` as a warning."""
 
 
-def build_controllers(config: ControllersConfig, handles: dict[str, JointHandle],
-                      joints: Sequence[JointSpec] = ()) -> list[Controller]:
-    """Create and configure the controllers of ``config``; one owner per joint.
-
-    ``joints`` (all of the robot's) lets the error for a fixed joint say so.
-    """
-    source = str(config.source)
-    unmovable = {joint.name: joint.kind for joint in joints if not joint.kind.is_actuated}
-    owners: dict[str, str] = {}
-    controllers = []
-    for spec in config.controllers:
-        controller = create_controller(spec.name, spec.type, spec.params, source)
-        for joint in controller.joint_names:
-            if joint in unmovable:
-                raise ControllerConfigError(
-                    f"{source}: {spec.name}: joint '{joint}' is a {unmovable[joint].value} "
-                    'joint; a controller can only drive revolute, continuous and prismatic '
-                    'joints')
-            if joint in owners:
-                raise ControllerConfigError(
-                    f"{source}: joint '{joint}' is claimed by both '{owners[joint]}' "
-                    f"and '{spec.name}'")
-            owners[joint] = spec.name
-        controller.configure(handles)
-        controllers.append(controller)
-    # Command controllers first: broadcasters then sample this step's efforts.
-    controllers.sort(key=lambda c: not isinstance(c, CommandController))
-    return controllers
-
-
 class Simulation:
     """One robot in PyBullet, driven by its controllers, advanced step by step.
 
@@ -101,29 +75,48 @@ class Simulation:
 
     def __init__(self, description: RobotDescription, controllers: ControllersConfig,
                  time_step: float, *, gui: bool = False,
+                 active_controllers: Sequence[str] | None = None,
                  initial_positions: Mapping[str, float] | None = None,
                  logger: Logger | None = None) -> None:
         self.description = description
         self._logger: Logger = logger or logging.getLogger(LOGGER_NAME)
         starts = start_positions(description.model, initial_positions)
         movable = [joint.name for joint in description.actuated_joints]
-        gains = plugin_gains(controllers.pid_gains, movable, str(controllers.source))
+        gains = plugin_gains(controllers.pid_gains, movable, controllers.label)
         load_messages: list[str] = []
         self.physics = Physics(
             description, time_step, gui=gui,
             initial_positions=[starts[joint].position for joint in movable],
             warn=load_messages.append)
         try:
+            gain = description.model.position_proportional_gain or TRACKING_GAIN
             self.handles = {
-                joint.name: JointHandle(joint, position, gains.get(joint.name))
+                joint.name: JointHandle(joint, position, gains.get(joint.name), gain)
                 for joint, position in zip(self.physics.joints,
                                            self.physics.initial_positions, strict=True)}
-            self.controllers = build_controllers(
-                controllers, self.handles, description.joints)
+            self.manager = ControllerManager(controllers, self.handles, description.model,
+                                             active=active_controllers)
+            self.controllers = self.manager.controllers
         except BaseException:
             self.physics.close()
             raise
         self._handle_list = list(self.handles.values())
+        self._time_step = time_step
+        self._steps = 0
+        self._states = self.physics.read_states()
+        self._apply_actuators()
+        self.manager.add_switch_listener(self._apply_actuators)
+        self._speed_limit = AT_CAP * self.physics.velocity_cap
+        self._last_warning: dict[str, float] = {}
+        self.startup_report = self._startup_report(description, starts, load_messages)
+
+    def _apply_actuators(self) -> None:
+        """Drive every joint as its active controller says (a joint without one: passive)."""
+        actuators = {}
+        for controller in self.manager.active:
+            actuators.update(controller.actuators())
+        for handle in self._handle_list:
+            handle.actuator = actuators.get(handle.name) or idle_actuator(handle.spec)
         velocity_driven = [handle.drive is Drive.VELOCITY for handle in self._handle_list]
         self.physics.set_drives(velocity_driven)
         self._effort_handles = [handle for handle, driven in zip(
@@ -133,13 +126,7 @@ class Simulation:
         self._velocity_slots = [slot for slot, driven in enumerate(velocity_driven) if driven]
         self._efforts = [0.0] * len(self._effort_handles)
         self._targets = [0.0] * len(self._velocity_handles)
-        self._time_step = time_step
-        self._steps = 0
-        self._states = self.physics.read_states()
         self._physics_step = self.physics.stepper()
-        self._speed_limit = AT_CAP * self.physics.velocity_cap
-        self._last_warning: dict[str, float] = {}
-        self.startup_report = self._startup_report(description, starts, load_messages)
 
     def report_startup(self) -> None:
         """Log :attr:`startup_report` (info and warnings), once."""
@@ -153,7 +140,7 @@ class Simulation:
 
     def _startup_report(self, description: RobotDescription, starts: Mapping[str, StartPosition],
                         load_messages: Sequence[str]) -> list[tuple[str, str]]:
-        report = [(WARNING, message) for message in (*description.warnings, *load_messages)]
+        report = [(WARNING, message) for message in load_messages]
         for handle in self._handle_list:
             report.append((INFO, f"joint '{handle.name}': "
                                  f'{handle.actuator.describe(handle.spec)}'))
@@ -183,7 +170,7 @@ class Simulation:
         return self._steps * self._time_step
 
     def command_controllers(self) -> list[CommandController]:
-        """Return the controllers that take commands from topics."""
+        """Return the (loaded) controllers that take commands from topics."""
         return [c for c in self.controllers if isinstance(c, CommandController)]
 
     def controller(self, name: str) -> Controller:
@@ -194,12 +181,12 @@ class Simulation:
         raise KeyError(name)
 
     def advance(self, steps: int) -> None:
-        """Run ``steps`` physics steps, updating every controller at each."""
+        """Run ``steps`` physics steps, updating every active controller at each."""
         # Everything the loop touches is a local: bound methods, the physics
         # stepper, the handles.  Per step this costs ~1 us of Python for the
         # pan/tilt against ~5 us inside PyBullet (see README, Performance).
         handles = self._handle_list
-        updates = [controller.update for controller in self.controllers]
+        updates = self.manager.updates
         effort_handles, efforts = self._effort_handles, self._efforts
         velocity_handles, targets = self._velocity_handles, self._targets
         readback = list(zip(velocity_handles, self._velocity_slots, strict=True))
@@ -273,16 +260,29 @@ class Simulation:
         self.close()
 
 
-def make_simulation(description_file: str, controllers_file: str, time_step: float, *,
+def make_simulation(description_file: str, controllers_file: str | None, time_step: float, *,
                     xacro_args: Sequence[str] = (), gui: bool = False,
+                    controllers_args: Mapping[str, str] | None = None,
+                    active_controllers: Sequence[str] | None = None,
                     initial_positions: Mapping[str, float] | None = None,
                     logger: Logger | None = None) -> Simulation:
-    """Load both files and build a :class:`Simulation` (for tools and tests); log its report."""
-    from pan_tilt_sim.model.controller_config import load_controllers_config
+    """Load both files and build a :class:`Simulation` (for tools and tests); log its report.
+
+    Without ``controllers_file`` the URDF's control plugin names it (see
+    :func:`~pan_tilt_sim.model.controller_config.controllers_files_for`).
+    """
+    from pan_tilt_sim.model.controller_config import (
+        controllers_files_for,
+        load_controllers_config,
+    )
     from pan_tilt_sim.model.description import load_description
 
-    simulation = Simulation(load_description(description_file, xacro_args),
-                            load_controllers_config(controllers_file), time_step, gui=gui,
+    description = load_description(description_file, xacro_args)
+    files = controllers_files_for(str(controllers_file or ''), description)
+    simulation = Simulation(description, load_controllers_config(files, controllers_args),
+                            time_step, gui=gui, active_controllers=active_controllers,
                             initial_positions=initial_positions, logger=logger)
+    for warning in description.warnings:
+        simulation._logger.warning(warning)
     simulation.report_startup()
     return simulation

@@ -13,17 +13,21 @@ limit, so that only an unstable joint ever reaches it.
 Each joint is driven one of two ways (:meth:`Physics.set_drives`):
 
 * **effort**: the joint gets the effort the controllers ask for, plus its
-  URDF damping and Coulomb friction.  These are applied implicitly, so they
-  are stable at any time step (PyBullet's own explicit ``jointDamping``
-  diverges once ``damping * time_step`` exceeds twice the joint's inertia):
-  a velocity motor holds the joint at zero speed with at most the force
-  that the damping and friction can give at the speed the joint would have
-  at the end of the step (implicit Euler of ``J v' = tau + g - d v - f sgn v``,
-  with ``J = 1 / (M^-1)_ii`` and the passive torque ``g`` read back from the
-  previous step).  Damping alone is a velocity gain on that motor,
-  ``d dt / (J + d dt)``; friction alone a constant force cap (static friction
-  included; a joint coupled by a mimic gear always takes the first form);
-  a joint with neither has no motor at all.
+  URDF damping and Coulomb friction (a velocity motor held at zero speed
+  whose force is capped at the friction: static friction included).
+  PyBullet applies damping explicitly, which diverges once ``damping *
+  time_step`` exceeds twice the joint's effective inertia ``J = 1 /
+  (M^-1)_ii``; it is kept only where it is twenty times inside that bound
+  (``d dt <= 0.1 J`` at every pose checked: there explicit and implicit
+  Euler are equally accurate, and it costs nothing per step -- the seed's
+  pan/tilt).  Elsewhere damping is implicit, stable at any time step: the
+  zero-speed motor resists with at most the force that damping and
+  friction give at the speed the joint would have at the end of the step
+  (implicit Euler of ``J v' = tau + g - d v - f sgn v``, with the passive
+  torque ``g`` read back from the previous step), or, for damping alone,
+  with the velocity gain ``d dt / (J + d dt)``.  A joint coupled by a mimic
+  gear always takes the first form; a joint with neither damping nor
+  friction has no motor at all.
 * **velocity** (the ideal actuator, :mod:`pan_tilt_sim.controllers.actuator`):
   a velocity motor drives the joint to the target the controllers ask for,
   with at most the joint's URDF effort limit; the torque it applied is read
@@ -76,6 +80,13 @@ UNLIMITED_FORCE = 1e9
 # How often the joints' effective inertias are recomputed for the damping
 # (they change with the pose of an arm), in physics steps.
 INERTIA_REFRESH_STEPS = 100
+# PyBullet's explicit damping is kept where damping * time_step is at most this
+# share of the joint's smallest effective inertia (it diverges at 2).
+EXPLICIT_DAMPING_SHARE = 0.1
+# Poses at which inertias are checked: the start, then every joint at these
+# fractions of its range (0 = lower, 1 = upper), or at these angles without limits.
+RANGE_FRACTIONS = (0.5, 0.25, 0.75)
+FREE_POSES = (0.0, math.pi / 2.0, -math.pi / 2.0)
 NO_MOTOR = 0.0  # force 0 removes a joint's motor row from PyBullet's solver
 MOTOR_VELOCITY_GAIN = 1.0  # a velocity motor that reaches its target in one step if it can
 
@@ -89,6 +100,21 @@ def _disconnect(client: int) -> None:
 
 def _ignore(message: str) -> None:
     """Drop ``message`` (the default log function)."""
+
+
+def check_poses(joints: Sequence[JointSpec], start: Sequence[float]) -> list[list[float]]:
+    """Return the poses to check inertias at: the start, then each of RANGE_FRACTIONS."""
+    poses = [list(start)]
+    for number, fraction in enumerate(RANGE_FRACTIONS):
+        pose = []
+        for joint in joints:
+            if joint.has_position_limits and math.isfinite(joint.lower) and math.isfinite(
+                    joint.upper):
+                pose.append(joint.lower + fraction * (joint.upper - joint.lower))
+            else:
+                pose.append(FREE_POSES[number % len(FREE_POSES)])
+        poses.append(pose)
+    return poses
 
 
 def velocity_cap(joints: Sequence[JointSpec]) -> float:
@@ -248,6 +274,12 @@ class Physics:
             inertias = list(numpy.diag(matrix))
         return [float(inertias[self._dof_indices[index]]) for index in self._indices]
 
+    def smallest_inertias(self) -> list[float]:
+        """Return each joint's smallest effective inertia over :func:`check_poses`."""
+        poses = check_poses(self._joints, self._initial_positions)
+        inertias = [self.effective_inertias(pose) for pose in poses]
+        return [min(values) for values in zip(*inertias, strict=True)]
+
     def gravity_torques(self, positions: Sequence[float] | None = None) -> list[float]:
         """Return the effort each joint needs to hold still against gravity at ``positions``."""
         if positions is None:
@@ -343,12 +375,13 @@ class _Drives:
 
     * velocity-driven joint: target from the controllers, force = effort limit,
       sent every step;
-    * effort joint with damping and friction (or damping and a mimic
+    * effort joint whose damping is implicit, with friction (or a mimic
       coupling): target 0, force ``f + d |v_end|`` from the implicit-Euler end
       speed, sent every step;
-    * effort joint with damping only: target 0, velocity gain
-      ``d dt / (J + d dt)``, sent when the inertias are refreshed;
-    * effort joint with friction only: target 0, force ``f``, sent once;
+    * effort joint whose damping is implicit, without friction: target 0,
+      velocity gain ``d dt / (J + d dt)``, sent when the inertias are refreshed;
+    * effort joint with friction and no or explicit damping: target 0, force
+      ``f``, sent once;
     * otherwise: no row.
 
     Everything the step function touches is bound to locals or to lists that
@@ -368,18 +401,27 @@ class _Drives:
         effort_slots = [k for k, driven in enumerate(velocity_driven) if not driven]
         self.velocity_slots = velocity_slots
         self.effort_slots = effort_slots
-        # Effort joints by what their damping and friction need.  A velocity gain
-        # makes the motor a hard constraint that would override a mimic gear's
-        # forces, so coupled joints always take the force-capped form.
+        # Effort joints by what their damping and friction need.  Explicit
+        # damping is PyBullet's own, where it is far inside its stability bound.
+        # A velocity gain makes the motor a hard constraint that would override a
+        # mimic gear's forces, so coupled joints always take the force-capped form.
+        damped = [k for k in effort_slots if joints[k].damping > 0.0]
+        smallest = physics.smallest_inertias() if damped else []
+        explicit = [k for k in damped
+                    if joints[k].damping * dt <= EXPLICIT_DAMPING_SHARE * smallest[k]]
+        for k, joint in enumerate(joints):
+            pybullet.changeDynamics(body, indices[k], jointDamping=joint.damping
+                                    if k in explicit else 0.0, physicsClientId=client)
         coupled = {joint for coupling in physics._mimics
                    for joint in (coupling.leader, coupling.follower)}
-        self._damped = [k for k in effort_slots if joints[k].damping > 0.0
-                        and joints[k].friction <= 0.0 and joints[k].name not in coupled]
-        implicit = [k for k in effort_slots
-                    if joints[k].damping > 0.0 and k not in self._damped]
+        self._damped = [k for k in damped if k not in explicit and joints[k].friction <= 0.0
+                        and joints[k].name not in coupled]
+        implicit = [k for k in damped if k not in explicit and k not in self._damped]
+        self.explicit, self.implicit = explicit, implicit
         frictional = [k for k in effort_slots
-                      if joints[k].friction > 0.0 and joints[k].damping <= 0.0]
-        plain = [k for k in effort_slots if joints[k].damping <= 0.0 and joints[k].friction <= 0.0]
+                      if joints[k].friction > 0.0 and (joints[k].damping <= 0.0 or k in explicit)]
+        plain = [k for k in effort_slots if joints[k].friction <= 0.0
+                 and (joints[k].damping <= 0.0 or k in explicit)]
         # Static rows: friction-only joints hold with their friction, plain
         # joints (and every velocity joint until its first step) have none.
         static = [(k, joints[k].friction) for k in frictional] + [
@@ -419,6 +461,17 @@ class _Drives:
         states_box = [physics.read_states()]
         self._states_box = states_box
         has_efforts = bool(effort_indices)
+
+        if not motor_count and not self._damped:
+            # Nothing to do per step but the efforts: the cheapest step.
+            def step(efforts: Sequence[float], targets: Sequence[float] = ()) -> list:
+                set_motors(body, effort_indices, torque_mode, effort_unused, effort_unused,
+                           efforts, effort_unused, effort_unused, client)
+                step_simulation(client)
+                return get_states(body, indices, client)
+            self.step = step
+            self.restart()
+            return
 
         def step(efforts: Sequence[float], targets: Sequence[float] = ()) -> list:
             countdown[0] -= 1

@@ -22,35 +22,8 @@ import math
 from collections.abc import Sequence
 
 from pan_tilt_sim.controllers.base import ActuatorKind, JointHandle
-from pan_tilt_sim.model.robot import JointKind, JointSpec
+from pan_tilt_sim.model.robot import JointKind
 from pan_tilt_sim.sim.physics import Physics
-
-# Poses for a joint without position limits (continuous), rad.
-FREE_POSES = (0.0, math.pi / 2.0, -math.pi / 2.0)
-# Where in its range (0 = lower, 1 = upper) a limited joint is put.
-RANGE_FRACTIONS = (0.5, 0.25, 0.75)
-
-
-def check_poses(joints: Sequence[JointSpec], start: Sequence[float]) -> list[list[float]]:
-    """Return the poses to check: the start, then each of RANGE_FRACTIONS for every joint."""
-    poses = [list(start)]
-    for number, fraction in enumerate(RANGE_FRACTIONS):
-        pose = []
-        for joint in joints:
-            if joint.has_position_limits and math.isfinite(joint.lower) and math.isfinite(
-                    joint.upper):
-                pose.append(joint.lower + fraction * (joint.upper - joint.lower))
-            else:
-                pose.append(FREE_POSES[number % len(FREE_POSES)])
-        poses.append(pose)
-    return poses
-
-
-def smallest_inertias(physics: Physics) -> list[float]:
-    """Return each joint's smallest effective inertia over :func:`check_poses`."""
-    poses = check_poses(physics.joints, physics.initial_positions)
-    inertias = [physics.effective_inertias(pose) for pose in poses]
-    return [min(values) for values in zip(*inertias, strict=True)]
 
 
 def largest_stable_time_step(p: float, d: float, inertia: float) -> float:
@@ -66,7 +39,7 @@ def pid_stability_warnings(physics: Physics, handles: Sequence[JointHandle],
     checked = [handle for handle in handles if handle.actuator.pid is not None]
     if not checked:
         return []
-    inertias = dict(zip((joint.name for joint in physics.joints), smallest_inertias(physics),
+    inertias = dict(zip((joint.name for joint in physics.joints), physics.smallest_inertias(),
                         strict=True))
     dt = time_step
     warnings = []

@@ -71,8 +71,9 @@ def test_a_position_controller_without_gains_asks_for_a_velocity_and_says_why():
         'c', {'type': 'position_controllers/JointPositionController', 'joint': 'j'})
     controller.configure({'j': handle})
     assert controller.ideal and controller.pid is None and controller.pids() == {}
-    assert handle.drive is Drive.VELOCITY
-    assert handle.actuator.describe(spec) == (
+    actuator = controller.actuators()['j']
+    assert actuator.drive is Drive.VELOCITY
+    assert actuator.describe(spec) == (
         'ideal position actuator (c), a velocity motor with at most 30 N*m: no PID gains for '
         'it in the YAML')
     controller.update(0.0, DT)  # no command yet: hold the start (0.002)
@@ -89,8 +90,10 @@ def test_the_effort_controllers_types_keep_a_pid_without_gains():
         handle = JointHandle(spec)
         controller = controller_type('c', {
             'type': controller_type.type_names[1], 'joint': 'j'})
+        controller.type_name = controller_type.type_names[1]  # as the registry sets it
         controller.configure({'j': handle})
-        assert handle.actuator.kind is kind and handle.drive is Drive.EFFORT
+        actuator = controller.actuators()['j']
+        assert actuator.kind is kind and actuator.drive is Drive.EFFORT
         assert controller.pid.gains == controller_type.default_gains.with_default_clamp(30.0)
 
 

@@ -129,13 +129,14 @@ def test_position_group_with_gains_ramps_each_setpoint_and_pushes_toward_it():
     assert slide.setpoint == pytest.approx(0.5 * DT)
     assert handles['shoulder'].effort > 0.0 and handles['slide'].effort > 0.0
     assert handles['follower'].effort == 0.0
-    assert {handle.drive for handle in handles.values()} == {Drive.EFFORT}
+    assert {actuator.drive for actuator in controller.actuators().values()} == {Drive.EFFORT}
 
 
 def test_position_group_without_gains_drives_the_ideal_actuator_within_the_limits():
     handles = make_handles()
     controller = group(GROUP_TYPES['position'], handles)
-    assert [handles[joint].drive for joint in ('shoulder', 'slide')] == [Drive.VELOCITY] * 2
+    assert [actuator.drive for actuator in controller.actuators().values()] == [
+        Drive.VELOCITY] * 2
     assert controller.pids() == {}
     assert controller.set_command([0.5, 0.25]) is CommandResult.ACCEPTED
     targets, setpoints = [], [0.0]
@@ -197,7 +198,7 @@ def test_velocity_group_without_gains_targets_the_clamped_command():
     assert controller.set_command([1.0, -0.9]) is CommandResult.CLAMPED  # slide: 0.5 m/s
     controller.update(0.0, DT)
     assert (handles['shoulder'].velocity_target, handles['slide'].velocity_target) == (1.0, -0.5)
-    assert handles['shoulder'].drive is Drive.VELOCITY
+    assert controller.actuators()['shoulder'].drive is Drive.VELOCITY
 
 
 def test_effort_group_applies_the_efforts_clamped_to_the_limits():
@@ -227,9 +228,10 @@ def test_gains_section_sets_each_joint_pid_and_the_ideal_actuator_drives_the_res
     assert shoulder.pid is None
     assert slide.pid.gains == PidGains(p=500.0, i=2.0, d=20.0, i_clamp_min=-3.0, i_clamp_max=3.0)
     assert list(controller.pids()) == ['slide']
-    assert handles['shoulder'].actuator.kind is ActuatorKind.IDEAL_POSITION
-    assert handles['slide'].actuator.kind is ActuatorKind.POSITION_PID
-    assert handles['slide'].actuator.gains_from == 'grp.gains.slide'
+    actuators = controller.actuators()
+    assert actuators['shoulder'].kind is ActuatorKind.IDEAL_POSITION
+    assert actuators['slide'].kind is ActuatorKind.POSITION_PID
+    assert actuators['slide'].gains_from == 'grp.gains.slide'
 
 
 def test_gazebo_ros_control_pid_gains_drive_a_joint_without_gains_of_its_own():
@@ -239,7 +241,8 @@ def test_gazebo_ros_control_pid_gains_drive_a_joint_without_gains_of_its_own():
     controller = group(GROUP_TYPES['position'], handles, gains={'slide': {'p': 500.0}})
     shoulder, slide = controller.members
     assert (shoulder.pid.gains.p, slide.pid.gains.p) == (7.0, 500.0)
-    assert handles['shoulder'].actuator.gains_from == 'gazebo_ros_control.pid_gains.shoulder'
+    assert controller.actuators()['shoulder'].gains_from == (
+        'gazebo_ros_control.pid_gains.shoulder')
 
 
 def test_ros2_controllers_gain_options_are_accepted():

@@ -261,7 +261,7 @@ def test_effort_is_pid_on_position_with_derivative_on_velocity_error():
     assert handles['a'].effort == pytest.approx(expected)
     # On the effort interface a joint without gains gets the default PID.
     assert controller.pids()['b'].gains == DEFAULT_POSITION_GAINS.with_default_clamp(1000.0)
-    assert handles['b'].actuator.gains_from == ''
+    assert controller.actuators()['b'].gains_from == ''
 
 
 @pytest.mark.parametrize('interfaces', [['position'], ['position', 'velocity'], ['velocity'], []])
@@ -270,7 +270,8 @@ def test_without_gains_the_ideal_actuator_tracks_the_desired_state(interfaces):
     controller = controller_for(handles, command_interfaces=interfaces,
                                 gains={'a': {'p': 50.0}})
     assert list(controller.pids()) == ['a']
-    assert handles['b'].drive is Drive.VELOCITY and handles['a'].drive is Drive.EFFORT
+    actuators = controller.actuators()
+    assert actuators['b'].drive is Drive.VELOCITY and actuators['a'].drive is Drive.EFFORT
     controller.set_command(trajectory((1.0, (0.0, 0.4))))
     handles['b'].position = 0.01
     for step in range(101):

@@ -199,7 +199,7 @@ def test_effort_controllers_keep_their_pid_with_default_gains(tmp_path):
         assert sim.handles['joint1'].actuator.kind is ActuatorKind.POSITION_PID
     assert ("joint 'joint1': position PID on effort (c), p 100 i 0.01 d 10: no gains in the "
             'YAML: defaults for c') in log.infos
-    assert "joint 'joint2': passive: no controller" in log.infos
+    assert "joint 'joint2': passive: no active controller" in log.infos
 
 
 def test_the_seeds_pan_still_settles_within_15_mrad_never_faster_than_its_limit(repo_root):
@@ -210,3 +210,31 @@ def test_the_seeds_pan_still_settles_within_15_mrad_never_faster_than_its_limit(
         fastest = track(sim, ['pan_joint'], 12.0)
         assert sim.joint_positions()['pan_joint'] == pytest.approx(1.0, abs=0.015)
         assert fastest['pan_joint'] <= 0.1 + 1e-4
+
+
+def test_switching_controllers_switches_the_actuators(tmp_path):
+    gains = '{joint1: {p: 3000.0, i: 500.0, d: 60.0}, joint2: {p: 1000.0, i: 200.0, d: 20.0}}'
+    yaml = ros2_control_yaml({
+        'arm': ('joint_trajectory_controller/JointTrajectoryController',
+                {'joints': ARM_JOINTS, 'command_interfaces': '[position]'}),
+        'pid_arm': ('position_controllers/JointGroupPositionController',
+                    {'joints': ARM_JOINTS, 'gains': gains})})
+    with simulation(tmp_path, two_link_arm_urdf(), yaml,
+                    active_controllers=['joint_state_broadcaster', 'arm']) as sim:
+        assert sim.handles['joint1'].drive is Drive.VELOCITY
+        sim.advance(500)
+        sim.manager.switch(activate=['pid_arm'], deactivate=['arm'])
+        assert [sim.handles[joint].actuator.kind for joint in ARM_JOINTS] == [
+            ActuatorKind.POSITION_PID] * 2
+        sim.controller('pid_arm').set_command([0.3, -0.3])
+        sim.advance(3000)
+        positions = sim.joint_positions()
+        assert [positions[joint] for joint in ARM_JOINTS] == pytest.approx([0.3, -0.3], abs=0.02)
+        sim.manager.switch(activate=['arm'], deactivate=['pid_arm'])
+        assert sim.handles['joint1'].drive is Drive.VELOCITY
+        held = sim.joint_positions()
+        sim.advance(1000)  # an activated controller starts from where the joints are
+        assert sim.joint_positions() == pytest.approx(held, abs=0.005)
+        sim.manager.switch(deactivate=['arm'])
+        assert [sim.handles[joint].actuator.kind for joint in ARM_JOINTS] == [
+            ActuatorKind.PASSIVE] * 2

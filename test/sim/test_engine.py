@@ -72,7 +72,8 @@ def test_unknown_controller_types_list_the_supported_ones(repo_root, tmp_path):
     description = load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
     config = _config(tmp_path, ('x', {'type': 'fancy/Controller', 'joint': 'pan_joint'}))
     with pytest.raises(ControllerConfigError,
-                       match=r"x.type: unknown controller type 'fancy/Controller' "
+                       match=r"x.type: unknown controller type 'fancy/Controller', and no "
+                             r'other controller in the file commands a joint '
                              r'\(supported: .*position_controllers/JointPositionController'):
         Simulation(description, config, DT)
 
@@ -168,6 +169,6 @@ def test_the_start_up_report_waits_for_report_startup(tmp_path, repo_root):
         simulation.report_startup()
         simulation.report_startup()
     assert log.infos == ["joint 'pan_joint': effort command (pan_effort)",
-                         "joint 'tilt_joint': passive: no controller",
+                         "joint 'tilt_joint': passive: no active controller",
                          "joint 'tilt_joint' starts at -1.5708: 0 is outside its limits "
                          '[-4.71239, -1.5708]']

@@ -13,7 +13,8 @@ from robot_fixtures import (
 )
 
 from pan_tilt_sim.sim.engine import make_simulation
-from pan_tilt_sim.sim.stability import check_poses, largest_stable_time_step
+from pan_tilt_sim.sim.physics import check_poses
+from pan_tilt_sim.sim.stability import largest_stable_time_step
 
 DT = 0.001
 # A star link about its joint's z axis: box about its centre plus m (L / 2)^2.
