@@ -202,6 +202,12 @@ class Physics:
         """``pybullet.getJointStates`` for the actuated joints: (position, velocity, ...)."""
         return pybullet.getJointStates(self._body, self._indices, self._client)
 
+    @property
+    def implicit_damping(self) -> tuple[str, ...]:
+        """The effort-driven joints whose URDF damping is applied implicitly (see the module)."""
+        drives = self._drives
+        return tuple(self._joints[k].name for k in sorted(drives.implicit + drives.damped))
+
     def set_drives(self, velocity_driven: Sequence[bool]) -> None:
         """Say which joints a velocity motor drives (True) and which take efforts (False).
 
@@ -417,7 +423,7 @@ class _Drives:
         self._damped = [k for k in damped if k not in explicit and joints[k].friction <= 0.0
                         and joints[k].name not in coupled]
         implicit = [k for k in damped if k not in explicit and k not in self._damped]
-        self.explicit, self.implicit = explicit, implicit
+        self.explicit, self.implicit, self.damped = explicit, implicit, self._damped
         frictional = [k for k in effort_slots
                       if joints[k].friction > 0.0 and (joints[k].damping <= 0.0 or k in explicit)]
         plain = [k for k in effort_slots if joints[k].friction <= 0.0

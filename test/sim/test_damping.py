@@ -91,3 +91,19 @@ def test_a_heavily_damped_passive_pendulum_creeps_down_at_10_ms(tmp_path, fricti
     assert max(abs(state[1]) for state in states) <= (weight - friction) * 1.01
     assert states[-1][0] == pytest.approx(expected, rel=0.02)
     assert all(b[0] >= a[0] for a, b in zip(states, states[1:], strict=False))
+
+
+def test_explicit_damping_is_kept_only_far_inside_its_stability_bound(tmp_path, repo_root):
+    # The seed: damping 50 * 1 ms = 0.05 against >= 1 kg m^2: PyBullet's own, free per step.
+    seed = load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
+    with Physics(seed, 0.001) as physics:
+        assert physics.implicit_damping == ()
+    with Physics(seed, 0.1) as physics:  # 5 against ~1: implicit
+        assert physics.implicit_damping == ('pan_joint', 'tilt_joint')
+    with Physics(wheel(tmp_path, damping=0.1), 0.001) as physics:
+        assert physics.implicit_damping == ('axle',)
+    with Physics(wheel(tmp_path, damping=0.001), 0.001) as physics:
+        assert physics.implicit_damping == ()  # 1e-6 <= 0.1 * 2.25e-5
+    with Physics(wheel(tmp_path, damping=0.1), 0.001) as physics:
+        physics.set_drives([True])  # an ideal actuator ignores the joint's damping
+        assert physics.implicit_damping == ()
