@@ -96,7 +96,8 @@ class SimNode(Node):
             controllers.namespace, description.plugin_namespace)
         self.simulation = Simulation(
             description, controllers, self.settings.time_step, gui=self.settings.gui,
-            active_controllers=self.settings.active_controllers)
+            active_controllers=self.settings.active_controllers,
+            initial_positions=self.settings.initial_positions, logger=self.get_logger())
         self._paused = self.settings.paused
         # Commands taken per controller (ignored ones included): a cheap health figure.
         self.commands_received = {c.name: 0 for c in self.simulation.command_controllers()}
@@ -136,11 +137,8 @@ class SimNode(Node):
         self._world_services = services.create_world_services(
             self, reset=self.reset, set_paused=self.set_paused)
         self._log_controllers(description, controllers)
-        for joint in self.simulation.physics.joints:
-            if joint.initial_position != 0.0:
-                self.get_logger().info(
-                    f"joint '{joint.name}' starts at {joint.initial_position:g}: 0 is outside "
-                    f'its limits [{joint.lower:g}, {joint.upper:g}]')
+        # Actuators, start positions, PyBullet's load messages, unstable gains.
+        self.simulation.report_startup()
         clock_period = self._clock_every * self.settings.time_step
         if abs(clock_period - CLOCK_PERIOD_S) > 1e-9:
             self.get_logger().info(
