@@ -92,6 +92,7 @@ class ControllerManager:
         self._controllers: list[Controller] = []
         self._by_name: dict[str, Controller] = {}
         self._states: dict[str, str] = {}
+        self._switch_listeners: list[Callable[[], None]] = []
         self._set_active(set())
         self.skipped: tuple[SkippedController, ...] = ()
         if autostart:
@@ -304,7 +305,13 @@ class ControllerManager:
         for controller in self._active:
             if controller.name in started:
                 controller.reset()
+        for listener in self._switch_listeners:
+            listener()
         return dropped
+
+    def add_switch_listener(self, listener: Callable[[], None]) -> None:
+        """Call ``listener()`` after every switch (the simulation re-drives the joints)."""
+        self._switch_listeners.append(listener)
 
     def _set_active(self, names: set[str]) -> None:
         self._active_names = frozenset(names)

@@ -90,6 +90,7 @@ class SimNode(Node):
         self.simulation = Simulation(
             description, controllers, self.settings.time_step, gui=self.settings.gui,
             active_controllers=self.settings.active_controllers,
+            initial_positions=self.settings.initial_positions, logger=self.get_logger(),
             autostart_controllers=self.settings.autostart_controllers)
         self._paused = self.settings.paused
         # Nodes of this process spun on sim_node's executor and destroyed with it.
@@ -138,11 +139,8 @@ class SimNode(Node):
             self, reset=self.reset, set_paused=self.set_paused)
         self._log_controllers(description, controllers)
         self._log_missing_interfaces()
-        for joint in self.simulation.physics.joints:
-            if joint.initial_position != 0.0:
-                self.get_logger().info(
-                    f"joint '{joint.name}' starts at {joint.initial_position:g}: 0 is outside "
-                    f'its limits [{joint.lower:g}, {joint.upper:g}]')
+        # Actuators, start positions, PyBullet's load messages, unstable gains.
+        self.simulation.report_startup()
         clock_period = self._clock_every * self.settings.time_step
         if abs(clock_period - CLOCK_PERIOD_S) > 1e-9:
             self.get_logger().info(
