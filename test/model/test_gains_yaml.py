@@ -124,7 +124,7 @@ def test_ros2_gains_are_written_where_the_loader_reads_them(tmp_path):
     assert '    gains.elbow.p: 5.0\n' in after
     assert '        i: 2.0\n        d: 12.0\n        i_clamp: 4.0\n' in after
     assert '      elbow: {p: 1.0, d: 0.2}\n' in after
-    assert after.endswith('    gains.elbow.p: 30.0   # the controller\'s own wins over /**\n'
+    assert after.endswith("    gains.elbow.p: 30.0   # the controller's own wins over /**\n"
                           '    gains.elbow.i: 0.5\n    gains.elbow.i_clamp: 1.0\n')
     assert '# shoulder carries the arm' in after
 

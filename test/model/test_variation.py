@@ -7,6 +7,7 @@ import pytest
 
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.model.robot import Inertial
 from pan_tilt_sim.model.transforms import Transform, quaternion_from_rpy
 from pan_tilt_sim.model.variation import (
     PAYLOAD_RADIUS_M,
@@ -15,7 +16,6 @@ from pan_tilt_sim.model.variation import (
     combined_inertial,
     vary_description,
 )
-from pan_tilt_sim.model.robot import Inertial
 
 SPHERE = 0.4 * PAYLOAD_RADIUS_M ** 2  # a 1 kg payload's own inertia about its centre
 

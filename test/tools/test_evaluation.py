@@ -1,4 +1,4 @@
-"""One evaluation: step_response's metrics, the cost and checks on top, and the same numbers anywhere."""
+"""One evaluation: step_response's metrics, the cost and checks on top, the same anywhere."""
 
 import dataclasses
 import math
