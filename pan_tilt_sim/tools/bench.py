@@ -21,6 +21,9 @@ a noisy machine:
   chains of 2, 8 and 32 revolute joints, each with a position controller
   (keys are the joint counts).
 
+``--tune`` measures something else instead: evaluations per second of
+``tune``/``sweep`` on each back end (:mod:`pan_tilt_sim.tools.tune_bench`).
+
 Rates are medians over windows of ``RATE_WINDOW_S``.  ``--runs N`` repeats
 everything and prints the median of each figure; ``--quick`` is a smoke run
 of a few seconds (every key present, no timing meaningful).
