@@ -199,10 +199,7 @@ class JointTuning:
 
     @property
     def best(self) -> Trial:
-        """The cheapest trial that meets the spec; else the one closest to meeting it."""
-        feasible = [trial for trial in self.trials if trial.feasible]
-        if feasible:
-            return min(feasible, key=lambda trial: (trial.evaluation.itae, trial.number))
+        """The cheapest trial that meets the spec (excess 0); else the one closest to it."""
         return min(self.trials, key=lambda trial: (trial.excess, trial.evaluation.itae,
                                                    trial.number))
 
