@@ -7,7 +7,9 @@ seed's pan stepped 0 -> 1 rad with the seed's gains, 15 s of sim time at
 -- and prints one JSON object:
 
 * ``cpu_s_per_evaluation`` -- CPU seconds of one evaluation in this process
-  (median): the core-seconds an evaluation costs wherever it runs;
+  (median): the core-seconds an evaluation costs wherever it runs, and
+  ``worker_cpu_s_per_evaluation``, the same measured inside each back end's
+  workers (it should match: the work is the same everywhere);
 * ``evaluations_per_s`` -- throughput of ``in_process`` (a loop here),
   ``local_1`` and ``local_2`` (1 and 2 spawned worker processes) and
   ``ray_2_nodes`` (Ray tasks on a two-node cluster started on this machine:
@@ -141,11 +143,11 @@ def pan_scenario() -> Scenario:
 
 
 def timed_map(backend: Backend, function: Callable[[Any, Any], Any], shared: Any,
-              items: Sequence[Any]) -> float:
-    """Return the wall seconds of one ``backend.map``."""
+              items: Sequence[Any]) -> tuple[float, list[Any]]:
+    """Return the wall seconds of one ``backend.map``, and its results."""
     started = time.perf_counter()
-    backend.map(function, shared, items)
-    return time.perf_counter() - started
+    results = backend.map(function, shared, items)
+    return time.perf_counter() - started, results
 
 
 def measure_backend(backend: Backend, scenario: Scenario, cases: Sequence[Case],
@@ -153,9 +155,10 @@ def measure_backend(backend: Backend, scenario: Scenario, cases: Sequence[Case],
     """Warm ``backend`` up, then time ``cases`` and ``echoes`` echo tasks on it."""
     backend.map(evaluate, scenario, cases[:2 * backend.parallelism])
     backend.map(echo, scenario, range(2 * backend.parallelism))
-    wall = timed_map(backend, evaluate, scenario, cases)
-    echo_wall = timed_map(backend, echo, scenario, list(range(echoes)))
+    wall, results = timed_map(backend, evaluate, scenario, cases)
+    echo_wall, _ = timed_map(backend, echo, scenario, list(range(echoes)))
     return {'wall_s': wall, 'evaluations': len(cases), 'parallelism': backend.parallelism,
+            'worker_cpu_s': statistics.median(result.cpu_s for result in results),
             'echo_ms': echo_wall / echoes * MILLISECONDS}
 
 
@@ -248,12 +251,14 @@ def summarise(rounds: Sequence[dict], names: Sequence[str], nodes: RayNodes | No
         f[n]['wall_s'] / f[n]['evaluations'] * f[n]['parallelism']
         - f['cpu_s_per_evaluation']) * MILLISECONDS) for name in names}
     dispatch = {name: median(lambda f, n=name: f[n]['echo_ms']) for name in names}
+    worker_cpu = {name: median(lambda f, n=name: f[n]['worker_cpu_s']) for name in names}
     duration = case.duration or (TARGET / 0.1 + 5.0)
     return {
         'evaluation': {'joint': JOINT, 'target': TARGET, 'sim_s': duration,
                        'steps': round(duration / scenario.time_step)},
         'cpu_s_per_evaluation': cpu,
         'in_process_cpu_share': median(lambda f: f['in_process_cpu_share']),
+        'worker_cpu_s_per_evaluation': worker_cpu,
         'evaluations_per_s': throughput,
         'overhead_ms_per_evaluation': overhead,
         'dispatch_ms_per_task': dispatch,

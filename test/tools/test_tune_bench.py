@@ -48,6 +48,7 @@ def test_bench_tune_quick_prints_one_json_object_with_every_back_end(quick):
     assert all(rate > 0 for rate in figures['evaluations_per_s'].values())
     assert set(figures['overhead_ms_per_evaluation']) == names
     assert set(figures['dispatch_ms_per_task']) == names
+    assert all(cpu > 0 for cpu in figures['worker_cpu_s_per_evaluation'].values())
     assert figures['cpu_s_per_evaluation'] > 0
     assert figures['ray_cluster_start_s'] > 0 and figures['ray_connect_s'] > 0
     assert figures['evaluation']['steps'] == 1000
@@ -63,7 +64,7 @@ def test_bench_tune_stops_the_ray_nodes_it_started(quick):
 def test_overhead_is_wall_per_evaluation_times_parallelism_less_its_cpu():
     rounds = [{'cpu_s_per_evaluation': 0.2, 'in_process_cpu_share': 1.0,
                'local_2': {'wall_s': 1.2, 'evaluations': 10, 'parallelism': 2,
-                           'echo_ms': 0.5}}]
+                           'worker_cpu_s': 0.21, 'echo_ms': 0.5}}]
     figures = tune_bench.summarise(rounds, ['local_2'], None, None, 0.5, 1,
                                    Case('pan_joint', (1.0,)), _Scenario())
     assert figures['evaluations_per_s'] == {'local_2': pytest.approx(10 / 1.2)}
