@@ -21,6 +21,9 @@ seed's pan stepped 0 -> 1 rad with the seed's gains, 15 s of sim time at
 * ``dispatch_ms_per_task`` -- per back end, the wall time per call of a task
   that does nothing but receive the same payload (the robot) and return:
   the back end's own cost, with no simulation to hide it;
+* ``ray_submit_ms_per_task`` -- the driver's own cost of submitting one Ray
+  task (``.remote()`` alone, not waiting for it): one driver keeps at most
+  about ``cpu_s_per_evaluation / submit`` cores busy;
 * ``ray_cluster_start_s`` and ``ray_connect_s`` -- starting the two nodes,
   and connecting a driver to them (which ships this package to the cluster);
 * ``load_average_1min`` before and after, and ``cpu_count``: how quiet the
@@ -162,6 +165,23 @@ def measure_backend(backend: Backend, scenario: Scenario, cases: Sequence[Case],
             'echo_ms': echo_wall / echoes * MILLISECONDS}
 
 
+def ray_submit_ms(scenario: Scenario, tasks: int) -> float:
+    """Return the driver's own cost of submitting one Ray task (no waiting), in ms.
+
+    The rate at which one driver can hand out tasks bounds how many cores it
+    can keep busy: about ``cpu_s_per_evaluation / submit`` of them.
+    """
+    import ray
+
+    remote = ray.remote(num_cpus=1)(echo)
+    shared = ray.put(scenario)
+    started = time.perf_counter()
+    refs = [remote.remote(shared, index) for index in range(tasks)]
+    submitted = time.perf_counter() - started
+    ray.get(refs)
+    return submitted / tasks * MILLISECONDS
+
+
 def cpu_per_evaluation(scenario: Scenario, case: Case, count: int) -> tuple[float, float]:
     """Return the median CPU seconds of one evaluation here, and CPU/wall over all of them."""
     cpu, started, wall_started = [], time.process_time(), time.perf_counter()
@@ -201,6 +221,7 @@ def run(*, quick: bool = False, runs: int = 1,
                     log('  ray_2_nodes')
                     figures['ray_2_nodes'] = measure_backend(ray_backend, scenario, cases,
                                                              echoes)
+                    figures['ray_submit_ms'] = ray_submit_ms(scenario, echoes)
                 rounds.append(figures)
         finally:
             if ray_backend is not None:
@@ -262,6 +283,8 @@ def summarise(rounds: Sequence[dict], names: Sequence[str], nodes: RayNodes | No
         'evaluations_per_s': throughput,
         'overhead_ms_per_evaluation': overhead,
         'dispatch_ms_per_task': dispatch,
+        'ray_submit_ms_per_task': None if nodes is None else median(
+            lambda f: f['ray_submit_ms']),
         'ray_cluster_start_s': None if nodes is None else nodes.start_s,
         'ray_connect_s': connect_s,
         'load_average_1min': {'before': load_before, 'after': os.getloadavg()[0]},

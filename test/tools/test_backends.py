@@ -22,8 +22,8 @@ def scenario(request):
 
 
 def test_local_processes_return_results_in_the_order_asked_not_finished(scenario):
-    # The first case takes ~30 times longer than the others, so it finishes last.
-    durations = [6.0, 0.2, 0.2, 0.2]
+    # The first case takes ~20 times longer than the others, so it finishes last.
+    durations = [2.0, 0.1, 0.1, 0.1]
     cases = [Case('pan_joint', (0.3,), duration=duration) for duration in durations]
     with LocalProcesses(2) as backend:
         results = backend.map(evaluate, scenario, cases)

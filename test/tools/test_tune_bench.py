@@ -51,6 +51,7 @@ def test_bench_tune_quick_prints_one_json_object_with_every_back_end(quick):
     assert all(cpu > 0 for cpu in figures['worker_cpu_s_per_evaluation'].values())
     assert figures['cpu_s_per_evaluation'] > 0
     assert figures['ray_cluster_start_s'] > 0 and figures['ray_connect_s'] > 0
+    assert figures['ray_submit_ms_per_task'] > 0
     assert figures['evaluation']['steps'] == 1000
 
 
