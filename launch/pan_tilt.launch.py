@@ -1,14 +1,23 @@
-"""Start the simulated pan/tilt: sim_node plus robot_state_publisher (for RViz and TF).
+"""Start the simulated robot: sim_node, plus robot_state_publisher where it is installed.
 
 The ROS 2 form of the seed's gazebo_pan_tilt.launch + pan_tilt_gazebo_control.launch::
 
     ros2 launch pan_tilt_sim pan_tilt.launch.py
     ros2 launch pan_tilt_sim pan_tilt.launch.py model:=/path/robot.xacro \
         controllers:=/path/controllers.yaml real_time_factor:=1.0 world:=targets gui:=false
+    ros2 launch pan_tilt_sim pan_tilt.launch.py \
+        model:=$(ros2 pkg prefix ur_description)/share/ur_description/urdf/ur.urdf.xacro \
+        xacro_args:='ur_type:=ur5e name:=ur5e' controllers:=.../ur_controllers.yaml \
+        active_controllers:='joint_state_broadcaster joint_trajectory_controller'
 
-sim_node loads the model and controllers, runs the physics and publishes
-joint_states, /clock, the camera and robot_description; robot_state_publisher
-turns joint_states into TF (use_sim_time), so sim_node's own TF is off.
+List arguments (``xacro_args``, ``controllers_args``, ``active_controllers``)
+take items separated by spaces or commas, or a YAML list as ``-p`` takes it.
+``controllers`` empty: the file the URDF's control plugin names.  sim_node
+loads the model and controllers, runs the physics and publishes
+joint_states, /clock, the camera and robot_description.  With
+robot_state_publisher installed, it turns joint_states into TF (on sim
+time) and sim_node's own TF is off; without it, sim_node publishes TF
+itself.  sim_node stops when this launch process dies, however it dies.
 """
 
 # ruff: noqa: I001 -- this repository's launch/ folder makes ruff take `launch` for first-party
@@ -18,14 +27,18 @@ from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
 from pan_tilt_sim.tools.launch_support import (
+    ROBOT_STATE_PUBLISHER,
+    bool_argument,
+    has_package,
+    list_argument,
     robot_setup,
     robot_state_publisher_parameters,
+    sim_node_environment,
     sim_node_parameters,
 )
-from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
 
 PACKAGE = 'pan_tilt_sim'
-TRUE_WORDS = ('true', '1', 'yes')
 
 
 def generate_launch_description() -> LaunchDescription:
@@ -34,8 +47,20 @@ def generate_launch_description() -> LaunchDescription:
     return LaunchDescription([
         DeclareLaunchArgument('model', default_value=str(share / DEFAULT_DESCRIPTION),
                               description='.urdf or .xacro file of the robot'),
-        DeclareLaunchArgument('controllers', default_value=str(share / DEFAULT_CONTROLLERS),
-                              description='controllers YAML'),
+        DeclareLaunchArgument('xacro_args', default_value='',
+                              description="xacro mappings, e.g. 'ur_type:=ur5e name:=ur5e'"),
+        DeclareLaunchArgument('controllers', default_value='',
+                              description="controllers YAML; empty = the one the URDF's "
+                              'control plugin names (the pan/tilt model: its own)'),
+        DeclareLaunchArgument('controllers_args', default_value='',
+                              description="values of the YAML's $(var name), e.g. "
+                              "'joint_prefix:=joint'"),
+        DeclareLaunchArgument('active_controllers', default_value='',
+                              description='controllers to activate; empty = all of them'),
+        DeclareLaunchArgument('time_step', default_value='0.001',
+                              description='physics step, s of sim time'),
+        DeclareLaunchArgument('robot_namespace', default_value='',
+                              description="namespace of the robot's topics; empty = derived"),
         DeclareLaunchArgument('real_time_factor', default_value='1.0',
                               description='sim seconds per wall second; 0 = as fast as possible'),
         DeclareLaunchArgument('world', default_value='targets',
@@ -47,20 +72,30 @@ def generate_launch_description() -> LaunchDescription:
 
 
 def launch_nodes(context, *args, **kwargs) -> list:
-    """Return sim_node and robot_state_publisher for the arguments given."""
-    model = LaunchConfiguration('model').perform(context)
-    controllers = LaunchConfiguration('controllers').perform(context)
-    setup = robot_setup(model, controllers)
+    """Return sim_node, and robot_state_publisher if installed, for the arguments given."""
+    def argument(name: str) -> str:
+        return LaunchConfiguration(name).perform(context)
+
+    model, controllers = argument('model'), argument('controllers')
+    xacro_args = list_argument(argument('xacro_args'))
+    controllers_args = list_argument(argument('controllers_args'))
+    robot_namespace = argument('robot_namespace')
+    # Read here first, as sim_node will: a bad file fails the launch before any node starts.
+    setup = robot_setup(model, controllers, xacro_args, robot_namespace, controllers_args)
+    with_state_publisher = has_package(ROBOT_STATE_PUBLISHER)
     sim_parameters = sim_node_parameters(
         model, controllers,
-        real_time_factor=float(LaunchConfiguration('real_time_factor').perform(context)),
-        world=LaunchConfiguration('world').perform(context),
-        gui=LaunchConfiguration('gui').perform(context).lower() in TRUE_WORDS)
-    return [
-        Node(package=PACKAGE, executable='sim_node', name='sim_node', output='screen',
-             parameters=[sim_parameters]),
-        Node(package='robot_state_publisher', executable='robot_state_publisher',
-             name='robot_state_publisher', output='screen',
-             parameters=[robot_state_publisher_parameters(setup)],
-             remappings=[('joint_states', setup.topic('joint_states'))]),
-    ]
+        real_time_factor=float(argument('real_time_factor')),
+        world=argument('world'), gui=bool_argument(argument('gui')),
+        xacro_args=xacro_args, controllers_args=controllers_args,
+        active_controllers=list_argument(argument('active_controllers')),
+        time_step=float(argument('time_step')), robot_namespace=robot_namespace,
+        publish_tf=not with_state_publisher)
+    nodes = [Node(package=PACKAGE, executable='sim_node', name='sim_node', output='screen',
+                  parameters=[sim_parameters], additional_env=sim_node_environment())]
+    if with_state_publisher:
+        nodes.append(Node(package=ROBOT_STATE_PUBLISHER, executable=ROBOT_STATE_PUBLISHER,
+                          name=ROBOT_STATE_PUBLISHER, output='screen',
+                          parameters=[robot_state_publisher_parameters(setup)],
+                          remappings=[('joint_states', setup.topic('joint_states'))]))
+    return nodes

@@ -17,6 +17,14 @@ class ControllerConfigError(ConfigurationError):
     """The controllers file cannot be used."""
 
 
+class ControllerSwitchError(ControllerConfigError):
+    """Activating or deactivating controllers would leave the robot in a state ros2_control refuses.
+
+    Two active controllers claiming one joint, a controller that is not loaded, or a
+    command interface the joint does not have; nothing was switched.
+    """
+
+
 class ParameterError(ConfigurationError):
     """A node parameter has a wrong type or value."""
 

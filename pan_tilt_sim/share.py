@@ -12,6 +12,8 @@ import sys
 PACKAGE_NAME = 'pan_tilt_sim'
 DEFAULT_DESCRIPTION = pathlib.Path('urdf', 'pan_tilt.xacro')
 DEFAULT_CONTROLLERS = pathlib.Path('config', 'pan_tilt_control.yaml')
+# The default model's robot name: the default controllers file is for this robot only.
+DEFAULT_ROBOT_NAME = 'ex_urdf_pan_tilt'
 
 
 def package_share() -> pathlib.Path:

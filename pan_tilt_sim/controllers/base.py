@@ -20,6 +20,9 @@ from pan_tilt_sim.controllers.pid import Pid
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.model.robot import JointSpec
 
+# The command interface a ros2_control controller package's controllers claim.
+PACKAGE_INTERFACES = {'position_controllers': 'position', 'velocity_controllers': 'velocity',
+                      'effort_controllers': 'effort'}
 # Largest command magnitude taken on a side without a limit (rad, m, rad/s, N*m...):
 # far beyond any real joint, small enough that PID arithmetic on it stays finite.
 MAX_COMMAND_MAGNITUDE = 1e12
@@ -68,6 +71,8 @@ class Controller(abc.ABC):
     """Base of every controller type; subclasses list their YAML ``type`` strings."""
 
     type_names: ClassVar[tuple[str, ...]] = ()
+    # The YAML type this controller was created from (the registry sets it).
+    type_name: str = ''
     # The YAML section the PID gains come from: 'pid' (ROS 1, one joint) or
     # 'gains' (ros2_controllers, per joint); the gain parameters follow it.
     gains_field: ClassVar[str] = 'gains'
@@ -89,6 +94,14 @@ class Controller(abc.ABC):
     @abc.abstractmethod
     def update(self, time: float, period: float) -> None:
         """Run one control step at sim ``time`` (s), ``period`` s after the previous one."""
+
+    def command_interfaces(self) -> dict[str, tuple[str, ...]]:
+        """Return the command interfaces this controller claims, by joint (ros2_control's claim).
+
+        ``position``, ``velocity`` or ``effort``: a joint whose ``<ros2_control>``
+        block lacks one of them cannot be driven by this controller.
+        """
+        return {}
 
     def reset(self) -> None:  # noqa: B027 -- stateless controllers need no reset
         """Forget commands and internal state, as after a fresh start."""

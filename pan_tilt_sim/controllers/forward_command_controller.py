@@ -77,6 +77,10 @@ class ForwardCommandController(MultiJointController):
         """The one-joint controller of each joint (their PIDs may be tuned live)."""
         return self._members
 
+    def command_interfaces(self) -> dict[str, tuple[str, ...]]:
+        """Return ``interface_name`` for every joint."""
+        return {joint: (self.interface_name,) for joint in self._joint_names}
+
     def pids(self) -> dict[str, Pid]:
         """Return each joint's PID (none for the effort interface)."""
         return {joint: pid for member in self._members for joint, pid in member.pids().items()}

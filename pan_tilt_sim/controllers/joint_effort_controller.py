@@ -15,6 +15,7 @@ class JointEffortController(SingleJointController):
     """Effort command -> effort."""
 
     type_names = ('effort_controllers/JointEffortController',)
+    default_interface = 'effort'
 
     def reset(self) -> None:
         """Apply no effort until commanded."""

@@ -70,10 +70,15 @@ class JointTrajectoryController(MultiJointController):
                 interface not in COMMAND_INTERFACES for interface in interfaces):
             raise self.error(COMMAND_INTERFACES_FIELD, f'{interfaces!r} must be a list of '
                              f"{', '.join(COMMAND_INTERFACES)}")
+        self._command_interfaces = tuple(interfaces)
         gains = joint_gains_from_params(self, self._joint_names)
         self._gains = [gains.get(joint, DEFAULT_POSITION_GAINS) for joint in self._joint_names]
         scales = feedforward_scales(self, self._joint_names)
         self._feedforward = [scales[joint] for joint in self._joint_names]
+
+    def command_interfaces(self) -> dict[str, tuple[str, ...]]:
+        """Return the ``command_interfaces`` listed, for every joint."""
+        return {joint: self._command_interfaces for joint in self._joint_names}
 
     def pids(self) -> dict[str, Pid]:
         """One PID per joint (their gains may be changed live)."""

@@ -25,6 +25,7 @@ class JointVelocityController(PidJointController):
     type_names = ('velocity_controllers/JointVelocityController',
                   'effort_controllers/JointVelocityController')
     default_gains = DEFAULT_VELOCITY_GAINS
+    default_interface = 'velocity'
 
     def reset(self) -> None:
         """Target zero velocity; forget the integral."""

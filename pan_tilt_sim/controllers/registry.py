@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from pan_tilt_sim.controllers.base import Controller
+from pan_tilt_sim.controllers.base import CommandController, Controller
 from pan_tilt_sim.controllers.forward_command_controller import ForwardCommandController
 from pan_tilt_sim.controllers.joint_effort_controller import JointEffortController
 from pan_tilt_sim.controllers.joint_group_effort_controller import JointGroupEffortController
@@ -51,4 +51,24 @@ def create_controller(name: str, type_name: Any, params: Mapping[str, Any],
         raise ControllerConfigError(
             f"{where}{name}.type: unknown controller type '{type_name}' "
             f"(supported: {', '.join(supported_types())})")
-    return cls(name, params, source)
+    controller = cls(name, params, source)
+    controller.type_name = type_name
+    return controller
+
+
+def is_known_type(type_name: Any) -> bool:
+    """Whether ``type_name`` is a controller type the simulator has."""
+    return isinstance(type_name, str) and type_name in CONTROLLER_TYPES
+
+
+def is_command_type(type_name: Any) -> bool:
+    """Whether a controller of ``type_name`` commands joints (known or not).
+
+    Unknown types are judged by name, as ros2_control names them: broadcasters
+    (``*Broadcaster``, ROS 1's ``*StateController``) only read.
+    """
+    cls = CONTROLLER_TYPES.get(type_name) if isinstance(type_name, str) else None
+    if cls is not None:
+        return issubclass(cls, CommandController)
+    base = str(type_name).rpartition('/')[2]
+    return not base.endswith(('Broadcaster', 'StateController'))

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
-from pan_tilt_sim.controllers.base import CommandController, JointHandle
+from pan_tilt_sim.controllers.base import PACKAGE_INTERFACES, CommandController, JointHandle
 from pan_tilt_sim.controllers.gains import PID_FIELD, gains_from_params
 from pan_tilt_sim.controllers.pid import Pid, PidGains
 
@@ -21,6 +21,8 @@ class SingleJointController(CommandController):
     """A command controller driving the one joint its ``joint`` parameter names."""
 
     gains_field = PID_FIELD
+    # The interface claimed unless the type's package says (effort_controllers/...).
+    default_interface: ClassVar[str] = 'position'
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
@@ -31,6 +33,11 @@ class SingleJointController(CommandController):
     def joint_names(self) -> tuple[str, ...]:
         """The one joint this controller drives."""
         return (self._joint_name,)
+
+    def command_interfaces(self) -> dict[str, tuple[str, ...]]:
+        """Return the one joint's interface: the type's package's, else the controller's own."""
+        package = self.type_name.partition('/')[0]
+        return {self._joint_name: (PACKAGE_INTERFACES.get(package, self.default_interface),)}
 
     def configure(self, joints: Mapping[str, JointHandle]) -> None:
         """Bind the joint's handle (and what :meth:`bind` derives from it), then reset."""

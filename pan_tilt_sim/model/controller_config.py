@@ -38,6 +38,21 @@ mean the same as nested mappings, as in ROS 2.  As in ros2_control, every
 controller's ``update_rate`` defaults to the controller_manager's, which
 defaults to 100 Hz.  The file gives no namespace: the robot's namespace
 comes from the node, the ``robot_namespace`` parameter or the URDF plugin.
+
+A ROS 1 file may also hold one controller and nothing else (``type`` at the
+top level, as ``rosparam load head.yaml ns=head`` expects): the controller is
+named after the file (``head``).
+
+Launch substitutions are expanded before the YAML is read, as a launch
+file's ``ParameterFile(..., allow_substs=True)`` does: ``$(var name)`` (and
+ROS 1's ``$(arg name)``) from the ``controllers_args`` mappings, ``$(env
+NAME)``, ``$(optenv NAME)`` and ``$(find-pkg-share PKG)``; one left
+unexpanded is an error naming it.
+
+Which file: the ``controllers_file`` parameter, else the files the URDF's
+gz_ros2_control / gazebo_ros2_control plugin names in ``<parameters>``, else
+-- for the shipped pan/tilt model only -- the shipped pan/tilt controllers
+(:func:`controllers_files_for`).
 """
 
 from __future__ import annotations
@@ -45,14 +60,21 @@ from __future__ import annotations
 import dataclasses
 import fnmatch
 import math
+import os
 import pathlib
-from collections.abc import Mapping
-from typing import Any
+import re
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
 import yaml
 
-from pan_tilt_sim.errors import ControllerConfigError
+from pan_tilt_sim.errors import ConfigurationError, ControllerConfigError
 from pan_tilt_sim.model import naming
+from pan_tilt_sim.model.resources import resolve_resource
+from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_ROBOT_NAME, package_share
+
+if TYPE_CHECKING:
+    from pan_tilt_sim.model.description import RobotDescription
 
 TYPE_FIELD = 'type'
 ROS2_PARAMETERS = 'ros__parameters'
@@ -63,6 +85,14 @@ DEFAULT_UPDATE_RATE = 100.0
 NAME_SEPARATOR = '/'
 PARAMETER_SEPARATOR = '.'
 WILDCARD_CHARACTERS = '*?['
+MAPPING_SEPARATOR = ':='
+CONTROLLERS_ARGS = 'controllers_args'
+CONTROLLERS_FILE = 'controllers_file'
+# A launch substitution: $(kind arg arg...); nested substitutions are not expanded.
+SUBSTITUTION = re.compile(
+    r'\$\((?P<kind>[A-Za-z][A-Za-z0-9_-]*)(?P<args>(?:[ \t]+[^()\s]+)*)[ \t]*\)')
+VARIABLE_KINDS = ('var', 'arg')  # launch's LaunchConfiguration; ROS 1's roslaunch arg
+EXPANDED_KINDS = (*VARIABLE_KINDS, 'env', 'optenv', 'find-pkg-share', 'find-pkg-prefix')
 
 
 @dataclasses.dataclass(frozen=True)
@@ -76,23 +106,165 @@ class ControllerSpec:
 
 @dataclasses.dataclass(frozen=True)
 class ControllersConfig:
-    """The controllers of one file, and the namespace the file wraps them in."""
+    """The controllers of one file (or several, read in order), and the namespace they share.
+
+    ``update_rate`` is the controller_manager's (ros2_control style files
+    only; None for ROS 1 files).
+    """
 
     controllers: tuple[ControllerSpec, ...]
     source: pathlib.Path
     namespace: str | None = None
+    sources: tuple[pathlib.Path, ...] = ()
+    update_rate: float | None = None
+
+    @property
+    def label(self) -> str:
+        """How errors name the file(s)."""
+        return ' + '.join(str(path) for path in self.sources) or str(self.source)
 
 
-def read_yaml(path: pathlib.Path) -> Any:
-    """Parse a YAML file; errors name the file and, for syntax errors, the line."""
+def parse_controllers_args(items: Sequence[str], field: str = CONTROLLERS_ARGS) -> dict[str, str]:
+    """Turn ``['name:=value', ...]`` into substitution values; errors name ``field``."""
+    values = {}
+    for item in items:
+        name, separator, value = item.partition(MAPPING_SEPARATOR)
+        if not separator or not name.strip():
+            raise ControllerConfigError(f"{field}: '{item}' is not of the form name:=value")
+        values[name.strip()] = value
+    return values
+
+
+def expand_substitutions(text: str, values: Mapping[str, str]) -> str:
+    """Expand the launch substitutions in ``text`` that can be; leave the others as written."""
+    def replace(match: re.Match) -> str:
+        expanded = _expansion(match, values)
+        return match.group(0) if expanded is None else expanded
+    return SUBSTITUTION.sub(replace, text)
+
+
+def _expansion(match: re.Match, values: Mapping[str, str]) -> str | None:
+    kind, args = match['kind'], match['args'].split()
+    if not args and kind != 'optenv':
+        return None
+    if kind in VARIABLE_KINDS:
+        name, default = args[0], args[1:]
+        return values.get(name, ' '.join(default) if default else None)
+    if kind in ('env', 'optenv'):
+        if not args:
+            return None
+        default = ' '.join(args[1:]) if len(args) > 1 else ('' if kind == 'optenv' else None)
+        return os.environ.get(args[0], default)
+    if kind in ('find-pkg-share', 'find-pkg-prefix') and len(args) == 1:
+        try:
+            share = resolve_resource(f'package://{args[0]}/.', pathlib.Path.cwd())
+        except ConfigurationError:
+            return None
+        return str(share if kind == 'find-pkg-share' else share.parent.parent)
+    return None
+
+
+def _unexpanded_problem(match: re.Match, args_name: str) -> str:
+    kind, args = match['kind'], match['args'].split()
+    text = match.group(0)
+    if kind in VARIABLE_KINDS and args:
+        return (f"{text} is not set: give it in {args_name} as '{args[0]}:=<value>' "
+                f'(a launch file would fill it from its arguments)')
+    if kind == 'env' and args:
+        return f'{text}: the environment variable {args[0]} is not set'
+    if kind in ('find-pkg-share', 'find-pkg-prefix') and len(args) == 1:
+        return f"{text}: package '{args[0]}' is not in the ament index"
+    return (f'{text} is a launch substitution sim_node does not expand (it expands '
+            f"{', '.join(f'$({kind} ...)' for kind in EXPANDED_KINDS)})")
+
+
+def _leftover_substitution(value: Any) -> re.Match | None:
+    """Return the first substitution left in a parsed document (keys and values)."""
+    if isinstance(value, str):
+        return SUBSTITUTION.search(value)
+    if isinstance(value, Mapping):
+        items = [item for pair in value.items() for item in pair]
+    elif isinstance(value, list | tuple):
+        items = list(value)
+    else:
+        return None
+    for item in items:
+        found = _leftover_substitution(item)
+        if found is not None:
+            return found
+    return None
+
+
+def _line_of(text: str, needle: str) -> str:
+    """Return ':<line>' of the first line outside comments holding ``needle``, or ''."""
+    for number, line in enumerate(text.splitlines(), 1):
+        if needle in line.split('#', 1)[0]:
+            return f':{number}'
+    return ''
+
+
+def controllers_files_for(given: str, description: RobotDescription, *,
+                          given_as: str = f"the parameter '{CONTROLLERS_FILE}'"
+                          ) -> tuple[pathlib.Path, ...]:
+    """Return the controller YAML file(s) to use for ``description``.
+
+    ``given`` (the user's ``controllers_file``) wins; relative paths are
+    taken from the current directory, ``package://`` works too.  Else the
+    files the URDF's control plugin names in ``<parameters>`` (``$(find
+    pkg)`` was expanded by xacro; ``package://`` and ``file://`` work;
+    a relative path is taken from the description's folder, or from the
+    current directory -- where Gazebo would look -- if only there it
+    exists).  Else, for the shipped pan/tilt model, its shipped controllers.
+    """
+    if given:
+        try:
+            return (resolve_resource(given, pathlib.Path.cwd()),)
+        except ConfigurationError as err:
+            raise ControllerConfigError(f'{given_as}: {err}') from None
+    named = []
+    for plugin in description.model.control_plugins:
+        for text in plugin.parameters:
+            named.append(_plugin_file(text, plugin.filename, description.source))
+    if named:
+        return tuple(named)
+    if description.name == DEFAULT_ROBOT_NAME:
+        return (package_share() / DEFAULT_CONTROLLERS,)
+    raise ControllerConfigError(
+        f'{description.source}: no controllers file: {given_as} is not set and the URDF names '
+        'none (no gz_ros2_control, ign_ros2_control or gazebo_ros2_control plugin with '
+        f'<parameters>); give the controller YAML with {given_as}')
+
+
+def _plugin_file(text: str, plugin: str, description_file: pathlib.Path) -> pathlib.Path:
+    origin = f"{description_file}: the {plugin} plugin's <parameters>"
+    try:
+        path = resolve_resource(text, description_file.parent)
+    except ConfigurationError as err:
+        raise ControllerConfigError(f'{origin}: {err}') from None
+    if not path.exists() and not pathlib.Path(text).is_absolute() and '://' not in text:
+        from_cwd = pathlib.Path(text).resolve()
+        if from_cwd.exists():
+            return from_cwd
+    if not path.is_file():
+        raise ControllerConfigError(
+            f"{origin} names '{text}' (resolved to {path}): no such file")
+    return path
+
+
+def read_text(path: pathlib.Path) -> str:
+    """Return a controllers file's text; errors name the file."""
     if path.is_dir():
         raise ControllerConfigError(f'controllers file {path}: is a directory, not a file')
     if not path.is_file():
         raise ControllerConfigError(f'controllers file {path}: no such file')
     try:
-        text = path.read_text(encoding='utf-8')
+        return path.read_text(encoding='utf-8')
     except (OSError, UnicodeDecodeError) as err:
         raise ControllerConfigError(f'controllers file {path}: cannot read: {err}') from None
+
+
+def parse_yaml(text: str, path: pathlib.Path) -> Any:
+    """Parse YAML text; errors name the file and, for syntax errors, the line."""
     try:
         return yaml.safe_load(text)
     except yaml.MarkedYAMLError as err:
@@ -104,17 +276,41 @@ def read_yaml(path: pathlib.Path) -> Any:
         raise ControllerConfigError(f'{path}: YAML error: {err}') from None
 
 
-def load_controllers_config(path: pathlib.Path | str) -> ControllersConfig:
-    """Read the controllers file at ``path``."""
-    path = pathlib.Path(path).expanduser().resolve()
-    document = read_yaml(path)
-    if not isinstance(document, Mapping) or not document:
-        raise ControllerConfigError(f'{path}: no controllers in it (expected a YAML mapping)')
-    nodes = _ros2_nodes(document, path)
-    if nodes:
-        return _ros2_control_config(nodes, path)
+def read_yaml(path: pathlib.Path) -> Any:
+    """Parse a YAML file; errors name the file and, for syntax errors, the line."""
+    return parse_yaml(read_text(path), path)
+
+
+def load_controllers_config(paths: pathlib.Path | str | Sequence[pathlib.Path | str],
+                            args: Mapping[str, str] | None = None, *,
+                            args_name: str = f"the parameter '{CONTROLLERS_ARGS}'"
+                            ) -> ControllersConfig:
+    """Read the controllers file(s) at ``paths`` (several: read in order, later ones win).
+
+    ``args`` are the values of ``$(var name)`` substitutions; ``args_name``
+    says in errors where they come from.
+    """
+    if isinstance(paths, str | os.PathLike):
+        paths = [paths]
+    paths = [pathlib.Path(path).expanduser().resolve() for path in paths]
+    documents = [(path, _read_document(path, args or {}, args_name)) for path in paths]
+    label = ' + '.join(str(path) for path in paths)
+    ros2 = [(path, _ros2_nodes(document, path)) for path, document in documents]
+    if all(nodes for _path, nodes in ros2):
+        config = _ros2_control_config([node for _path, nodes in ros2 for node in nodes], label)
+        return dataclasses.replace(config, source=paths[0], sources=tuple(paths))
+    if len(documents) > 1:
+        mixed = ', '.join(str(path) for path, nodes in ros2 if not nodes)
+        raise ControllerConfigError(
+            f'{label}: several controller files must all be ros2_control style '
+            f'(ros__parameters); not so: {mixed}')
+    path, document = documents[0]
     namespace = None
     controllers = _controllers_in(document)
+    if not controllers and isinstance(document.get(TYPE_FIELD), str):
+        # ROS 1: one controller per file, named by the namespace it is loaded into.
+        controllers = [ControllerSpec(name=_name_from_file(path), type=document[TYPE_FIELD],
+                                      params=document)]
     if not controllers and len(document) == 1:
         (key, inner), = document.items()
         if isinstance(inner, Mapping):
@@ -124,7 +320,30 @@ def load_controllers_config(path: pathlib.Path | str) -> ControllersConfig:
         raise ControllerConfigError(
             f"{path}: no controllers in it (a controller is a mapping with a '{TYPE_FIELD}')")
     _check_names(path, controllers, namespace)
-    return ControllersConfig(controllers=tuple(controllers), source=path, namespace=namespace)
+    return ControllersConfig(controllers=tuple(controllers), source=path, namespace=namespace,
+                             sources=(path,))
+
+
+def _read_document(path: pathlib.Path, args: Mapping[str, str],
+                   args_name: str) -> Mapping[Any, Any]:
+    """Read one file, substitutions expanded; it must be a non-empty mapping."""
+    text = read_text(path)
+    expanded = expand_substitutions(text, args)
+    document = parse_yaml(expanded, path)
+    if not isinstance(document, Mapping) or not document:
+        raise ControllerConfigError(f'{path}: no controllers in it (expected a YAML mapping)')
+    leftover = _leftover_substitution(document)
+    if leftover is not None:
+        raise ControllerConfigError(
+            f'{path}{_line_of(expanded, leftover.group(0))}: '
+            f'{_unexpanded_problem(leftover, args_name)}')
+    return document
+
+
+def _name_from_file(path: pathlib.Path) -> str:
+    """Name a file's one controller after the file: ``head.yaml`` -> ``head``."""
+    name = re.sub(r'\W', '_', path.stem) or 'controller'
+    return f'_{name}' if name[0].isdigit() else name
 
 
 def _check_names(path: pathlib.Path, controllers: list[ControllerSpec],
@@ -202,7 +421,7 @@ def _merge_into(target: dict[str, Any], overrides: Mapping[str, Any]) -> None:
 
 
 def _ros2_control_config(nodes: list[tuple[str, dict[str, Any]]],
-                         path: pathlib.Path) -> ControllersConfig:
+                         path: str) -> ControllersConfig:
     patterns: list[tuple[str, dict[str, Any]]] = []
     own: dict[str, dict[str, Any]] = {}
     for name, params in nodes:
@@ -240,10 +459,11 @@ def _ros2_control_config(nodes: list[tuple[str, dict[str, Any]]],
         raise ControllerConfigError(
             f'{path}: no controllers in it (ros2_control style: expected '
             f'{CONTROLLER_MANAGER}: {ROS2_PARAMETERS}: <name>: {{{TYPE_FIELD}: ...}})')
-    return ControllersConfig(controllers=tuple(controllers), source=path)
+    return ControllersConfig(controllers=tuple(controllers), source=pathlib.Path(path),
+                             update_rate=update_rate)
 
 
-def _update_rate(manager: Mapping[str, Any], path: pathlib.Path) -> float:
+def _update_rate(manager: Mapping[str, Any], path: str) -> float:
     rate = manager.get(UPDATE_RATE_FIELD, DEFAULT_UPDATE_RATE)
     if isinstance(rate, bool) or not isinstance(rate, int | float) or not (
             math.isfinite(rate) and rate > 0):

@@ -9,7 +9,9 @@ URDF, whose meshes are local files PyBullet can load
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import io
 import os
 import pathlib
 import xml.etree.ElementTree as ElementTree
@@ -23,6 +25,8 @@ from pan_tilt_sim.model.urdf import parse_xml, read_model
 
 XACRO_SUFFIX = '.xacro'
 MAPPING_SEPARATOR = ':='
+# Lines xacro adds after a warning to say where it was.
+XACRO_LOCATION_PREFIXES = ('when processing file:', 'included from:')
 # Converted meshes are kept between runs (keyed on content) under the user cache.
 MESH_CACHE_SUBDIR = pathlib.Path('pan_tilt_sim', 'meshes')
 
@@ -41,6 +45,9 @@ class RobotDescription:
     urdf_xml: str
     physics_urdf: str
     source: pathlib.Path
+    # What xacro warned about while expanding the file ("redefining global
+    # symbol: pi"...), one line each, for the caller to log once.
+    warnings: tuple[str, ...] = ()
 
     @property
     def name(self) -> str:
@@ -75,12 +82,19 @@ def parse_xacro_args(xacro_args: Sequence[str]) -> dict[str, str]:
     return mappings
 
 
-def run_xacro(path: pathlib.Path, mappings: dict[str, str]) -> str:
-    """Expand a xacro file with ``mappings``; errors name the file and line."""
+def run_xacro(path: pathlib.Path, mappings: dict[str, str]) -> tuple[str, tuple[str, ...]]:
+    """Expand a xacro file with ``mappings``; return the URDF and xacro's warnings.
+
+    xacro prints its warnings on stderr; they are captured instead, so that
+    a failed start-up prints only its one error line and a good one can log
+    them through the node's logger.  Errors name the file and line.
+    """
     import xacro  # deferred: only xacro files need it
 
+    captured = io.StringIO()
     try:
-        document = xacro.process_file(str(path), mappings=mappings)
+        with contextlib.redirect_stderr(captured):
+            document = xacro.process_file(str(path), mappings=mappings)
     except ExpatError as err:
         raise DescriptionError(
             f'{path}:{err.lineno}: not well-formed XML: {_expat_reason(err)}') from None
@@ -89,11 +103,32 @@ def run_xacro(path: pathlib.Path, mappings: dict[str, str]) -> str:
     except Exception as err:  # xacro surfaces NameError, KeyError... from user expressions
         raise DescriptionError(
             f'{path}: xacro error: {type(err).__name__}: {one_line(str(err))}') from None
-    return document.toprettyxml(indent='  ')
+    return document.toprettyxml(indent='  '), xacro_warnings(path, captured.getvalue())
 
 
-def read_description_xml(path: pathlib.Path, xacro_args: Sequence[str] = ()) -> str:
-    """Return the URDF text of a .urdf or .xacro file."""
+def xacro_warnings(path: pathlib.Path, text: str) -> tuple[str, ...]:
+    """Fold what xacro printed into one line per warning, each naming the file once.
+
+    xacro follows a warning with the file it was processing ("when
+    processing file: ...", "included from: ..."); that is kept only where it
+    names another file than ``path`` (an included one).
+    """
+    warnings: list[str] = []
+    for line in text.splitlines():
+        line = line.strip()
+        if not line:
+            continue
+        if line.startswith(XACRO_LOCATION_PREFIXES) and warnings:
+            if line.partition(':')[2].strip() != str(path):
+                warnings[-1] += f' ({line})'
+            continue
+        warnings.append(f'{path}: xacro: {line}')
+    return tuple(dict.fromkeys(warnings))
+
+
+def read_description_xml(path: pathlib.Path,
+                         xacro_args: Sequence[str] = ()) -> tuple[str, tuple[str, ...]]:
+    """Return the URDF text of a .urdf or .xacro file, and xacro's warnings."""
     if path.is_dir():
         raise DescriptionError(f'robot description file {path}: is a directory, not a file')
     if not path.is_file():
@@ -108,13 +143,13 @@ def read_description_xml(path: pathlib.Path, xacro_args: Sequence[str] = ()) -> 
     if 'xmlns:xacro' in text and '<xacro:' in text:
         # A URDF-named file that uses xacro macros: expand it, as `xacro` would.
         return run_xacro(path, mappings)
-    return text
+    return text, ()
 
 
 def load_description(path: pathlib.Path | str, xacro_args: Sequence[str] = ()) -> RobotDescription:
     """Read a .urdf/.xacro file into a :class:`RobotDescription` (parsed once)."""
     path = pathlib.Path(path).expanduser().resolve()
-    urdf_xml = read_description_xml(path, xacro_args)
+    urdf_xml, warnings = read_description_xml(path, xacro_args)
     root = parse_xml(urdf_xml, path)
     model = read_model(root, path)
     if not model.actuated_joints:
@@ -130,6 +165,7 @@ def load_description(path: pathlib.Path | str, xacro_args: Sequence[str] = ()) -
         urdf_xml=urdf_xml,
         physics_urdf=ElementTree.tostring(root, encoding='unicode'),
         source=path,
+        warnings=warnings,
     )
 
 

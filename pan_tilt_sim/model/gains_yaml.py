@@ -37,6 +37,7 @@ GAINS_FIELD = 'gains'
 PID_VALUE_FIELDS = ('p', 'i', 'd', 'i_clamp', 'i_clamp_min', 'i_clamp_max')
 NAME_SEPARATOR = '/'
 PARAMETER_SEPARATOR = '.'
+NUMBER_TAGS = ('tag:yaml.org,2002:int', 'tag:yaml.org,2002:float')
 
 
 @dataclasses.dataclass(frozen=True)
@@ -105,6 +106,10 @@ def rewrite_gains(text: str, source: str, updates: Sequence[GainsUpdate]) -> str
             written = yaml_float(value)
             if field in definitions:
                 node = definitions[field].value
+                if node.tag not in NUMBER_TAGS:
+                    raise ControllerConfigError(
+                        f'{where}.{field}: {node.value!r} is not a number in the file (a '
+                        'substitution?); tune writes numbers only, so edit it by hand')
                 edits.append((node.start_mark.index, node.end_mark.index, written))
             else:
                 edits.append(_addition(text, last_sibling, field, written))
@@ -165,6 +170,8 @@ def _parameter_mappings(root: yaml.MappingNode, source: str,
     entry = _get(root, controller)
     if isinstance(entry, yaml.MappingNode) and _get(entry, TYPE_FIELD) is not None:
         return [entry]
+    if _get(root, TYPE_FIELD) is not None:
+        return [root]  # ROS 1: one controller per file, named after the file
     pairs = list(_pairs(root))
     if len(pairs) == 1 and isinstance(pairs[0][1], yaml.MappingNode):
         entry = _get(pairs[0][1], controller)

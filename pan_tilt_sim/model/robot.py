@@ -18,6 +18,7 @@ import functools
 import math
 from collections.abc import Mapping
 
+from pan_tilt_sim.model.sensors import SensorSpec
 from pan_tilt_sim.model.transforms import (
     Transform,
     Vector,
@@ -26,6 +27,7 @@ from pan_tilt_sim.model.transforms import (
 )
 
 DEFAULT_AXIS: Vector = (1.0, 0.0, 0.0)  # URDF's default joint axis
+POSITION_PROPORTIONAL_GAIN = 'position_proportional_gain'
 
 
 class JointKind(enum.Enum):
@@ -238,6 +240,8 @@ class ControlPlugin:
     name: str = ''
     namespace: str | None = None
     parameters: tuple[str, ...] = ()  # controller YAML files, as written (after xacro)
+    # The plugin's other one-value settings (hold_joints, position_proportional_gain...).
+    settings: Mapping[str, str] = dataclasses.field(default_factory=dict)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -249,12 +253,34 @@ class RobotModel:
     joints: tuple[JointSpec, ...]
     ros2_control: tuple[ControlSystem, ...] = ()
     control_plugins: tuple[ControlPlugin, ...] = ()
+    # <gazebo reference="..."><sensor> tags the simulator models, and one line
+    # per sensor tag it skipped (unsupported type, plugin or reference).
+    sensors: tuple[SensorSpec, ...] = ()
+    sensor_warnings: tuple[str, ...] = ()
 
     @property
     def plugin_namespace(self) -> str | None:
         """The namespace the first control plugin gives the robot's topics, if any."""
         return next((plugin.namespace for plugin in self.control_plugins if plugin.namespace),
                     None)
+
+    @property
+    def position_proportional_gain(self) -> float | None:
+        """gz_ros2_control's ``position_proportional_gain``, if the URDF sets it.
+
+        gz_ros2_control turns a position command into a joint velocity
+        command of ``gain * update_rate * (command - position)``; the gain is
+        read from the plugin's ``<position_proportional_gain>`` element, else
+        from a ``<param name="position_proportional_gain">`` of a
+        ``<ros2_control>`` block's ``<hardware>``.  The parser checks that it
+        is a number > 0.
+        """
+        texts = [plugin.settings.get(POSITION_PROPORTIONAL_GAIN)
+                 for plugin in self.control_plugins]
+        texts += [system.hardware_params.get(POSITION_PROPORTIONAL_GAIN)
+                  for system in self.ros2_control]
+        text = next((text for text in texts if text is not None), None)
+        return None if text is None else float(text)
 
     def control_joint(self, name: str) -> ControlJoint | None:
         """Return the ``<ros2_control>`` entry of joint ``name``, or None if it has none."""

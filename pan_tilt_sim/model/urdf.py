@@ -17,6 +17,7 @@ from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.robot import (
     DEFAULT_AXIS,
+    POSITION_PROPORTIONAL_GAIN,
     ControlInterface,
     ControlJoint,
     ControlPlugin,
@@ -29,6 +30,28 @@ from pan_tilt_sim.model.robot import (
     Mimic,
     RobotModel,
     Shape,
+)
+from pan_tilt_sim.model.sensors import (
+    CHILD,
+    CHILD_TO_PARENT,
+    PARENT,
+    PARENT_TO_CHILD,
+    ROS1,
+    ROS1_ONLY_PLUGINS,
+    ROS2_ONLY_PLUGINS,
+    SENSOR,
+    SENSOR_TYPES,
+    SHARED_PLUGINS,
+    CameraSpec,
+    ForceTorqueSpec,
+    ImuSpec,
+    Noise,
+    PluginSpec,
+    RaySpec,
+    ScanAxis,
+    SensorKind,
+    SensorSpec,
+    plugin_stem,
 )
 from pan_tilt_sim.model.transforms import ZERO_VECTOR, Transform, Vector, quaternion_from_rpy
 
@@ -87,8 +110,30 @@ def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
                 raise DescriptionError(
                     f"{source}: <ros2_control name=\"{system.name}\">: joint '{joint.name}' is "
                     'not a joint of this robot')
+    _check_position_gain(plugins, systems, source)
+    sensors, sensor_warnings = _SensorReader(source, links, joints).read(root)
     return RobotModel(name=root.get('name', ''), links=links, joints=joints,
-                      ros2_control=systems, control_plugins=plugins)
+                      ros2_control=systems, control_plugins=plugins,
+                      sensors=sensors, sensor_warnings=sensor_warnings)
+
+
+def _check_position_gain(plugins: tuple[ControlPlugin, ...], systems: tuple[ControlSystem, ...],
+                         source: pathlib.Path) -> None:
+    """``position_proportional_gain``, wherever given, must be a number > 0."""
+    places = [(f"the {plugin.filename} plugin's <{POSITION_PROPORTIONAL_GAIN}>",
+               plugin.settings.get(POSITION_PROPORTIONAL_GAIN)) for plugin in plugins]
+    places += [(f'<ros2_control name="{system.name}">: <hardware> <param '
+                f'name="{POSITION_PROPORTIONAL_GAIN}">',
+                system.hardware_params.get(POSITION_PROPORTIONAL_GAIN)) for system in systems]
+    for place, text in places:
+        if text is None:
+            continue
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not (math.isfinite(value) and value > 0.0):
+            raise DescriptionError(f"{source}: {place}: '{text}' must be a number > 0")
 
 
 def parse_urdf(urdf_xml: str, source: pathlib.Path) -> RobotModel:
@@ -276,6 +321,360 @@ def _control_plugins(root: ElementTree.Element) -> tuple[ControlPlugin, ...]:
                 break
         parameters = tuple(text.strip() for text in (
             element.text for element in plugin.findall('parameters')) if text and text.strip())
+        settings = {child.tag: (child.text or '').strip() for child in plugin
+                    if child.tag != 'parameters' and not len(child)}
         plugins.append(ControlPlugin(filename=filename, name=plugin.get('name', ''),
-                                     namespace=namespace, parameters=parameters))
+                                     namespace=namespace, parameters=parameters,
+                                     settings=settings))
     return tuple(plugins)
+
+
+# --- sensors: <gazebo reference="..."><sensor>, and the ft_sensor model plugin -------------
+
+CAMERA_MAX_FOV = math.pi  # rad: a pinhole camera sees less than a half-space
+FT_FRAMES = (CHILD, PARENT, SENSOR)
+FT_DIRECTIONS = (CHILD_TO_PARENT, PARENT_TO_CHILD)
+NOISE_AXES = ('x', 'y', 'z')
+PLUGIN_NUMBERS = ('updateRate', 'updateRateHZ', 'gaussianNoise', 'pointCloudCutoff',
+                  'pointCloudCutoffMax', 'min_depth', 'max_depth', 'update_rate',
+                  'gaussian_noise')
+REMAP_SEPARATOR = ':='
+ROS1_REQUIRED = {  # gazebo_plugins (ROS 1) that stop without these elements
+    'gazebo_ros_imu_sensor': 'frameName',
+    'gazebo_ros_ft_sensor': 'topicName',
+}
+
+
+class _SensorReader:
+    """Reads the sensors of one URDF; what it cannot use becomes a warning, not an error.
+
+    Malformed numbers in a sensor the simulator would use end start-up
+    (:class:`DescriptionError` naming the sensor and the element); a sensor
+    type, plugin or reference the simulator does not support is skipped with
+    one warning naming it, as Gazebo skips what it cannot load.
+    """
+
+    def __init__(self, source: pathlib.Path, links: tuple[Link, ...],
+                 joints: tuple[JointSpec, ...]) -> None:
+        self.source = source
+        self.links = {link.name for link in links}
+        self.joints = {joint.name: joint for joint in joints}
+        self.warnings: list[str] = []
+
+    def read(self, root: ElementTree.Element) -> tuple[tuple[SensorSpec, ...], tuple[str, ...]]:
+        sensors = []
+        for gazebo in root.findall('gazebo'):
+            reference = gazebo.get('reference')
+            for element in gazebo.findall('sensor'):
+                sensor = self.sensor(element, reference)
+                if sensor is not None:
+                    sensors.append(sensor)
+            if reference is None:
+                for plugin in gazebo.findall('plugin'):
+                    sensor = self.model_plugin(plugin)
+                    if sensor is not None:
+                        sensors.append(sensor)
+        return tuple(sensors), tuple(self.warnings)
+
+    def skip(self, what: str, why: str) -> None:
+        self.warnings.append(f'{self.source}: {what} skipped: {why}')
+
+    def error(self, owner: str, problem: str) -> DescriptionError:
+        return DescriptionError(f'{self.source}: {owner}: {problem}')
+
+    # --- one <sensor> ------------------------------------------------------------------
+
+    def sensor(self, element: ElementTree.Element, reference: str | None) -> SensorSpec | None:
+        name = element.get('name', '')
+        sensor_type = element.get('type', '')
+        what = f"sensor '{name}' (type '{sensor_type}')"
+        owner = f"sensor '{name}'"
+        if sensor_type not in SENSOR_TYPES:
+            self.skip(what, f"type '{sensor_type}' is not simulated (supported: "
+                      f"{', '.join(SENSOR_TYPES)})")
+            return None
+        kind, colour = SENSOR_TYPES[sensor_type]
+        joint = parent_link = ''
+        if reference is None:
+            self.skip(what, 'its <gazebo> has no reference="..." naming a link')
+            return None
+        if reference in self.joints and reference not in self.links:
+            if kind is not SensorKind.FORCE_TORQUE:
+                self.skip(what, f"it references joint '{reference}'; only force_torque "
+                          'sensors go on joints')
+                return None
+            joint = reference
+            link = self.joints[reference].child
+            parent_link = self.joints[reference].parent
+        elif reference in self.links:
+            if kind is SensorKind.FORCE_TORQUE:
+                self.skip(what, f"a force_torque sensor references a joint, not link "
+                          f"'{reference}'")
+                return None
+            link = reference
+        else:
+            self.skip(what, f"reference '{reference}' is not a link or joint of this robot")
+            return None
+        plugin = None
+        plugin_elements = element.findall('plugin')
+        if plugin_elements:
+            plugin = self.plugin(plugin_elements[0], owner)
+            problem = self.plugin_problem(plugin, kind, sensor_type)
+            if problem:
+                self.skip(what, problem)
+                return None
+        fields: dict = {}
+        if kind in (SensorKind.CAMERA, SensorKind.DEPTH):
+            fields['camera'] = self.camera(element.find('camera'), owner)
+        elif kind is SensorKind.LIDAR:
+            ray = element.find('ray')
+            fields['ray'] = self.ray(ray if ray is not None else element.find('lidar'), owner)
+        elif kind is SensorKind.IMU:
+            fields['imu'] = self.imu(element.find('imu'), owner)
+        else:
+            fields['force_torque'] = self.force_torque(element.find('force_torque'), owner)
+        frame_id = ''
+        for tag in ('frame_id', 'gz_frame_id', 'ignition_frame_id'):
+            text = (element.findtext(tag) or '').strip()
+            if text:
+                frame_id = text
+                break
+        return SensorSpec(
+            name=name, type=sensor_type, kind=kind, link=link, joint=joint,
+            parent_link=parent_link, colour=colour,
+            pose=self.pose(element.find('pose'), owner),
+            update_rate=self.rate(element, owner),
+            topic=(element.findtext('topic') or '').strip(), frame_id=frame_id,
+            plugin=plugin, **fields)
+
+    def plugin_problem(self, plugin: PluginSpec, kind: SensorKind, sensor_type: str) -> str:
+        stem = plugin.stem
+        served = (ROS1_ONLY_PLUGINS.get(stem), ROS2_ONLY_PLUGINS.get(stem),
+                  *SHARED_PLUGINS.get(stem, ()))
+        if kind not in served:
+            return (f"plugin '{plugin.filename}' is not simulated for a {sensor_type} sensor")
+        if plugin.generation == ROS1:
+            required = ROS1_REQUIRED.get(stem)
+            if required and plugin.get(required) is None:
+                return f"ROS 1 plugin '{plugin.filename}' needs <{required}> (Gazebo stops it)"
+        elif stem == 'gazebo_ros_ray_sensor':
+            output = plugin.get('output_type', 'sensor_msgs/PointCloud2')
+            if output not in ('sensor_msgs/LaserScan', 'sensor_msgs/PointCloud2'):
+                return f'<output_type>{output}</output_type> is not simulated (LaserScan, ' \
+                    'PointCloud2 are)'
+        return ''
+
+    def model_plugin(self, element: ElementTree.Element) -> SensorSpec | None:
+        """Read a ``<gazebo><plugin>`` that is a sensor: gazebo_ros_ft_sensor on a joint."""
+        stem = plugin_stem(element.get('filename', ''))
+        if stem == 'gazebo_ros_imu':
+            self.skip(f"plugin '{element.get('filename')}'",
+                      'the ROS 1 model-plugin IMU is not simulated; declare <sensor type="imu"> '
+                      'with libgazebo_ros_imu_sensor.so')
+            return None
+        if stem != 'gazebo_ros_ft_sensor':
+            return None
+        name = element.get('name', stem)
+        owner = f"plugin '{name}'"
+        plugin = self.plugin(element, owner)
+        what = f"force-torque plugin '{name}'"
+        joint = plugin.get('jointName') if plugin.generation == ROS1 else plugin.get('joint_name')
+        if not joint:
+            self.skip(what, 'it names no joint (<jointName> / <joint_name>; <body_name> is not '
+                      'simulated)')
+            return None
+        if joint not in self.joints:
+            self.skip(what, f"joint '{joint}' is not a joint of this robot")
+            return None
+        problem = self.plugin_problem(plugin, SensorKind.FORCE_TORQUE, 'force_torque')
+        if problem:
+            self.skip(what, problem)
+            return None
+        return SensorSpec(name=name, type='force_torque', kind=SensorKind.FORCE_TORQUE,
+                          link=self.joints[joint].child, joint=joint,
+                          parent_link=self.joints[joint].parent, plugin=plugin,
+                          force_torque=ForceTorqueSpec(), model_plugin=True)
+
+    def plugin(self, element: ElementTree.Element, owner: str) -> PluginSpec:
+        params = {child.tag: (child.text or '').strip() for child in element
+                  if child.tag != 'ros'}
+        for key in PLUGIN_NUMBERS:
+            text = params.get(key)
+            if text:
+                self.float_text(text, f'{owner}: plugin <{key}>')
+        namespace = None
+        remappings = []
+        ros = element.find('ros')
+        if ros is not None:
+            text = ros.findtext('namespace')
+            if text is not None:
+                namespace = text.strip()
+            rules = [(child.text or '').strip() for child in ros.findall('remapping')]
+            for argument in ros.findall('argument'):
+                words = (argument.text or '').split()
+                rules += [word for word in words if REMAP_SEPARATOR in word]
+            for rule in rules:
+                source, separator, target = rule.partition(REMAP_SEPARATOR)
+                if not separator or not source.strip() or not target.strip():
+                    raise self.error(owner, f"<remapping>{rule}</remapping> is not 'from:=to'")
+                remappings.append((source.strip(), target.strip()))
+        return PluginSpec(filename=element.get('filename', ''), name=element.get('name', ''),
+                          params=params, ros_namespace=namespace,
+                          remappings=tuple(remappings))
+
+    # --- values ------------------------------------------------------------------------
+
+    def float_text(self, text: str, owner: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if math.isnan(value):
+            raise DescriptionError(f'{self.source}: {owner}: "{text}" is not a number')
+        return value
+
+    def number(self, element: ElementTree.Element | None, path: str, default: float,
+               owner: str) -> float:
+        if element is None:
+            return default
+        text = element.findtext(path)
+        if text is None or not text.strip():
+            return default
+        value = self.float_text(text.strip(), f'{owner}: <{path}>')
+        if not math.isfinite(value):
+            raise self.error(owner, f'<{path}>{text.strip()}</{path}> is not finite')
+        return value
+
+    def integer(self, element: ElementTree.Element | None, path: str, default: int,
+                owner: str) -> int:
+        value = self.number(element, path, float(default), owner)
+        if value != int(value) or value < 1:
+            raise self.error(owner, f'<{path}> must be a whole number >= 1, got {value:g}')
+        return int(value)
+
+    def rate(self, element: ElementTree.Element, owner: str) -> float:
+        rate = self.number(element, 'update_rate', 0.0, owner)
+        if rate < 0.0:
+            raise self.error(owner, f'<update_rate> must be >= 0 Hz, got {rate:g}')
+        return rate
+
+    def pose(self, element: ElementTree.Element | None, owner: str) -> Transform:
+        if element is None or not (element.text or '').strip():
+            return Transform()
+        text = element.text.strip()
+        try:
+            values = [float(value) for value in text.split()]
+        except ValueError:
+            values = []
+        if len(values) != 6 or not all(math.isfinite(value) for value in values):
+            raise self.error(owner, f'<pose>{text}</pose> is not six numbers (x y z roll pitch '
+                             'yaw)')
+        return Transform(tuple(values[:3]), quaternion_from_rpy(*values[3:]))
+
+    def noise(self, element: ElementTree.Element | None, owner: str,
+              kind: str | None = None) -> Noise:
+        if element is None:
+            return Noise()
+        noise_type = (kind or element.get('type') or element.findtext('type') or '').strip()
+        if noise_type == 'none' or not noise_type:
+            return Noise()
+        if not noise_type.startswith('gaussian'):
+            raise self.error(owner, f"noise type '{noise_type}' is not gaussian or none")
+        values = {field: self.number(element, field, 0.0, owner)
+                  for field in ('mean', 'stddev', 'bias_mean', 'bias_stddev')}
+        for field in ('stddev', 'bias_stddev'):
+            if values[field] < 0.0:
+                raise self.error(owner, f'<noise><{field}> must be >= 0, got {values[field]:g}')
+        return Noise(**values)
+
+    def axes_noise(self, element: ElementTree.Element | None, owner: str
+                   ) -> tuple[Noise, Noise, Noise]:
+        if element is None:
+            return (Noise(), Noise(), Noise())
+        return tuple(self.noise(element.find(f'{axis}/noise'), owner)  # type: ignore[return-value]
+                     for axis in NOISE_AXES)
+
+    def camera(self, element: ElementTree.Element | None, owner: str) -> CameraSpec:
+        if element is None:
+            return CameraSpec()
+        default = CameraSpec()
+        fov = self.number(element, 'horizontal_fov', default.horizontal_fov, owner)
+        if not 0.0 < fov < CAMERA_MAX_FOV:
+            raise self.error(owner, f'<horizontal_fov> must be > 0 and < pi rad, got {fov:g}')
+        near = self.number(element, 'clip/near', default.near, owner)
+        far = self.number(element, 'clip/far', default.far, owner)
+        if not 0.0 < near < far:
+            raise self.error(owner, f'<clip> needs 0 < near < far, got near {near:g}, '
+                             f'far {far:g}')
+        depth_near = self.number(element, 'depth_camera/clip/near', 0.0, owner) or None
+        depth_far = self.number(element, 'depth_camera/clip/far', 0.0, owner) or None
+        return CameraSpec(
+            width=self.integer(element, 'image/width', default.width, owner),
+            height=self.integer(element, 'image/height', default.height, owner),
+            horizontal_fov=fov, near=near, far=far,
+            format=(element.findtext('image/format') or default.format).strip(),
+            noise=self.noise(element.find('noise'), owner),
+            depth_near=depth_near, depth_far=depth_far)
+
+    def scan_axis(self, element: ElementTree.Element | None, owner: str,
+                  default_samples: int) -> ScanAxis:
+        if element is None:
+            return ScanAxis()
+        axis = ScanAxis(
+            samples=self.integer(element, 'samples', default_samples, owner),
+            resolution=self.number(element, 'resolution', 1.0, owner),
+            min_angle=self.number(element, 'min_angle', 0.0, owner),
+            max_angle=self.number(element, 'max_angle', 0.0, owner))
+        if axis.resolution <= 0.0:
+            raise self.error(owner, f'<{element.tag}><resolution> must be > 0, got '
+                             f'{axis.resolution:g}')
+        if axis.max_angle < axis.min_angle:
+            raise self.error(owner, f'<{element.tag}> max_angle {axis.max_angle:g} is below '
+                             f'min_angle {axis.min_angle:g}')
+        return axis
+
+    def ray(self, element: ElementTree.Element | None, owner: str) -> RaySpec:
+        if element is None:
+            raise self.error(owner, 'a ray/lidar sensor needs <ray> (or <lidar>) with <scan> '
+                             'and <range>')
+        scan = element.find('scan')
+        horizontal = self.scan_axis(None if scan is None else scan.find('horizontal'), owner,
+                                    640)
+        vertical = self.scan_axis(None if scan is None else scan.find('vertical'), owner, 1)
+        range_min = self.number(element, 'range/min', 0.0, owner)
+        range_max = self.number(element, 'range/max', 0.0, owner)
+        if not 0.0 <= range_min < range_max:
+            raise self.error(owner, f'<range> needs 0 <= min < max, got min {range_min:g}, '
+                             f'max {range_max:g}')
+        return RaySpec(horizontal=horizontal, vertical=vertical, range_min=range_min,
+                       range_max=range_max,
+                       range_resolution=self.number(element, 'range/resolution', 0.0, owner),
+                       noise=self.noise(element.find('noise'), owner))
+
+    def imu(self, element: ElementTree.Element | None, owner: str) -> ImuSpec:
+        if element is None:
+            return ImuSpec()
+        angular = self.axes_noise(element.find('angular_velocity'), owner)
+        linear = self.axes_noise(element.find('linear_acceleration'), owner)
+        old = element.find('noise')  # SDF 1.4: one <noise> with <rate> and <accel>
+        if old is not None:
+            kind = (old.get('type') or old.findtext('type') or '').strip()
+            rate = self.noise(old.find('rate'), owner, kind)
+            accel = self.noise(old.find('accel'), owner, kind)
+            angular, linear = (rate, rate, rate), (accel, accel, accel)
+        return ImuSpec(angular_velocity_noise=angular, linear_acceleration_noise=linear)
+
+    def force_torque(self, element: ElementTree.Element | None, owner: str) -> ForceTorqueSpec:
+        if element is None:
+            return ForceTorqueSpec()
+        frame = (element.findtext('frame') or CHILD).strip()
+        direction = (element.findtext('measure_direction') or CHILD_TO_PARENT).strip()
+        if frame not in FT_FRAMES:
+            raise self.error(owner, f"<frame>{frame}</frame> is not one of "
+                             f"{', '.join(FT_FRAMES)}")
+        if direction not in FT_DIRECTIONS:
+            raise self.error(owner, f"<measure_direction>{direction}</measure_direction> is "
+                             f"not one of {', '.join(FT_DIRECTIONS)}")
+        return ForceTorqueSpec(frame=frame, measure_direction=direction,
+                               force_noise=self.axes_noise(element.find('force'), owner),
+                               torque_noise=self.axes_noise(element.find('torque'), owner))

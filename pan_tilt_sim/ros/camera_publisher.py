@@ -61,21 +61,24 @@ def declare_world(node: Node) -> str:
     """Declare the ``world`` parameter and return its checked value."""
     return check_world(params.declare(
         node, 'world', params.STRING, DEFAULT_WORLD,
-        f"Scenery the camera sees: {' or '.join(WORLDS)} (a ground plane and coloured "
-        'targets). Visual only: it never touches the physics.'))
+        f"Scenery around the robot: {' or '.join(WORLDS)} (a ground plane and coloured "
+        'target cubes, static; cameras and lidars see them).'))
 
 
-def declare_camera(node: Node, links: Sequence[str]) -> CameraSettings | None:
+def declare_camera(node: Node, links: Sequence[str],
+                   urdf_cameras: bool = False) -> CameraSettings | None:
     """Declare the ``camera.*`` parameters; return the settings, or None when it is off.
 
-    ``links`` are the robot's link names (the camera is on by default when it
-    has ``camera.link``).
+    ``links`` are the robot's link names: the camera is on by default when the
+    robot has ``camera.link`` and its URDF declares no camera sensor of its
+    own (``urdf_cameras``).
     """
     link = params.declare(node, 'camera.link', params.STRING, DEFAULT_LINK,
                           'Link carrying the camera, at its tip, looking along its +z.')
     enabled = params.declare(
-        node, 'camera.enabled', params.BOOL, link in links,
-        'Render and publish camera images (default: true when the robot has camera.link).')
+        node, 'camera.enabled', params.BOOL, link in links and not urdf_cameras,
+        'Render and publish camera images (default: true when the robot has camera.link '
+        'and its URDF declares no camera sensor).')
     values = {
         'width': params.declare(node, 'camera.width', params.INTEGER, DEFAULT_WIDTH,
                                 'Image width in pixels.'),

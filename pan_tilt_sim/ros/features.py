@@ -7,7 +7,8 @@ whatever is due at the present sim time.  Topics (with the seed's files):
 * ``/ex_urdf_pan_tilt/robot_description`` -- std_msgs/String, transient local;
 * ``/tf``, ``/tf_static`` -- where tf2_msgs is installed;
 * ``/ex_urdf_pan_tilt/camera/image_raw`` -- sensor_msgs/Image, rgb8;
-* ``/ex_urdf_pan_tilt/camera/camera_info`` -- sensor_msgs/CameraInfo.
+* ``/ex_urdf_pan_tilt/camera/camera_info`` -- sensor_msgs/CameraInfo;
+* the topics of the sensors the URDF declares (:mod:`.sensor_publishers`).
 """
 
 from __future__ import annotations
@@ -15,8 +16,10 @@ from __future__ import annotations
 from rclpy.node import Node
 
 from pan_tilt_sim.model import naming
+from pan_tilt_sim.model.sensors import SensorKind
 from pan_tilt_sim.ros.camera_publisher import CameraPublisher, declare_camera, declare_world
 from pan_tilt_sim.ros.robot_state import RobotStatePublisher
+from pan_tilt_sim.ros.sensor_publishers import SensorSet, declare_noise_seed
 from pan_tilt_sim.sim.camera import Renderer
 from pan_tilt_sim.sim.engine import Simulation
 from pan_tilt_sim.sim.world import build_world
@@ -30,16 +33,20 @@ class NodeFeatures:
     """
 
     def __init__(self, node: Node, simulation: Simulation, robot_namespace: str, *,
-                 gui: bool = False) -> None:
+                 gui: bool = False, sensor_namespace: str = '') -> None:
         description = simulation.description
         model = description.model
         world = declare_world(node)
-        settings = declare_camera(node, model.link_names)
-        if settings is not None or gui:
-            # The scenery lives in the simulation's client: visual only, no physics cost.
-            build_world(world, simulation.physics.client_id, ground=gui)
+        urdf_cameras = any(sensor.kind in (SensorKind.CAMERA, SensorKind.DEPTH)
+                           for sensor in model.sensors)
+        settings = declare_camera(node, model.link_names, urdf_cameras)
+        # The scenery lives in the simulation's client: static bodies the cameras
+        # see and the lidars hit (their cost to a physics step is within noise).
+        build_world(world, simulation.physics.client_id, ground=gui)
+        self.sensors = SensorSet(node, simulation, world, namespace_override=sensor_namespace,
+                                 seed=declare_noise_seed(node))
         self.camera: CameraPublisher | None = None
-        static = []
+        static = list(self.sensors.static_frames)
         if settings is not None:
             renderer = Renderer(simulation.physics, model, settings, world)
             self.camera = CameraPublisher(
@@ -57,9 +64,19 @@ class NodeFeatures:
         self.robot_state.update()
         if self.camera is not None:
             self.camera.update()
+        self.sensors.update()
+
+    def steps_until_due(self, step: int) -> int | None:
+        """Return how many steps after ``step`` a watched sensor must see the world (or None)."""
+        return self.sensors.steps_until_due(step)
+
+    def refresh_readers(self) -> None:
+        """Ask, once per batch of steps, whether anybody reads what is published periodically."""
+        self.robot_state.refresh_readers()
 
     def reset(self) -> None:
         """Start every schedule again: sim time was reset, or the world put back."""
         self.robot_state.reset()
         if self.camera is not None:
             self.camera.reset()
+        self.sensors.reset()

@@ -32,6 +32,27 @@ MAX_CATCH_UP_S = 0.1
 STEP_EPSILON = 1e-6
 
 
+class Throttle:
+    """A token bucket: on average one event per ``period`` of wall time, bursts of ``burst``."""
+
+    def __init__(self, period: float, burst: int,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        self._period = period
+        self._burst = float(burst)
+        self._clock = clock
+        self._tokens = self._burst
+        self._refilled = clock()
+
+    def allow(self) -> bool:
+        """Take a token if one is there; return whether the event may happen now."""
+        now = self._clock()
+        tokens = min(self._burst, self._tokens + (now - self._refilled) / self._period)
+        self._refilled = now
+        allowed = tokens >= 1.0
+        self._tokens = tokens - 1.0 if allowed else tokens
+        return allowed
+
+
 class Pacer:
     """Tells each tick how many physics steps are due."""
 

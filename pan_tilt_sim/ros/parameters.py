@@ -20,7 +20,7 @@ from rclpy.parameter import Parameter
 
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model.naming import check_namespace
-from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
 
 BOOL = ParameterType.PARAMETER_BOOL
 INTEGER = ParameterType.PARAMETER_INTEGER
@@ -59,9 +59,15 @@ def _specs() -> tuple[_Spec, ...]:
         # No default: rclpy cannot declare an empty string array, so "not set" means none.
         _Spec('xacro_args', ParameterType.PARAMETER_STRING_ARRAY, None,
               "xacro mappings for a .xacro description, each 'name:=value'."),
-        _Spec('controllers_file', ParameterType.PARAMETER_STRING,
-              str(share / DEFAULT_CONTROLLERS),
-              'Controller YAML (ROS 1 rosparam style or ros2_control style).'),
+        # Empty: the file the URDF's control plugin names, else (pan/tilt model) the default.
+        _Spec('controllers_file', ParameterType.PARAMETER_STRING, '',
+              'Controller YAML (ROS 1 rosparam style or ros2_control style); empty = the one '
+              "the URDF's gz_ros2_control/gazebo_ros2_control plugin names in <parameters>."),
+        _Spec('controllers_args', ParameterType.PARAMETER_STRING_ARRAY, None,
+              "Values of the controller YAML's $(var name) substitutions, each 'name:=value'."),
+        _Spec('active_controllers', ParameterType.PARAMETER_STRING_ARRAY, None,
+              'The controllers to activate (as spawners would); unset or empty = all of them. '
+              'The others are loaded but inactive.'),
         _Spec('time_step', ParameterType.PARAMETER_DOUBLE, DEFAULT_TIME_STEP,
               'Physics step in seconds of sim time (0 < time_step <= 0.1).'),
         _Spec('real_time_factor', ParameterType.PARAMETER_DOUBLE, DEFAULT_REAL_TIME_FACTOR,
@@ -84,6 +90,9 @@ class SimParameters:
     robot_description_file: str
     xacro_args: tuple[str, ...]
     controllers_file: str
+    controllers_args: tuple[str, ...]
+    # None: every controller active (unset, or set to an empty list).
+    active_controllers: tuple[str, ...] | None
     time_step: float
     real_time_factor: float
     paused: bool
@@ -97,6 +106,8 @@ def declare_parameters(node: Node) -> SimParameters:
                                  read_only=spec.read_only)
               for spec in _specs()}
     values['xacro_args'] = tuple(values['xacro_args'])
+    values['controllers_args'] = tuple(values['controllers_args'])
+    values['active_controllers'] = tuple(values['active_controllers']) or None
     checked = SimParameters(**values)
     check_time_step(checked.time_step)
     check_real_time_factor(checked.real_time_factor)
@@ -126,8 +137,9 @@ def coerce(name: str, wanted: int, value: Any) -> Any:
     if wanted == ParameterType.PARAMETER_DOUBLE and isinstance(value, int) and not isinstance(
             value, bool):
         return float(value)
-    if wanted == ParameterType.PARAMETER_STRING_ARRAY and value is None:
-        return []  # declared without a value: not set
+    if wanted == ParameterType.PARAMETER_STRING_ARRAY and (
+            value is None or (isinstance(value, list | tuple) and not value)):
+        return []  # declared without a value, or empty (`-p x:=[]` reads as not set)
     ok = {
         ParameterType.PARAMETER_BOOL: lambda v: isinstance(v, bool),
         ParameterType.PARAMETER_INTEGER: lambda v: isinstance(v, int) and not isinstance(v, bool),

@@ -51,6 +51,9 @@ class TfSink(Protocol):
     def tf_static(self, transforms: list[TransformStamped]) -> None:
         """Publish the fixed frames (latched)."""
 
+    def has_readers(self) -> bool:
+        """Whether anybody subscribes to /tf now."""
+
 
 def latched_publisher(node: Node, message_type: type, topic: str):
     """Create a publisher whose last message late subscribers still receive."""
@@ -80,6 +83,10 @@ class TfPublishers:
     def tf_static(self, transforms: list[TransformStamped]) -> None:
         """Publish the fixed frames on /tf_static."""
         self._static.publish(self._type(transforms=transforms))
+
+    def has_readers(self) -> bool:
+        """Whether anybody subscribes to /tf now."""
+        return self._tf.get_subscription_count() > 0
 
 
 def create_tf_sink(node: Node) -> TfSink | None:
@@ -136,6 +143,7 @@ class RobotStatePublisher:
             'robot_state_publisher does it.')
         self.static_frames = static_transforms(model, extra_static)
         self._schedule = PeriodicSchedule(TF_PERIOD_S)
+        self._readers = True  # until the first refresh_readers()
         factory = create_tf_sink if tf_sink_factory is None else tf_sink_factory
         self._sink = factory(node) if enabled else None
         if self._sink is None:
@@ -153,12 +161,16 @@ class RobotStatePublisher:
         """Whether TF is being published."""
         return self._sink is not None
 
+    def refresh_readers(self) -> None:
+        """Ask whether anybody subscribes to /tf (nothing is computed for nobody)."""
+        self._readers = self._sink is not None and self._sink.has_readers()
+
     def update(self) -> None:
-        """Publish /tf for the moving joints when due."""
+        """Publish /tf for the moving joints when due (and somebody listens)."""
         if self._sink is None:
             return
         now = self._clock()
-        if not self._schedule.take(now):
+        if not self._schedule.take(now) or not self._readers:
             return
         frames = moving_transforms(self._model, self._positions())
         for frame, message in zip(frames, self._messages, strict=True):

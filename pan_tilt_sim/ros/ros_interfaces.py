@@ -57,13 +57,11 @@ def clock_message(seconds: float, into: Clock | None = None) -> Clock:
     return message
 
 
-def joint_state_message(time: float, names: Sequence[str], positions: Sequence[float],
-                        velocities: Sequence[float], efforts: Sequence[float],
-                        into: JointState | None = None) -> JointState:
-    """Return a ``sensor_msgs/JointState`` stamped with sim time (fields copied)."""
-    message = JointState() if into is None else into
+def joint_state_message(time: float, positions: Sequence[float], velocities: Sequence[float],
+                        efforts: Sequence[float], into: JointState) -> JointState:
+    """Fill ``into`` (whose ``name`` is set) with sim time and the joint values; return it."""
+    message = into
     stamp(time, message.header.stamp)
-    message.name = list(names)
     message.position = positions
     message.velocity = velocities
     message.effort = efforts

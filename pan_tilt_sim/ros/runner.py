@@ -14,6 +14,13 @@
   (which shut the context down and so end the spin) to these.  A signal
   while the node is being built aborts the build; while spinning it ends the
   spin; while the node is being destroyed it is only noted.
+* Started by a launch file, the program must not outlive it: when
+  ``PAN_TILT_SIM_PARENT_PID`` names the launch process's pid, the program
+  stops (SIGTERM, so as cleanly as on Ctrl-C) when that process dies -- at
+  once if it is already gone.  Linux's ``PR_SET_PDEATHSIG`` does it when
+  the launch process is the parent; a watcher thread when something stands
+  between them (``--launch-prefix``) or off Linux.  Without the variable
+  (``nohup sim_node &``) the program outlives its shell, as any program does.
 * Importing rclpy and PyBullet takes about half a second, so this module
   imports neither until the handlers are in place, and knows no node: the
   program (``pan_tilt_sim.__main__``) hands :func:`run` a factory that
@@ -24,12 +31,14 @@ from __future__ import annotations
 
 import ast
 import contextlib
+import ctypes
 import os
 import re
 import signal
 import sys
 import tempfile
 import threading
+import time
 import traceback
 from collections.abc import Callable, Iterator, Sequence
 from typing import TYPE_CHECKING
@@ -45,6 +54,10 @@ STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 LOG_LEVEL_FLAG = '--log-level'
 DEBUG_LEVEL = 'debug'
 STDERR_FD = 2
+# The pid of the process whose death must stop the program (set by the launch file).
+PARENT_PID_VARIABLE = 'PAN_TILT_SIM_PARENT_PID'
+PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
+PARENT_POLL_S = 0.5  # the watcher thread's period where prctl is not available
 # rcl's generic last word on any bad argument; the specific reason comes before it.
 _RCL_GENERIC_ERROR = 'Failed to parse global arguments'
 _RCL_LOG_LINE = re.compile(r'^\[(?:WARN|ERROR|FATAL)\] \[[^\]]*\] \[rcl[^\]]*\]: (?P<text>.*)$')
@@ -101,6 +114,57 @@ class StopSignals:
         if first and self._interruptible:
             self._interruptible = False
             raise StopRequested(self.received.name)
+
+
+def stop_with_parent(environ: dict[str, str] | None = None) -> bool:
+    """Arrange for SIGTERM when the process named by ``PAN_TILT_SIM_PARENT_PID`` dies.
+
+    Returns whether a process is watched.  When it is this process's parent,
+    Linux's parent-death signal does it; when something stands between them
+    (a launch prefix such as gdb), or off Linux, a watcher thread polls.  If
+    the process is already gone, SIGTERM is sent at once.
+    """
+    text = (os.environ if environ is None else environ).get(PARENT_PID_VARIABLE, '').strip()
+    if not text.isdigit():
+        return False
+    parent = int(text)
+    if os.getppid() == parent and _parent_death_signal(signal.SIGTERM):
+        if os.getppid() != parent:  # it died before the request took effect
+            os.kill(os.getpid(), signal.SIGTERM)
+        return True
+    if not _is_alive(parent):
+        os.kill(os.getpid(), signal.SIGTERM)
+        return True
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True,
+                     name='parent-watch').start()
+    return True
+
+
+def _parent_death_signal(signum: int) -> bool:
+    """Ask Linux to send ``signum`` when the parent dies; False where that is not possible."""
+    if not sys.platform.startswith('linux'):
+        return False
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        return libc.prctl(PR_SET_PDEATHSIG, int(signum), 0, 0, 0) == 0
+    except (OSError, AttributeError):
+        return False
+
+
+def _is_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # someone else's process: it exists
+        return True
+    return True
+
+
+def _watch_parent(parent: int) -> None:
+    while _is_alive(parent):
+        time.sleep(PARENT_POLL_S)
+    os.kill(os.getpid(), signal.SIGTERM)
 
 
 def debug_requested(argv: Sequence[str]) -> bool:
@@ -188,6 +252,7 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
     with StopSignals() as stop:
         try:
             with stop.interruptible():
+                stop_with_parent()
                 init_ros(args, debug=debug)
                 initialized = True
                 node = make_node()

@@ -23,12 +23,18 @@ from pan_tilt_sim.controllers import CommandController, CommandResult
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
 from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.model import naming
-from pan_tilt_sim.model.controller_config import load_controllers_config
-from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.model.controller_config import (
+    CONTROLLERS_ARGS,
+    ControllersConfig,
+    controllers_files_for,
+    load_controllers_config,
+    parse_controllers_args,
+)
+from pan_tilt_sim.model.description import RobotDescription, load_description
 from pan_tilt_sim.ros import parameters, services
 from pan_tilt_sim.ros.features import NodeFeatures
 from pan_tilt_sim.ros.gain_parameters import GainParameters
-from pan_tilt_sim.ros.pacing import Pacer
+from pan_tilt_sim.ros.pacing import Pacer, Throttle
 from pan_tilt_sim.ros.ros_interfaces import (
     COMMAND_MESSAGES,
     NANOSECONDS_PER_SECOND,
@@ -42,6 +48,12 @@ NODE_NAME = 'sim_node'
 # per tick, and each wake-up of rclpy's executor (~0.35 ms) costs < 2 % CPU.
 TICK_PERIOD_S = 0.02
 CLOCK_PERIOD_S = 0.01  # sim seconds between /clock messages (100 Hz of sim time)
+# /clock leaves at most once per this much wall time on average (Gazebo's clock
+# publisher throttles the same way), in bursts of up to CLOCK_BURST messages;
+# the newest stamp always leaves at the end of each batch.
+CLOCK_MIN_WALL_PERIOD_S = 0.001
+# A tick's worth (20 ms) of bursts: up to ~10x real time every 10 ms stamp leaves.
+CLOCK_BURST = 20
 QUEUE_DEPTH = 10
 WARNING_THROTTLE_S = 1.0
 _OWN_PARAMETERS = {field.name for field in dataclasses.fields(parameters.SimParameters)}
@@ -66,12 +78,16 @@ class SimNode(Node):
         self.settings = parameters.declare_parameters(self)
         description = load_description(
             self.settings.robot_description_file, self.settings.xacro_args)
-        controllers = load_controllers_config(self.settings.controllers_file)
+        controllers = load_controllers_config(
+            controllers_files_for(self.settings.controllers_file, description),
+            parse_controllers_args(self.settings.controllers_args,
+                                   f"parameter '{CONTROLLERS_ARGS}'"))
         self.robot_namespace = naming.resolve_robot_namespace(
             self.get_namespace(), self.settings.robot_namespace,
             controllers.namespace, description.plugin_namespace)
         self.simulation = Simulation(
-            description, controllers, self.settings.time_step, gui=self.settings.gui)
+            description, controllers, self.settings.time_step, gui=self.settings.gui,
+            active_controllers=self.settings.active_controllers)
         self._paused = self.settings.paused
         # Commands taken per controller (ignored ones included): a cheap health figure.
         self.commands_received = {c.name: 0 for c in self.simulation.command_controllers()}
@@ -79,11 +95,18 @@ class SimNode(Node):
         self._clock_every = clock_period_steps(self.settings.time_step)
         self._clock_publisher = self.create_publisher(Clock, '/clock', QUEUE_DEPTH)
         self._clock_message = Clock()
+        self._clock_readers = True  # until the first batch asks
+        self._clock_pending = False
+        self._clock_throttle = Throttle(CLOCK_MIN_WALL_PERIOD_S, CLOCK_BURST)
         self._wire_controllers()
         try:
             self.gain_parameters = GainParameters(self, self.simulation.controllers)
+            # Sensors follow an explicit namespace (the node's, or robot_namespace) the
+            # way Gazebo's spawn -robot_namespace moves every plugin; else their plugins'.
             self.features = NodeFeatures(
-                self, self.simulation, self.robot_namespace, gui=self.settings.gui)
+                self, self.simulation, self.robot_namespace, gui=self.settings.gui,
+                sensor_namespace=naming.normalize(self.get_namespace())
+                or naming.normalize(self.settings.robot_namespace))
         except BaseException:
             self.simulation.close()
             raise
@@ -96,6 +119,7 @@ class SimNode(Node):
         self.add_post_set_parameters_callback(self._apply_parameters)
         self._world_services = services.create_world_services(
             self, reset=self.reset, set_paused=self.set_paused)
+        self._log_controllers(description, controllers)
         for joint in self.simulation.physics.joints:
             if joint.initial_position != 0.0:
                 self.get_logger().info(
@@ -108,7 +132,8 @@ class SimNode(Node):
                 f'time): the nearest whole number of time_step to 10 ms')
         self.get_logger().info(
             f"simulating '{description.name}' from {description.source} "
-            f"with {len(self.simulation.controllers)} controllers; topics under "
+            f"with {len(self.simulation.manager.active)} active controllers from "
+            f"{controllers.label}; topics under "
             f"'{self.robot_namespace or '/'}', time_step {self.settings.time_step} s, "
             f'real_time_factor {self._pacer.real_time_factor}')
 
@@ -134,17 +159,36 @@ class SimNode(Node):
         return naming.join(self.robot_namespace, *names)
 
     def run_steps(self, steps: int) -> None:
-        """Advance ``steps`` physics steps, publishing /clock and the features when due."""
+        """Advance ``steps`` physics steps, publishing /clock and the features when due.
+
+        /clock stamps stay on the 10 ms grid of sim time.  They leave through a
+        token bucket -- one token per wall millisecond, at most CLOCK_BURST held
+        -- and the newest grid stamp reached always leaves at the end of the
+        batch.  So up to ~10x real time every stamp leaves (at factor 1 nothing
+        is dropped); far above it /clock comes about once per wall millisecond
+        and use_sim_time timers see sim time advance in jumps of that size.
+        Nothing is published that nobody reads (see :meth:`_refresh_readers`).
+        """
         simulation = self.simulation
+        every = self._clock_every
+        clock_wanted = self._clock_readers
+        allow_clock = self._clock_throttle.allow
         while steps > 0:
-            chunk = min(steps, self._clock_every - simulation.steps % self._clock_every)
+            chunk = min(steps, every - simulation.steps % every)
+            sensor_due = self.features.steps_until_due(simulation.steps)
+            if sensor_due is not None:  # a watched sensor samples between /clock messages
+                chunk = min(chunk, sensor_due)
             simulation.advance(chunk)
             steps -= chunk
-            if simulation.steps % self._clock_every == 0:
-                self._publish_clock()
+            if simulation.steps % every == 0 and clock_wanted:
+                self._clock_pending = True
+                if allow_clock():
+                    self._publish_clock()
             # Every /clock period, not once per batch: batches at factor 0 last
             # ~5 ms of wall time, which may be many frames of sim time.
             self.features.after_steps()
+        if self._clock_pending:
+            self._publish_clock()
 
     @property
     def paused(self) -> bool:
@@ -204,38 +248,92 @@ class SimNode(Node):
             return
         steps = self._pacer.steps_due()
         if steps:
+            self._refresh_readers()
             self.run_steps(steps)
 
+    def _refresh_readers(self) -> None:
+        """Find out, once per batch, which of the periodic topics anybody reads.
+
+        A publish costs 3-5 us even with no subscriber; asking costs ~0.7 us.
+        A subscriber that appears mid-batch is served from the next batch on
+        (within ~5 ms of wall time), well inside DDS's own matching delay.
+        """
+        self._clock_readers = self._clock_publisher.get_subscription_count() > 0
+        for controller, publisher, sink in self._joint_state_sinks:
+            controller.set_sink(sink if publisher.get_subscription_count() > 0 else None)
+        self.features.refresh_readers()
+
     def _publish_clock(self) -> None:
+        """Publish the newest stamp on the /clock grid (at or before the present sim time)."""
+        simulation = self.simulation
+        grid_steps = simulation.steps - simulation.steps % self._clock_every
         self._clock_publisher.publish(
-            clock_message(self.simulation.time, self._clock_message))
+            clock_message(grid_steps * simulation.time_step, self._clock_message))
+        self._clock_pending = False
 
     def _wire_controllers(self) -> None:
+        self._joint_state_sinks = []
         for controller in self.simulation.controllers:
             if isinstance(controller, JointStateController):
                 publisher = self.create_publisher(
                     JointState, self.topic('joint_states'), QUEUE_DEPTH)
-                controller.set_sink(self._joint_state_sink(publisher))
+                sink = self._joint_state_sink(publisher, controller.names)
+                self._joint_state_sinks.append((controller, publisher, sink))
+                controller.set_sink(sink)
             elif isinstance(controller, CommandController):
                 message_type, extract = COMMAND_MESSAGES[controller.command_kind]
                 self.create_subscription(
                     message_type, self.topic(controller.name, controller.command_topic),
                     self._command_callback(controller, extract), QUEUE_DEPTH)
 
-    def _joint_state_sink(self, publisher):
+    def _log_controllers(self, description: RobotDescription,
+                         controllers: ControllersConfig) -> None:
+        """Say once what xacro warned about, and what is skipped, inactive or missing."""
+        logger = self.get_logger()
+        for warning in description.warnings:
+            logger.warning(warning)
+        manager = self.simulation.manager
+        for skipped in manager.skipped:
+            logger.info(f"controller '{skipped.name}' (type '{skipped.type}') skipped: "
+                        f'{skipped.reason}')
+        inactive = [c.name for c in manager.controllers if not manager.is_active(c.name)]
+        if inactive:
+            logger.info(f"loaded but inactive (not in 'active_controllers'): "
+                        f"{', '.join(inactive)}")
+        broadcasters = [c for c in manager.controllers if isinstance(c, JointStateController)]
+        topic = self.topic('joint_states')
+        if not broadcasters:
+            logger.warning(
+                f'no joint_state_broadcaster in {controllers.label}: nothing will '
+                f'be published on {topic}')
+        elif not any(manager.is_active(c.name) for c in broadcasters):
+            logger.warning(
+                f"{', '.join(c.name for c in broadcasters)}: inactive (not in "
+                f"'active_controllers'): nothing will be published on {topic}")
+
+    @staticmethod
+    def _joint_state_sink(publisher, names):
         message = JointState()
+        message.name = list(names)  # once: the names never change
 
         def publish(time, names, positions, velocities, efforts) -> None:
             publisher.publish(
-                joint_state_message(time, names, positions, velocities, efforts, message))
+                joint_state_message(time, positions, velocities, efforts, message))
         return publish
 
     def _command_callback(self, controller: CommandController, extract):
         logger = self.get_logger()
         name = controller.name
 
+        is_active = self.simulation.manager.is_active
+
         def store(message) -> None:
             self.commands_received[name] += 1
+            if not is_active(name):
+                logger.warning(f'{name}: ignored a command: the controller is inactive '
+                               "(not in 'active_controllers')",
+                               throttle_duration_sec=WARNING_THROTTLE_S)
+                return
             value = extract(message)
             result = controller.set_command(value)
             if result is not CommandResult.ACCEPTED:

@@ -1,65 +1,38 @@
 """The simulation loop: physics and controllers, stepped together, no ROS.
 
 Each step is ros2_control's read / update / write around one physics step:
-the measured joint states go into the joint handles, every controller
+the measured joint states go into the joint handles, every active controller
 updates (command controllers first, so broadcasters sample fresh efforts),
 the efforts go to PyBullet, and PyBullet advances one ``time_step``.  Sim
 time is kept as a step count, so it never accumulates rounding error.
+Which controllers are loaded and which are active is the
+:class:`~pan_tilt_sim.controllers.manager.ControllerManager`'s business.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
-from pan_tilt_sim.controllers import CommandController, Controller, JointHandle, create_controller
-from pan_tilt_sim.errors import ControllerConfigError
+from pan_tilt_sim.controllers import CommandController, Controller, JointHandle
+from pan_tilt_sim.controllers.manager import ControllerManager
 from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription
-from pan_tilt_sim.model.robot import JointSpec
 from pan_tilt_sim.sim.physics import STATE_POSITION, STATE_VELOCITY, Physics
-
-
-def build_controllers(config: ControllersConfig, handles: dict[str, JointHandle],
-                      joints: Sequence[JointSpec] = ()) -> list[Controller]:
-    """Create and configure the controllers of ``config``; one owner per joint.
-
-    ``joints`` (all of the robot's) lets the error for a fixed joint say so.
-    """
-    source = str(config.source)
-    unmovable = {joint.name: joint.kind for joint in joints if not joint.kind.is_actuated}
-    owners: dict[str, str] = {}
-    controllers = []
-    for spec in config.controllers:
-        controller = create_controller(spec.name, spec.type, spec.params, source)
-        for joint in controller.joint_names:
-            if joint in unmovable:
-                raise ControllerConfigError(
-                    f"{source}: {spec.name}: joint '{joint}' is a {unmovable[joint].value} "
-                    'joint; a controller can only drive revolute, continuous and prismatic '
-                    'joints')
-            if joint in owners:
-                raise ControllerConfigError(
-                    f"{source}: joint '{joint}' is claimed by both '{owners[joint]}' "
-                    f"and '{spec.name}'")
-            owners[joint] = spec.name
-        controller.configure(handles)
-        controllers.append(controller)
-    # Command controllers first: broadcasters then sample this step's efforts.
-    controllers.sort(key=lambda c: not isinstance(c, CommandController))
-    return controllers
 
 
 class Simulation:
     """One robot in PyBullet, driven by its controllers, advanced step by step."""
 
     def __init__(self, description: RobotDescription, controllers: ControllersConfig,
-                 time_step: float, *, gui: bool = False) -> None:
+                 time_step: float, *, gui: bool = False,
+                 active_controllers: Sequence[str] | None = None) -> None:
         self.description = description
         self.physics = Physics(description, time_step, gui=gui)
         try:
             self.handles = {joint.name: JointHandle(joint) for joint in self.physics.joints}
-            self.controllers = build_controllers(
-                controllers, self.handles, description.joints)
+            self.manager = ControllerManager(controllers, self.handles, description.model,
+                                             active=active_controllers)
+            self.controllers = self.manager.controllers
         except BaseException:
             self.physics.close()
             raise
@@ -86,7 +59,7 @@ class Simulation:
         return self._steps * self._time_step
 
     def command_controllers(self) -> list[CommandController]:
-        """Return the controllers that take commands from topics."""
+        """Return the (loaded) controllers that take commands from topics."""
         return [c for c in self.controllers if isinstance(c, CommandController)]
 
     def controller(self, name: str) -> Controller:
@@ -97,12 +70,12 @@ class Simulation:
         raise KeyError(name)
 
     def advance(self, steps: int) -> None:
-        """Run ``steps`` physics steps, updating every controller at each."""
+        """Run ``steps`` physics steps, updating every active controller at each."""
         # Everything the loop touches is a local: bound methods, the physics
         # stepper, the handles.  Per step this costs ~1 us of Python for the
         # pan/tilt against ~5 us inside PyBullet (see README, Performance).
         handles = self._handle_list
-        updates = [controller.update for controller in self.controllers]
+        updates = self.manager.updates
         efforts = self._efforts
         physics_step = self._physics_step
         dt = self._time_step
@@ -154,11 +127,22 @@ class Simulation:
         self.close()
 
 
-def make_simulation(description_file: str, controllers_file: str, time_step: float, *,
-                    xacro_args: Sequence[str] = (), gui: bool = False) -> Simulation:
-    """Load both files and build a :class:`Simulation` (for tools and tests)."""
-    from pan_tilt_sim.model.controller_config import load_controllers_config
+def make_simulation(description_file: str, controllers_file: str | None, time_step: float, *,
+                    xacro_args: Sequence[str] = (), gui: bool = False,
+                    controllers_args: Mapping[str, str] | None = None,
+                    active_controllers: Sequence[str] | None = None) -> Simulation:
+    """Load both files and build a :class:`Simulation` (for tools and tests).
+
+    Without ``controllers_file`` the URDF's control plugin names it (see
+    :func:`~pan_tilt_sim.model.controller_config.controllers_files_for`).
+    """
+    from pan_tilt_sim.model.controller_config import (
+        controllers_files_for,
+        load_controllers_config,
+    )
     from pan_tilt_sim.model.description import load_description
 
-    return Simulation(load_description(description_file, xacro_args),
-                      load_controllers_config(controllers_file), time_step, gui=gui)
+    description = load_description(description_file, xacro_args)
+    files = controllers_files_for(str(controllers_file or ''), description)
+    return Simulation(description, load_controllers_config(files, controllers_args), time_step,
+                      gui=gui, active_controllers=active_controllers)

@@ -1,32 +1,49 @@
 """bench: how fast sim_node runs, printed as one JSON object.
 
-``ros2 run pan_tilt_sim bench`` (or ``python -m pan_tilt_sim.tools.bench``) runs the
-seed's pan/tilt model and prints, measured in one run so that ratios hold on
-a noisy machine:
+``ros2 run pan_tilt_sim bench`` (or ``python -m pan_tilt_sim.tools.bench``)
+runs the seed's pan/tilt model and prints, measured in one run so that
+ratios hold on a noisy machine (CPU figures come from the processes' and
+threads' own CPU clocks, which other work on the machine distorts far less
+than wall time):
 
-* ``raw_steps_per_s``: bare ``stepSimulation()`` on the same model and time
-  step, in this process, on its own PyBullet client -- the physical limit;
-* ``node_steps_per_s`` and ``x_real_time``: sim_node at real_time_factor 0,
-  both position controllers moving, JointState and /clock published,
-  measured from outside the node's process: a probe takes the latest
-  JointState every ``SAMPLE_PERIOD_S`` and divides sim time by wall time;
-* ``ratio_to_raw`` = node_steps_per_s / raw_steps_per_s;
-* at real_time_factor 1: ``rtf_error`` (|sim/wall - 1|, the slope of the
-  JointState stamps against their arrival times), JointState inter-arrival
-  ``joint_states_p50_ms`` / ``joint_states_p99_ms`` (wall ms) and
-  ``cpu_percent``, the node process's CPU time per wall time (% of one core);
+* ``raw``: PyBullet alone on the physics the node runs (same model, time
+  step, friction motors, the efforts the node's controllers applied,
+  replayed, positional calls): ``step_us_cpu``, the thread CPU microseconds
+  of one ``stepSimulation`` (median over windows), the ``steps_per_s`` that
+  allows, ``calls_us_cpu`` for the three calls the engine makes per step
+  (set efforts, step, read states), and ``wall_steps_per_s``: bare
+  ``stepSimulation`` calls per wall second, beside them;
+* ``factor_0``: sim_node at real_time_factor 0, both position controllers
+  moving, in three cases, one after the other: ``no_subscriber``,
+  ``clock_subscriber`` (a reliable /clock subscriber in its own process, as
+  ``ros2 topic echo /clock`` makes; rclpy's use_sim_time TimeSource makes a
+  best-effort one) and ``joint_state_subscriber`` (a reliable JointState
+  subscriber in its own process).  Each gives ``steps_per_s`` (sim time over
+  wall time between two JointStates the probe takes at the ends of the
+  window, subscribing only for them), ``ratio_to_raw`` (over
+  ``raw.steps_per_s``), ``node_cpu_us_per_step`` (the node's busiest
+  thread: the one stepping the physics) and, with a subscriber,
+  ``subscriber_cpu_percent`` (% of one core);
+* ``factor_1``: at real_time_factor 1 with a /clock subscriber:
+  ``cpu_percent`` (the node process, % of one core),
+  ``clock_subscriber_cpu_percent``, JointState inter-arrival
+  ``joint_states_p50_ms`` / ``joint_states_p99_ms`` and ``rtf_error``
+  (|sim/wall - 1|, the slope of JointState stamps against arrival times);
 * ``startup_s``: process start to the first JointState at the probe, median
   of ``STARTUP_RUNS``;
-* ``scaling``: node_steps_per_s at real_time_factor 0 for generated serial
-  chains of 2, 8 and 32 revolute joints, each with a position controller
-  (keys are the joint counts).
+* ``scaling``: serial chains of 2, 8 and 32 revolute joints, each with a
+  position controller, at real_time_factor 0 with no subscriber:
+  ``steps_per_s`` and ``node_cpu_us_per_step`` (keys are the joint counts).
+* ``sensor_us_per_message``: wall microseconds sim_node spends per message
+  of each sensor of ``urdf/pan_tilt_sensors.xacro`` with every topic watched
+  (:mod:`pan_tilt_sim.tools.sensor_cost`, in this process).
 
 ``--tune`` measures something else instead: evaluations per second of
 ``tune``/``sweep`` on each back end (:mod:`pan_tilt_sim.tools.tune_bench`).
 
-Rates are medians over windows of ``RATE_WINDOW_S``.  ``--runs N`` repeats
-everything and prints the median of each figure; ``--quick`` is a smoke run
-of a few seconds (every key present, no timing meaningful).
+``--runs N`` repeats everything and prints the median of each figure;
+``--quick`` is a smoke run of a few seconds (every key present, no timing
+meaningful).
 
 Every sim_node runs as a child process with ``ROS_AUTOMATIC_DISCOVERY_RANGE=
 LOCALHOST`` and the bench's ROS domain: ``--domain-id``, else the
@@ -67,7 +84,10 @@ from pan_tilt_sim.model.controller_config import load_controllers_config
 from pan_tilt_sim.model.description import load_description
 from pan_tilt_sim.ros.ros_interfaces import seconds
 from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.sim.engine import Simulation, make_simulation
 from pan_tilt_sim.sim.physics import Physics
+from pan_tilt_sim.sim.profiling import pybullet_step_cost
+from pan_tilt_sim.tools.sensor_cost import sensor_costs
 
 DEFAULT_TIME_STEP = 0.001  # s, the issue's reference step
 CHAIN_JOINTS = (2, 8, 32)
@@ -78,8 +98,13 @@ MILLISECONDS_PER_SECOND = 1e3
 PERCENT = 100.0
 P99 = 98  # index of the 99th percentile among statistics.quantiles(n=100)
 
-SAMPLE_PERIOD_S = 0.05  # at factor 0 the probe takes the latest JointState this often
-RATE_WINDOW_S = 0.5  # rates are medians over windows this long
+RATE_WINDOW_S = 0.5  # the bare stepSimulation rate is a median over windows this long
+RAW_SIM_S = 20.0  # sim seconds of the node's controllers replayed for the raw figure
+QUICK_RAW_SIM_S = 3.0
+CLOCK_TOPIC = '/clock'
+CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
+JOINT_STATE_TYPE = 'sensor_msgs/msg/JointState'
+SUBSCRIBER_CASES = ('no_subscriber', 'clock_subscriber', 'joint_state_subscriber')
 COMMAND_PERIOD_S = 0.25  # wall seconds between alternating position commands
 COMMAND_SPAN = 0.25  # targets sit this fraction of the range inside each limit
 UNLIMITED_TARGET = 1.0  # rad, +- target of a joint without position limits
@@ -99,17 +124,19 @@ class Plan:
     """How long each part of a run lasts (wall seconds) and how often it repeats."""
 
     raw_s: float
+    raw_sim_s: float
     warmup_s: float
     fast_s: float
     paced_s: float
     startup_runs: int
     chain_s: float
+    sensor_sim_s: float = 2.0  # sim seconds with every sensor watched
 
 
-FULL_PLAN = Plan(raw_s=3.0, warmup_s=1.0, fast_s=5.0, paced_s=10.0,
+FULL_PLAN = Plan(raw_s=3.0, raw_sim_s=RAW_SIM_S, warmup_s=1.0, fast_s=5.0, paced_s=10.0,
                  startup_runs=STARTUP_RUNS, chain_s=3.0)
-QUICK_PLAN = Plan(raw_s=0.3, warmup_s=0.2, fast_s=0.6, paced_s=0.6, startup_runs=1,
-                  chain_s=0.4)
+QUICK_PLAN = Plan(raw_s=0.3, raw_sim_s=QUICK_RAW_SIM_S, warmup_s=0.2, fast_s=0.6, paced_s=0.6,
+                  startup_runs=1, chain_s=0.4, sensor_sim_s=0.3)
 
 
 class BenchError(RuntimeError):
@@ -194,22 +221,6 @@ _CHAIN_LINK_BODY = (
     '<inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>')
 
 
-def windowed_rate(samples: Sequence[tuple[float, float]], window: float) -> float:
-    """Median over consecutive windows of at least ``window`` x of (x, y) of dy/dx."""
-    rates = []
-    start = 0
-    for end in range(1, len(samples)):
-        dx = samples[end][0] - samples[start][0]
-        if dx >= window:
-            rates.append((samples[end][1] - samples[start][1]) / dx)
-            start = end
-    if not rates and len(samples) >= 2 and samples[-1][0] > samples[0][0]:
-        rates.append((samples[-1][1] - samples[0][1]) / (samples[-1][0] - samples[0][0]))
-    if not rates:
-        raise BenchError('too few samples to measure a rate')
-    return statistics.median(rates)
-
-
 def slope(samples: Sequence[tuple[float, float]]) -> float:
     """Least-squares slope of y against x."""
     if len(samples) < 2:
@@ -223,8 +234,9 @@ def slope(samples: Sequence[tuple[float, float]]) -> float:
     return num / den
 
 
-def raw_steps_per_s(description_file: pathlib.Path, time_step: float, duration: float) -> float:
-    """Time bare ``stepSimulation()`` on the model; median over windows of RATE_WINDOW_S."""
+def bare_steps_per_s(description_file: pathlib.Path, time_step: float,
+                     duration: float) -> float:
+    """Time bare ``stepSimulation()`` calls in wall time; median over windows of RATE_WINDOW_S."""
     with Physics(load_description(description_file), time_step) as physics:
         step = physics.bare_stepper()
         started = time.perf_counter()
@@ -242,6 +254,40 @@ def raw_steps_per_s(description_file: pathlib.Path, time_step: float, duration: 
     return statistics.median(rates)
 
 
+def recorded_efforts(simulation: Simulation, model: Model, sim_seconds: float) -> list:
+    """Run the engine with the bench's alternating commands; return the efforts of each step."""
+    controllers = {controller.name: controller for controller in simulation.command_controllers()}
+    targets = [(controllers[topic.rsplit('/', 2)[-2]], pair)
+               for topic, pair in model.commands.items()]
+    handles = list(simulation.handles.values())
+    steps_per_command = max(1, round(COMMAND_PERIOD_S / simulation.time_step))
+    efforts = []
+    for step in range(round(sim_seconds / simulation.time_step)):
+        if step % steps_per_command == 0:
+            which = (step // steps_per_command) % 2
+            for controller, pair in targets:
+                controller.set_command(pair[which])
+        simulation.advance(1)
+        efforts.append([handle.effort for handle in handles])
+    return efforts
+
+
+def raw_figures(model: Model, time_step: float, sim_seconds: float,
+                wall_seconds: float) -> dict[str, float]:
+    """PyBullet alone on the node's physics: stepSimulation's CPU cost, the calls', bare wall."""
+    with make_simulation(model.description_file, model.controllers_file,
+                         time_step) as simulation:
+        efforts = recorded_efforts(simulation, model, sim_seconds)
+        with Physics(simulation.description, time_step) as replay:
+            step_us, calls_us = pybullet_step_cost(replay, efforts)
+    return {
+        'step_us_cpu': step_us,
+        'steps_per_s': 1e6 / step_us,
+        'calls_us_cpu': calls_us,
+        'wall_steps_per_s': bare_steps_per_s(model.description_file, time_step, wall_seconds),
+    }
+
+
 def cpu_seconds(pid: int) -> float:
     """CPU time (user + system, all threads) a process has used so far."""
     try:
@@ -252,6 +298,45 @@ def cpu_seconds(pid: int) -> float:
         return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
     times = psutil.Process(pid).cpu_times()
     return times.user + times.system
+
+
+def busiest_thread_cpu_seconds(pid: int) -> float:
+    """CPU time (user + system) of the process's busiest thread so far (psutil, else /proc)."""
+    try:
+        import psutil
+    except ImportError:
+        best = 0.0
+        for task in pathlib.Path(f'/proc/{pid}/task').iterdir():
+            fields = (task / 'stat').read_text().rpartition(')')[2].split()
+            best = max(best, (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK'))
+        return best
+    return max(thread.user_time + thread.system_time
+               for thread in psutil.Process(pid).threads())
+
+
+class Listener:
+    """A subscriber in its own process (``pan_tilt_sim.tools.listener``)."""
+
+    def __init__(self, topic: str, type_name: str, env: dict[str, str],
+                 log_file: pathlib.Path) -> None:
+        with open(log_file, 'wb') as log:
+            self.process = subprocess.Popen(
+                [sys.executable, '-m', 'pan_tilt_sim.tools.listener', topic, type_name],
+                stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT, env=env)
+
+    def cpu_seconds(self) -> float:
+        """CPU seconds the listener has used so far."""
+        return cpu_seconds(self.process.pid)
+
+    def stop(self) -> None:
+        """Stop the listener (SIGINT), killing it if it lingers."""
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGINT)
+            try:
+                self.process.wait(STOP_TIMEOUT_S)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait()
 
 
 class NodeProcess:
@@ -281,6 +366,10 @@ class NodeProcess:
     def cpu_seconds(self) -> float:
         """CPU seconds the node has used so far."""
         return cpu_seconds(self.process.pid)
+
+    def busiest_thread_cpu_seconds(self) -> float:
+        """CPU seconds the node's busiest thread (the physics) has used so far."""
+        return busiest_thread_cpu_seconds(self.process.pid)
 
     def stop(self) -> None:
         """Ctrl-C the node and wait for it; kill it if it does not stop."""
@@ -382,43 +471,84 @@ class Bench:
                 raise BenchError(f'no {what} within {timeout} s')
             probe.spin_once(SPIN_TIMEOUT_S)
 
-    def fast_steps_per_s(self, model: Model, duration: float) -> float:
-        """Measure sim_node's steps per wall second at factor 0, seen from this process."""
-        samples: list[tuple[float, float]] = []
-        with self.node(model, 0.0) as node, self.probe.joint_states(
-                model.joint_states_topic, 1, lambda wall, sim: samples.append((wall, sim))):
-            self.spin_until(node, lambda: bool(samples), FIRST_MESSAGE_TIMEOUT_S,
+    @contextlib.contextmanager
+    def listener(self, topic: str, type_name: str) -> Iterator[Listener]:
+        """Run a subscriber process on ``topic`` for the duration of the block."""
+        self._node_count += 1
+        listener = Listener(topic, type_name, self.env,
+                            self.folder / f'listener_{self._node_count}.log')
+        try:
+            yield listener
+        finally:
+            listener.stop()
+
+    def joint_state_sample(self, node: NodeProcess, model: Model) -> tuple[float, float]:
+        """Subscribe just long enough for one JointState; return (arrival s, sim stamp s)."""
+        got: list[tuple[float, float]] = []
+        with self.probe.joint_states(model.joint_states_topic, 1,
+                                     lambda wall, sim: got.append((wall, sim))):
+            self.spin_until(node, lambda: bool(got), FIRST_MESSAGE_TIMEOUT_S,
                             f'JointState on {model.joint_states_topic}')
+        return got[0]
+
+    def fast(self, model: Model, duration: float, case: str = SUBSCRIBER_CASES[0]
+             ) -> dict[str, float]:
+        """Measure sim_node at factor 0 with the subscriber of ``case`` in its own process."""
+        with contextlib.ExitStack() as running:
+            node = running.enter_context(self.node(model, 0.0))
+            listener = None
+            if case == 'clock_subscriber':
+                listener = running.enter_context(self.listener(CLOCK_TOPIC, CLOCK_TYPE))
+            elif case == 'joint_state_subscriber':
+                listener = running.enter_context(
+                    self.listener(model.joint_states_topic, JOINT_STATE_TYPE))
             commander = Commander(self.probe, model)
-            for phase, seconds in (('warm-up', self.plan.warmup_s), ('measure', duration)):
-                samples.clear()
-                deadline = time.monotonic() + seconds
-                while time.monotonic() < deadline:
-                    node.check_alive()
-                    commander.send_when_due()
-                    # Sleep, then take the newest sample (depth 1): the probe stays idle.
-                    time.sleep(SAMPLE_PERIOD_S)
-                    self.probe.spin_once(SPIN_TIMEOUT_S)
-                if phase == 'measure' and len(samples) < 2:
-                    raise BenchError('too few JointState samples at real_time_factor 0')
-        return windowed_rate(samples, RATE_WINDOW_S) / self.time_step
+            self.joint_state_sample(node, model)  # it runs
+            self._wait(node, commander, self.plan.warmup_s)
+            wall_start, sim_start = self.joint_state_sample(node, model)
+            node_cpu = node.busiest_thread_cpu_seconds()
+            listener_cpu = listener.cpu_seconds() if listener else 0.0
+            self._wait(node, commander, duration)
+            wall_end, sim_end = self.joint_state_sample(node, model)
+            node_cpu = node.busiest_thread_cpu_seconds() - node_cpu
+            listener_cpu = (listener.cpu_seconds() - listener_cpu) if listener else 0.0
+        steps = (sim_end - sim_start) / self.time_step
+        if steps <= 0 or wall_end <= wall_start:
+            raise BenchError(f'sim time did not advance at real_time_factor 0 ({case})')
+        figures = {'steps_per_s': steps / (wall_end - wall_start),
+                   'node_cpu_us_per_step': node_cpu / steps * 1e6}
+        if listener is not None:
+            figures['subscriber_cpu_percent'] = listener_cpu / (wall_end - wall_start) * PERCENT
+        return figures
+
+    def _wait(self, node: NodeProcess, commander: Commander, seconds: float) -> None:
+        """Let the node run for ``seconds`` of wall time, sending the commands when due."""
+        deadline = time.monotonic() + seconds
+        while time.monotonic() < deadline:
+            node.check_alive()
+            commander.send_when_due()
+            time.sleep(min(COMMAND_PERIOD_S / 5, max(0.0, deadline - time.monotonic())))
 
     def paced(self, model: Model) -> dict[str, float]:
         """Measure rtf error, JointState inter-arrival and CPU share at real_time_factor 1."""
         samples: list[tuple[float, float]] = []
-        with self.node(model, 1.0) as node, self.probe.joint_states(
-                model.joint_states_topic, 10, lambda wall, sim: samples.append((wall, sim))):
+        with self.node(model, 1.0) as node, self.listener(CLOCK_TOPIC, CLOCK_TYPE) as clock, \
+                self.probe.joint_states(model.joint_states_topic, 10,
+                                        lambda wall, sim: samples.append((wall, sim))):
             self.spin_until(node, lambda: bool(samples), FIRST_MESSAGE_TIMEOUT_S,
                             f'JointState on {model.joint_states_topic}')
             commander = Commander(self.probe, model)
             for seconds in (self.plan.warmup_s, self.plan.paced_s):
                 samples.clear()
                 cpu_start, wall_start = node.cpu_seconds(), time.monotonic()
+                clock_start = clock.cpu_seconds()
                 while time.monotonic() < wall_start + seconds:
                     node.check_alive()
                     commander.send_when_due()
                     self.probe.spin_once(SPIN_TIMEOUT_S)
-                cpu = (node.cpu_seconds() - cpu_start) / (time.monotonic() - wall_start)
+                wall = time.monotonic() - wall_start
+                cpu = (node.cpu_seconds() - cpu_start) / wall
+                clock_cpu = (clock.cpu_seconds() - clock_start) / wall
         if len(samples) < 3:
             raise BenchError('too few JointState messages at real_time_factor 1')
         gaps = [later[0] - earlier[0] for earlier, later in zip(samples, samples[1:], strict=False)]
@@ -427,6 +557,7 @@ class Bench:
             'joint_states_p50_ms': statistics.median(gaps) * MILLISECONDS_PER_SECOND,
             'joint_states_p99_ms': percentile_99(gaps) * MILLISECONDS_PER_SECOND,
             'cpu_percent': cpu * PERCENT,
+            'clock_subscriber_cpu_percent': clock_cpu * PERCENT,
         }
 
     def startup_s(self, model: Model) -> float:
@@ -486,11 +617,14 @@ def percentile_99(values: Sequence[float]) -> float:
 def run_once(bench: Bench, model: Model) -> dict:
     """Measure every figure once; return them as the JSON object's fields."""
     plan = bench.plan
-    bench.log('raw stepSimulation')
-    raw = raw_steps_per_s(model.description_file, bench.time_step, plan.raw_s)
-    bench.log('sim_node at real_time_factor 0')
-    node = bench.fast_steps_per_s(model, plan.fast_s)
-    bench.log('sim_node at real_time_factor 1')
+    bench.log("PyBullet alone on the node's physics")
+    raw = raw_figures(model, bench.time_step, plan.raw_sim_s, plan.raw_s)
+    factor_0 = {}
+    for case in SUBSCRIBER_CASES:
+        bench.log(f'sim_node at real_time_factor 0, {case.replace("_", " ")}')
+        figures = bench.fast(model, plan.fast_s, case)
+        factor_0[case] = {**figures, 'ratio_to_raw': figures['steps_per_s'] / raw['steps_per_s']}
+    bench.log('sim_node at real_time_factor 1 with a /clock subscriber')
     paced = bench.paced(model)
     bench.log('start-up')
     startup = bench.startup_s(model)
@@ -498,16 +632,17 @@ def run_once(bench: Bench, model: Model) -> dict:
     for joints in CHAIN_JOINTS:
         bench.log(f'chain of {joints} joints at real_time_factor 0')
         urdf, controllers = chain_files(joints, bench.folder)
-        scaling[str(joints)] = bench.fast_steps_per_s(load_model(urdf, controllers),
-                                                      plan.chain_s)
+        scaling[str(joints)] = bench.fast(load_model(urdf, controllers), plan.chain_s)
+    bench.log('sensors, every topic watched')
+    sensors = {name: figures['us_per_message'] for name, figures in sensor_costs(
+        sim_seconds=plan.sensor_sim_s, domain_id=bench.domain_id).items()}
     return {
-        'raw_steps_per_s': raw,
-        'node_steps_per_s': node,
-        'x_real_time': node * bench.time_step,
-        'ratio_to_raw': node / raw,
-        **paced,
+        'raw': raw,
+        'factor_0': factor_0,
+        'factor_1': paced,
         'startup_s': startup,
         'scaling': scaling,
+        'sensor_us_per_message': sensors,
     }
 
 
@@ -523,11 +658,11 @@ def median_of(results: Sequence[dict]) -> dict:
 
 
 def rounded(figures: dict) -> dict:
-    """Round figures for printing: 4 significant digits, steps/s as integers."""
+    """Round figures for printing: rates (``*steps_per_s``) as integers, else 4 digits."""
     out = {}
     for key, value in figures.items():
         if isinstance(value, dict):
-            out[key] = {k: round(v) for k, v in value.items()}
+            out[key] = rounded(value)
         elif key.endswith('steps_per_s'):
             out[key] = round(value)
         else:

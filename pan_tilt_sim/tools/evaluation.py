@@ -28,20 +28,33 @@ What is measured (``step_response``'s metrics, plus):
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import pathlib
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 
-from pan_tilt_sim.controllers import Controller
+from pan_tilt_sim.controllers import CommandController, Controller
 from pan_tilt_sim.controllers.pid import PidGains
 from pan_tilt_sim.errors import ConfigurationError
-from pan_tilt_sim.model.controller_config import ControllersConfig, load_controllers_config
+from pan_tilt_sim.model.controller_config import (
+    ControllersConfig,
+    controllers_files_for,
+    load_controllers_config,
+    parse_controllers_args,
+)
 from pan_tilt_sim.model.description import RobotDescription, load_description
 from pan_tilt_sim.model.variation import PhysicalVariation, vary_description
 from pan_tilt_sim.sim.engine import Simulation
-from pan_tilt_sim.tools.step_response import StepMetrics, StepRecord, record_step, step_metrics
+from pan_tilt_sim.tools.step_response import (
+    StepMetrics,
+    StepRecord,
+    activate_the_rest,
+    position_controller,
+    record_step,
+    step_metrics,
+)
 
 FINAL_WINDOW_S = 0.5
 # A record shorter than this many windows uses its last tenth instead.
@@ -54,20 +67,59 @@ SPEED_CAP = 99.0
 
 @dataclasses.dataclass(frozen=True)
 class Scenario:
-    """The robot and its controllers, loaded once by the caller; sent to workers by value."""
+    """The robot and its controllers, loaded once by the caller; sent to workers by value.
+
+    ``active_controllers`` as ``step_response --active-controllers``: None
+    activates the stepped joint's position controller, then every other that
+    claims no joint an earlier one claims.
+    """
 
     description: RobotDescription
     controllers: ControllersConfig
     time_step: float
+    active_controllers: tuple[str, ...] | None = None
+    controllers_args: tuple[str, ...] = ()  # NAME:=VALUE, as read (to read the YAML again)
 
 
-def load_scenario(model: str | pathlib.Path, controllers: str | pathlib.Path,
-                  time_step: float, xacro_args: Sequence[str] = ()) -> Scenario:
-    """Read the robot description and the controllers YAML into a :class:`Scenario`."""
+def load_scenario(model: str | pathlib.Path, controllers: str | pathlib.Path | None,
+                  time_step: float, xacro_args: Sequence[str] = (), *,
+                  controllers_args: Sequence[str] = (),
+                  active_controllers: Sequence[str] | None = None) -> Scenario:
+    """Read the robot description and its controllers YAML as sim_node and step_response do.
+
+    ``controllers`` empty or None: the file(s) the URDF's control plugin
+    names, else the shipped pan/tilt's own.  ``controllers_args`` are the
+    ``NAME:=VALUE`` values of the YAML's ``$(var NAME)``.
+    """
     if not (math.isfinite(time_step) and 0.0 < time_step <= 0.1):
         raise ConfigurationError(f'--time-step: {time_step} must be > 0 and <= 0.1 s')
-    return Scenario(load_description(model, xacro_args), load_controllers_config(controllers),
-                    time_step)
+    description = load_description(model, xacro_args)
+    files = controllers_files_for(str(controllers or ''), description, given_as='--controllers')
+    config = load_controllers_config(
+        files, parse_controllers_args(controllers_args, '--controllers-args'),
+        args_name='--controllers-args')
+    return Scenario(description, config, time_step,
+                    None if not active_controllers else tuple(active_controllers),
+                    tuple(controllers_args))
+
+
+@contextlib.contextmanager
+def simulation_for(scenario: Scenario, joint: str, description: RobotDescription | None = None,
+                   time_step: float | None = None) -> Iterator[tuple[Simulation,
+                                                                      CommandController]]:
+    """Build the scenario's simulation with ``joint``'s stepping controller active.
+
+    Yields the simulation and that controller, activated as ``step_response``
+    activates them.
+    """
+    active = scenario.active_controllers
+    with Simulation(description or scenario.description, scenario.controllers,
+                    time_step or scenario.time_step,
+                    active_controllers=list(active) if active else []) as simulation:
+        driver = position_controller(simulation, joint)
+        if not active:
+            activate_the_rest(simulation)
+        yield simulation, driver
 
 
 @dataclasses.dataclass(frozen=True)
@@ -117,15 +169,15 @@ class Evaluation:
 
 
 def controller_of(simulation: Simulation, joint: str) -> Controller:
-    """Return the controller driving ``joint``; ConfigurationError if none does."""
-    for controller in simulation.controllers:
+    """Return the active controller driving ``joint``; ConfigurationError if none does."""
+    for controller in simulation.manager.active:
         if joint in controller.joint_names:
             return controller
-    raise ConfigurationError(f"--joint: no controller drives '{joint}'")
+    raise ConfigurationError(f"--joint: no active controller drives '{joint}'")
 
 
 def apply_gains(simulation: Simulation, gains: Mapping[str, PidGains]) -> None:
-    """Give each joint's PID the gains of ``gains`` (its controller must have a PID)."""
+    """Give each joint's PID the gains of ``gains`` (its active controller must have a PID)."""
     for joint, joint_gains in gains.items():
         pid = controller_of(simulation, joint).pids().get(joint)
         if pid is None:
@@ -137,20 +189,15 @@ def evaluate(scenario: Scenario, case: Case) -> Evaluation:
     """Simulate ``case``: a fresh simulation, each target stepped from the initial state."""
     started = time.process_time()
     description = vary_description(scenario.description, case.variation)
-    time_step = case.time_step or scenario.time_step
     steps = []
-    with Simulation(description, scenario.controllers, time_step) as simulation:
+    with simulation_for(scenario, case.joint, description, case.time_step) as (simulation,
+                                                                              driver):
         apply_gains(simulation, dict(case.gains))
-        handle = simulation.handles.get(case.joint)
-        if handle is None:
-            raise ConfigurationError(
-                f"--joint: '{case.joint}' is not a movable joint of the robot (movable "
-                f"joints: {', '.join(simulation.handles)})")
-        effort_limit = handle.spec.effort_limit
+        effort_limit = simulation.handles[case.joint].spec.effort_limit
         for index, target in enumerate(case.targets):
             if index:
                 simulation.reset()
-            record = record_step(simulation, case.joint, target, case.duration)
+            record = record_step(simulation, case.joint, target, case.duration, driver.name)
             steps.append(step_result(record, effort_limit, case.keep_records))
     return Evaluation(case.joint, tuple(steps), time.process_time() - started)
 

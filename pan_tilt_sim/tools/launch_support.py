@@ -1,23 +1,39 @@
 """What launch/pan_tilt.launch.py computes, without the ``launch`` package.
 
-The launch file starts sim_node and robot_state_publisher; this module reads
-the model and controllers once, as sim_node will, to hand
-robot_state_publisher the processed URDF and the joint_states topic in the
-robot's namespace.  Kept apart so it can be tested where ``launch`` is not
-installed.
+The launch file starts sim_node and, where its package is installed,
+robot_state_publisher; this module reads the model and controllers once, as
+sim_node will, to hand robot_state_publisher the processed URDF and the
+joint_states topic in the robot's namespace, and turns the launch arguments
+(strings) into sim_node's parameters.  Kept apart so it can be tested where
+``launch`` is not installed.
+
+sim_node is started with :data:`~pan_tilt_sim.ros.runner.PARENT_PID_VARIABLE`
+set to the launch process's pid: it then stops when that process dies,
+however it dies, so a failed or killed launch never leaves it running as an
+orphan.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import os
 from collections.abc import Sequence
 from typing import Any
 
+import yaml
+
 from pan_tilt_sim.model import naming
-from pan_tilt_sim.model.controller_config import load_controllers_config
+from pan_tilt_sim.model.controller_config import (
+    controllers_files_for,
+    load_controllers_config,
+    parse_controllers_args,
+)
 from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.ros.runner import PARENT_PID_VARIABLE
 
 ROOT_NAMESPACE = '/'
+ROBOT_STATE_PUBLISHER = 'robot_state_publisher'
+TRUE_WORDS = ('true', '1', 'yes', 'on')
 
 
 @dataclasses.dataclass(frozen=True)
@@ -32,31 +48,92 @@ class RobotSetup:
         return naming.join(self.namespace, *names)
 
 
-def robot_setup(model: str, controllers: str, xacro_args: Sequence[str] = (),
-                robot_namespace: str = '') -> RobotSetup:
+def list_argument(text: str) -> list[str]:
+    """Read a list-valued launch argument.
+
+    Either a YAML list, as ``-p`` takes it (``"['ur_type:=ur5e', 'name:=ur5e']"``,
+    ``[joint_state_broadcaster, joint_trajectory_controller]``), or items
+    separated by spaces or commas (``"ur_type:=ur5e name:=ur5e"``).  Empty: [].
+    """
+    text = text.strip()
+    if text.startswith('['):
+        try:
+            items = yaml.safe_load(text)
+        except yaml.YAMLError:
+            items = None
+        if isinstance(items, list):
+            return [str(item) for item in items]
+    return text.replace(',', ' ').split()
+
+
+def bool_argument(text: str) -> bool:
+    """Read a boolean launch argument (true/1/yes/on, any case)."""
+    return text.strip().lower() in TRUE_WORDS
+
+
+def has_package(name: str) -> bool:
+    """Whether the ament index knows package ``name`` (so ``launch_ros`` can start it)."""
+    from ament_index_python.packages import PackageNotFoundError, get_package_prefix
+
+    try:
+        get_package_prefix(name)
+    except (PackageNotFoundError, ValueError, LookupError, OSError):
+        return False
+    return True
+
+
+def robot_setup(model: str, controllers: str = '', xacro_args: Sequence[str] = (),
+                robot_namespace: str = '',
+                controllers_args: Sequence[str] = ()) -> RobotSetup:
     """Load the model and controllers as sim_node does (in the root namespace)."""
     description = load_description(model, xacro_args)
-    config = load_controllers_config(controllers)
+    files = controllers_files_for(controllers, description,
+                                  given_as="the launch argument 'controllers'")
+    config = load_controllers_config(
+        files, parse_controllers_args(controllers_args, "launch argument 'controllers_args'"),
+        args_name="the launch argument 'controllers_args'")
     namespace = naming.resolve_robot_namespace(
         ROOT_NAMESPACE, robot_namespace, config.namespace, description.plugin_namespace)
     return RobotSetup(description.urdf_xml, namespace)
 
 
 def sim_node_parameters(model: str, controllers: str, *, real_time_factor: float,
-                        world: str, gui: bool) -> dict[str, Any]:
-    """Return sim_node's parameters when robot_state_publisher runs beside it.
+                        world: str, gui: bool, xacro_args: Sequence[str] = (),
+                        controllers_args: Sequence[str] = (),
+                        active_controllers: Sequence[str] = (),
+                        time_step: float | None = None, robot_namespace: str = '',
+                        publish_tf: bool = False) -> dict[str, Any]:
+    """Return sim_node's parameters.
 
-    robot_state_publisher publishes TF from joint_states, so sim_node does not.
-    sim_node keeps use_sim_time off: it is the clock (it publishes /clock).
+    With robot_state_publisher beside it (``publish_tf`` False), that node
+    turns joint_states into TF and sim_node publishes none; without it
+    sim_node publishes TF itself.  sim_node keeps use_sim_time off: it is
+    the clock (it publishes /clock).  Empty lists and an empty controllers
+    file are left out (sim_node's defaults: none, and the file the URDF names).
     """
-    return {
+    parameters: dict[str, Any] = {
         'robot_description_file': model,
-        'controllers_file': controllers,
         'real_time_factor': real_time_factor,
         'world': world,
         'gui': gui,
-        'publish_tf': False,
+        'publish_tf': publish_tf,
     }
+    if controllers:
+        parameters['controllers_file'] = controllers
+    for name, values in (('xacro_args', xacro_args), ('controllers_args', controllers_args),
+                         ('active_controllers', active_controllers)):
+        if values:
+            parameters[name] = list(values)
+    if time_step is not None:
+        parameters['time_step'] = time_step
+    if robot_namespace:
+        parameters['robot_namespace'] = robot_namespace
+    return parameters
+
+
+def sim_node_environment() -> dict[str, str]:
+    """Return what sim_node's environment adds: this (the launch) process's pid as its parent."""
+    return {PARENT_PID_VARIABLE: str(os.getpid())}
 
 
 def robot_state_publisher_parameters(setup: RobotSetup) -> dict[str, Any]:

@@ -1,13 +1,25 @@
-"""step_response: step a joint's position controller and measure the response. No ROS graph.
+"""step_response: step a joint by position and measure the response. No ROS graph.
 
 ::
 
     ros2 run pan_tilt_sim step_response --joint pan_joint --target 1.0 --plot step.png
 
 runs the simulation in this process as fast as it goes (it never imports
-rclpy), commands the joint's position controller to ``--target`` at t = 0,
-records position, setpoint and effort every physics step for ``--duration``
-seconds of sim time, and prints JSON:
+rclpy), commands the joint to ``--target`` at t = 0 through the controller
+that drives it by position, records position, setpoint and effort every
+physics step for ``--duration`` seconds of sim time, and prints JSON.
+
+Any controller that takes position commands will do: a position controller
+(its command), a forward-command group on the position interface (the
+joint's element, the other joints holding their setpoints), or a joint
+trajectory controller (a one-point trajectory due at once, the other joints
+holding).  ``--controller`` picks one; by default the active controller of
+the joint is used when it takes positions, else the first that does.  The
+controllers file is read as sim_node reads it (``--controllers``, else the
+file the URDF's control plugin names; ``--controllers-args`` for its
+``$(var ...)``); ``--active-controllers`` chooses the active set, else every
+controller is activated that claims no joint an earlier one claims (the
+stepping controller first).  The metrics:
 
 * ``rise_time_s`` -- 10 % to 90 % of the step (linear interpolation between samples);
 * ``overshoot_percent`` -- how far past the target the joint went, in % of the step;
@@ -33,12 +45,21 @@ import pathlib
 import sys
 from collections.abc import Sequence
 
-from pan_tilt_sim.controllers import CommandResult
+from pan_tilt_sim.controllers import CommandController, CommandResult
+from pan_tilt_sim.controllers.forward_command_controller import ForwardCommandController
 from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
-from pan_tilt_sim.errors import ConfigurationError
+from pan_tilt_sim.controllers.joint_trajectory_controller import JointTrajectoryController
+from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
+from pan_tilt_sim.errors import ConfigurationError, ControllerSwitchError
+from pan_tilt_sim.model.controller_config import (
+    controllers_files_for,
+    load_controllers_config,
+    parse_controllers_args,
+)
+from pan_tilt_sim.model.description import load_description
 from pan_tilt_sim.model.robot import JointKind
-from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
-from pan_tilt_sim.sim.engine import Simulation, make_simulation
+from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.sim.engine import Simulation
 
 PROGRAM = 'step_response'
 EXIT_CONFIGURATION_ERROR = 2
@@ -163,35 +184,90 @@ def step_metrics(record: StepRecord) -> StepMetrics:
     )
 
 
-def position_controller(simulation: Simulation, joint: str) -> JointPositionController:
-    """Return the position controller driving ``joint``; ConfigurationError if none."""
+def takes_positions(controller: CommandController) -> bool:
+    """Whether ``controller`` takes position commands for its joints."""
+    if isinstance(controller, ForwardCommandController):
+        return controller.interface_name == 'position'
+    return isinstance(controller, JointPositionController | JointTrajectoryController)
+
+
+def position_controller(simulation: Simulation, joint: str,
+                        name: str | None = None) -> CommandController:
+    """Return the controller that steps ``joint`` by position, activated.
+
+    ``name`` picks it; else the joint's active controller when it takes
+    positions, else the first loaded one that does (the controllers that
+    claim its joints are deactivated).  ConfigurationError if there is none.
+    """
     if joint not in simulation.handles:
         raise ConfigurationError(
             f"--joint: '{joint}' is not a movable joint of the robot "
             f"(movable joints: {', '.join(simulation.handles)})")
-    for controller in simulation.controllers:
-        if joint in controller.joint_names:
-            if isinstance(controller, JointPositionController):
-                return controller
+    manager = simulation.manager
+    drivers = [c for c in simulation.command_controllers() if joint in c.joint_names]
+    if name is not None:
+        chosen = next((c for c in drivers if c.name == name), None)
+        if chosen is None or not takes_positions(chosen):
             raise ConfigurationError(
-                f"--joint: '{joint}' is driven by '{controller.name}', which is not a "
-                'position controller; step_response steps position controllers')
-    raise ConfigurationError(f"--joint: no controller drives '{joint}'")
+                f"--controller: '{name}' is not a loaded controller that drives '{joint}' by "
+                f"position (controllers of '{joint}': "
+                f"{', '.join(_described(c) for c in drivers) or 'none'})")
+    else:
+        candidates = [c for c in drivers if takes_positions(c)]
+        active = [c for c in candidates if manager.is_active(c.name)]
+        chosen = (active or candidates or [None])[0]
+        if chosen is None:
+            if not drivers:
+                raise ConfigurationError(f"--joint: no controller drives '{joint}'")
+            raise ConfigurationError(
+                f"--joint: no controller takes position commands for '{joint}' (its "
+                f"controllers: {', '.join(_described(c) for c in drivers)}); step_response "
+                'steps position, forward-command (position) and trajectory controllers')
+    if not manager.is_active(chosen.name):
+        rivals = [c.name for c in manager.active if set(c.joint_names) & set(chosen.joint_names)]
+        try:
+            manager.switch(activate=[chosen.name], deactivate=rivals)
+        except ControllerSwitchError as err:
+            raise ConfigurationError(f'--controller: {err}') from None
+    return chosen
+
+
+def _described(controller: CommandController) -> str:
+    return f'{controller.name} ({controller.type_name})'
+
+
+def command_position(controller: CommandController, joint: str,
+                     target: float) -> CommandResult:
+    """Command ``joint`` to ``target``; the controller's other joints keep their setpoints."""
+    if isinstance(controller, JointPositionController):
+        return controller.set_command(target)
+    setpoints = controller.setpoints()
+    setpoints[joint] = target
+    values = [setpoints[name] for name in controller.joint_names]
+    if isinstance(controller, JointTrajectoryController):
+        # One point due at once: the desired position steps, as a position command does.
+        return controller.set_command(JointTrajectory(
+            controller.joint_names, (TrajectoryPoint(0.0, tuple(values)),)))
+    return controller.set_command(values)
 
 
 def record_step(simulation: Simulation, joint: str, target: float,
-                duration: float | None = None) -> StepRecord:
+                duration: float | None = None, controller: str | None = None) -> StepRecord:
     """Step ``joint`` to ``target`` at the present state and record the response.
 
     ``duration`` (s of sim time) defaults to the velocity-limited ramp's
-    length plus ``SETTLE_ALLOWANCE_S``.
+    length plus ``SETTLE_ALLOWANCE_S``; ``controller`` names the controller
+    to step with (see :func:`position_controller`).
     """
-    controller = position_controller(simulation, joint)
+    driver = position_controller(simulation, joint, controller)
     spec = simulation.handles[joint].spec
     initial = simulation.joint_positions()[joint]
-    result = controller.set_command(target)
-    if result is CommandResult.REJECTED:
+    if not math.isfinite(target):
         raise ConfigurationError(f'--target: {target!r} is not a finite number')
+    result = command_position(driver, joint, target)
+    if result is CommandResult.REJECTED:
+        raise ConfigurationError(
+            f'--target: {target!r}: {driver.command_problem(target, result)}')
     commanded = spec.clamp_position(target)
     if commanded == initial:
         raise ConfigurationError(
@@ -204,20 +280,21 @@ def record_step(simulation: Simulation, joint: str, target: float,
     steps = max(1, round(duration / simulation.time_step))
     start = simulation.time
     handle = simulation.handles[joint]
+    setpoints = driver.setpoints
     times, positions = [0.0], [initial]
-    setpoints, efforts = [controller.setpoint], [handle.effort]
+    recorded_setpoints, efforts = [setpoints()[joint]], [handle.effort]
     for _ in range(steps):
         simulation.advance(1)
         times.append(simulation.time - start)
         positions.append(simulation.joint_positions()[joint])
-        setpoints.append(controller.setpoint)
+        recorded_setpoints.append(setpoints()[joint])
         efforts.append(handle.effort)
     units = LINEAR_UNITS if spec.kind is JointKind.PRISMATIC else ANGULAR_UNITS
-    return StepRecord(joint=joint, controller=controller.name, initial=initial,
+    return StepRecord(joint=joint, controller=driver.name, initial=initial,
                       target=commanded, velocity_limit=spec.velocity_limit,
                       position_unit=units[0], effort_unit=units[1],
                       times=tuple(times), positions=tuple(positions),
-                      setpoints=tuple(setpoints), efforts=tuple(efforts))
+                      setpoints=tuple(recorded_setpoints), efforts=tuple(efforts))
 
 
 def report(record: StepRecord, metrics: StepMetrics, gains: dict[str, float]) -> dict:
@@ -287,41 +364,90 @@ def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     """Read the command line."""
     share = package_share()
     parser = argparse.ArgumentParser(
-        prog=PROGRAM, description='Step a joint position controller in the simulator '
-        '(no ROS graph) and print rise time, overshoot, settling time, ... as JSON.')
+        prog=PROGRAM, description='Step a joint by position in the simulator (no ROS graph) '
+        'and print rise time, overshoot, settling time, ... as JSON.')
     parser.add_argument('--joint', required=True, help='joint to step, e.g. pan_joint')
     parser.add_argument('--target', required=True, type=float, help='position to step to')
     parser.add_argument('--model', default=str(share / DEFAULT_DESCRIPTION),
                         help='.urdf or .xacro file (default: the pan/tilt model)')
     parser.add_argument('--xacro-args', nargs='*', default=[], metavar='NAME:=VALUE',
                         help='xacro mappings for a .xacro model')
-    parser.add_argument('--controllers', default=str(share / DEFAULT_CONTROLLERS),
-                        help='controllers YAML (default: the pan/tilt controllers)')
+    parser.add_argument('--controllers', default='',
+                        help="controllers YAML (default: the one the URDF's control plugin "
+                        'names; for the pan/tilt model its own)')
+    parser.add_argument('--controllers-args', nargs='*', default=[], metavar='NAME:=VALUE',
+                        help="values of the YAML's $(var NAME) substitutions")
+    parser.add_argument('--active-controllers', nargs='*', default=None, metavar='NAME',
+                        help='controllers to activate (default: every one that claims no '
+                        'joint an earlier one claims)')
+    parser.add_argument('--controller', default=None, metavar='NAME',
+                        help="the controller to step with (default: the joint's active one "
+                        'if it takes positions, else the first that does)')
     parser.add_argument('--time-step', type=float, default=DEFAULT_TIME_STEP,
                         help=f'physics step in s (default {DEFAULT_TIME_STEP})')
     parser.add_argument('--duration', type=float, default=None,
                         help='seconds of sim time to record (default: the velocity-limited '
                         f'ramp plus {SETTLE_ALLOWANCE_S:g} s)')
     parser.add_argument('--plot', type=pathlib.Path, default=None, metavar='FILE.png',
-                        help='also write a plot of the response to this PNG file')
+                        help='also write a plot of the response to this PNG file '
+                        '(needs matplotlib)')
     return parser.parse_args(argv)
+
+
+def check_plot_target(path: pathlib.Path) -> None:
+    """Fail before the run, not after it: matplotlib must import and the folder must exist."""
+    try:
+        import matplotlib  # noqa: F401 -- only whether it is there
+    except ImportError:
+        raise ConfigurationError(
+            '--plot: matplotlib is not installed (pip install matplotlib)') from None
+    if not path.parent.resolve().is_dir():
+        raise ConfigurationError(f'--plot: cannot write {path}: no folder {path.parent}')
+
+
+def build_simulation(args: argparse.Namespace) -> Simulation:
+    """Load the model and its controllers as sim_node would, activated as ``args`` say."""
+    description = load_description(args.model, args.xacro_args)
+    files = controllers_files_for(args.controllers, description, given_as='--controllers')
+    config = load_controllers_config(
+        files, parse_controllers_args(args.controllers_args, '--controllers-args'),
+        args_name='--controllers-args')
+    active = args.active_controllers or None
+    return Simulation(description, config, args.time_step,
+                      active_controllers=[] if active is None else active)
+
+
+def activate_the_rest(simulation: Simulation) -> None:
+    """Activate, in order, every inactive controller that claims no joint an active one claims."""
+    manager = simulation.manager
+    for controller in manager.controllers:
+        if not manager.is_active(controller.name):
+            try:
+                manager.switch(activate=[controller.name])
+            except ControllerSwitchError:
+                continue
 
 
 def run(args: argparse.Namespace) -> dict:
     """Simulate the step that ``args`` ask for; return the JSON summary."""
     if not (math.isfinite(args.time_step) and 0.0 < args.time_step):
         raise ConfigurationError(f'--time-step: {args.time_step} must be > 0 s')
-    with make_simulation(args.model, args.controllers, args.time_step,
-                         xacro_args=args.xacro_args) as simulation:
-        record = record_step(simulation, args.joint, args.target, args.duration)
-        gains = position_controller(simulation, args.joint).pid.gains
+    if args.plot is not None:
+        check_plot_target(args.plot)
+    with build_simulation(args) as simulation:
+        driver = position_controller(simulation, args.joint, args.controller)
+        if not args.active_controllers:
+            activate_the_rest(simulation)
+        record = record_step(simulation, args.joint, args.target, args.duration, driver.name)
+        pid = driver.pids().get(args.joint)
     metrics = step_metrics(record)
     if args.plot is not None:
         try:
             plot(record, metrics, args.plot)
         except OSError as err:
             raise ConfigurationError(f'--plot: cannot write {args.plot}: {err}') from None
-    return report(record, metrics, {'p': gains.p, 'i': gains.i, 'd': gains.d})
+    gains = {} if pid is None else {'p': pid.gains.p, 'i': pid.gains.i, 'd': pid.gains.d}
+    return report(record, metrics, gains)
 
 
 def main(argv: Sequence[str] | None = None) -> None:

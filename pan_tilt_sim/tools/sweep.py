@@ -394,7 +394,9 @@ def run(args: argparse.Namespace, log: Callable[[str], None]) -> tuple[list[dict
                                  f"of the --vary axes ({', '.join(names) or 'none'})")
     spec = tune.spec_from(args)
     targets = tune.parse_targets(args.joint, args.target)
-    scenario = load_scenario(args.model, args.controllers, args.time_step, args.xacro_args)
+    scenario = load_scenario(args.model, args.controllers, args.time_step, args.xacro_args,
+                             controllers_args=args.controllers_args,
+                             active_controllers=args.active_controllers)
     plans = tune.plan_joints(scenario, args.joint, targets)
     payload_link = args.payload_link
     if 'payload' in names:

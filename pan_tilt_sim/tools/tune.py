@@ -50,8 +50,8 @@ import warnings
 from collections.abc import Callable, Mapping, Sequence
 
 from pan_tilt_sim.controllers.pid import PidGains
-from pan_tilt_sim.errors import ConfigurationError
-from pan_tilt_sim.model.controller_config import load_controllers_config
+from pan_tilt_sim.errors import ConfigurationError, ControllerConfigError
+from pan_tilt_sim.model.controller_config import load_controllers_config, parse_controllers_args
 from pan_tilt_sim.model.gains_yaml import (
     GainsUpdate,
     clamp_values,
@@ -60,7 +60,6 @@ from pan_tilt_sim.model.gains_yaml import (
     rewrite_gains,
 )
 from pan_tilt_sim.model.robot import JointKind, JointSpec
-from pan_tilt_sim.sim.engine import Simulation
 from pan_tilt_sim.tools import step_response
 from pan_tilt_sim.tools.backends import Backend, BackendError, InProcess, make_backend
 from pan_tilt_sim.tools.evaluation import (
@@ -69,9 +68,9 @@ from pan_tilt_sim.tools.evaluation import (
     Evaluation,
     Scenario,
     Spec,
-    controller_of,
     evaluate,
     load_scenario,
+    simulation_for,
     violations,
 )
 
@@ -291,18 +290,16 @@ def plan_joints(scenario: Scenario, joints: Sequence[str],
                 targets: Mapping[str, Sequence[float]]) -> list[JointPlan]:
     """Check every joint can be tuned (a PID with gains in the YAML); return what to tune."""
     plans = []
-    with Simulation(scenario.description, scenario.controllers, scenario.time_step) as sim:
-        for joint in joints:
-            step_response.position_controller(sim, joint)  # raises for anything else
-            controller = controller_of(sim, joint)
+    specs = {spec.name: spec for spec in scenario.controllers.controllers}
+    for joint in joints:
+        with simulation_for(scenario, joint) as (sim, controller):
             pid = controller.pids().get(joint)
-            spec = next(s for s in scenario.controllers.controllers if s.name == controller.name)
-            if pid is None or loaded_gains(spec.params, controller.gains_field, joint) is None:
-                field = ('pid' if controller.gains_field == 'pid'
-                         else f'gains.{joint}')
+            params = specs[controller.name].params
+            if pid is None or loaded_gains(params, controller.gains_field, joint) is None:
+                field = 'pid' if controller.gains_field == 'pid' else f'gains.{joint}'
                 raise ConfigurationError(
                     f"--joint: '{joint}': its controller '{controller.name}' has no {field} "
-                    f'entry in {scenario.controllers.source}; tune changes the gains a file '
+                    f'entry in {scenario.controllers.label}; tune changes the gains a file '
                     f'gives (add e.g. {field}: {{p: 100.0, i: 0.01, d: 10.0}})')
             plans.append(JointPlan(sim.handles[joint].spec, controller.name,
                                    controller.gains_field, pid.gains, tuple(targets[joint])))
@@ -498,22 +495,43 @@ def plot(result: TuneResult, path: pathlib.Path) -> None:
 
 
 def write_yaml(scenario: Scenario, result: TuneResult, out: pathlib.Path) -> None:
-    """Write the controllers YAML with the new gains; check it loads back to exactly them."""
-    source = scenario.controllers.source
-    text = source.read_text(encoding='utf-8')
-    updates = []
+    """Write the controllers YAML with the new gains; check it loads back to exactly them.
+
+    With several controller files (ros2_control reads them in order, later
+    ones win), the one rewritten is the last that gives the tuned gains; all
+    of them must be in one file.
+    """
+    config = scenario.controllers
+    files = list(config.sources or (config.source,))
+    texts = [path.read_text(encoding='utf-8') for path in files]
+    updates: dict[int, list[GainsUpdate]] = {}
     for tuning in result.tunings:
-        gains = tuning.best.gains
         path = ('pid',) if tuning.gains_field == 'pid' else ('gains', tuning.joint)
-        existing = gain_fields(text, str(source), tuning.controller, path)
+        found = [(index, _fields_in(text, str(files[index]), tuning.controller, path))
+                 for index, text in enumerate(texts)]
+        index, existing = next(((i, f) for i, f in reversed(found) if f), (len(files) - 1, []))
+        gains = tuning.best.gains
         values = {'p': gains.p, 'i': gains.i, 'd': gains.d,
                   **clamp_values(gains.i_clamp_max, existing)}
-        updates.append(GainsUpdate(tuning.controller, tuning.joint, tuning.gains_field, values))
-    new_text = rewrite_gains(text, str(source), updates)
+        updates.setdefault(index, []).append(
+            GainsUpdate(tuning.controller, tuning.joint, tuning.gains_field, values))
+    if len(updates) > 1:
+        raise ConfigurationError(
+            f"--out: the tuned joints' gains are in several files ("
+            f"{', '.join(str(files[index]) for index in sorted(updates))}); tune writes one: "
+            'tune the joints of each file separately')
+    (index, file_updates), = updates.items()
+    new_text = rewrite_gains(texts[index], str(files[index]), file_updates)
     with tempfile.TemporaryDirectory(prefix='pan_tilt_tune_') as folder:
-        check = pathlib.Path(folder) / source.name
-        check.write_text(new_text, encoding='utf-8')
-        written = load_controllers_config(check)
+        copies = []
+        for number, (path, text) in enumerate(zip(files, texts, strict=True)):
+            copy = pathlib.Path(folder, str(number), path.name)  # the name can name a controller
+            copy.parent.mkdir()
+            copy.write_text(new_text if number == index else text, encoding='utf-8')
+            copies.append(copy)
+        written = load_controllers_config(
+            copies, parse_controllers_args(scenario.controllers_args, '--controllers-args'),
+            args_name='--controllers-args')
     params = {spec.name: spec.params for spec in written.controllers}
     for tuning in result.tunings:
         read = PidGains.from_mapping({k: v for k, v in loaded_gains(
@@ -526,6 +544,14 @@ def write_yaml(scenario: Scenario, result: TuneResult, out: pathlib.Path) -> Non
         out.write_text(new_text, encoding='utf-8')
     except OSError as err:
         raise ConfigurationError(f'--out: cannot write {out}: {err}') from None
+
+
+def _fields_in(text: str, source: str, controller: str, path: Sequence[str]) -> list[str]:
+    """Return the PID fields ``text`` gives the controller at ``path`` (none: not in it)."""
+    try:
+        return gain_fields(text, source, controller, path)
+    except ControllerConfigError:
+        return []
 
 
 # --- command line -----------------------------------------------------------------------------
@@ -575,7 +601,7 @@ def parse_ranges(values: Sequence[str]) -> dict[str, tuple[float, float]]:
 
 def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the robot, specification and back-end options ``tune`` and ``sweep`` share."""
-    from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
+    from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
 
     share = package_share()
     parser.add_argument('--joint', action='append', required=True, metavar='NAME',
@@ -587,8 +613,14 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
                         help='.urdf or .xacro file (default: the pan/tilt model)')
     parser.add_argument('--xacro-args', nargs='*', default=[], metavar='NAME:=VALUE',
                         help='xacro mappings for a .xacro model')
-    parser.add_argument('--controllers', default=str(share / DEFAULT_CONTROLLERS),
-                        help='controllers YAML (default: the pan/tilt controllers)')
+    parser.add_argument('--controllers', default='',
+                        help="controllers YAML (default: the one the URDF's control plugin "
+                        'names; for the pan/tilt model its own)')
+    parser.add_argument('--controllers-args', nargs='*', default=[], metavar='NAME:=VALUE',
+                        help="values of the YAML's $(var NAME) substitutions")
+    parser.add_argument('--active-controllers', nargs='*', default=None, metavar='NAME',
+                        help="controllers to activate (default: the stepped joint's position "
+                        'controller, then every one that claims no joint an earlier one claims)')
     parser.add_argument('--time-step', type=float, default=step_response.DEFAULT_TIME_STEP,
                         help=f'physics step in s (default {step_response.DEFAULT_TIME_STEP})')
     parser.add_argument('--duration', type=float, default=None,
@@ -659,7 +691,9 @@ def run(args: argparse.Namespace, log: Callable[[str], None]) -> tuple[TuneResul
     ranges = parse_ranges(args.range)
     targets = parse_targets(args.joint, args.target)
     _optuna()
-    scenario = load_scenario(args.model, args.controllers, args.time_step, args.xacro_args)
+    scenario = load_scenario(args.model, args.controllers, args.time_step, args.xacro_args,
+                             controllers_args=args.controllers_args,
+                             active_controllers=args.active_controllers)
     plans = plan_joints(scenario, args.joint, targets)
     before = evaluate_plans(scenario, plans, {}, args.duration)
     with make_backend(args.workers, args.address) as backend:

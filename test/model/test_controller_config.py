@@ -1,12 +1,22 @@
 """Reading controller YAML: the seeds' ROS 1 (rosparam) layout and ros2_control's."""
 
+import dataclasses
 import math
 import textwrap
 
 import pytest
+from mesh_fixtures import make_ament_prefix
+from ros2_control_fixtures import ARM_XACRO, CONTROLLERS_FILE, HEAD_YAML, UR_STYLE_YAML, write
 
 from pan_tilt_sim.errors import ControllerConfigError
-from pan_tilt_sim.model.controller_config import DEFAULT_UPDATE_RATE, load_controllers_config
+from pan_tilt_sim.model.controller_config import (
+    DEFAULT_UPDATE_RATE,
+    controllers_files_for,
+    load_controllers_config,
+    parse_controllers_args,
+)
+from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.share import package_share
 from pan_tilt_sim.sim.engine import make_simulation
 
 
@@ -333,3 +343,218 @@ def test_ros1_and_ros2_control_yaml_give_the_same_motion(repo_root, write_yaml):
     assert ros1 == ros2
     assert ros1[-1]['wrist_joint'] == pytest.approx(-4.0, abs=0.01)
     assert ros1[-1]['shoulder_joint'] == pytest.approx(0.8, abs=0.01)
+
+
+# --- launch substitutions: $(var ...) and friends -------------------------------------------
+
+RRBOT_STYLE = """
+    joint_state_broadcaster:
+      ros__parameters:
+        type: joint_state_broadcaster/JointStateBroadcaster
+
+    forward_position_controller:
+      ros__parameters:
+        type: forward_command_controller/ForwardCommandController
+        joints:
+          - $(var joint_prefix)1
+          - $(var joint_prefix)2
+        interface_name: position
+    """
+
+
+def test_var_substitutions_take_the_values_given(write_yaml):
+    specs = by_name(load_controllers_config(write_yaml(RRBOT_STYLE), {'joint_prefix': 'joint'}))
+    assert specs['forward_position_controller'].params['joints'] == ['joint1', 'joint2']
+
+
+def test_an_unset_var_is_an_error_naming_it_its_line_and_the_parameter(write_yaml):
+    path = write_yaml(RRBOT_STYLE)
+    with pytest.raises(ControllerConfigError) as caught:
+        load_controllers_config(path, {'other': 'x'})
+    assert str(caught.value) == (
+        f"{path}:10: $(var joint_prefix) is not set: give it in the parameter "
+        "'controllers_args' as 'joint_prefix:=<value>' (a launch file would fill it from its "
+        'arguments)')
+
+
+def test_a_var_default_an_arg_and_env_substitutions_expand(write_yaml, monkeypatch):
+    monkeypatch.setenv('PAN_TILT_SIM_TEST_RATE', '25')
+    monkeypatch.delenv('PAN_TILT_SIM_TEST_UNSET', raising=False)
+    (spec,) = load_controllers_config(write_yaml("""
+        $(var name ctrl):
+          type: position_controllers/JointPositionController
+          joint: $(arg prefix)pan_joint$(optenv PAN_TILT_SIM_TEST_UNSET)
+          publish_rate: $(env PAN_TILT_SIM_TEST_RATE)
+        """), {'prefix': 'my_'}).controllers
+    assert (spec.name, spec.params['joint']) == ('ctrl', 'my_pan_joint')
+    assert spec.params['publish_rate'] == 25  # expanded before the YAML is read, as launch does
+
+
+def test_a_substitution_in_a_comment_is_no_error(write_yaml):
+    (spec,) = load_controllers_config(write_yaml("""
+        # joints are $(var prefix)N in the upstream file
+        a: {type: effort_controllers/JointEffortController, joint: pan_joint}
+        """)).controllers
+    assert spec.params['joint'] == 'pan_joint'
+
+
+@pytest.mark.parametrize(('text', 'message'), [
+    ('joint: $(env PAN_TILT_SIM_TEST_UNSET)',
+     '$(env PAN_TILT_SIM_TEST_UNSET): the environment variable PAN_TILT_SIM_TEST_UNSET is not '
+     'set'),
+    ('joint: $(dirname)/x', '$(dirname) is a launch substitution sim_node does not expand'),
+    ('joint: $(find-pkg-share no_such_package_here)/x',
+     "$(find-pkg-share no_such_package_here): package 'no_such_package_here' is not in the "
+     'ament index'),
+])
+def test_substitutions_that_cannot_be_expanded_say_why(write_yaml, monkeypatch, text, message):
+    monkeypatch.delenv('PAN_TILT_SIM_TEST_UNSET', raising=False)
+    path = write_yaml(f'a:\n  type: effort_controllers/JointEffortController\n  {text}\n')
+    with pytest.raises(ControllerConfigError) as caught:
+        load_controllers_config(path)
+    assert str(caught.value).startswith(f'{path}:3: {message}')
+
+
+def test_find_pkg_share_expands_through_the_ament_index(write_yaml):
+    (spec,) = load_controllers_config(write_yaml("""
+        a:
+          type: effort_controllers/JointEffortController
+          joint: $(find-pkg-share pan_tilt_sim)/x
+        """)).controllers
+    assert spec.params['joint'] == f'{package_share()}/x'
+
+
+@pytest.mark.parametrize('item', ['no_separator', ':=value'])
+def test_controllers_args_must_be_name_value_mappings(item):
+    with pytest.raises(ControllerConfigError,
+                       match=rf"^parameter 'controllers_args': '{item}' is not of the form "
+                             'name:=value$'):
+        parse_controllers_args([item], "parameter 'controllers_args'")
+    assert parse_controllers_args(['a:=1', 'b:=x:=y', 'c:=']) == {'a': '1', 'b': 'x:=y', 'c': ''}
+
+
+# --- ROS 1 files with one controller; several files -----------------------------------------
+
+def test_a_ros1_file_with_one_controller_names_it_after_the_file(write_yaml):
+    config = load_controllers_config(write_yaml(HEAD_YAML, name='head.yaml'))
+    (spec,) = config.controllers
+    assert (spec.name, spec.type, spec.params['joint']) == (
+        'head', 'position_controllers/JointPositionController', 'joint1')
+    assert config.namespace is None
+
+
+def test_a_file_name_that_is_no_ros_name_gives_a_valid_controller_name(write_yaml):
+    (spec,) = load_controllers_config(write_yaml(HEAD_YAML, name='2-head.yaml')).controllers
+    assert spec.name == '_2_head'
+
+
+def test_several_ros2_files_are_read_in_order_later_ones_winning(write_yaml):
+    declarations = write_yaml("""
+        controller_manager:
+          ros__parameters:
+            update_rate: 50
+            arm: {type: position_controllers/JointGroupPositionController}
+        arm:
+          ros__parameters: {joints: [a]}
+        """, name='manager.yaml')
+    own = write_yaml("""
+        arm:
+          ros__parameters: {joints: [a, b]}
+        """, name='arm.yaml')
+    config = load_controllers_config([declarations, own])
+    (arm,) = config.controllers
+    assert arm.params['joints'] == ['a', 'b']
+    assert config.update_rate == 50.0
+    assert config.sources == (declarations, own)
+    assert config.label == f'{declarations} + {own}'
+
+
+def test_ros1_files_have_no_update_rate_and_ros2_files_their_managers(write_yaml, repo_root):
+    assert load_controllers_config(repo_root / 'config' / 'pan_tilt_control.yaml'
+                                   ).update_rate is None
+    assert load_controllers_config(write_yaml(ROS2_FILE)).update_rate == 250.0
+
+
+# --- which controllers file: the parameter, the URDF's plugin, the default -----------------
+
+def _description(tmp_path, controllers_file=CONTROLLERS_FILE, text=UR_STYLE_YAML):
+    tmp_path.mkdir(parents=True, exist_ok=True)
+    write(tmp_path, CONTROLLERS_FILE, text)
+    xacro = write(tmp_path, 'two_link_arm.urdf.xacro', ARM_XACRO)
+    return load_description(xacro, [f'controllers:={controllers_file}'])
+
+
+def test_the_file_the_urdf_plugin_names_is_used_relative_to_the_urdf(tmp_path):
+    description = _description(tmp_path)
+    assert controllers_files_for('', description) == (tmp_path / CONTROLLERS_FILE,)
+
+
+def test_a_given_controllers_file_wins_over_the_urdf(tmp_path, monkeypatch):
+    description = _description(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    assert controllers_files_for('other.yaml', description) == (tmp_path / 'other.yaml',)
+
+
+def test_the_plugin_may_name_a_package_uri(tmp_path, monkeypatch):
+    prefix = make_ament_prefix(tmp_path, 'arm_bringup',
+                               {'config/controllers.yaml': UR_STYLE_YAML})
+    monkeypatch.setenv('AMENT_PREFIX_PATH', str(prefix))
+    description = _description(tmp_path / 'src', 'package://arm_bringup/config/controllers.yaml')
+    assert controllers_files_for('', description) == (
+        prefix / 'share' / 'arm_bringup' / 'config' / 'controllers.yaml',)
+
+
+def test_a_relative_plugin_path_found_only_from_the_current_folder_is_taken_from_there(
+        tmp_path, monkeypatch):
+    description = _description(tmp_path / 'robot', 'config/c.yaml')
+    (tmp_path / 'config').mkdir()
+    write(tmp_path / 'config', 'c.yaml', HEAD_YAML)
+    monkeypatch.chdir(tmp_path)
+    assert controllers_files_for('', description) == (tmp_path / 'config' / 'c.yaml',)
+
+
+def test_a_plugin_file_that_does_not_exist_says_where_it_was_named(tmp_path):
+    description = _description(tmp_path, 'missing.yaml')
+    with pytest.raises(ControllerConfigError) as caught:
+        controllers_files_for('', description)
+    assert str(caught.value) == (
+        f"{description.source}: the gz_ros2_control-system plugin's <parameters> names "
+        f"'missing.yaml' (resolved to {tmp_path / 'missing.yaml'}): no such file")
+
+
+def test_the_default_model_gets_the_default_controllers(repo_root, seeds_dir):
+    for model in (repo_root / 'urdf' / 'pan_tilt.xacro', seeds_dir / 'pan_tilt.xacro'):
+        assert controllers_files_for('', load_description(model)) == (
+            package_share() / 'config' / 'pan_tilt_control.yaml',)
+
+
+def test_a_robot_that_names_no_controllers_file_is_told_exactly_that(repo_root):
+    description = load_description(repo_root / 'test' / '..' / 'urdf' / 'three_joint_arm.xacro')
+    bare = dataclasses.replace(description, model=dataclasses.replace(
+        description.model, control_plugins=()))
+    with pytest.raises(ControllerConfigError) as caught:
+        controllers_files_for('', bare)
+    assert str(caught.value) == (
+        f"{description.source}: no controllers file: the parameter 'controllers_file' is not "
+        'set and the URDF names none (no gz_ros2_control, ign_ros2_control or '
+        "gazebo_ros2_control plugin with <parameters>); give the controller YAML with the "
+        "parameter 'controllers_file'")
+
+
+def test_the_shipped_arm_names_its_controllers_in_its_plugin(repo_root):
+    description = load_description(repo_root / 'urdf' / 'three_joint_arm.xacro')
+    assert controllers_files_for('', description) == (
+        package_share() / 'config' / 'three_joint_arm_controllers.yaml',)
+
+
+def test_a_given_controllers_file_may_be_a_package_uri_and_a_bad_one_names_the_parameter(
+        tmp_path):
+    description = _description(tmp_path)
+    assert controllers_files_for('package://pan_tilt_sim/config/pan_tilt_control.yaml',
+                                 description) == (
+        package_share() / 'config' / 'pan_tilt_control.yaml',)
+    with pytest.raises(ControllerConfigError,
+                       match=r"^the parameter 'controllers_file': resource "
+                             r"'package://no_such_package_here/c.yaml': package "
+                             r"'no_such_package_here' is not in the ament index"):
+        controllers_files_for('package://no_such_package_here/c.yaml', description)

@@ -3,6 +3,7 @@
 import math
 
 import pytest
+from ros2_control_fixtures import ARM_XACRO, write, write_arm
 
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.description import load_description, parse_xacro_args
@@ -98,3 +99,25 @@ def test_malformed_xacro_args_are_refused(args):
 def test_a_missing_file_names_the_file(tmp_path):
     with pytest.raises(DescriptionError, match='nope.urdf: no such file'):
         load_description(tmp_path / 'nope.urdf')
+
+
+# --- xacro's own warnings -------------------------------------------------------------------
+
+def test_xacro_warnings_are_kept_for_the_caller_not_printed(tmp_path, capfd):
+    xacro = write_arm(tmp_path)
+    description = load_description(xacro)
+    assert capfd.readouterr().err == ''
+    assert description.warnings == (
+        f'{xacro}: xacro: warning: redefining global symbol: pi',)
+
+
+def test_a_xacro_error_prints_nothing_beside_the_one_error(tmp_path, capfd):
+    xacro = write(tmp_path, 'broken.urdf.xacro', ARM_XACRO.replace(
+        '<link name="world"/>', '<link name="${no_such_property}"/>'))
+    with pytest.raises(DescriptionError, match='no_such_property'):
+        load_description(xacro)
+    assert capfd.readouterr().err == ''
+
+
+def test_a_plain_urdf_has_no_warnings(repo_root):
+    assert load_description(repo_root / 'urdf' / 'pan_tilt.xacro').warnings == ()

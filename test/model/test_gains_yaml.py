@@ -161,3 +161,18 @@ def test_a_controller_without_gains_in_the_file_is_an_error():
                                                    {'p': 2.0})])
     with pytest.raises(ControllerConfigError, match="no controller 'nope'"):
         gain_fields(ROS1, 'f.yaml', 'nope', ('pid',))
+
+
+def test_a_gain_given_by_a_substitution_is_left_to_the_user():
+    text = ROS1.replace('pid: {p: 100.0,', 'pid: {p: $(var pan_p),')
+    with pytest.raises(ControllerConfigError, match=r"pid\.p: '\$\(var pan_p\)' is not a number"):
+        rewrite_gains(text, 'f.yaml', [GainsUpdate('pan_controller', 'pan_joint', 'pid',
+                                                   {'p': 2.0})])
+
+
+def test_a_ros1_file_of_one_controller_is_that_controller(tmp_path):
+    text = 'type: position_controllers/JointPositionController\njoint: pan_joint\n' \
+           'pid: {p: 10.0, d: 1.0}\n'
+    after = rewrite_gains(text, 'pan.yaml', [GainsUpdate('pan', 'pan_joint', 'pid',
+                                                         {'p': 20.0, 'i_clamp': 3.0})])
+    assert after == text.replace('{p: 10.0, d: 1.0}', '{p: 20.0, d: 1.0, i_clamp: 3.0}')

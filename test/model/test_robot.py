@@ -138,3 +138,23 @@ def test_a_bad_ros2_control_block_is_an_error_naming_it(old, new, message):
     with pytest.raises(DescriptionError) as caught:
         parse_urdf(CONTROLLED.replace(old, new), pathlib.Path('c.urdf'))
     assert str(caught.value) == f'c.urdf: {message}'
+
+
+def test_position_proportional_gain_comes_from_the_plugin_else_the_hardware():
+    assert parse_urdf(CONTROLLED, pathlib.Path('c.urdf')).position_proportional_gain == 0.5
+    in_plugin = CONTROLLED.replace(
+        '<ros><namespace>', '<position_proportional_gain>0.2</position_proportional_gain>'
+        '<ros><namespace>')
+    assert parse_urdf(in_plugin, pathlib.Path('c.urdf')).position_proportional_gain == 0.2
+    assert arm_model().position_proportional_gain is None
+
+
+@pytest.mark.parametrize('value', ['fast', '0', '-0.1', 'nan'])
+def test_a_position_proportional_gain_that_is_no_positive_number_is_an_error(value):
+    text = CONTROLLED.replace('<param name="position_proportional_gain">0.5</param>',
+                              f'<param name="position_proportional_gain">{value}</param>')
+    with pytest.raises(DescriptionError) as caught:
+        parse_urdf(text, pathlib.Path('c.urdf'))
+    assert str(caught.value) == (
+        'c.urdf: <ros2_control name="Sys">: <hardware> <param name="position_proportional_gain">: '
+        f"'{value}' must be a number > 0")

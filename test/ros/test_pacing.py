@@ -1,6 +1,6 @@
 """Pacing: steps per tick follow wall time times the real-time factor."""
 
-from pan_tilt_sim.ros.pacing import FAST_BATCH_STEPS, FAST_TICK_S, MAX_CATCH_UP_S, Pacer
+from pan_tilt_sim.ros.pacing import FAST_BATCH_STEPS, FAST_TICK_S, MAX_CATCH_UP_S, Pacer, Throttle
 
 
 class FakeClock:
@@ -87,3 +87,25 @@ def test_restart_forgets_time_spent_paused():
     assert pacer.steps_due() == 0
     clock.now += 0.02
     assert pacer.steps_due() == 20
+
+
+# --- the /clock throttle: one per wall millisecond on average, in bursts ----------------
+
+def test_the_throttle_allows_a_burst_then_one_event_per_period():
+    clock = FakeClock()
+    throttle = Throttle(0.001, 20, clock)
+    assert sum(throttle.allow() for _ in range(100)) == 20  # the burst, at one instant
+    clock.now += 0.0105
+    assert sum(throttle.allow() for _ in range(100)) == 10  # 10.5 ms: 10 whole tokens
+    assert not throttle.allow()
+    clock.now += 0.0006
+    assert throttle.allow()  # the half token left and a bit more than half a period
+
+
+def test_the_throttle_lets_a_real_time_tick_through_whole():
+    # At real_time_factor 1 a 20 ms tick reaches two or three /clock stamps at once.
+    clock = FakeClock()
+    throttle = Throttle(0.001, 20, clock)
+    for _ in range(50):
+        clock.now += 0.02
+        assert all(throttle.allow() for _ in range(3))

@@ -7,7 +7,8 @@ measure sim time against wall time (within +-20 %, over more than a second).
 import time
 
 import pytest
-from node_harness import sim_node
+from node_harness import PROBE_QUEUE, sim_node, stamp_s
+from rosgraph_msgs.msg import Clock
 
 PACE_TOLERANCE = 0.2
 MEASURE_WALL_S = 1.5
@@ -26,6 +27,17 @@ def test_at_real_time_factor_1_sim_time_follows_wall_time():
         assert harness.spin_until(lambda: harness.simulation.time > 0.05), 'sim did not start'
         factor = measured_factor(harness)
     assert factor == pytest.approx(1.0, rel=PACE_TOLERANCE)
+
+
+def test_at_real_time_factor_1_every_10_ms_stamp_reaches_a_clock_subscriber():
+    with sim_node(real_time_factor=1.0) as harness:
+        clock = harness.collect(Clock, '/clock', PROBE_QUEUE)
+        harness.wait_for_subscribers('/clock')
+        first = len(clock)
+        assert harness.spin_until(lambda: len(clock) >= first + 100, 5.0)
+        times = [stamp_s(m) for m in clock[first:]]
+    assert all(b - a == pytest.approx(0.01, abs=1e-9)
+               for a, b in zip(times, times[1:], strict=False)), times
 
 
 def test_a_live_change_of_real_time_factor_sets_the_pace_0_then_1_then_half():

@@ -139,6 +139,9 @@ class RecordingTfSink:
     def tf_static(self, transforms):
         self.static_messages.append([_copy(t) for t in transforms])
 
+    def has_readers(self):
+        return True
+
 
 def _copy(transform: TransformStamped) -> tuple:
     t, r = transform.transform.translation, transform.transform.rotation

@@ -71,7 +71,8 @@ def test_unknown_controller_types_list_the_supported_ones(repo_root, tmp_path):
     description = load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
     config = _config(tmp_path, ('x', {'type': 'fancy/Controller', 'joint': 'pan_joint'}))
     with pytest.raises(ControllerConfigError,
-                       match=r"x.type: unknown controller type 'fancy/Controller' "
+                       match=r"x.type: unknown controller type 'fancy/Controller', and no "
+                             r'other controller in the file commands a joint '
                              r'\(supported: .*position_controllers/JointPositionController'):
         Simulation(description, config, DT)
 

@@ -14,18 +14,28 @@ import sim_process
 from pan_tilt_sim.sim.engine import make_simulation
 from pan_tilt_sim.tools import bench
 
-QUICK_TIMEOUT_S = 240
-FIGURES = {
-    'raw_steps_per_s': int,
-    'node_steps_per_s': int,
-    'x_real_time': float,
-    'ratio_to_raw': float,
-    'rtf_error': float,
-    'joint_states_p50_ms': float,
-    'joint_states_p99_ms': float,
-    'cpu_percent': float,
-    'startup_s': float,
+QUICK_TIMEOUT_S = 300
+RAW = {'step_us_cpu', 'steps_per_s', 'calls_us_cpu', 'wall_steps_per_s'}
+FACTOR_0 = {
+    'no_subscriber': {'steps_per_s', 'node_cpu_us_per_step', 'ratio_to_raw'},
+    'clock_subscriber': {'steps_per_s', 'node_cpu_us_per_step', 'ratio_to_raw',
+                         'subscriber_cpu_percent'},
+    'joint_state_subscriber': {'steps_per_s', 'node_cpu_us_per_step', 'ratio_to_raw',
+                               'subscriber_cpu_percent'},
 }
+FACTOR_1 = {'cpu_percent', 'clock_subscriber_cpu_percent', 'joint_states_p50_ms',
+            'joint_states_p99_ms', 'rtf_error'}
+
+
+def leaves(figures: dict, prefix: str = '') -> dict:
+    """Flatten nested figures to {'a.b': value}."""
+    flat = {}
+    for key, value in figures.items():
+        if isinstance(value, dict):
+            flat.update(leaves(value, f'{prefix}{key}.'))
+        else:
+            flat[f'{prefix}{key}'] = value
+    return flat
 
 
 @pytest.fixture(scope='module')
@@ -40,20 +50,26 @@ def quick_run():
 
 @pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
 def test_quick_prints_exactly_one_json_object_with_every_figure(quick_run):
-    stdout, _ = quick_run
-    figures = json.loads(stdout)
-    assert set(figures) == {*FIGURES, 'scaling'}
-    for key, kind in FIGURES.items():
-        assert isinstance(figures[key], kind), (key, figures[key])
-        assert math.isfinite(figures[key]) and figures[key] >= 0, (key, figures[key])
-    assert figures['raw_steps_per_s'] > 0 and figures['node_steps_per_s'] > 0
+    figures = json.loads(quick_run[0])
+    assert set(figures) == {'raw', 'factor_0', 'factor_1', 'startup_s', 'scaling',
+                            'sensor_us_per_message'}
+    assert set(figures['raw']) == RAW
+    assert {case: set(values) for case, values in figures['factor_0'].items()} == FACTOR_0
+    assert set(figures['factor_1']) == FACTOR_1
+    assert set(figures['scaling']) == {str(joints) for joints in bench.CHAIN_JOINTS}
+    for key, value in leaves(figures).items():
+        kind = int if key.endswith('steps_per_s') else float
+        assert isinstance(value, kind), (key, value)
+        assert math.isfinite(value) and value >= 0, (key, value)
+    assert figures['raw']['steps_per_s'] > 0
+    assert all(case['steps_per_s'] > 0 for case in figures['factor_0'].values())
 
 
 @pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
-def test_quick_reports_every_chain_length(quick_run):
-    scaling = json.loads(quick_run[0])['scaling']
-    assert set(scaling) == {str(joints) for joints in bench.CHAIN_JOINTS}
-    assert all(isinstance(rate, int) and rate > 0 for rate in scaling.values())
+def test_quick_reports_the_cost_of_each_sensor_per_message(quick_run):
+    costs = json.loads(quick_run[0])['sensor_us_per_message']
+    assert set(costs) == {'depth_camera', 'lidar', 'tilt_imu', 'tilt_ft'}
+    assert all(isinstance(cost, float) and cost > 0 for cost in costs.values()), costs
 
 
 @pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
@@ -62,22 +78,11 @@ def test_quick_keeps_pybullet_and_node_output_off_stdout(quick_run):
     assert stdout.count('\n') == 1 and stdout.lstrip().startswith('{')
 
 
-def test_rounded_gives_integer_rates_and_four_significant_digits():
-    figures = bench.rounded({'raw_steps_per_s': 123456.7, 'ratio_to_raw': 0.123456,
-                             'scaling': {'2': 9876.4}})
-    assert figures == {'raw_steps_per_s': 123457, 'ratio_to_raw': 0.1235,
-                       'scaling': {'2': 9876}}
-
-
-def test_windowed_rate_is_the_median_rate_over_windows():
-    # 10 units per second, with one window of 30 per second in the middle.
-    samples = [(0.0, 0.0), (0.5, 5.0), (1.0, 10.0), (1.5, 25.0), (2.0, 30.0), (2.5, 35.0)]
-    assert bench.windowed_rate(samples, 0.5) == pytest.approx(10.0)
-
-
-def test_windowed_rate_needs_two_samples():
-    with pytest.raises(bench.BenchError):
-        bench.windowed_rate([(0.0, 0.0)], 0.5)
+def test_rounded_gives_integer_rates_and_four_significant_digits_at_any_depth():
+    figures = bench.rounded({'raw': {'steps_per_s': 123456.7, 'step_us_cpu': 3.14159},
+                             'scaling': {'2': {'steps_per_s': 9876.4}}})
+    assert figures == {'raw': {'steps_per_s': 123457, 'step_us_cpu': 3.142},
+                       'scaling': {'2': {'steps_per_s': 9876}}}
 
 
 def test_slope_fits_a_line_through_jittered_samples():

@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 import pytest
+from ros2_control_fixtures import write_arm
 
 from pan_tilt_sim.tools import step_response
 from pan_tilt_sim.tools.step_response import (
@@ -160,3 +161,85 @@ def test_user_errors_exit_2_with_one_line(capsys, argv, message):
     err = capsys.readouterr().err
     assert exit_info.value.code == 2
     assert message in err and err.count('\n') == 1
+
+
+# --- any controller that takes positions: groups, forward commands, trajectories ----------
+
+@pytest.fixture
+def ur_style_arm(tmp_path):
+    """Return the step_response arguments for the UR-style arm (three controllers per joint)."""
+    xacro = write_arm(tmp_path)
+    return ['--model', str(xacro), '--controllers-args', 'prefix:=', '--duration', '2']
+
+
+def run_tool(argv):
+    return step_response.run(step_response.parse_args(argv))
+
+
+@pytest.mark.parametrize(('controller', 'expected'), [
+    ([], 'joint_trajectory_controller'),  # the first that takes positions
+    (['--controller', 'forward_position_controller'], 'forward_position_controller'),
+])
+def test_the_joint_steps_through_whichever_controller_takes_positions(ur_style_arm, controller,
+                                                                      expected):
+    summary = run_tool([*ur_style_arm, '--joint', 'joint2', '--target', '0.5', *controller])
+    assert summary['controller'] == expected
+    assert summary['target'] == 0.5
+    assert summary['steady_state_error'] == pytest.approx(0.0, abs=0.01)
+    assert summary['gains'] == {'p': 100.0, 'i': 0.01, 'd': 10.0}
+
+
+def test_the_other_joints_of_a_group_hold_while_one_steps(ur_style_arm):
+    args = step_response.parse_args([*ur_style_arm, '--joint', 'joint2', '--target', '0.5',
+                                     '--controller', 'forward_position_controller'])
+    with step_response.build_simulation(args) as simulation:
+        record = step_response.record_step(simulation, 'joint2', 0.5, 1.0,
+                                           'forward_position_controller')
+        assert record.positions[-1] == pytest.approx(0.5, abs=0.02)
+        assert simulation.joint_positions()['joint1'] == pytest.approx(0.0, abs=0.05)
+
+
+def test_a_controller_that_does_not_take_positions_is_refused(ur_style_arm, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        step_response.main([*ur_style_arm, '--joint', 'joint1', '--target', '0.5',
+                            '--controller', 'forward_velocity_controller'])
+    err = capsys.readouterr().err
+    assert exit_info.value.code == 2 and err.count('\n') == 1
+    assert ("--controller: 'forward_velocity_controller' is not a loaded controller that "
+            "drives 'joint1' by position") in err
+
+
+def test_a_joint_driven_only_by_velocity_says_so(tmp_path, capsys):
+    xacro = write_arm(tmp_path, """
+        velocity_controller:
+          type: velocity_controllers/JointVelocityController
+          joint: joint1
+        """)
+    with pytest.raises(SystemExit):
+        step_response.main(['--model', str(xacro), '--joint', 'joint1', '--target', '0.5'])
+    assert ("no controller takes position commands for 'joint1' (its controllers: "
+            'velocity_controller (velocity_controllers/JointVelocityController))') in (
+                capsys.readouterr().err)
+
+
+def test_plot_without_matplotlib_is_one_line_before_the_run(monkeypatch, capsys, tmp_path):
+    monkeypatch.setitem(sys.modules, 'matplotlib', None)  # import matplotlib -> ImportError
+
+    def no_run(args):
+        raise AssertionError('the simulation ran before the missing matplotlib was reported')
+    monkeypatch.setattr(step_response, 'build_simulation', no_run)
+    with pytest.raises(SystemExit) as exit_info:
+        step_response.main(['--joint', 'pan_joint', '--target', '1',
+                            '--plot', str(tmp_path / 'step.png')])
+    err = capsys.readouterr().err
+    assert exit_info.value.code == 2
+    assert err == 'step_response: error: --plot: matplotlib is not installed ' \
+                  '(pip install matplotlib)\n'
+
+
+def test_plot_into_a_missing_folder_is_refused_before_the_run(monkeypatch, capsys, tmp_path):
+    monkeypatch.setattr(step_response, 'build_simulation', lambda args: pytest.fail('ran'))
+    with pytest.raises(SystemExit):
+        step_response.main(['--joint', 'pan_joint', '--target', '1',
+                            '--plot', str(tmp_path / 'no' / 'step.png')])
+    assert f"no folder {tmp_path / 'no'}" in capsys.readouterr().err

@@ -1,10 +1,12 @@
 """tune: gains that meet a spec the seed's fail, written back in the user's style, seed for seed."""
 
+import dataclasses
 import json
 import math
 import subprocess
 import sys
 import textwrap
+import types
 
 import pytest
 
@@ -273,3 +275,26 @@ def test_itae_and_violations_rank_the_trials():
         trial(0, 1.0, error=0.5), trial(1, 0.1, settling=2.0)), {})
     assert infeasible.best.number == 0 and not infeasible.met
     assert math.isclose(infeasible.best.excess, 0.5)
+
+
+def test_with_several_controller_files_the_one_whose_gains_win_is_rewritten(repo_root,
+                                                                            tmp_path):
+    # ros2_control reads the files in order, later ones winning: the second file's pid
+    # is the one in force, so that is the file tune writes (the first stays as it is).
+    first, second = tmp_path / 'a' / 'base.yaml', tmp_path / 'b' / 'override.yaml'
+    first.parent.mkdir()
+    second.parent.mkdir()
+    first.write_text(ROS2_CONTROLLERS)
+    second.write_text('tilt_controller:\n  ros__parameters:\n    pid: {p: 50.0, d: 5.0}\n')
+    scenario = load_scenario(repo_root / 'urdf' / 'pan_tilt.xacro', first, 0.001)
+    scenario = dataclasses.replace(scenario, controllers=load_controllers_config([first,
+                                                                                  second]))
+    tuned = PidGains(p=75.0, i=0.5, d=4.0, i_clamp_min=-2.0, i_clamp_max=2.0)
+    result = tune.TuneResult((tune.JointTuning(
+        'tilt_joint', 'tilt_controller', 'pid', PidGains(), (tune.Trial(
+            0, tuned, types.SimpleNamespace(itae=1.0), {'effort': -1.0}),), {}),), {}, {},
+        Spec())
+    out = tmp_path / 'out.yaml'
+    tune.write_yaml(scenario, result, out)
+    assert out.read_text() == ('tilt_controller:\n  ros__parameters:\n'
+                               '    pid: {p: 75.0, d: 4.0, i: 0.5, i_clamp: 2.0}\n')

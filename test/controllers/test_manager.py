@@ -1,0 +1,222 @@
+"""ControllerManager: loaded and active controllers, as ros2_control's controller_manager.
+
+A UR-style file declares three controllers on the same joints plus vendor
+types; the manager loads what it can, activates what it is told, refuses
+what ros2_control would refuse, and switches controllers atomically.
+"""
+
+from __future__ import annotations
+
+import pytest
+from ros2_control_fixtures import UR_STYLE_YAML, write, write_arm
+
+from pan_tilt_sim.controllers import JointHandle
+from pan_tilt_sim.controllers.manager import ControllerManager
+from pan_tilt_sim.errors import ControllerConfigError, ControllerSwitchError
+from pan_tilt_sim.model.controller_config import load_controllers_config
+from pan_tilt_sim.model.description import load_description
+
+ARGS = {'prefix': ''}
+JTC = 'joint_trajectory_controller'
+FORWARD_POSITION = 'forward_position_controller'
+FORWARD_VELOCITY = 'forward_velocity_controller'
+JSB = 'joint_state_broadcaster'
+DT = 0.001
+
+
+@pytest.fixture
+def arm(tmp_path):
+    """Return a function building a manager for the arm with a YAML (default: UR style)."""
+    def build(yaml=UR_STYLE_YAML, active=None, args=ARGS):
+        xacro = write_arm(tmp_path, yaml)
+        description = load_description(xacro)
+        handles = {joint.name: JointHandle(joint) for joint in description.actuated_joints}
+        config = load_controllers_config(tmp_path / 'arm_controllers.yaml', args)
+        return ControllerManager(config, handles, description.model, active=active), handles
+    return build
+
+
+def run(manager, steps=10):
+    for step in range(steps):
+        for update in manager.updates:
+            update(step * DT, DT)
+
+
+# --- start-up: which controllers, which active -------------------------------------------
+
+def test_without_active_controllers_two_controllers_on_one_joint_is_an_error(arm):
+    with pytest.raises(ControllerConfigError) as caught:
+        arm()
+    message = str(caught.value)
+    assert "joint 'joint1' is claimed by both 'joint_trajectory_controller' and " \
+           "'forward_velocity_controller'" in message
+    assert "the parameter 'active_controllers'" in message
+
+
+def test_the_active_ones_run_the_others_are_loaded_inactive_and_vendor_types_skipped(arm):
+    manager, _ = arm(active=[JSB, JTC])
+    assert [c.name for c in manager.active] == [JTC, JSB]  # command controllers update first
+    assert {c.name for c in manager.controllers} == {JSB, JTC, FORWARD_POSITION,
+                                                       FORWARD_VELOCITY}
+    assert not manager.is_active(FORWARD_POSITION)
+    assert [(s.name, s.type) for s in manager.skipped] == [
+        ('io_and_status_controller', 'acme_controllers/GPIOController'),
+        ('speed_scaling_state_broadcaster', 'acme_controllers/SpeedScalingStateBroadcaster'),
+        ('scaled_joint_trajectory_controller',
+         'acme_controllers/ScaledJointTrajectoryController')]
+    assert all(s.reason == 'a controller type this simulator does not have'
+               for s in manager.skipped)
+
+
+def test_an_inactive_controller_runs_no_update(arm):
+    manager, handles = arm(active=[JSB, JTC])
+    manager.controller(FORWARD_POSITION).set_command([1.0, 1.0])
+    run(manager)
+    assert [handle.effort for handle in handles.values()] == [0.0, 0.0]  # JTC holds at rest
+    manager.switch(activate=[FORWARD_POSITION], deactivate=[JTC])
+    manager.controller(FORWARD_POSITION).set_command([1.0, 1.0])
+    run(manager)
+    assert all(handle.effort > 0.0 for handle in handles.values())
+
+
+def test_a_vendor_type_listed_as_active_is_an_error_listing_the_supported_types(arm):
+    with pytest.raises(ControllerConfigError) as caught:
+        arm(active=[JSB, 'scaled_joint_trajectory_controller'])
+    message = str(caught.value)
+    assert ("scaled_joint_trajectory_controller.type: unknown controller type "
+            "'acme_controllers/ScaledJointTrajectoryController', and the parameter "
+            "'active_controllers' lists it (supported: ") in message
+    assert 'joint_trajectory_controller/JointTrajectoryController' in message
+
+
+def test_an_active_name_the_file_does_not_have_is_an_error(arm):
+    with pytest.raises(ControllerConfigError) as caught:
+        arm(active=[JSB, 'arm_controller'])
+    assert str(caught.value).startswith(
+        "the parameter 'active_controllers': no controller 'arm_controller' in ")
+    assert 'its controllers: joint_state_broadcaster, io_and_status_controller' in str(
+        caught.value)
+
+
+def test_two_active_controllers_on_one_joint_is_an_error_naming_both(arm):
+    with pytest.raises(ControllerConfigError) as caught:
+        arm(active=[JTC, FORWARD_POSITION])
+    assert str(caught.value) == (
+        "the parameter 'active_controllers': 'joint_trajectory_controller' and "
+        "'forward_position_controller' both claim joint 'joint1'; only one active controller "
+        'can command a joint')
+
+
+VENDOR_ONLY = """
+    controller_manager:
+      ros__parameters:
+        joint_state_broadcaster: {type: joint_state_broadcaster/JointStateBroadcaster}
+        speed_scaling: {type: acme_controllers/SpeedScalingStateBroadcaster}
+        arm_controller: {type: acme_controllers/RobotController}
+    arm_controller:
+      ros__parameters: {joints: [joint1, joint2]}
+    """
+
+
+def test_when_every_controller_that_commands_joints_is_unknown_start_up_stops(arm):
+    with pytest.raises(ControllerConfigError) as caught:
+        arm(VENDOR_ONLY)
+    assert ("arm_controller.type: unknown controller type 'acme_controllers/RobotController', "
+            'and no other controller in the file commands a joint (supported: ') in str(
+                caught.value)
+
+
+def test_a_vendor_controller_beside_a_known_one_is_skipped_when_all_are_active(arm):
+    manager, _ = arm("""
+        controller_manager:
+          ros__parameters:
+            joint_state_broadcaster: {type: joint_state_broadcaster/JointStateBroadcaster}
+            group: {type: position_controllers/JointGroupPositionController}
+            arm_controller: {type: acme_controllers/RobotController}
+        group:
+          ros__parameters: {joints: [joint1]}
+        """)
+    assert [c.name for c in manager.active] == ['group', JSB]
+    assert [s.name for s in manager.skipped] == ['arm_controller']
+
+
+def test_an_inactive_controller_that_cannot_load_is_skipped_with_its_reason(arm):
+    broken = UR_STYLE_YAML.replace('    interface_name: velocity\n',
+                                   '    interface_name: velocity\n    joints: [elbow]\n')
+    manager, _ = arm(broken, active=[JSB, JTC])
+    (velocity,) = [s for s in manager.skipped if s.name == FORWARD_VELOCITY]
+    assert velocity.reason.startswith('cannot be loaded: ')
+    assert "joint 'elbow' is not a movable joint of the robot" in velocity.reason
+    with pytest.raises(ControllerConfigError, match="joint 'elbow' is not a movable joint"):
+        arm(broken, active=[JSB, FORWARD_VELOCITY])
+
+
+# --- the URDF's <ros2_control> interfaces ------------------------------------------------
+
+def test_an_effort_controller_on_a_position_only_joint_is_refused(arm):
+    effort = UR_STYLE_YAML.replace('velocity_controllers/JointGroupVelocityController',
+                                   'effort_controllers/JointGroupEffortController')
+    with pytest.raises(ControllerConfigError) as caught:
+        arm(effort, active=[FORWARD_VELOCITY])
+    assert str(caught.value).endswith(
+        ": forward_velocity_controller (effort_controllers/JointGroupEffortController) claims "
+        "the 'effort' command interface of joint 'joint1', which the URDF's <ros2_control> "
+        'block does not give it (its command interfaces: position, velocity)')
+
+
+def test_joints_outside_every_ros2_control_block_take_any_interface(tmp_path):
+    from pan_tilt_sim.share import package_share
+
+    description = load_description(package_share() / 'urdf' / 'pan_tilt.xacro')
+    handles = {joint.name: JointHandle(joint) for joint in description.actuated_joints}
+    path = write(tmp_path, 'e.yaml',
+                 'e: {type: effort_controllers/JointEffortController, joint: pan_joint}\n')
+    manager = ControllerManager(load_controllers_config(path), handles, description.model)
+    assert [c.name for c in manager.active] == ['e']
+
+
+# --- switching at run time ---------------------------------------------------------------
+
+def test_switching_hands_the_joints_over_and_the_new_controller_holds_them(arm):
+    manager, handles = arm(active=[JSB, JTC])
+    handles['joint1'].position, handles['joint2'].position = 0.3, -0.2
+    manager.switch(activate=[FORWARD_POSITION], deactivate=[JTC])
+    assert [c.name for c in manager.active] == [FORWARD_POSITION, JSB]
+    assert manager.controller(FORWARD_POSITION).setpoints() == {'joint1': 0.3, 'joint2': -0.2}
+
+
+def test_a_conflicting_switch_is_refused_and_changes_nothing(arm):
+    manager, _ = arm(active=[JSB, JTC])
+    with pytest.raises(ControllerSwitchError,
+                       match="'joint_trajectory_controller' and 'forward_position_controller' "
+                             "would both claim joint 'joint1'"):
+        manager.switch(activate=[FORWARD_POSITION])
+    assert [c.name for c in manager.active] == [JTC, JSB]
+
+
+def test_a_switch_to_an_interface_the_joint_lacks_is_refused(arm):
+    manager, _ = arm(active=[JSB, JTC])
+    with pytest.raises(ControllerSwitchError, match="'velocity' command interface of joint "
+                                                    "'joint2'"):
+        manager.switch(activate=[FORWARD_VELOCITY], deactivate=[JTC])
+    assert manager.is_active(JTC) and not manager.is_active(FORWARD_VELOCITY)
+
+
+def test_switching_an_unknown_or_skipped_controller_is_refused(arm):
+    manager, _ = arm(active=[JSB, JTC])
+    with pytest.raises(ControllerSwitchError, match="no loaded controller "
+                                                    "'scaled_joint_trajectory_controller'"):
+        manager.switch(activate=['scaled_joint_trajectory_controller'], deactivate=[JTC])
+
+
+def test_a_deactivated_controller_holds_nothing_its_joints_keep_the_last_command(arm):
+    manager, handles = arm(active=[JSB, FORWARD_POSITION])
+    manager.controller(FORWARD_POSITION).set_command([1.0, -1.0])
+    run(manager)
+    last = [handle.effort for handle in handles.values()]
+    assert last[0] > 0.0 > last[1]
+    manager.switch(deactivate=[FORWARD_POSITION])
+    handles['joint1'].position = 0.5  # the joint moves; nobody recomputes its command
+    run(manager)
+    assert [handle.effort for handle in handles.values()] == last
+    assert [c.name for c in manager.active] == [JSB]
