@@ -14,6 +14,10 @@ seed's pan stepped 0 -> 1 rad with the seed's gains, 15 s of sim time at
   ``local_1`` and ``local_2`` (1 and 2 spawned worker processes) and
   ``ray_2_nodes`` (Ray tasks on a two-node cluster started on this machine:
   a head node and a second node, one CPU each, all on 127.0.0.1);
+* ``worker_busy_share`` -- per back end, the share of its workers' wall time
+  spent evaluating (their CPU time over wall time x parallelism): 1 on an
+  idle machine with no overhead; on a shared machine it shows how much of a
+  core the workers actually got;
 * ``overhead_ms_per_evaluation`` -- per back end, wall time per evaluation
   times the back end's parallelism, less ``cpu_s_per_evaluation``: what
   running it there costs beyond the simulation itself (dispatch,
@@ -273,6 +277,8 @@ def summarise(rounds: Sequence[dict], names: Sequence[str], nodes: RayNodes | No
         - f['cpu_s_per_evaluation']) * MILLISECONDS) for name in names}
     dispatch = {name: median(lambda f, n=name: f[n]['echo_ms']) for name in names}
     worker_cpu = {name: median(lambda f, n=name: f[n]['worker_cpu_s']) for name in names}
+    busy = {name: median(lambda f, n=name: f[n]['worker_cpu_s'] * f[n]['evaluations']
+                         / (f[n]['wall_s'] * f[n]['parallelism'])) for name in names}
     duration = case.duration or (TARGET / 0.1 + 5.0)
     return {
         'evaluation': {'joint': JOINT, 'target': TARGET, 'sim_s': duration,
@@ -281,6 +287,7 @@ def summarise(rounds: Sequence[dict], names: Sequence[str], nodes: RayNodes | No
         'in_process_cpu_share': median(lambda f: f['in_process_cpu_share']),
         'worker_cpu_s_per_evaluation': worker_cpu,
         'evaluations_per_s': throughput,
+        'worker_busy_share': busy,
         'overhead_ms_per_evaluation': overhead,
         'dispatch_ms_per_task': dispatch,
         'ray_submit_ms_per_task': None if nodes is None else median(

@@ -71,6 +71,7 @@ def test_overhead_is_wall_per_evaluation_times_parallelism_less_its_cpu():
     assert figures['evaluations_per_s'] == {'local_2': pytest.approx(10 / 1.2)}
     # 1.2 s for 10 on 2 workers: 0.24 core-s each, 0.04 more than the 0.2 s of simulation.
     assert figures['overhead_ms_per_evaluation'] == {'local_2': pytest.approx(40.0)}
+    assert figures['worker_busy_share'] == {'local_2': pytest.approx(0.21 * 10 / 2.4)}
     assert figures['evaluation']['steps'] == 15000
 
 
