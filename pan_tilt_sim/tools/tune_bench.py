@@ -28,6 +28,9 @@ seed's pan stepped 0 -> 1 rad with the seed's gains, 15 s of sim time at
 * ``ray_submit_ms_per_task`` -- the driver's own cost of submitting one Ray
   task (``.remote()`` alone, not waiting for it): one driver keeps at most
   about ``cpu_s_per_evaluation / submit`` cores busy;
+* ``tpe_ms_per_trial`` -- ``tune``'s driver cost per candidate: Optuna's TPE
+  ask + tell with 64 and 512 candidates already known (keys), the same
+  sampler, space and constraints, cheap made-up costs;
 * ``ray_cluster_start_s`` and ``ray_connect_s`` -- starting the two nodes,
   and connecting a driver to them (which ships this package to the cluster);
 * ``load_average_1min`` before and after, and ``cpu_count``: how quiet the
@@ -52,7 +55,9 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import json
+import math
 import os
+import random
 import statistics
 import subprocess
 import sys
@@ -81,6 +86,9 @@ LOOPBACK = '127.0.0.1'
 # Keeps every Ray address on 127.0.0.1 (see the module docstring).
 RAY_LOOPBACK_ENV = {'RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER': '0', 'RAY_USAGE_STATS_ENABLED': '0'}
 MILLISECONDS = 1e3
+# Optuna's cost per trial is measured with this many trials already told.
+FULL_TPE_HISTORY = (64, 512)
+QUICK_TPE_HISTORY = (16,)
 
 # Run by the child process that holds the two Ray nodes: print the address, wait for SIGTERM.
 _CLUSTER_SCRIPT = f'''
@@ -186,6 +194,34 @@ def ray_submit_ms(scenario: Scenario, tasks: int) -> float:
     return submitted / tasks * MILLISECONDS
 
 
+def tpe_ms_per_trial(history: int, batch: int = 8) -> float | None:
+    """Return the driver's Optuna cost per trial (ask + tell) of the last batch of ``history``.
+
+    The same sampler, search space and constraints as ``tune``, told cheap
+    made-up costs: what ``tune``'s driver spends per candidate when ``history``
+    candidates are known.  None without Optuna.
+    """
+    if importlib.util.find_spec('optuna') is None:
+        return None
+    import optuna
+
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    study = optuna.create_study(direction='minimize', sampler=optuna.samplers.TPESampler(
+        seed=0, multivariate=True, constant_liar=True))
+    space = {name: optuna.distributions.FloatDistribution(1e-3, 1e3, log=True)
+             for name in ('p', 'i', 'd', 'i_clamp')}
+    generator = random.Random(0)
+    last = 0.0
+    for _ in range(history // batch):
+        started = time.perf_counter()
+        for trial in [study.ask(space) for _ in range(batch)]:
+            for name in ('overshoot', 'settling', 'error', 'effort'):
+                trial.set_constraint(name, generator.uniform(-1.0, 1.0))
+            study.tell(trial, sum(math.log(value) ** 2 for value in trial.params.values()))
+        last = (time.perf_counter() - started) / batch
+    return last * MILLISECONDS
+
+
 def cpu_per_evaluation(scenario: Scenario, case: Case, count: int) -> tuple[float, float]:
     """Return the median CPU seconds of one evaluation here, and CPU/wall over all of them."""
     cpu, started, wall_started = [], time.process_time(), time.perf_counter()
@@ -204,6 +240,8 @@ def run(*, quick: bool = False, runs: int = 1,
     echoes = QUICK_ECHO_TASKS if quick else ECHO_TASKS
     cases = [case] * evaluations
     load_before = os.getloadavg()[0]
+    tpe = {str(history): tpe_ms_per_trial(history)
+           for history in (QUICK_TPE_HISTORY if quick else FULL_TPE_HISTORY)}
     rounds: list[dict[str, Any]] = []
     with tempfile.TemporaryDirectory(prefix='pan_tilt_tune_bench_') as folder:
         nodes, ray_backend, connect_s = _start_ray(folder, log)
@@ -233,7 +271,9 @@ def run(*, quick: bool = False, runs: int = 1,
             if nodes is not None:
                 nodes.stop()
     names = ['in_process', *backends, *(['ray_2_nodes'] if ray_backend is not None else [])]
-    return summarise(rounds, names, nodes, connect_s, load_before, runs, case, scenario)
+    figures = summarise(rounds, names, nodes, connect_s, load_before, runs, case, scenario)
+    figures['tpe_ms_per_trial'] = tpe
+    return figures
 
 
 def _start_ray(folder: str, log: Callable[[str], None]

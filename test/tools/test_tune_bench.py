@@ -52,6 +52,7 @@ def test_bench_tune_quick_prints_one_json_object_with_every_back_end(quick):
     assert figures['cpu_s_per_evaluation'] > 0
     assert figures['ray_cluster_start_s'] > 0 and figures['ray_connect_s'] > 0
     assert figures['ray_submit_ms_per_task'] > 0
+    assert figures['tpe_ms_per_trial']['16'] > 0
     assert figures['evaluation']['steps'] == 1000
 
 
