@@ -10,11 +10,22 @@
 #   source, only when the source changed since the last install, so the
 #   venv's ament layout (lib/pan_tilt_sim/, share/pan_tilt_sim/, ament index
 #   marker) always matches the tree and the tree gets no build/ or egg-info;
+# * builds the interface packages of interfaces/ (tf2_msgs, control_msgs,
+#   controller_manager_msgs, simulation_interfaces: not on PyPI) into the
+#   venv with scripts/build_interfaces.py, in test mode (or when asked), only
+#   when interfaces/, that script, the requirements or AMENT_PREFIX_PATH /
+#   PYTHONPATH changed since the last build; the script itself skips a
+#   package that a ROS install (or anything else) already provides and
+#   rebuilds only the packages whose definitions changed;
 # * leaves REPO and VENV set, PYTHONPATH unset (a sourced ROS install's
 #   Python 3.12 packages must not shadow the venv's).
 #
 # Environment: PAN_TILT_SIM_VENV (venv path), PAN_TILT_SIM_PYTHON
-# (interpreter to create it with, default python3.11).
+# (interpreter to create it with, default python3.11),
+# PAN_TILT_SIM_INTERFACES: auto (default: `test` builds the interface
+# packages, `runtime` uses whatever is built), build (`runtime` builds them
+# too, installing requirements-build.txt) or skip (never build);
+# PAN_TILT_SIM_INTERFACES_FORCE=1 rebuilds them even when up to date.
 
 REPO=$(cd -- "$(dirname -- "${BASH_SOURCE[0]}")/.." && pwd)
 VENV=${PAN_TILT_SIM_VENV:-$REPO/.venv}
@@ -39,15 +50,19 @@ _pts_create_venv() {
 
 _pts_hash() { sha256sum | cut -d' ' -f1; }
 
+# tar of the given repo paths, names, modes and contents only, for hashing.
+_pts_tar() {
+    tar -C "$REPO" --sort=name --owner=0 --group=0 --numeric-owner --mtime=@0 \
+        --exclude=__pycache__ --exclude='*.pyc' --exclude='*.egg-info' -cf - "$@"
+}
+
 # Hash of the source files setup.py installs: names, modes and contents.
 _pts_source_hash() {
     local present=() item
     for item in "${_PTS_SOURCES[@]}"; do
         [[ -e $REPO/$item ]] && present+=("$item")
     done
-    tar -C "$REPO" --sort=name --owner=0 --group=0 --numeric-owner --mtime=@0 \
-        --exclude=__pycache__ --exclude='*.pyc' --exclude='*.egg-info' \
-        -cf - "${present[@]}" | _pts_hash
+    _pts_tar "${present[@]}" | _pts_hash
 }
 
 _pts_install_package() {
@@ -65,6 +80,38 @@ _pts_install_package() {
         _pts_die "installing pan_tilt_sim failed"
     fi
     rm -rf -- "$tmp"
+}
+
+# Build interfaces/ into the venv when due (see the top of this file).
+_pts_interfaces() {
+    local mode=$1 deps_hash=$2 want=${PAN_TILT_SIM_INTERFACES:-auto} key stamp force=()
+    case $want in
+        auto) [[ $mode == test ]] || return 0 ;;
+        build) ;;
+        skip) return 0 ;;
+        *) _pts_die "PAN_TILT_SIM_INTERFACES is auto, build or skip, not '$want'" ;;
+    esac
+    # What a ROS install on these paths provides is not built (the script
+    # checks), so they are part of the key.
+    key=$({ echo "$deps_hash"; printf '%s\n' "${AMENT_PREFIX_PATH:-}" "${PYTHONPATH:-}"
+            _pts_tar interfaces scripts/build_interfaces.py; } | _pts_hash)
+    stamp=$VENV/.pan_tilt_sim-interfaces
+    if [[ -n ${PAN_TILT_SIM_INTERFACES_FORCE:-} ]]; then
+        force=(--force)
+    elif [[ "$(cat "$stamp" 2>/dev/null)" == "$key" ]]; then
+        return 0
+    fi
+    if [[ "$(cat "$VENV/.pan_tilt_sim-deps-test" 2>/dev/null)" != "$deps_hash" \
+            && "$(cat "$VENV/.pan_tilt_sim-deps-build" 2>/dev/null)" != "$deps_hash" ]]; then
+        _pts_say "installing requirements-build.txt (the rosidl generators)"
+        "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check \
+                -r "$REPO/requirements-build.txt" \
+            || _pts_die "installing requirements-build.txt failed"
+        echo "$deps_hash" >"$VENV/.pan_tilt_sim-deps-build"
+    fi
+    "$VENV/bin/python" "$REPO/scripts/build_interfaces.py" --prefix "$VENV" "${force[@]}" \
+        || _pts_die "building the interface packages failed (PAN_TILT_SIM_INTERFACES=skip does without them)"
+    echo "$key" >"$stamp"
 }
 
 prepare_venv() {
@@ -90,7 +137,8 @@ prepare_venv() {
 
     # The test set includes the runtime set, so a current test stamp is
     # enough for runtime use too.
-    deps_hash=$(cat "$REPO/requirements.txt" "$REPO/requirements-test.txt" | _pts_hash)
+    deps_hash=$(cat "$REPO/requirements.txt" "$REPO/requirements-test.txt" \
+        "$REPO/requirements-build.txt" | _pts_hash)
     deps_stamp=$VENV/.pan_tilt_sim-deps-$mode
     if [[ "$(cat "$deps_stamp" 2>/dev/null)" != "$deps_hash" \
             && "$(cat "$VENV/.pan_tilt_sim-deps-test" 2>/dev/null)" != "$deps_hash" ]]; then
@@ -107,6 +155,8 @@ prepare_venv() {
         _pts_install_package
         echo "$src_hash" >"$src_stamp"
     fi
+
+    _pts_interfaces "$mode" "$deps_hash"
 
     if [[ -n ${_PTS_LOCK_FD:-} ]]; then
         exec {_PTS_LOCK_FD}<&-
