@@ -407,7 +407,7 @@ def table(result: TuneResult) -> str:
                 joint = tuning.joint if number == 0 else ''
                 target = f'{old.target:g}' if number == 0 else ''
                 lines.append(f'{joint:<16}{target:>9}  {name:<24}{_shown(was):>11}'
-                             f'{_shown(now):>11}  {bound}')
+                             f'{_shown(now):>11}  {bound}'.rstrip())
         lines.append(f'{tuning.joint:<16}{"":>9}  gains: {describe_gains(tuning.before)}'
                      f' -> {describe_gains(tuning.best.gains)}')
     return '\n'.join(lines)
