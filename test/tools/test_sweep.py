@@ -138,3 +138,14 @@ def test_user_errors_exit_2_with_one_line(args, message):
     result = run_sweep(['--joint', 'pan_joint', '--target', '1', *args])
     assert result.returncode == 2, result.stdout + result.stderr
     assert message in result.stderr and result.stderr.count('\n') == 1, result.stderr
+
+
+def test_random_samples_are_binned_for_the_heatmap():
+    x = sweep.parse_axis('mass=0:80')
+    rows = [{'mass': 1.0, 'passed': True}, {'mass': 9.0, 'passed': False},
+            {'mass': 79.0, 'passed': False}, {'mass': 80.0, 'passed': True}]
+    xs, ys, counts = sweep.heatmap_cells(rows, x, None, binned=True)
+    assert xs == [5.0 + 10.0 * k for k in range(sweep.HEATMAP_BINS)] and ys == [0.0]
+    assert counts[0][0] == (1, 2)  # 1 and 9 kg share the first 10 % bin, one failing
+    assert counts[0][-1] == (1, 2)  # the top of the range goes into the last bin
+    assert sum(total for _, total in counts[0]) == 4
