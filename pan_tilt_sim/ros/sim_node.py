@@ -31,7 +31,7 @@ from pan_tilt_sim.model.controller_config import (
     parse_controllers_args,
 )
 from pan_tilt_sim.model.description import RobotDescription, load_description
-from pan_tilt_sim.ros import parameters, services
+from pan_tilt_sim.ros import parameters, services, simulation_services
 from pan_tilt_sim.ros.features import NodeFeatures
 from pan_tilt_sim.ros.gain_parameters import GainParameters
 from pan_tilt_sim.ros.pacing import Pacer, Throttle
@@ -89,6 +89,7 @@ class SimNode(Node):
             description, controllers, self.settings.time_step, gui=self.settings.gui,
             active_controllers=self.settings.active_controllers)
         self._paused = self.settings.paused
+        self.steps_run = 0  # physics steps this node has run (never reset; see run_steps)
         # Commands taken per controller (ignored ones included): a cheap health figure.
         self.commands_received = {c.name: 0 for c in self.simulation.command_controllers()}
         self._pacer = Pacer(self.settings.real_time_factor, self.settings.time_step)
@@ -119,6 +120,8 @@ class SimNode(Node):
         self.add_post_set_parameters_callback(self._apply_parameters)
         self._world_services = services.create_world_services(
             self, reset=self.reset, set_paused=self.set_paused)
+        # simulation_interfaces (where installed): its own module, its own callback groups.
+        self.simulation_interfaces = simulation_services.create(self, self._world_services)
         self._log_controllers(description, controllers)
         for joint in self.simulation.physics.joints:
             if joint.initial_position != 0.0:
@@ -179,6 +182,7 @@ class SimNode(Node):
             if sensor_due is not None:  # a watched sensor samples between /clock messages
                 chunk = min(chunk, sensor_due)
             simulation.advance(chunk)
+            self.steps_run += chunk
             steps -= chunk
             if simulation.steps % every == 0 and clock_wanted:
                 self._clock_pending = True
@@ -212,12 +216,24 @@ class SimNode(Node):
             self._pacer.restart()
             self._retime()
 
-    def reset(self, *, reset_time: bool = True) -> None:
-        """Put the robot back to its initial state; sim time to 0 if asked (/clock says so).
+    def step(self, steps: int) -> None:
+        """Run ``steps`` steps now, paused or not (stepping on request, see stepping.py)."""
+        self._refresh_readers()
+        self.run_steps(steps)
 
-        Every periodic publication (joint states, TF, camera) starts again from now.
+    def reset(self, *, reset_time: bool = True, reset_state: bool = True) -> None:
+        """Put the world back to its initial state; sim time to 0 if asked (/clock says so).
+
+        The state is the robot's joints and controllers and the poses of the
+        entities in the world (spawned objects stay; see simulation_services
+        for more).  Every periodic publication (joint states, TF, camera)
+        starts again from now.
         """
-        self.simulation.reset(reset_time=reset_time)
+        if reset_state:
+            self.simulation.reset(reset_time=reset_time)
+            self.features.entities.reset_state()
+        elif reset_time:
+            self.simulation.reset_time()
         self._pacer.restart()
         self._publish_clock()
         self.features.reset()
@@ -226,6 +242,9 @@ class SimNode(Node):
     def destroy_node(self) -> None:
         """Stop ticking and release PyBullet."""
         self._timer.cancel()
+        if self.simulation_interfaces is not None:
+            self.simulation_interfaces.close()
+        self.features.close()
         self.simulation.close()
         logger = self.get_logger()
         super().destroy_node()
