@@ -14,15 +14,26 @@ PROGRAM = 'sim_node'
 
 
 def make_sim_node():
-    """Build the SimNode (imports rclpy and PyBullet: call it once the handlers are in)."""
+    """Build the SimNode (imports rclpy and PyBullet: call it once the handlers are in).
+
+    Its physics runs in a paced thread of its own (see
+    :mod:`pan_tilt_sim.ros.physics_thread`).
+    """
     from pan_tilt_sim.ros.sim_node import SimNode
 
-    return SimNode()
+    return SimNode(physics_thread=True)
+
+
+def make_executor(node):
+    """Return the executor that takes turns with the node's physics thread."""
+    from pan_tilt_sim.ros.physics_thread import TurnTakingExecutor
+
+    return TurnTakingExecutor(node.turns, context=node.context)
 
 
 def main(args: list[str] | None = None) -> None:
     """Run sim_node until SIGINT/SIGTERM (exit 0); a configuration error exits with code 2."""
-    runner.main(make_sim_node, args, program=PROGRAM)
+    runner.main(make_sim_node, args, program=PROGRAM, make_executor=make_executor)
 
 
 if __name__ == '__main__':

@@ -68,7 +68,7 @@ def node_figures(seconds: float) -> dict[str, float]:
 
     rclpy.init()
     node = SimNode(parameter_overrides=[Parameter('real_time_factor', value=0.0)])
-    executor = spinning.make_executor()
+    executor = spinning.single_threaded(node.context)
     executor.add_node(node)
     simulation = node.simulation
     for controller in simulation.command_controllers():
@@ -111,11 +111,8 @@ def main() -> None:
     """Print the per-step figures."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--seconds', type=float, default=5.0, help='node run, wall s')
-    parser.add_argument('--executor', choices=('events', 'single_threaded'), default=None)
     args = parser.parse_args()
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    if args.executor:
-        os.environ['PAN_TILT_SIM_EXECUTOR'] = args.executor
     from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
     from pan_tilt_sim.sim.engine import make_simulation
 

@@ -46,6 +46,7 @@ from typing import TYPE_CHECKING
 from pan_tilt_sim.errors import ArgumentError, ConfigurationError, one_line
 
 if TYPE_CHECKING:
+    from rclpy.executors import Executor
     from rclpy.node import Node
 
 EXIT_OK = 0
@@ -243,8 +244,12 @@ def _ros_is_shut_down() -> bool:
 
 
 def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
-        program: str) -> int:
-    """Build a node with ``make_node``, spin it until stopped; return the exit code."""
+        program: str, make_executor: Callable[[Node], Executor] | None = None) -> int:
+    """Build a node with ``make_node``, spin it until stopped; return the exit code.
+
+    ``make_executor(node)`` gives the executor to spin it on (default: rclpy's
+    SingleThreadedExecutor).
+    """
     debug = debug_requested(sys.argv if args is None else args)
     node: Node | None = None
     initialized = False
@@ -264,7 +269,9 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
                 # Only while the context is alive: an executor whose construction
                 # a signal cuts short complains from __del__ with a traceback.
                 spinning.spin(node, on_ready=lambda: node.get_logger().debug(
-                    'started; spinning until SIGINT or SIGTERM'))
+                    'started; spinning until SIGINT or SIGTERM'), make_executor=(
+                    spinning.single_threaded if make_executor is None
+                    else lambda context: make_executor(node)))
         except ConfigurationError as err:
             failure = err
         except KeyboardInterrupt:
@@ -287,8 +294,8 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
 
 
 def main(make_node: Callable[[], Node], args: list[str] | None = None, *,
-         program: str) -> None:
+         program: str, make_executor: Callable[[Node], Executor] | None = None) -> None:
     """Run a node program; exit 0 when stopped by a signal, 2 on a configuration error."""
-    status = run(make_node, args, program=program)
+    status = run(make_node, args, program=program, make_executor=make_executor)
     if status != EXIT_OK:
         sys.exit(status)

@@ -35,6 +35,7 @@ from pan_tilt_sim.ros import parameters, services, simulation_services
 from pan_tilt_sim.ros.features import NodeFeatures
 from pan_tilt_sim.ros.gain_parameters import GainParameters
 from pan_tilt_sim.ros.pacing import Pacer, Throttle
+from pan_tilt_sim.ros.physics_thread import PhysicsThread, Turns
 from pan_tilt_sim.ros.ros_interfaces import (
     COMMAND_MESSAGES,
     NANOSECONDS_PER_SECOND,
@@ -71,9 +72,17 @@ def clock_period_steps(time_step: float) -> int:
 
 
 class SimNode(Node):
-    """Loads the robot and its controllers, and runs them in PyBullet."""
+    """Loads the robot and its controllers, and runs them in PyBullet.
 
-    def __init__(self, **kwargs) -> None:
+    The physics is driven either by a timer on the node's executor (the
+    default: tests and embedding spin it on one executor with their own
+    nodes) or, with ``physics_thread=True`` (the sim_node program), by a paced
+    thread of its own that takes turns with the executor's callbacks through
+    :attr:`turns`; spin the node on a ``TurnTakingExecutor(node.turns)``
+    then (see :mod:`pan_tilt_sim.ros.physics_thread`).
+    """
+
+    def __init__(self, *, physics_thread: bool = False, **kwargs) -> None:
         super().__init__(NODE_NAME, **kwargs)
         self.settings = parameters.declare_parameters(self)
         description = load_description(
@@ -113,7 +122,14 @@ class SimNode(Node):
             raise
         self._publish_clock()
         self.features.after_steps()  # their first samples at t = 0, as /clock's
-        self._timer = self.create_timer(self._tick_period(), self._on_tick)
+        self.turns: Turns | None = None
+        self._physics_thread: PhysicsThread | None = None
+        self._timer = None
+        if physics_thread:
+            self.turns = Turns()
+            self._physics_thread = PhysicsThread(self._on_tick, self._thread_period, self.turns)
+        else:
+            self._timer = self.create_timer(self._tick_period(), self._on_tick)
         # Checked in the on-set callback, applied in the post-set one: a change
         # that any callback refuses is applied nowhere.
         self.add_on_set_parameters_callback(self._check_parameters)
@@ -121,7 +137,12 @@ class SimNode(Node):
         self._world_services = services.create_world_services(
             self, reset=self.reset, set_paused=self.set_paused)
         # simulation_interfaces (where installed): its own module, its own callback groups.
-        self.simulation_interfaces = simulation_services.create(self, self._world_services)
+        try:
+            self.simulation_interfaces = simulation_services.create(self, self._world_services)
+        except BaseException:
+            self.features.close()
+            self.simulation.close()
+            raise
         self._log_controllers(description, controllers)
         for joint in self.simulation.physics.joints:
             if joint.initial_position != 0.0:
@@ -139,6 +160,8 @@ class SimNode(Node):
             f"{controllers.label}; topics under "
             f"'{self.robot_namespace or '/'}', time_step {self.settings.time_step} s, "
             f'real_time_factor {self._pacer.real_time_factor}')
+        if self._physics_thread is not None:
+            self._physics_thread.start()  # last: nothing may fail after it runs
 
     def create_publisher(self, *args, **kwargs):
         """Create a publisher without rclpy's default QoS-event handler (see below)."""
@@ -241,7 +264,10 @@ class SimNode(Node):
 
     def destroy_node(self) -> None:
         """Stop ticking and release PyBullet."""
-        self._timer.cancel()
+        if self._physics_thread is not None:
+            self._physics_thread.stop()
+        if self._timer is not None:
+            self._timer.cancel()
         if self.simulation_interfaces is not None:
             self.simulation_interfaces.close()
         self.features.close()
@@ -255,8 +281,17 @@ class SimNode(Node):
         # Paused, a zero-period timer would spin the CPU for nothing.
         return 0.0 if self._pacer.fast and not self._paused else TICK_PERIOD_S
 
+    def _thread_period(self) -> float | None:
+        """Wall seconds the physics thread waits before its next tick (None: until woken)."""
+        if self._paused:
+            return None
+        return 0.0 if self._pacer.fast else TICK_PERIOD_S
+
     def _retime(self) -> None:
-        """Give the tick timer the period that the pace and the pause state call for."""
+        """Give the ticks the period that the pace and the pause state call for."""
+        if self._physics_thread is not None:
+            self._physics_thread.wake()
+            return
         period_ns = round(self._tick_period() * NANOSECONDS_PER_SECOND)
         if self._timer.timer_period_ns != period_ns:
             self._timer.timer_period_ns = period_ns

@@ -11,29 +11,7 @@ from pan_tilt_sim.ros import spinning
 SPIN_BUDGET_S = 10.0
 
 
-def test_the_single_threaded_executor_is_the_default(context, monkeypatch):
-    monkeypatch.delenv(spinning.EXECUTOR_VARIABLE, raising=False)
-    executor = spinning.make_executor(context)
-    try:
-        assert isinstance(executor, SingleThreadedExecutor)
-    finally:
-        executor.shutdown()
-
-
-def test_the_environment_can_ask_for_the_events_executor(context, monkeypatch):
-    pytest.importorskip('rclpy.experimental')
-    monkeypatch.setenv(spinning.EXECUTOR_VARIABLE, spinning.EVENTS)
-    executor = spinning.make_executor(context)
-    try:
-        assert not isinstance(executor, SingleThreadedExecutor)
-        assert type(executor).__name__ == 'EventsExecutor'
-    finally:
-        executor.shutdown()
-
-
-@pytest.mark.parametrize('kind', [spinning.EVENTS, spinning.SINGLE_THREADED])
-def test_spin_runs_timers_and_returns_once_the_context_shuts_down(context, monkeypatch, kind):
-    monkeypatch.setenv(spinning.EXECUTOR_VARIABLE, kind)
+def test_spin_runs_timers_and_returns_once_the_context_shuts_down(context):
     node = rclpy.create_node('spinning_test', context=context)
     ticks = []
 
@@ -50,6 +28,22 @@ def test_spin_runs_timers_and_returns_once_the_context_shuts_down(context, monke
         node.destroy_node()
     assert len(ticks) == 5
     assert time.monotonic() - started < SPIN_BUDGET_S
+
+
+def test_spin_uses_the_executor_it_is_given(context):
+    node = rclpy.create_node('spinning_test', context=context)
+    made = []
+
+    def make(executor_context):
+        made.append(SingleThreadedExecutor(context=executor_context))
+        return made[-1]
+
+    node.create_timer(0.01, lambda: rclpy.try_shutdown(context=context))
+    try:
+        spinning.spin(node, make_executor=make)
+    finally:
+        node.destroy_node()
+    assert len(made) == 1
 
 
 def test_spin_lets_keyboard_interrupt_through(context):

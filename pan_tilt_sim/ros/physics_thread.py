@@ -1,0 +1,156 @@
+"""The physics in a paced thread of its own, taking turns with the executor's callbacks.
+
+Woken 50 times a second only to step the physics, rclpy's Python executor
+costs ~0.35-0.65 ms per wake-up (it rebuilds its wait set of every
+subscription, service and timer), more than half of sim_node's CPU at
+real_time_factor 1, and more with every service added.  So the sim_node
+program steps the physics from a :class:`PhysicsThread`, which sleeps
+between ticks, and the executor wakes only for messages, services and
+parameters.
+
+Both still take turns, as when a timer drove the physics: every callback
+runs between two batches of steps, never during one.  :class:`Turns` is
+that lock; a callback waiting for its turn goes before the next batch, so
+at real_time_factor 0 a command waits at most for the batch in progress
+(~5 ms).  :class:`TurnTakingExecutor` is rclpy's SingleThreadedExecutor
+with each callback run inside its turn.  If the physics thread fails, the
+executor raises its exception, so the program ends with the traceback.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import threading
+import time
+from collections.abc import Callable, Iterator
+
+from rclpy.context import Context
+from rclpy.executors import ShutdownException, SingleThreadedExecutor, TimeoutException
+
+JOIN_TIMEOUT_S = 5.0
+
+
+class Turns:
+    """A lock the physics and the callbacks take in turns; waiting callbacks go first."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._condition = threading.Condition()
+        self._callbacks_waiting = 0
+        self.failure: BaseException | None = None
+
+    @contextlib.contextmanager
+    def callback(self) -> Iterator[None]:
+        """Hold the simulation for one executor callback."""
+        with self._condition:
+            self._callbacks_waiting += 1
+        self._lock.acquire()
+        with self._condition:
+            self._callbacks_waiting -= 1
+            self._condition.notify_all()
+        try:
+            yield
+        finally:
+            self._lock.release()
+
+    @contextlib.contextmanager
+    def physics(self) -> Iterator[None]:
+        """Hold the simulation for one batch of steps, once no callback is waiting."""
+        with self._condition:
+            self._condition.wait_for(lambda: self._callbacks_waiting == 0)
+        self._lock.acquire()
+        try:
+            yield
+        finally:
+            self._lock.release()
+
+
+class TurnTakingExecutor(SingleThreadedExecutor):
+    """rclpy's SingleThreadedExecutor, running each callback in its turn (see :class:`Turns`)."""
+
+    def __init__(self, turns: Turns, *, context: Context | None = None) -> None:
+        super().__init__(context=context)
+        self._turns = turns
+
+    def spin_once(self, timeout_sec: float | None = None) -> None:
+        """Wait for one ready callback (without holding the turn), then run it in its turn."""
+        if self._turns.failure is not None:
+            raise self._turns.failure
+        try:
+            handler, _entity, _node = self.wait_for_ready_callbacks(timeout_sec)
+        except (ShutdownException, TimeoutException):
+            return
+        with self._turns.callback():
+            handler()
+        if handler.exception() is not None:
+            raise handler.exception()
+        handler.result()
+
+
+class PhysicsThread:
+    """Calls ``tick()`` in its turn, then waits ``period()`` s: 0 = at once, None = until woken.
+
+    ``wake()`` cuts a wait short (the pace or the pause state changed); the
+    next tick then starts a fresh schedule.  Ticks are scheduled on a fixed
+    grid of wall time, so sleeping does not make the period drift.
+    """
+
+    def __init__(self, tick: Callable[[], None], period: Callable[[], float | None],
+                 turns: Turns, name: str = 'physics') -> None:
+        self._tick = tick
+        self._period = period
+        self._turns = turns
+        self._wake = threading.Event()
+        self._stopping = False
+        self._thread = threading.Thread(target=self._run, name=name, daemon=True)
+
+    def start(self) -> None:
+        """Start ticking."""
+        self._thread.start()
+
+    def wake(self) -> None:
+        """End the present wait now (the pace or the pause state changed)."""
+        self._wake.set()
+
+    def stop(self) -> None:
+        """Stop after the batch in progress and wait for the thread to end."""
+        self._stopping = True
+        self._wake.set()
+        if self._thread.is_alive() and self._thread is not threading.current_thread():
+            self._thread.join(JOIN_TIMEOUT_S)
+
+    @property
+    def alive(self) -> bool:
+        """Whether the thread is running."""
+        return self._thread.is_alive()
+
+    def _run(self) -> None:
+        try:
+            self._loop()
+        except BaseException as error:  # handed to the executor, which raises it
+            self._turns.failure = error
+
+    def _loop(self) -> None:
+        next_tick = time.monotonic()
+        while not self._stopping:
+            with self._turns.physics():
+                if self._stopping:
+                    return
+                self._tick()
+            period = self._period()
+            if period is None:
+                self._wait(None)
+                next_tick = time.monotonic()
+                continue
+            next_tick += period
+            now = time.monotonic()
+            if next_tick < now - period:  # far behind (a stall): restart the grid
+                next_tick = now
+            if next_tick > now and self._wait(next_tick - now):
+                next_tick = time.monotonic()
+
+    def _wait(self, seconds: float | None) -> bool:
+        """Wait ``seconds`` (None: until woken); return whether ``wake()`` ended it."""
+        woken = self._wake.wait(seconds)
+        self._wake.clear()
+        return woken

@@ -1,0 +1,134 @@
+"""The physics in a thread of its own, taking turns with the executor's callbacks."""
+
+import threading
+import time
+
+import pytest
+import rclpy
+from rclpy.parameter import Parameter
+from std_msgs.msg import Float64
+
+from pan_tilt_sim.ros.physics_thread import PhysicsThread, Turns, TurnTakingExecutor
+from pan_tilt_sim.ros.sim_node import SimNode
+
+BUDGET_S = 10.0
+
+
+def wait_for(condition, budget_s=BUDGET_S, step_s=0.005):
+    deadline = time.monotonic() + budget_s
+    while not condition():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(step_s)
+    return True
+
+
+# --- Turns and the thread, without ROS -------------------------------------------------
+
+def test_a_waiting_callback_goes_before_the_next_batch():
+    turns, order = Turns(), []
+    in_batch = threading.Event()
+
+    def tick():
+        order.append('batch')
+        in_batch.set()
+        time.sleep(0.02)  # a batch of steps in progress
+
+    thread = PhysicsThread(tick, lambda: 0.0, turns)
+    thread.start()
+    try:
+        assert in_batch.wait(BUDGET_S)
+        with turns.callback():  # waits for the batch in progress, not for more
+            order.append('callback')
+        assert wait_for(lambda: order.count('batch') >= 3)
+    finally:
+        thread.stop()
+    assert order.index('callback') <= 2
+
+
+def test_ticks_keep_their_period_and_a_paused_thread_waits_until_woken():
+    ticks, period = [], [0.02]
+    thread = PhysicsThread(lambda: ticks.append(time.monotonic()), lambda: period[0], Turns())
+    thread.start()
+    try:
+        assert wait_for(lambda: len(ticks) >= 26)
+        gaps = [b - a for a, b in zip(ticks[1:26], ticks[2:26], strict=False)]
+        period[0] = None  # paused
+        thread.wake()
+        time.sleep(0.1)
+        held = len(ticks)
+        time.sleep(0.2)
+        assert len(ticks) == held  # no tick while paused
+        period[0] = 0.02
+        thread.wake()
+        assert wait_for(lambda: len(ticks) > held)
+    finally:
+        thread.stop()
+    assert 0.018 < sum(gaps) / len(gaps) < 0.022  # the grid does not drift
+    assert not thread.alive
+
+
+def test_a_failing_tick_makes_the_executor_raise_it(context):
+    turns = Turns()
+
+    def tick():
+        raise RuntimeError('the physics broke')
+
+    thread = PhysicsThread(tick, lambda: 0.0, turns)
+    executor = TurnTakingExecutor(turns, context=context)
+    thread.start()
+    try:
+        assert wait_for(lambda: not thread.alive)
+        with pytest.raises(RuntimeError, match='the physics broke'):
+            executor.spin_once(timeout_sec=0.01)
+    finally:
+        executor.shutdown()
+
+
+# --- sim_node with its physics thread -------------------------------------------------
+
+@pytest.fixture
+def threaded(context):
+    """A SimNode stepping in its own thread, spun by a TurnTakingExecutor in another."""
+    node = SimNode(physics_thread=True, context=context,
+                   parameter_overrides=[Parameter('real_time_factor', value=1.0)])
+    probe = rclpy.create_node('probe', context=context)
+    executor = TurnTakingExecutor(node.turns, context=context)
+    executor.add_node(node)
+    executor.add_node(probe)
+    spinning = threading.Thread(target=lambda: executor.spin(), daemon=True)
+    spinning.start()
+    yield node, probe
+    executor.shutdown()
+    spinning.join(BUDGET_S)
+    probe.destroy_node()
+    node.destroy_node()
+
+
+def test_with_its_thread_sim_time_follows_wall_time_and_commands_arrive(threaded):
+    node, probe = threaded
+    assert wait_for(lambda: node.simulation.time > 0.1)
+    sim_start, wall_start = node.simulation.time, time.monotonic()
+    time.sleep(1.5)
+    factor = (node.simulation.time - sim_start) / (time.monotonic() - wall_start)
+    assert factor == pytest.approx(1.0, rel=0.2)
+    publisher = probe.create_publisher(
+        Float64, '/ex_urdf_pan_tilt/joint1_position_controller/command', 10)
+    assert wait_for(lambda: publisher.get_subscription_count() > 0)
+    publisher.publish(Float64(data=0.5))
+    controller = node.simulation.controller('joint1_position_controller')
+    assert wait_for(lambda: node.commands_received['joint1_position_controller'] > 0)
+    assert wait_for(lambda: controller.setpoints()['pan_joint'] > 0.0)
+
+
+def test_with_its_thread_a_paused_node_holds_and_destroying_it_stops_the_thread(threaded):
+    node, _ = threaded
+    assert wait_for(lambda: node.simulation.time > 0.05)
+    with node.turns.callback():
+        node.set_paused(True)
+    held = node.simulation.time
+    time.sleep(0.2)
+    assert node.simulation.time == held
+    thread = node._physics_thread
+    node.destroy_node()
+    assert not thread.alive
