@@ -118,6 +118,9 @@ def _describe(text: str, source: pathlib.Path, base: pathlib.Path) -> RobotDescr
         model = read_model(root, source)
     except DescriptionError as err:
         raise EntityResourceError(ResourceProblem.PARSE_ERROR, str(err)) from None
+    if not model.name:  # urdfdom and PyBullet refuse it too
+        raise EntityResourceError(ResourceProblem.PARSE_ERROR,
+                                  f'{source}: <robot> has no name attribute (URDF requires one)')
     if not model.links:
         raise EntityResourceError(ResourceProblem.PARSE_ERROR, f'{source}: the URDF has no link')
     for link, role, mesh in mesh_elements(root):

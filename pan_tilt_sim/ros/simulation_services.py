@@ -164,6 +164,7 @@ class SimulationServices:
         self._stopped_at: int | None = node.steps_run if node.paused else None
         self._quit_timer = None
         self._quitting = False
+        self._closed = False
         self._goal_jobs: dict[bytes, StepJob] = {}
         self._drop_clashing(namespace, gazebo_services)
         # The awaiting callbacks (a step request waits for its steps) get their own
@@ -216,7 +217,10 @@ class SimulationServices:
         return states.STATE_PAUSED
 
     def close(self) -> None:
-        """Stop stepping (a job in progress fails) and serving."""
+        """Stop stepping (a job in progress fails) and serving the action (idempotent)."""
+        if self._closed:
+            return
+        self._closed = True
         self._runner.close()
         if self._quit_timer is not None:
             self._quit_timer.cancel()

@@ -404,7 +404,9 @@ class Entities:
                 raise SpawnError(SpawnProblem.NAME_INVALID,
                                  'no name given and the URDF has none (allow_renaming makes one)')
             self._check_name(wanted, allow_renaming)
-        base = wanted if wanted and _NAME.fullmatch(wanted) else DEFAULT_NAME
+        base = '_'.join(wanted.split()) or DEFAULT_NAME  # white space made underscores
+        if base not in self._entities:
+            return base
         number = 1
         while f'{base}_{number}' in self._entities:
             number += 1

@@ -1,0 +1,58 @@
+"""End to end: the sim_node program controlled through simulation_interfaces, to QUITTING.
+
+The program steps its physics from a thread of its own and runs callbacks in
+turns with it (ros/physics_thread.py); the stepping requests, the action and
+QUITTING must work there as in-process.
+"""
+
+from __future__ import annotations
+
+import subprocess
+
+import pytest
+import sim_process
+from entity_fixtures import box_urdf
+from node_harness import PROBE_QUEUE, NodeHarness, stamp_s
+from rosgraph_msgs.msg import Clock
+from sim_interfaces_client import OK, SimInterfaces, State, action, pose, position
+
+STARTUP_BUDGET_S = 20.0
+EXIT_BUDGET_S = 5.0
+
+
+def test_a_paused_program_steps_spawns_and_quits_with_exit_code_0():
+    process = sim_process.start('-p', 'paused:=true', '-p', 'world:=ground')
+    harness = NodeHarness()
+    try:
+        clock = []
+        harness.probe.create_subscription(Clock, '/clock', clock.append, PROBE_QUEUE)
+        client = SimInterfaces(harness)
+        assert client.state() == State.STATE_STOPPED
+        assert client.spawn('box', resource_string=box_urdf(),
+                            at=pose(1.0, 0.0, 0.3)).result.result == OK
+        assert client.step(500).result == OK
+        assert harness.spin_until(lambda: clock and stamp_s(clock[-1]) >= 0.5)
+        assert stamp_s(clock[-1]) == pytest.approx(0.5)
+        assert position(client.entity_state('box'))[2] == pytest.approx(0.1, abs=2e-3)
+
+        goal = client.action_client().send_goal_async(action.SimulateSteps.Goal(steps=2000))
+        assert harness.spin_until(goal.done)
+        result = goal.result().get_result_async()
+        assert harness.spin_until(result.done)
+        assert result.result().result.result.result == OK
+        assert harness.spin_until(lambda: stamp_s(clock[-1]) >= 2.5)
+        assert client.state() == State.STATE_PAUSED
+
+        assert client.set_state(State.STATE_QUITTING).result == OK
+        try:
+            _stdout, stderr = process.communicate(timeout=EXIT_BUDGET_S)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f'sim_node did not quit within {EXIT_BUDGET_S} s of QUITTING')
+    finally:
+        harness.close()
+        if process.poll() is None:
+            process.kill()
+            process.communicate()
+    assert process.returncode == 0, stderr
+    assert 'Traceback' not in stderr
+    assert 'QUITTING' in stderr
