@@ -31,7 +31,7 @@ from pan_tilt_sim.model.controller_config import (
     parse_controllers_args,
 )
 from pan_tilt_sim.model.description import RobotDescription, load_description
-from pan_tilt_sim.ros import parameters, services, simulation_services
+from pan_tilt_sim.ros import parameters, services, simulation_services, topic_hardware
 from pan_tilt_sim.ros.features import NodeFeatures
 from pan_tilt_sim.ros.gain_parameters import GainParameters
 from pan_tilt_sim.ros.pacing import Pacer, Throttle
@@ -87,16 +87,22 @@ class SimNode(Node):
         self.settings = parameters.declare_parameters(self)
         description = load_description(
             self.settings.robot_description_file, self.settings.xacro_args)
-        controllers = load_controllers_config(
-            controllers_files_for(self.settings.controllers_file, description),
-            parse_controllers_args(self.settings.controllers_args,
-                                   f"parameter '{CONTROLLERS_ARGS}'"))
+        # Topic-based hardware (topic_based_ros2_control): no YAML controllers run here.
+        self._topic_settings = topic_hardware.declare(self, description)
+        if self._topic_settings is not None:
+            controllers = topic_hardware.controllers_config(self._topic_settings)
+        else:
+            controllers = load_controllers_config(
+                controllers_files_for(self.settings.controllers_file, description),
+                parse_controllers_args(self.settings.controllers_args,
+                                       f"parameter '{CONTROLLERS_ARGS}'"))
         self.robot_namespace = naming.resolve_robot_namespace(
             self.get_namespace(), self.settings.robot_namespace,
             controllers.namespace, description.plugin_namespace)
         self.simulation = Simulation(
             description, controllers, self.settings.time_step, gui=self.settings.gui,
-            active_controllers=self.settings.active_controllers)
+            active_controllers=(None if self._topic_settings is not None
+                                else self.settings.active_controllers))
         self._paused = self.settings.paused
         self.steps_run = 0  # physics steps this node has run (never reset; see run_steps)
         # Commands taken per controller (ignored ones included): a cheap health figure.
@@ -326,6 +332,14 @@ class SimNode(Node):
         self._clock_pending = False
 
     def _wire_controllers(self) -> None:
+        self.topic_hardware = None
+        if self._topic_settings is not None:
+            self.topic_hardware = topic_hardware.TopicHardware(
+                self, self._topic_settings, self.simulation.description,
+                self.simulation.controllers, self._joint_state_sink)
+            hardware = self.topic_hardware
+            self._joint_state_sinks = [(hardware.broadcaster, hardware.publisher, hardware.sink)]
+            return
         self._joint_state_sinks = []
         for controller in self.simulation.controllers:
             if isinstance(controller, JointStateController):
