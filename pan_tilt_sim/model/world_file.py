@@ -18,7 +18,8 @@ give::
         tags: [pushable]                    # optional, for GetEntities' tag filter
 
 Every problem ends start-up with one line naming the file and the field
-(:class:`WorldFileError`).  Reading the objects' URDFs is the entity
+(:class:`WorldFileError`), or the parameter when its value names nothing
+(:class:`~pan_tilt_sim.errors.ParameterError`).  Reading the objects' URDFs is the entity
 resource module's business; this module only checks the file's shape.
 """
 
@@ -32,7 +33,7 @@ from typing import Any
 
 import yaml
 
-from pan_tilt_sim.errors import ConfigurationError
+from pan_tilt_sim.errors import ConfigurationError, ParameterError
 from pan_tilt_sim.model.resources import resolve_resource
 from pan_tilt_sim.model.transforms import (
     IDENTITY_ROTATION,
@@ -54,7 +55,7 @@ NORM_TOLERANCE = 1e-6  # a quaternion whose norm is this close to 0 is no rotati
 
 
 class WorldFileError(ConfigurationError):
-    """The world file (or the ``world`` parameter) cannot be used."""
+    """The world file cannot be used (a bad ``world`` value itself is a ParameterError)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -89,14 +90,14 @@ def world_from_parameter(value: str) -> World:
     if value in SCENERIES:
         return World(value)
     if not value.strip():
-        raise WorldFileError(
+        raise ParameterError(
             f"parameter 'world' must be one of {', '.join(SCENERIES)} or a world file, got ''")
     try:
         path = resolve_resource(value, pathlib.Path.cwd())
     except ConfigurationError as err:
-        raise WorldFileError(f"parameter 'world': {err}") from None
+        raise ParameterError(f"parameter 'world': {err}") from None
     if not path.is_file():
-        raise WorldFileError(
+        raise ParameterError(
             f"parameter 'world': '{value}' is none of {', '.join(SCENERIES)}, and no world "
             f'file ({path}: no such file)')
     return read_world_file(path)

@@ -7,6 +7,7 @@ import textwrap
 
 import pytest
 
+from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model.world_file import (
     SCENERIES,
     EntitySpec,
@@ -89,12 +90,12 @@ def test_every_problem_names_the_file_and_the_field(tmp_path, text, message):
 
 
 def test_neither_a_scenery_nor_a_file_lists_the_choices(tmp_path):
-    with pytest.raises(WorldFileError, match=r"'moon' is none of empty, ground, targets, "
+    with pytest.raises(ParameterError, match=r"'moon' is none of empty, ground, targets, "
                                              r'and no world file \(.*moon: no such file\)'):
         world_from_parameter('moon')
-    with pytest.raises(WorldFileError, match="parameter 'world': .*no_such_package"):
+    with pytest.raises(ParameterError, match="parameter 'world': .*no_such_package"):
         world_from_parameter('package://no_such_package/world.yaml')
-    with pytest.raises(WorldFileError, match="parameter 'world' must be one of"):
+    with pytest.raises(ParameterError, match="parameter 'world' must be one of"):
         world_from_parameter('')
 
 
