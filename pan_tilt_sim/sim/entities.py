@@ -9,7 +9,8 @@ client:
 * **objects** from a world file or spawned at run time: any URDF, loaded as a
   free-floating PyBullet body with the URDF's inertia.  They fall under
   gravity, land on the ground plane (added with the first object, see
-  :func:`~pan_tilt_sim.sim.world.add_ground_plane`), collide with the robot
+  :func:`~pan_tilt_sim.sim.world.add_ground_plane`; the robot's links that
+  touch the ground in the initial pose never meet it), collide with the robot
   and the targets, can be pushed and grasped, and the cameras and lidars see
   them -- they are ordinary bodies in the client those render in.  An object
   whose URDF says ``<gazebo><static>true</static></gazebo>`` is fixed where
@@ -50,7 +51,7 @@ from pan_tilt_sim.model.transforms import IDENTITY_ROTATION, ZERO_VECTOR, Transf
 from pan_tilt_sim.model.world_file import World, WorldFileError
 from pan_tilt_sim.sim.bullet import pybullet, quiet_native_output
 from pan_tilt_sim.sim.physics import BASE_LINK_INDEX, Physics
-from pan_tilt_sim.sim.world import add_ground_plane
+from pan_tilt_sim.sim.world import add_ground_plane, grounded_links
 
 WORLD_FRAMES = ('', 'world')  # frame ids that mean the world frame
 WORLD_ORIGIN = Transform()
@@ -180,6 +181,8 @@ class Entities:
         self._robot = physics.body_id
         self._ground_wanted = ground
         self._ground: int | None = None
+        # Taken now, in the robot's initial pose (see world.add_ground_plane).
+        self._grounded = grounded_links(self._client, self._robot)
         self._workdir = tempfile.TemporaryDirectory(prefix='pan_tilt_sim_entities_')
         self._files = 0
         self._entities: dict[str, Entity] = {}
@@ -473,7 +476,7 @@ class Entities:
 
     def _ensure_ground(self) -> None:
         if self._ground_wanted and self._ground is None:
-            self._ground = add_ground_plane(self._client, self._robot)
+            self._ground = add_ground_plane(self._client, self._robot, self._grounded)
 
 
 @dataclasses.dataclass(frozen=True)

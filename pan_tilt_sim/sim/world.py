@@ -10,13 +10,16 @@ multibodies -- even visual-only ones -- cost the seed's physics step
 +1.1 us (3.5 -> 4.6 us, +31 %), four static rigid bodies with collision
 shapes +0.08 us (within noise; measured by stepping the seed 20,000 times,
 median of 8 interleaved runs).  Cameras, depth cameras and lidars meet the
-ground plane analytically.  For the robot the ground is not there at all:
-it is fixed to the world, and a plane at z = 0 would touch the seed's pan
-link (whose collision cylinder reaches below z = 0) and change its physics.
-Objects spawned into the world (:mod:`pan_tilt_sim.sim.entities`) do land
-on it: :func:`add_ground_plane` adds the plane as a collision body, with
-every collision between it and the robot's links switched off, when the
-first object arrives -- so a world without objects pays nothing for it.
+ground plane analytically.  Objects spawned into the world
+(:mod:`pan_tilt_sim.sim.entities`) land on it: :func:`add_ground_plane`
+adds the plane as a collision body when the first object arrives -- so a
+world without objects pays nothing for it.  The robot is fixed to the
+world, and its links that touch the ground or reach below it in the
+initial pose (:func:`grounded_links`: the seed's base and its pan link,
+whose collision cylinder reaches below z = 0; a base sunk into the floor)
+never collide with the plane: they would be held by it (a wheel half in the
+ground turns 0 rad/s instead of 42 under the same torque).  Every other
+link meets the ground as any object does: a gripper cannot go through it.
 
 The ground is the plane z = 0.  TinyRenderer's cost grows with the pixels it
 shades, and a ground body covers half of every horizontal view (measured: 9 ms
@@ -57,6 +60,9 @@ BASE_LINK = -1  # PyBullet's link index of a body's base
 # speck of a visual shape, fully transparent, keeps the ground plane unseen.
 INVISIBLE_RADIUS = 1e-6
 INVISIBLE_RGBA = (0.0, 0.0, 0.0, 0.0)
+# A robot link whose box (PyBullet's, with its ~1 mm margin) reaches below this
+# height in the initial pose touches the ground: the plane leaves it alone.
+GROUND_CLEARANCE = 0.002  # m
 
 
 @dataclasses.dataclass(frozen=True)
@@ -121,11 +127,19 @@ def build_world(name: str, client: int, *, ground: bool = False) -> dict[str, in
     return targets
 
 
-def add_ground_plane(client: int, robot: int) -> int:
-    """Add the plane z = 0 as a static collision body that never touches ``robot``; return it.
+def grounded_links(client: int, robot: int) -> list[int]:
+    """Return the robot's links (-1: the base) within GROUND_CLEARANCE of z = 0 or below it."""
+    return [link for link in range(BASE_LINK, pybullet.getNumJoints(robot, physicsClientId=client))
+            if pybullet.getAABB(robot, link, physicsClientId=client)[0][2] < GROUND_CLEARANCE]
 
-    The camera does not draw it (it paints the ground itself) and rays hit it
-    where the analytic ground is anyway.
+
+def add_ground_plane(client: int, robot: int, grounded: list[int]) -> int:
+    """Add the plane z = 0 as a static collision body, not touching ``grounded`` links; return it.
+
+    ``grounded`` are the robot's links that touched the ground in its initial
+    pose (:func:`grounded_links`).  The camera does not draw the plane (it
+    paints the ground itself) and rays hit it where the analytic ground is
+    anyway.
     """
     shape = pybullet.createCollisionShape(pybullet.GEOM_PLANE, physicsClientId=client)
     speck = pybullet.createVisualShape(pybullet.GEOM_SPHERE, radius=INVISIBLE_RADIUS,
@@ -133,7 +147,7 @@ def add_ground_plane(client: int, robot: int) -> int:
     plane = pybullet.createMultiBody(
         baseMass=STATIC_MASS, baseCollisionShapeIndex=shape, baseVisualShapeIndex=speck,
         useMaximalCoordinates=True, physicsClientId=client)
-    for link in range(BASE_LINK, pybullet.getNumJoints(robot, physicsClientId=client)):
+    for link in grounded:
         pybullet.setCollisionFilterPair(plane, robot, BASE_LINK, link, enableCollision=0,
                                         physicsClientId=client)
     return plane

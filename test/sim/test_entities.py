@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from entity_fixtures import box_urdf, write_box
+from entity_fixtures import RIG_CONTROLLERS, RIG_URDF, box_urdf, write_box
 
 from pan_tilt_sim.engine import make_simulation
 from pan_tilt_sim.model.transforms import Transform
@@ -40,28 +40,53 @@ def seed():
     simulation.close()
 
 
-def _pan_run(spawn_something: bool) -> list[float]:
-    """Command the seed's pan to 1 rad; return its positions over 2 s."""
-    simulation = make_simulation(SEED, None, TIME_STEP)
+def _rig_run(tmp_path, spawn_something: bool) -> tuple[float, float]:
+    """Spin the rig's wheel with 0.5 N*m for 1 s, the plunger free; return (speed, height)."""
+    urdf = tmp_path / 'rig.urdf'
+    urdf.write_text(RIG_URDF)
+    controllers = tmp_path / 'rig.yaml'
+    controllers.write_text(RIG_CONTROLLERS)
+    simulation = make_simulation(urdf, controllers, TIME_STEP)
     try:
         entities = Entities(simulation.physics, simulation.description.name)
-        if spawn_something:
+        if spawn_something:  # the ground becomes a body with the first object
             entities.spawn('far', resource_string=box_urdf(), pose=Transform((5.0, 5.0, 0.1)))
             assert entities.has_ground
-        simulation.controller('joint1_position_controller').set_command(1.0)
-        positions = []
-        for _ in range(20):
-            simulation.advance(100)
-            positions.append(simulation.joint_positions()['pan_joint'])
+        simulation.controller('spin_effort').set_command(0.5)
+        simulation.advance(1000)
         entities.close()
-        return positions
+        return (simulation.joint_velocities()['spin'], simulation.joint_positions()['lift'])
     finally:
         simulation.close()
 
 
-def test_the_ground_never_touches_the_robot():
-    """The seed's pan cylinder reaches below z = 0: with a ground body, it moves the same."""
-    assert _pan_run(spawn_something=True) == _pan_run(spawn_something=False)
+def test_robot_links_in_the_ground_at_start_never_touch_it_the_others_do(tmp_path):
+    """The wheel, half in the ground from the start, turns as without a ground (not held);
+    the plunger, clear of it at start, lands on it instead of falling to its limit."""
+    without_speed, without_height = _rig_run(tmp_path, spawn_something=False)
+    speed, height = _rig_run(tmp_path, spawn_something=True)
+    assert speed == pytest.approx(without_speed) and speed > 10.0
+    assert without_height == pytest.approx(-1.0, abs=1e-3)  # no ground: down to the limit
+    assert height == pytest.approx(-0.25, abs=2e-3)  # resting on the ground (0.3 - 0.05)
+
+
+def test_the_seeds_pan_moves_the_same_with_a_ground_body():
+    """The seed's pan cylinder reaches below z = 0."""
+    runs = []
+    for spawn_something in (False, True):
+        simulation = make_simulation(SEED, None, TIME_STEP)
+        try:
+            entities = Entities(simulation.physics, simulation.description.name)
+            if spawn_something:
+                entities.spawn('far', resource_string=box_urdf(),
+                               pose=Transform((5.0, 5.0, 0.1)))
+            simulation.controller('joint1_position_controller').set_command(1.0)
+            simulation.advance(2000)
+            runs.append(simulation.joint_positions()['pan_joint'])
+            entities.close()
+        finally:
+            simulation.close()
+    assert runs[0] == runs[1]
 
 
 def test_the_ground_is_added_with_the_first_object(seed):
@@ -235,3 +260,21 @@ def _write(folder, text):
     path = folder / 'w.yaml'
     path.write_text(text)
     return path
+
+
+def test_the_ground_body_is_not_drawn_by_the_camera():
+    """The camera paints the ground itself; a drawn ground plane would cost ~16 ms a frame."""
+    from pan_tilt_sim.sim.camera import CameraSettings, Renderer
+
+    simulation = make_simulation(SEED, None, TIME_STEP)
+    try:
+        build_world(TARGETS, simulation.physics.client_id)
+        renderer = Renderer(simulation.physics, simulation.description.model, CameraSettings())
+        before = renderer.render()
+        entities = Entities(simulation.physics, simulation.description.name)
+        entities.spawn('behind', resource_string=box_urdf(), pose=Transform((5.0, 0.0, 0.1)))
+        assert entities.has_ground
+        assert renderer.render() == before
+        entities.close()
+    finally:
+        simulation.close()
