@@ -325,8 +325,6 @@ class Entities:
             raise SpawnError(SpawnProblem.INVALID_POSE,
                              f"unknown frame '{frame}' (use '' or 'world', an entity's name, or "
                              'a link of the robot)') from None
-        if name:
-            self._check_name(name, allow_renaming)
         try:
             resource = read_entity_resource(uri, resource_string, base_dir=base_dir)
         except EntityResourceError as err:
