@@ -123,3 +123,58 @@ ARM_URDF = """<robot name="arm">
   <joint name="flange" type="fixed"><parent link="slider"/><child link="tool"/>
     <origin xyz="0.02 0 0.07" rpy="1.5707963 0 0"/></joint>
 </robot>"""
+
+
+# A two-link arm in the x-z plane, both joints about y, so gravity loads them;
+# horizontal along +x at q = 0.  Each link is a rod of the given mass and length
+# (centre of mass at its middle); the tip frame ``tool0`` has no <inertial>.
+def two_link_arm_urdf(masses=(2.0, 1.0), length=0.5, effort=100.0, velocity=2.0,
+                      damping=0.0, friction=0.0, tip_frame=True) -> str:
+    links = []
+    for number, mass in enumerate(masses, start=1):
+        inertia = mass * length * length / 12.0
+        links.append(
+            f'<link name="link{number}"><inertial><origin xyz="{length / 2} 0 0"/>'
+            f'<mass value="{mass}"/><inertia ixx="1e-6" iyy="{inertia}" izz="{inertia}" '
+            'ixy="0" ixz="0" iyz="0"/></inertial></link>')
+    joints = []
+    for number, (parent, origin) in enumerate(
+            (('base_link', '0 0 1'), ('link1', f'{length} 0 0')), start=1):
+        joints.append(
+            f'<joint name="joint{number}" type="revolute"><parent link="{parent}"/>'
+            f'<child link="link{number}"/><origin xyz="{origin}"/><axis xyz="0 1 0"/>'
+            f'<limit lower="-3" upper="3" effort="{effort}" velocity="{velocity}"/>'
+            f'<dynamics damping="{damping}" friction="{friction}"/></joint>')
+    tip = (f'<link name="tool0"/><joint name="flange" type="fixed"><parent link="link2"/>'
+           f'<child link="tool0"/><origin xyz="{length} 0 0"/></joint>') if tip_frame else ''
+    return ('<?xml version="1.0"?>\n<robot name="two_link_arm">\n<link name="base_link"/>\n'
+            + '\n'.join(links + joints) + '\n' + tip + '\n</robot>\n')
+
+
+def arm_holding_torques(q1: float, q2: float, masses=(2.0, 1.0), length=0.5,
+                        gravity=9.81) -> tuple[float, float]:
+    """Return the efforts that hold :func:`two_link_arm_urdf` still at (q1, q2).
+
+    A positive angle about +y turns +x toward -z, so gravity pulls each
+    joint toward positive angles and holding takes negative efforts.
+    """
+    import math
+
+    m1, m2 = masses
+    second = m2 * gravity * length / 2.0 * math.cos(q1 + q2)
+    first = (m1 * gravity * length / 2.0 * math.cos(q1)
+             + m2 * gravity * length * math.cos(q1)) + second
+    return (-first, -second)
+
+
+def ros2_control_yaml(controllers: dict, update_rate: int = 100) -> str:
+    """Return a ros2_control-style YAML: {name: (type, {parameters})} plus a broadcaster."""
+    lines = ['controller_manager:', '  ros__parameters:', f'    update_rate: {update_rate}',
+             '    joint_state_broadcaster:',
+             '      type: joint_state_broadcaster/JointStateBroadcaster']
+    for name, (type_name, _params) in controllers.items():
+        lines += [f'    {name}:', f'      type: {type_name}']
+    for name, (_type, params) in controllers.items():
+        lines += [f'{name}:', '  ros__parameters:']
+        lines += [f'    {key}: {value}' for key, value in params.items()]
+    return '\n'.join(lines) + '\n'

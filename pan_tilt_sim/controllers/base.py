@@ -4,21 +4,32 @@ A controller is pure Python: it is built from its YAML parameters, then
 :meth:`Controller.configure` hands it the :class:`JointHandle` objects of
 the joints it names, and :meth:`Controller.update` runs once per physics
 step.  Handles carry the measured state (written by the simulation before
-each update) and the effort command (written by the controller, read by the
-simulation after it).  Controllers never touch PyBullet or rclpy.
+each update) and what the controller wants the physics to do with the joint
+(read by the simulation after it).  At configure time the controller tells
+each of its joints' handles which :class:`Actuator` drives it:
+
+* :attr:`Drive.EFFORT` -- the physics applies ``handle.effort`` (N*m or N):
+  an effort command, or a PID's output;
+* :attr:`Drive.VELOCITY` -- the ideal actuator: a velocity motor moves the
+  joint at ``handle.velocity_target`` with at most the joint's effort limit,
+  and the simulation writes the effort it applied back into ``handle.effort``.
+
+Controllers never touch PyBullet or rclpy.
 """
 
 from __future__ import annotations
 
 import abc
+import dataclasses
 import enum
 import math
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
-from pan_tilt_sim.controllers.pid import Pid
+from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
+from pan_tilt_sim.controllers.pid import Pid, PidGains
 from pan_tilt_sim.errors import ControllerConfigError
-from pan_tilt_sim.model.robot import JointSpec
+from pan_tilt_sim.model.robot import JointKind, JointSpec
 
 # The command interface a ros2_control controller package's controllers claim.
 PACKAGE_INTERFACES = {'position_controllers': 'position', 'velocity_controllers': 'velocity',
@@ -28,27 +39,119 @@ PACKAGE_INTERFACES = {'position_controllers': 'position', 'velocity_controllers'
 MAX_COMMAND_MAGNITUDE = 1e12
 
 
+class Drive(enum.Enum):
+    """How the physics moves a joint."""
+
+    EFFORT = 'effort'  # apply handle.effort
+    VELOCITY = 'velocity'  # velocity motor to handle.velocity_target, force <= effort limit
+
+
+class ActuatorKind(enum.Enum):
+    """What drives a joint, and through which :class:`Drive`."""
+
+    PASSIVE = ('passive: no active controller', Drive.EFFORT)
+    MIMIC = ('mimic: follows its leader', Drive.EFFORT)
+    EFFORT = ('effort command', Drive.EFFORT)
+    POSITION_PID = ('position PID on effort', Drive.EFFORT)
+    VELOCITY_PID = ('velocity PID on effort', Drive.EFFORT)
+    IDEAL_POSITION = ('ideal position actuator', Drive.VELOCITY)
+    IDEAL_VELOCITY = ('ideal velocity actuator', Drive.VELOCITY)
+
+    @property
+    def label(self) -> str:
+        """How the start-up log names it."""
+        return self.value[0]
+
+    @property
+    def drive(self) -> Drive:
+        """What the physics applies for it."""
+        return self.value[1]
+
+
+@dataclasses.dataclass(frozen=True)
+class Actuator:
+    """What drives one joint, decided once at configure time, and why."""
+
+    kind: ActuatorKind = ActuatorKind.PASSIVE
+    controller: str = ''
+    # For a PID: its live object and where its gains came from ('' = the defaults).
+    pid: Pid | None = None
+    gains_from: str = ''
+
+    @property
+    def drive(self) -> Drive:
+        """What the physics applies for this joint."""
+        return self.kind.drive
+
+    def describe(self, spec: JointSpec) -> str:
+        """One line for the start-up log: the actuator and the reason it was chosen."""
+        owner = f' ({self.controller})' if self.controller else ''
+        if self.pid is not None:
+            gains = self.pid.gains
+            source = (f'gains from {self.gains_from}' if self.gains_from else
+                      f'no gains in the YAML: defaults for {self.controller}')
+            return (f'{self.kind.label}{owner}, p {gains.p:g} i {gains.i:g} d {gains.d:g}: '
+                    f'{source}')
+        if self.drive is Drive.VELOCITY:
+            force = 'N' if spec.kind is JointKind.PRISMATIC else 'N*m'
+            limit = (f'at most {spec.effort_limit:g} {force}' if math.isfinite(spec.effort_limit)
+                     else 'no effort limit in the URDF')
+            return (f'{self.kind.label}{owner}, a velocity motor with {limit}: no PID gains '
+                    'for it in the YAML')
+        return f'{self.kind.label}{owner}'
+
+
+def idle_actuator(spec: JointSpec) -> Actuator:
+    """Return what drives a joint no active controller claims: nothing, or its mimic leader."""
+    return Actuator(ActuatorKind.MIMIC if spec.mimic is not None else ActuatorKind.PASSIVE)
+
+
 class JointHandle:
-    """State and effort command of one joint, shared by simulation and controllers."""
+    """State and command of one joint, shared by simulation and controllers.
 
-    __slots__ = ('spec', 'position', 'velocity', 'effort')
+    ``initial_position`` is where the joint starts and resets to;
+    ``plugin_gains`` are the joint's ``gazebo_ros_control/pid_gains`` (None
+    if the YAML gives none), which a position or velocity controller without
+    gains of its own uses, as gazebo_ros_control does; ``tracking_gain`` is
+    the share of its position error an ideal position actuator closes per
+    step (gz_ros2_control's ``position_proportional_gain``).  ``actuator``
+    is what drives the joint now: the simulation sets it from the active
+    controllers (:meth:`Controller.actuators`).
+    """
 
-    def __init__(self, spec: JointSpec) -> None:
+    __slots__ = ('spec', 'position', 'velocity', 'effort', 'velocity_target',
+                 'initial_position', 'plugin_gains', 'tracking_gain', 'actuator')
+
+    def __init__(self, spec: JointSpec, initial_position: float | None = None,
+                 plugin_gains: PidGains | None = None,
+                 tracking_gain: float = TRACKING_GAIN) -> None:
         self.spec = spec
-        self.position = spec.initial_position
+        self.initial_position = (spec.initial_position if initial_position is None
+                                 else initial_position)
+        self.plugin_gains = plugin_gains
+        self.tracking_gain = tracking_gain
+        self.actuator = idle_actuator(spec)
+        self.position = self.initial_position
         self.velocity = 0.0
         self.effort = 0.0
+        self.velocity_target = 0.0
 
     @property
     def name(self) -> str:
         """The joint's URDF name."""
         return self.spec.name
 
+    @property
+    def drive(self) -> Drive:
+        """How the physics moves the joint (see :class:`Drive`)."""
+        return self.actuator.drive
+
     def reset(self) -> None:
         """Return to the joint's initial state (at rest, no effort)."""
-        self.position = self.spec.initial_position
+        self.position = self.initial_position
         self.velocity = 0.0
         self.effort = 0.0
+        self.velocity_target = 0.0
 
 
 class CommandKind(enum.Enum):
@@ -108,6 +211,10 @@ class Controller(abc.ABC):
 
     def pids(self) -> dict[str, Pid]:
         """Return the PIDs of this controller by joint (gains may change live); none here."""
+        return {}
+
+    def actuators(self) -> dict[str, Actuator]:
+        """Return what drives each of this controller's joints while it is active; none here."""
         return {}
 
     def error(self, field: str, problem: str) -> ControllerConfigError:

@@ -4,17 +4,18 @@ The controller drives the ``joints`` it names through one command
 interface, ``interface_name`` (position, velocity or effort), and takes
 ``std_msgs/msg/Float64MultiArray`` commands on ``<controller>/commands``:
 element k is the command of the k-th joint.  Each joint behaves exactly
-like the one-joint controller of its interface (limits, ramp, PID), which
-it is built from, with gains from ``gains: {<joint>: {p, i, d, i_clamp}}``
-or, where a joint has none, that controller's defaults:
+like the one-joint controller of its interface (limits, ramp, actuator), which
+it is built from, with gains from ``gains: {<joint>: {p, i, d, i_clamp}}``:
 
-* position: p 100, i 0.01, d 10 -- the seed's gains.  As a continuous-time
-  loop ``J q'' + (b + d) q' + p q = 0`` is stable for every positive
-  inertia J and damping b; the explicit 1 ms step keeps it stable while
-  ``d * time_step < 2 * J``, i.e. for inertias above 0.005 kg m^2 (or
-  masses above 5 g on a prismatic joint).  Lighter links need their own
-  gains (a smaller d) in the YAML.
-* velocity: p 10 -- a first-order loop, stable under the same bound.
+* position and velocity: a joint with gains (there, or in
+  ``gazebo_ros_control/pid_gains``) is driven by a PID on effort; one
+  without by the ideal actuator (see :mod:`~pan_tilt_sim.controllers.actuator`),
+  as Gazebo does.  A PID is stable while (for the position loop)
+  ``d * time_step / 2 + p * time_step^2 / 4`` stays below the joint's
+  effective inertia -- at the default 1 ms step and the seed's p 100, d 10,
+  inertias above 0.005 kg m^2 (or 5 g on a prismatic joint); the simulation
+  warns at start-up about any joint that is too light for its gains.
+* effort: the command is the effort.
 
 A command of the wrong length, or with a NaN or infinite element, is
 rejected whole and nothing changes.  The ``JointGroup*Controller`` types
@@ -28,18 +29,20 @@ from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.base import (
     MAX_COMMAND_MAGNITUDE,
+    Actuator,
     CommandController,
     CommandKind,
     CommandResult,
     JointHandle,
     is_sane_number,
 )
-from pan_tilt_sim.controllers.gains import PID_FIELD, joint_gains_from_params
+from pan_tilt_sim.controllers.gains import GAINS_FIELD, PID_FIELD, joint_gains_from_params
 from pan_tilt_sim.controllers.joint_effort_controller import JointEffortController
 from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
 from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
 from pan_tilt_sim.controllers.multi_joint import JOINTS_FIELD, MultiJointController
 from pan_tilt_sim.controllers.pid import Pid
+from pan_tilt_sim.controllers.single_joint import PidJointController
 
 INTERFACE_FIELD = 'interface_name'
 # The one-joint controller each command interface stands for.
@@ -71,6 +74,9 @@ class ForwardCommandController(MultiJointController):
         self._members = tuple(
             member_type(name, {'joint': joint, PID_FIELD: gains.get(joint)}, source)
             for joint in self._joint_names)
+        for joint, member in zip(self._joint_names, self._members, strict=True):
+            if isinstance(member, PidJointController):
+                member.gains_origin = f'{name}.{GAINS_FIELD}.{joint}'
 
     @property
     def members(self) -> tuple[CommandController, ...]:
@@ -82,8 +88,13 @@ class ForwardCommandController(MultiJointController):
         return {joint: (self.interface_name,) for joint in self._joint_names}
 
     def pids(self) -> dict[str, Pid]:
-        """Return each joint's PID (none for the effort interface)."""
+        """Return each joint's PID (none for the effort interface or the ideal actuator)."""
         return {joint: pid for member in self._members for joint, pid in member.pids().items()}
+
+    def actuators(self) -> dict[str, Actuator]:
+        """Return what drives each joint while this controller is active."""
+        return {joint: actuator for member in self._members
+                for joint, actuator in member.actuators().items()}
 
     def setpoints(self) -> dict[str, float]:
         """Return each joint's one-joint controller's setpoint."""

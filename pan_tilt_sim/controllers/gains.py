@@ -1,6 +1,6 @@
 """Reading a controller's PID gains from its YAML parameters.
 
-Two layouts:
+Three places, the first that gives gains for a joint wins:
 
 * ROS 1 (gazebo_ros_control), one joint per controller:
   ``pid: {p, i, d, i_clamp...}``;
@@ -10,7 +10,14 @@ Two layouts:
   :func:`feedforward_scales`) and the angle-wrapping flags
   ``angle_wraparound`` / ``normalize_error``, which are accepted and not
   used: this simulator never wraps angles (continuous joints' commands are
-  taken as they are).
+  taken as they are);
+* gazebo_ros_control's own ``gazebo_ros_control/pid_gains/<joint>`` (read
+  into each joint's handle, see :func:`plugin_gains`).
+
+Where none gives gains, a position or velocity interface gets the ideal
+actuator (see :mod:`pan_tilt_sim.controllers.actuator`); an effort
+controller's PID (``effort_controllers/*``, a trajectory controller on the
+effort interface) falls back to its defaults.
 """
 
 from __future__ import annotations
@@ -19,17 +26,19 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from pan_tilt_sim.controllers.base import Controller
+from pan_tilt_sim.controllers.base import Controller, JointHandle
 from pan_tilt_sim.controllers.pid import GainsError, PidGains
+from pan_tilt_sim.errors import ControllerConfigError
 
 PID_FIELD = 'pid'
 GAINS_FIELD = 'gains'
+PLUGIN_GAINS_FIELD = 'gazebo_ros_control.pid_gains'
 FEEDFORWARD_FIELD = 'ff_velocity_scale'
 # Per-joint entries of ros2_controllers' gains that are not PID gains.
 NON_PID_FIELDS = (FEEDFORWARD_FIELD, 'angle_wraparound', 'normalize_error')
 
 
-def gains_from_params(controller: Controller, default: PidGains) -> PidGains:
+def gains_from_params(controller: Controller, default: PidGains | None) -> PidGains | None:
     """Return the ``pid: {p, i, d, i_clamp...}`` section of ``controller``, or ``default``.
 
     The section may already be a :class:`PidGains` (group controllers build
@@ -92,3 +101,36 @@ def _pid_gains(controller: Controller, joint: str, entry: Mapping[str, Any]) -> 
         return PidGains.from_mapping(values)
     except GainsError as err:
         raise controller.error(f'{GAINS_FIELD}.{joint}', str(err)) from None
+
+
+def plugin_gains(entries: Mapping[str, Any], joints: Sequence[str],
+                 source: str = '') -> dict[str, PidGains]:
+    """Return ``gazebo_ros_control/pid_gains`` as gains by joint; errors name the entry."""
+    where = f'{source}: ' if source else ''
+    gains = {}
+    for joint, entry in entries.items():
+        field = f'{PLUGIN_GAINS_FIELD}.{joint}'
+        if joint not in joints:
+            raise ControllerConfigError(
+                f"{where}{field}: '{joint}' is not a movable joint of the robot "
+                f"(movable joints: {', '.join(joints) or 'none'})")
+        try:
+            gains[joint] = PidGains.from_mapping(entry)
+        except GainsError as err:
+            raise ControllerConfigError(f'{where}{field}: {err}') from None
+    return gains
+
+
+def choose_gains(own: PidGains | None, own_field: str, handle: JointHandle,
+                 default: PidGains | None = None) -> tuple[PidGains | None, str]:
+    """Return the gains that drive ``handle``'s joint and where they come from.
+
+    ``own`` (the controller's, from ``own_field``) first, then the joint's
+    ``gazebo_ros_control/pid_gains``, then ``default`` (from '').  None: no
+    gains anywhere -- the joint gets the ideal actuator.
+    """
+    if own is not None:
+        return own, own_field
+    if handle.plugin_gains is not None:
+        return handle.plugin_gains, f'{PLUGIN_GAINS_FIELD}.{handle.name}'
+    return default, ''

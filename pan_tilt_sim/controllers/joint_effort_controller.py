@@ -6,7 +6,7 @@ first command the effort is zero.
 
 from __future__ import annotations
 
-from pan_tilt_sim.controllers.base import CommandResult
+from pan_tilt_sim.controllers.base import Actuator, ActuatorKind, CommandResult
 from pan_tilt_sim.controllers.limits import check_effort
 from pan_tilt_sim.controllers.single_joint import SingleJointController
 
@@ -16,6 +16,10 @@ class JointEffortController(SingleJointController):
 
     type_names = ('effort_controllers/JointEffortController',)
     default_interface = 'effort'
+
+    def actuators(self) -> dict[str, Actuator]:
+        """Return what drives the joint while active: the physics applies the effort."""
+        return {self._joint_name: Actuator(ActuatorKind.EFFORT, self.name)}
 
     def reset(self) -> None:
         """Apply no effort until commanded."""

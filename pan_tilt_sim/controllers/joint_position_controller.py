@@ -1,52 +1,65 @@
 """``position_controllers/`` and ``effort_controllers/JointPositionController``.
 
 The command (rad or m) becomes a setpoint that is clamped to the joint's
-position limits and ramps toward the command no faster than the velocity
-limit; a PID on the position error, with the derivative on the measured
-velocity, gives the joint effort, clamped to the effort limit.  Until the
-first command arrives the setpoint is the joint's position at start, so the
-joint holds still.
+position limits and moves toward the command within the velocity limit.
+Until the first command arrives the setpoint is the joint's position at
+start, so the joint holds still.  What follows the setpoint:
+
+* with PID gains (``pid:``, or ``gazebo_ros_control/pid_gains/<joint>``; the
+  ``effort_controllers/`` type always, with defaults): the setpoint ramps at
+  the velocity limit, and a PID on the position error, with the derivative
+  on the measured velocity, gives the joint effort, clamped to the effort
+  limit -- gazebo_ros_control's behaviour with gains;
+* without: the ideal actuator (:mod:`pan_tilt_sim.controllers.actuator`):
+  the setpoint also respects an acceleration limit, and a velocity motor
+  capped at the effort limit tracks it.
 """
 
 from __future__ import annotations
 
-from pan_tilt_sim.controllers.base import CommandResult, JointHandle
+from pan_tilt_sim.controllers.actuator import ARRIVED, SETPOINT_ACCELERATION, ramp
+from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult, JointHandle
 from pan_tilt_sim.controllers.limits import PositionLimits
 from pan_tilt_sim.controllers.pid import PidGains
 from pan_tilt_sim.controllers.single_joint import PidJointController
 
-# The seed's gains, used when the YAML gives none: with the seed's damping
-# they track critically damped or slower for link inertias up to ~10 kg m^2.
+# The seed's gains, the effort_controllers type's defaults when the YAML gives
+# none: with the seed's damping they track critically damped or slower for
+# link inertias up to ~10 kg m^2.
 DEFAULT_POSITION_GAINS = PidGains(p=100.0, i=0.01, d=10.0)
 
 
 class JointPositionController(PidJointController):
-    """Position setpoint -> effort, through a PID."""
+    """Position setpoint -> effort through a PID, or -> the ideal actuator."""
 
     type_names = ('position_controllers/JointPositionController',
                   'effort_controllers/JointPositionController')
     default_gains = DEFAULT_POSITION_GAINS
+    pid_kind = ActuatorKind.POSITION_PID
+    ideal_kind = ActuatorKind.IDEAL_POSITION
 
     @property
     def setpoint(self) -> float:
-        """Return the rate-limited position setpoint the PID tracks now."""
+        """Return the limited position setpoint the joint tracks now."""
         return self._setpoint
 
     def bind(self, handle: JointHandle) -> None:
-        """Take the joint's position limits and velocity limit, and build the PID."""
+        """Take the joint's position limits and velocity limit, and choose the actuator."""
         super().bind(handle)
         self._limits = PositionLimits(handle.spec)
         self._max_velocity = self._limits.max_velocity
 
     def setpoints(self) -> dict[str, float]:
-        """Return the rate-limited position setpoint the PID tracks now."""
+        """Return the limited position setpoint the joint tracks now."""
         return {self._joint_name: self._setpoint}
 
     def reset(self) -> None:
         """Hold the joint where it is; forget commands and the integral."""
         self._setpoint = self._handle.position
+        self._rate = 0.0
         self._command = self._setpoint
-        self._pid.reset()
+        if self._pid is not None:
+            self._pid.reset()
 
     def set_command(self, value: float) -> CommandResult:
         """Store a position command (clamped to the limits; NaN/Inf rejected)."""
@@ -56,14 +69,29 @@ class JointPositionController(PidJointController):
         return result
 
     def update(self, time: float, period: float) -> None:
-        """Ramp the setpoint, then compute and clamp the effort."""
-        # The ramp (at most max_velocity * period per step) and clamp_effort,
-        # written out: this runs every
-        # physics step, and the two calls cost a third of it.
+        """Move the setpoint, then compute the effort or the velocity target."""
         handle = self._handle
         setpoint = self._setpoint
         command = self._command
-        max_step = self._max_velocity * period
+        max_velocity = self._max_velocity
+        if self._pid is None:
+            # The ideal actuator: the trapezoidal ramp and the tracking target,
+            # written out (the common case of a setpoint at rest on its command
+            # costs two comparisons).
+            rate = self._rate
+            delta = command - setpoint
+            if rate != 0.0 or not -ARRIVED < delta < ARRIVED:
+                setpoint, rate = ramp(setpoint, rate, command, period, max_velocity,
+                                      SETPOINT_ACCELERATION)
+                self._setpoint, self._rate = setpoint, rate
+            target = rate + self._tracking_gain / period * (setpoint - handle.position)
+            handle.velocity_target = (max_velocity if target > max_velocity else
+                                      -max_velocity if target < -max_velocity else target)
+            return
+        # The ramp (at most max_velocity * period per step) and clamp_effort,
+        # written out: this runs every physics step, and the two calls cost a
+        # third of it.
+        max_step = max_velocity * period
         delta = command - setpoint
         if delta > max_step:
             setpoint += max_step

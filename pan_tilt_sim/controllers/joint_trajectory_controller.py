@@ -14,15 +14,18 @@ needs control_msgs, which this simulator does without).
   to the first point still in the future -- points already past are
   skipped -- by cubic Hermite interpolation when the points carry
   velocities, linearly otherwise, and hold the last point after the end.
-* Every joint is driven by effort from a PID on the position error whose
-  derivative acts on the velocity error (desired minus measured velocity),
-  plus ``ff_velocity_scale`` times the desired velocity, as in
-  ros2_controllers; gains per joint come from ``gains: {<joint>: {p, i, d,
-  i_clamp, ff_velocity_scale}}``, else the position controller's defaults
-  (p 100, i 0.01, d 10: see
-  :mod:`~pan_tilt_sim.controllers.forward_command_controller` for why they
-  are stable).  ``command_interfaces`` may name position, velocity or
-  effort; all of them are realised as effort through this PID.
+* A joint with PID gains -- ``gains: {<joint>: {p, i, d, i_clamp,
+  ff_velocity_scale}}``, else ``gazebo_ros_control/pid_gains/<joint>`` -- is
+  driven by effort from a PID on the position error whose derivative acts
+  on the velocity error (desired minus measured velocity), plus
+  ``ff_velocity_scale`` times the desired velocity, as in ros2_controllers.
+* A joint without gains is driven by the ideal actuator (see
+  :mod:`~pan_tilt_sim.controllers.actuator`): a velocity motor capped at the
+  effort limit tracks the desired position, with the desired velocity as
+  feed-forward -- what gz_ros2_control does for a position (or velocity)
+  command interface.  Only on the ``effort`` command interface (which has
+  no ideal actuator) does a joint without gains fall back to the position
+  controller's default PID (p 100, i 0.01, d 10).
 * Before the first trajectory every joint holds its position at start.
 """
 
@@ -34,12 +37,19 @@ from typing import Any
 
 from pan_tilt_sim.controllers.base import (
     MAX_COMMAND_MAGNITUDE,
+    Actuator,
+    ActuatorKind,
     CommandKind,
     CommandResult,
     JointHandle,
     is_sane_number,
 )
-from pan_tilt_sim.controllers.gains import feedforward_scales, joint_gains_from_params
+from pan_tilt_sim.controllers.gains import (
+    GAINS_FIELD,
+    choose_gains,
+    feedforward_scales,
+    joint_gains_from_params,
+)
 from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
 from pan_tilt_sim.controllers.limits import PositionLimits, clamp_effort
 from pan_tilt_sim.controllers.multi_joint import JOINTS_FIELD, MultiJointController
@@ -52,6 +62,7 @@ from pan_tilt_sim.controllers.trajectory import (
 
 COMMAND_INTERFACES_FIELD = 'command_interfaces'
 COMMAND_INTERFACES = ('position', 'velocity', 'effort')
+EFFORT_INTERFACE = 'effort'
 # A knot this close after the start is taken as at the start (float stamps).
 TIME_EPSILON = 1e-9
 
@@ -70,9 +81,10 @@ class JointTrajectoryController(MultiJointController):
                 interface not in COMMAND_INTERFACES for interface in interfaces):
             raise self.error(COMMAND_INTERFACES_FIELD, f'{interfaces!r} must be a list of '
                              f"{', '.join(COMMAND_INTERFACES)}")
+        self._effort_interface = EFFORT_INTERFACE in interfaces
         self._command_interfaces = tuple(interfaces)
         gains = joint_gains_from_params(self, self._joint_names)
-        self._gains = [gains.get(joint, DEFAULT_POSITION_GAINS) for joint in self._joint_names]
+        self._gains = [gains.get(joint) for joint in self._joint_names]
         scales = feedforward_scales(self, self._joint_names)
         self._feedforward = [scales[joint] for joint in self._joint_names]
 
@@ -81,8 +93,13 @@ class JointTrajectoryController(MultiJointController):
         return {joint: self._command_interfaces for joint in self._joint_names}
 
     def pids(self) -> dict[str, Pid]:
-        """One PID per joint (their gains may be changed live)."""
-        return dict(zip(self._joint_names, self._pids, strict=True))
+        """Return the PID of every joint that has one (their gains may be changed live)."""
+        return {joint: pid for joint, pid in zip(self._joint_names, self._pids, strict=True)
+                if pid is not None}
+
+    def actuators(self) -> dict[str, Actuator]:
+        """Return what drives each joint while this controller is active."""
+        return dict(zip(self._joint_names, self._actuators, strict=True))
 
     def setpoints(self) -> dict[str, float]:
         """Return the desired positions the PIDs track now."""
@@ -94,12 +111,27 @@ class JointTrajectoryController(MultiJointController):
         return list(self._desired_positions)
 
     def configure(self, joints: Mapping[str, JointHandle]) -> None:
-        """Bind the joints, their limits and a PID each."""
+        """Bind the joints and their limits; give each a PID or the ideal actuator."""
         self._handles = [self.handle(joints, joint, JOINTS_FIELD) for joint in self._joint_names]
         self._limits = [PositionLimits(handle.spec) for handle in self._handles]
         self._effort_limits = [handle.spec.effort_limit for handle in self._handles]
-        self._pids = [Pid(gains.with_default_clamp(limit))
-                      for gains, limit in zip(self._gains, self._effort_limits, strict=True)]
+        self._max_velocities = [handle.spec.velocity_limit for handle in self._handles]
+        self._tracking_gains = [handle.tracking_gain for handle in self._handles]
+        default = DEFAULT_POSITION_GAINS if self._effort_interface else None
+        self._pids: list[Pid | None] = []
+        self._actuators: list[Actuator] = []
+        for handle, own, limit in zip(self._handles, self._gains, self._effort_limits,
+                                      strict=True):
+            gains, source = choose_gains(own, f'{self.name}.{GAINS_FIELD}.{handle.name}',
+                                         handle, default)
+            if gains is None:
+                self._pids.append(None)
+                self._actuators.append(Actuator(ActuatorKind.IDEAL_POSITION, self.name))
+            else:
+                pid = Pid(gains.with_default_clamp(limit))
+                self._pids.append(pid)
+                self._actuators.append(
+                    Actuator(ActuatorKind.POSITION_PID, self.name, pid, source))
         count = len(self._handles)
         self._desired_positions = [0.0] * count
         self._desired_velocities = [0.0] * count
@@ -111,7 +143,9 @@ class JointTrajectoryController(MultiJointController):
         for index, handle in enumerate(self._handles):
             self._desired_positions[index] = handle.position
             self._desired_velocities[index] = 0.0
-            self._pids[index].reset()
+            pid = self._pids[index]
+            if pid is not None:
+                pid.reset()
         self._plan: TrajectoryPlan | None = None
         self._pending: JointTrajectory | None = None
 
@@ -153,10 +187,19 @@ class JointTrajectoryController(MultiJointController):
             self._plan.sample(time, desired_positions, desired_velocities)
         handles, pids = self._handles, self._pids
         feedforward, effort_limits = self._feedforward, self._effort_limits
+        max_velocities, tracking_gains = self._max_velocities, self._tracking_gains
         for index in self._indices:
             handle = handles[index]
             desired_velocity = desired_velocities[index]
-            effort = pids[index].compute(
+            pid = pids[index]
+            if pid is None:  # the ideal actuator: track the desired state
+                target = desired_velocity + tracking_gains[index] / period * (
+                    desired_positions[index] - handle.position)
+                limit = max_velocities[index]
+                handle.velocity_target = (limit if target > limit else
+                                          -limit if target < -limit else target)
+                continue
+            effort = pid.compute(
                 desired_positions[index], handle.position, period,
                 handle.velocity - desired_velocity)
             effort += feedforward[index] * desired_velocity

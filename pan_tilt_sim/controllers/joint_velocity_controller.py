@@ -1,36 +1,44 @@
 """``velocity_controllers/`` and ``effort_controllers/JointVelocityController``.
 
-The command (rad/s or m/s) is clamped to the joint's velocity limit; a PID
-on the velocity error gives the joint effort, clamped to the effort limit.
-The derivative acts on the measured velocity (its finite difference), so a
-step in the command gives no kick.  Before the first command the target
-velocity is zero.
+The command (rad/s or m/s) is clamped to the joint's velocity limit.
+Before the first command the target velocity is zero.  What follows it:
+
+* with PID gains (``pid:``, or ``gazebo_ros_control/pid_gains/<joint>``; the
+  ``effort_controllers/`` type always, with defaults): a PID on the velocity
+  error gives the joint effort, clamped to the effort limit.  The derivative
+  acts on the measured velocity (its finite difference), so a step in the
+  command gives no kick;
+* without: the ideal actuator (:mod:`pan_tilt_sim.controllers.actuator`), a
+  velocity motor at the command, capped at the effort limit.
 """
 
 from __future__ import annotations
 
-from pan_tilt_sim.controllers.base import CommandResult
+from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult
 from pan_tilt_sim.controllers.limits import check_velocity
 from pan_tilt_sim.controllers.pid import PidGains
 from pan_tilt_sim.controllers.single_joint import PidJointController
 
-# Proportional-only by default: effort = 10 N*m per rad/s of error, a
-# first-order loop that is stable for any inertia and damping.
+# The effort_controllers type's defaults: effort = 10 N*m per rad/s of error,
+# a first-order loop, stable while 10 * time_step < 2 * the joint's inertia.
 DEFAULT_VELOCITY_GAINS = PidGains(p=10.0)
 
 
 class JointVelocityController(PidJointController):
-    """Velocity command -> effort, through a PID."""
+    """Velocity command -> effort through a PID, or -> the ideal actuator."""
 
     type_names = ('velocity_controllers/JointVelocityController',
                   'effort_controllers/JointVelocityController')
     default_gains = DEFAULT_VELOCITY_GAINS
+    pid_kind = ActuatorKind.VELOCITY_PID
+    ideal_kind = ActuatorKind.IDEAL_VELOCITY
     default_interface = 'velocity'
 
     def reset(self) -> None:
         """Target zero velocity; forget the integral."""
         self._command = 0.0
-        self._pid.reset()
+        if self._pid is not None:
+            self._pid.reset()
 
     def set_command(self, value: float) -> CommandResult:
         """Store a velocity command (clamped to the limit; NaN/Inf rejected)."""
@@ -40,9 +48,12 @@ class JointVelocityController(PidJointController):
         return result
 
     def update(self, time: float, period: float) -> None:
-        """Compute and clamp the effort for the present velocity error."""
-        # clamp_effort written out: this runs every physics step.
+        """Compute and clamp the effort for the velocity error, or set the velocity target."""
         handle = self._handle
+        if self._pid is None:
+            handle.velocity_target = self._command
+            return
+        # clamp_effort written out: this runs every physics step.
         effort = self._pid.compute(self._command, handle.velocity, period)
         limit = self._effort_limit
         handle.effort = limit if effort > limit else -limit if effort < -limit else effort

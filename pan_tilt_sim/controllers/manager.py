@@ -118,6 +118,7 @@ class ControllerManager:
         self._controllers = loaded
         self._by_name = {controller.name: controller for controller in loaded}
         self.skipped: tuple[SkippedController, ...] = tuple(skipped)
+        self._switch_listeners: list[Callable[[], None]] = []
         active_names = set(self._by_name) if wanted is None else set(wanted)
         problem = self._problem(active_names)
         if problem is not None:
@@ -185,6 +186,12 @@ class ControllerManager:
         for controller in self._active:
             if controller.name in started:
                 controller.reset()
+        for listener in self._switch_listeners:
+            listener()
+
+    def add_switch_listener(self, listener: Callable[[], None]) -> None:
+        """Call ``listener()`` after every switch (the simulation re-drives the joints)."""
+        self._switch_listeners.append(listener)
 
     def _set_active(self, names: set[str]) -> None:
         self._active_names = frozenset(names)

@@ -12,7 +12,10 @@ ROS 1 style (``rosparam load``), as in both seeds::
         pid: {p: 100.0, i: 0.01, d: 10.0}
 
 A single top-level key whose value holds the controllers is the robot's
-namespace, as ``rosparam load`` inside ``ns=...`` would make it.
+namespace, as ``rosparam load`` inside ``ns=...`` would make it.  Beside the
+controllers, gazebo_ros_control's own PID gains for a joint's position or
+velocity interface, ``gazebo_ros_control: {pid_gains: {<joint>: {p, i, d}}}``,
+are kept as written (:attr:`ControllersConfig.pid_gains`).
 
 ros2_control style (a ROS 2 parameter file), recognised by its
 ``ros__parameters`` keys::
@@ -80,6 +83,8 @@ TYPE_FIELD = 'type'
 ROS2_PARAMETERS = 'ros__parameters'
 UPDATE_RATE_FIELD = 'update_rate'
 CONTROLLER_MANAGER = 'controller_manager'
+GAZEBO_ROS_CONTROL = 'gazebo_ros_control'
+PID_GAINS = 'pid_gains'
 # ros2_control's controller_manager runs at 100 Hz unless told otherwise.
 DEFAULT_UPDATE_RATE = 100.0
 NAME_SEPARATOR = '/'
@@ -117,6 +122,8 @@ class ControllersConfig:
     namespace: str | None = None
     sources: tuple[pathlib.Path, ...] = ()
     update_rate: float | None = None
+    # gazebo_ros_control/pid_gains/<joint>: {p, i, d, ...} as written (ROS 1 layout).
+    pid_gains: Mapping[str, Any] = dataclasses.field(default_factory=dict)
 
     @property
     def label(self) -> str:
@@ -306,6 +313,7 @@ def load_controllers_config(paths: pathlib.Path | str | Sequence[pathlib.Path | 
             f'(ros__parameters); not so: {mixed}')
     path, document = documents[0]
     namespace = None
+    holder: Mapping[Any, Any] = document
     controllers = _controllers_in(document)
     if not controllers and isinstance(document.get(TYPE_FIELD), str):
         # ROS 1: one controller per file, named by the namespace it is loaded into.
@@ -316,12 +324,28 @@ def load_controllers_config(paths: pathlib.Path | str | Sequence[pathlib.Path | 
         if isinstance(inner, Mapping):
             controllers = _controllers_in(inner)
             namespace = str(key) if controllers else None
+            holder = inner
     if not controllers:
         raise ControllerConfigError(
             f"{path}: no controllers in it (a controller is a mapping with a '{TYPE_FIELD}')")
     _check_names(path, controllers, namespace)
     return ControllersConfig(controllers=tuple(controllers), source=path, namespace=namespace,
-                             sources=(path,))
+                             sources=(path,), pid_gains=_plugin_pid_gains(holder, path))
+
+
+def _plugin_pid_gains(holder: Mapping[Any, Any], path: pathlib.Path) -> dict[str, Any]:
+    """Return ``gazebo_ros_control: pid_gains:`` beside the controllers, by joint ({} if none)."""
+    plugin = holder.get(GAZEBO_ROS_CONTROL)
+    if plugin is None:
+        return {}
+    gains = plugin.get(PID_GAINS) if isinstance(plugin, Mapping) else None
+    if gains is None and isinstance(plugin, Mapping):
+        return {}
+    if not isinstance(gains, Mapping):
+        raise ControllerConfigError(
+            f'{path}: {GAZEBO_ROS_CONTROL}.{PID_GAINS}: expected a mapping of joint names '
+            'to {p, i, d}')
+    return {str(joint): entry for joint, entry in gains.items()}
 
 
 def _read_document(path: pathlib.Path, args: Mapping[str, str],

@@ -4,7 +4,8 @@ Nothing here knows about PyBullet or ROS: it reads the file (running xacro
 with the user's mappings when the file is a xacro), parses it once into the
 robot model (:mod:`pan_tilt_sim.model.urdf`), and makes PyBullet's copy of the
 URDF, whose meshes are local files PyBullet can load
-(:mod:`pan_tilt_sim.model.resources`).
+(:mod:`pan_tilt_sim.model.resources`) and whose links without ``<inertial>``
+are explicitly massless (:mod:`pan_tilt_sim.model.inertials`).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from collections.abc import Sequence
 from xml.parsers.expat import ExpatError
 
 from pan_tilt_sim.errors import DescriptionError, one_line
+from pan_tilt_sim.model.inertials import complete_inertials
 from pan_tilt_sim.model.resources import localize_meshes
 from pan_tilt_sim.model.robot import JointSpec, RobotModel
 from pan_tilt_sim.model.urdf import parse_xml, read_model
@@ -38,7 +40,8 @@ class RobotDescription:
     ``urdf_xml`` is the URDF as the user wrote it (xacro's output, meshes
     still ``package://...``): what robot_description publishes and
     robot_state_publisher and RViz read.  ``physics_urdf`` is PyBullet's
-    copy, whose meshes point at loadable local files.
+    copy, whose meshes point at loadable local files and whose massless
+    links say so.
     """
 
     model: RobotModel
@@ -46,7 +49,8 @@ class RobotDescription:
     physics_urdf: str
     source: pathlib.Path
     # What xacro warned about while expanding the file ("redefining global
-    # symbol: pi"...), one line each, for the caller to log once.
+    # symbol: pi"...) and what making PyBullet's copy had to change (a frozen
+    # joint's massless links), one line each, for the caller to log once.
     warnings: tuple[str, ...] = ()
 
     @property
@@ -154,19 +158,34 @@ def load_description(path: pathlib.Path | str, xacro_args: Sequence[str] = ()) -
     model = read_model(root, path)
     if not model.actuated_joints:
         raise DescriptionError(f'{path}: the robot has no movable joints to control')
-    # PyBullet's copy: the parsed tree with every mesh made loadable.  The
-    # model was read before, so it keeps the URIs as written.
-    try:
-        localize_meshes(root, path.parent, mesh_cache_dir())
-    except DescriptionError as err:
-        raise DescriptionError(f'{path}: {err}') from None
+    # The model was read before, so it keeps the URIs as written.
+    physics_urdf, physics_warnings = physics_copy(root, model, path.parent, path)
     return RobotDescription(
         model=model,
         urdf_xml=urdf_xml,
-        physics_urdf=ElementTree.tostring(root, encoding='unicode'),
+        physics_urdf=physics_urdf,
         source=path,
-        warnings=warnings,
+        warnings=warnings + physics_warnings,
     )
+
+
+def physics_copy(root: ElementTree.Element, model: RobotModel, base_dir: pathlib.Path,
+                 source: pathlib.Path) -> tuple[str, tuple[str, ...]]:
+    """Turn the parsed tree into PyBullet's copy; return its text and what had to change.
+
+    Every mesh made loadable (relative ones taken from ``base_dir``) and every
+    massless link explicit; errors name ``source``.  Also used for the
+    objects spawned into the world (:mod:`pan_tilt_sim.model.entity_resource`).
+    """
+    try:
+        localize_meshes(root, base_dir, mesh_cache_dir())
+    except DescriptionError as err:
+        raise DescriptionError(f'{source}: {err}') from None
+    warnings = complete_inertials(root, model)
+    # One element per line: PyBullet's reader fails on some long one-line files
+    # ("Cannot load URDF file."), which minified URDFs would be.
+    ElementTree.indent(root)
+    return ElementTree.tostring(root, encoding='unicode'), warnings
 
 
 def mesh_cache_dir() -> pathlib.Path:

@@ -29,10 +29,10 @@ from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.description import (
     XACRO_SUFFIX,
     RobotDescription,
-    mesh_cache_dir,
+    physics_copy,
     read_description_xml,
 )
-from pan_tilt_sim.model.resources import localize_meshes, mesh_elements, resolve_resource
+from pan_tilt_sim.model.resources import mesh_elements, resolve_resource
 from pan_tilt_sim.model.urdf import URDF_ROOT_TAG, parse_xml, read_model
 
 URDF_SUFFIX = '.urdf'
@@ -140,11 +140,8 @@ def _describe(text: str, source: pathlib.Path, base: pathlib.Path) -> RobotDescr
                 f"{source}: link '{link}' {role}: mesh '{uri}' (resolved to {path}): "
                 'file not found')
     try:
-        localize_meshes(root, base, mesh_cache_dir())
+        physics_urdf, warnings = physics_copy(root, model, base, source)
     except DescriptionError as err:
-        raise EntityResourceError(ResourceProblem.UNSUPPORTED_ASSETS, f'{source}: {err}') from None
-    # One element per line: PyBullet's reader fails on some long one-line files.
-    ElementTree.indent(root)
-    return RobotDescription(model=model, urdf_xml=text,
-                            physics_urdf=ElementTree.tostring(root, encoding='unicode'),
-                            source=source)
+        raise EntityResourceError(ResourceProblem.UNSUPPORTED_ASSETS, str(err)) from None
+    return RobotDescription(model=model, urdf_xml=text, physics_urdf=physics_urdf,
+                            source=source, warnings=warnings)

@@ -96,6 +96,13 @@ def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
             raise DescriptionError(
                 f"{source}: joint '{joint.name}' mimics '{joint.mimic.joint}', "
                 'which is not a joint of this robot')
+    children = {joint.child for joint in joints}
+    roots = [link.name for link in links if link.name not in children]
+    if len(roots) > 1:
+        # urdfdom refuses such a file; PyBullet crashes on it.
+        raise DescriptionError(
+            f"{source}: links {', '.join(repr(root) for root in roots)} are each the child of "
+            'no joint: a URDF must be one tree with one root link')
     plugins = _control_plugins(root)
     for plugin in plugins:
         namespace = plugin.namespace

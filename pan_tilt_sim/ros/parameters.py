@@ -19,6 +19,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from pan_tilt_sim.errors import ParameterError
+from pan_tilt_sim.model.initial_positions import parse_initial_positions
 from pan_tilt_sim.model.naming import check_namespace
 from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
 
@@ -80,6 +81,9 @@ def _specs() -> tuple[_Spec, ...]:
         _Spec('robot_namespace', ParameterType.PARAMETER_STRING, '',
               "Namespace of the robot's topics; empty = derived from the node namespace, "
               'the controllers file or the gazebo_ros_control plugin.'),
+        _Spec('initial_positions', ParameterType.PARAMETER_STRING_ARRAY, None,
+              "Start positions, each 'joint:=value' (rad or m); they override the URDF's "
+              '<ros2_control> initial_value, and the reset services return to them.'),
     )
 
 
@@ -98,6 +102,7 @@ class SimParameters:
     paused: bool
     gui: bool
     robot_namespace: str
+    initial_positions: dict[str, float]
 
 
 def declare_parameters(node: Node) -> SimParameters:
@@ -106,6 +111,7 @@ def declare_parameters(node: Node) -> SimParameters:
                                  read_only=spec.read_only)
               for spec in _specs()}
     values['xacro_args'] = tuple(values['xacro_args'])
+    values['initial_positions'] = parse_initial_positions(values['initial_positions'])
     values['controllers_args'] = tuple(values['controllers_args'])
     values['active_controllers'] = tuple(values['active_controllers']) or None
     checked = SimParameters(**values)

@@ -102,7 +102,8 @@ class SimNode(Node):
         self.simulation = Simulation(
             description, controllers, self.settings.time_step, gui=self.settings.gui,
             active_controllers=(None if self._topic_settings is not None
-                                else self.settings.active_controllers))
+                                else self.settings.active_controllers),
+            initial_positions=self.settings.initial_positions, logger=self.get_logger())
         self._paused = self.settings.paused
         self.steps_run = 0  # physics steps this node has run (never reset; see run_steps)
         # Commands taken per controller (ignored ones included): a cheap health figure.
@@ -150,11 +151,8 @@ class SimNode(Node):
             self.simulation.close()
             raise
         self._log_controllers(description, controllers)
-        for joint in self.simulation.physics.joints:
-            if joint.initial_position != 0.0:
-                self.get_logger().info(
-                    f"joint '{joint.name}' starts at {joint.initial_position:g}: 0 is outside "
-                    f'its limits [{joint.lower:g}, {joint.upper:g}]')
+        # Actuators, start positions, PyBullet's load messages, unstable gains.
+        self.simulation.report_startup()
         clock_period = self._clock_every * self.settings.time_step
         if abs(clock_period - CLOCK_PERIOD_S) > 1e-9:
             self.get_logger().info(

@@ -170,7 +170,8 @@ class Renderer:
         # Each pixel's viewing ray in optical axes: ((u - cx) / fx, (v - cy) / fy, 1).
         self._ray_x = (numpy.arange(settings.width) - camera.cx) / camera.fx
         self._ray_y = (numpy.arange(settings.height) - camera.cy) / camera.fy
-        initial = {joint.name: joint.initial_position for joint in physics.joints}
+        initial = {joint.name: position for joint, position in zip(
+            physics.joints, physics.initial_positions, strict=True)}
         self.mount = camera_mount(model, settings.link, initial)
         self._projection = pybullet.computeProjectionMatrixFOV(
             vertical_fov_deg(settings), settings.width / settings.height,

@@ -1,35 +1,99 @@
 """The simulation loop: physics and controllers, stepped together, no ROS.
 
 Each step is ros2_control's read / update / write around one physics step:
-the measured joint states go into the joint handles, every active controller
-updates (command controllers first, so broadcasters sample fresh efforts),
-the efforts go to PyBullet, and PyBullet advances one ``time_step``.  Sim
-time is kept as a step count, so it never accumulates rounding error.
-Which controllers are loaded and which are active is the
-:class:`~pan_tilt_sim.controllers.manager.ControllerManager`'s business.
+the measured joint states go into the joint handles (and, for joints an
+ideal actuator drives, the effort its motor applied), every active
+controller updates (command controllers first, so broadcasters sample fresh
+efforts), the efforts and velocity targets go to PyBullet, and PyBullet
+advances one ``time_step``.  Sim time is kept as a step count, so it never
+accumulates rounding error.  Which controllers are loaded and which are
+active is the :class:`~pan_tilt_sim.controllers.manager.ControllerManager`'s
+business; the active ones say how each of their joints is driven
+(:meth:`~pan_tilt_sim.controllers.base.Controller.actuators`), and a joint no
+active controller claims is passive -- it keeps the last effort applied.
+
+At start-up the simulation says, through the logger it is given, which
+actuator drives each joint and why, where each joint starts, what PyBullet
+said while loading the robot, and which PID gains are too high for their
+joint's inertia at this time step (:mod:`pan_tilt_sim.sim.stability`).
+While running, a joint at PyBullet's speed cap or with a non-finite state
+gets a warning (at most one per joint per second).
 """
 
 from __future__ import annotations
 
+import logging
+import math
+import time as wall_time
 from collections.abc import Mapping, Sequence
+from typing import Protocol
 
 from pan_tilt_sim.controllers import CommandController, Controller, JointHandle
+from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
+from pan_tilt_sim.controllers.base import Drive, idle_actuator
+from pan_tilt_sim.controllers.gains import plugin_gains
 from pan_tilt_sim.controllers.manager import ControllerManager
 from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription
-from pan_tilt_sim.sim.physics import STATE_POSITION, STATE_VELOCITY, Physics
+from pan_tilt_sim.model.initial_positions import FROM_DEFAULT, StartPosition, start_positions
+from pan_tilt_sim.sim.physics import (
+    STATE_MOTOR_TORQUE,
+    STATE_POSITION,
+    STATE_VELOCITY,
+    Physics,
+    health_problem,
+)
+from pan_tilt_sim.sim.stability import pid_stability_warnings
+
+LOGGER_NAME = 'pan_tilt_sim'
+# A joint this close to PyBullet's speed cap is riding it.
+AT_CAP = 0.99
+WARNING_THROTTLE_S = 1.0  # wall seconds between two warnings about one joint
+INFO, WARNING = 'info', 'warning'
+
+
+class Logger(Protocol):
+    """What the simulation logs through: rclpy's node logger and logging.Logger both fit."""
+
+    def info(self, message: str) -> object:
+        """Log ``message`` as information."""
+
+    def warning(self, message: str) -> object:
+        """Log ``message`` as a warning."""
 
 
 class Simulation:
-    """One robot in PyBullet, driven by its controllers, advanced step by step."""
+    """One robot in PyBullet, driven by its controllers, advanced step by step.
+
+    ``initial_positions`` (joint name -> position) override the URDF's
+    ``initial_value`` (see :mod:`pan_tilt_sim.model.initial_positions`).
+    What the simulation has to say at start-up waits in
+    :attr:`startup_report` until :meth:`report_startup` logs it (the node
+    does that once it is completely built, so that a start-up error stays
+    the only line); run-time warnings go to ``logger`` at once.
+    """
 
     def __init__(self, description: RobotDescription, controllers: ControllersConfig,
                  time_step: float, *, gui: bool = False,
-                 active_controllers: Sequence[str] | None = None) -> None:
+                 active_controllers: Sequence[str] | None = None,
+                 initial_positions: Mapping[str, float] | None = None,
+                 logger: Logger | None = None) -> None:
         self.description = description
-        self.physics = Physics(description, time_step, gui=gui)
+        self._logger: Logger = logger or logging.getLogger(LOGGER_NAME)
+        starts = start_positions(description.model, initial_positions)
+        movable = [joint.name for joint in description.actuated_joints]
+        gains = plugin_gains(controllers.pid_gains, movable, controllers.label)
+        load_messages: list[str] = []
+        self.physics = Physics(
+            description, time_step, gui=gui,
+            initial_positions=[starts[joint].position for joint in movable],
+            warn=load_messages.append)
         try:
-            self.handles = {joint.name: JointHandle(joint) for joint in self.physics.joints}
+            gain = description.model.position_proportional_gain or TRACKING_GAIN
+            self.handles = {
+                joint.name: JointHandle(joint, position, gains.get(joint.name), gain)
+                for joint, position in zip(self.physics.joints,
+                                           self.physics.initial_positions, strict=True)}
             self.manager = ControllerManager(controllers, self.handles, description.model,
                                              active=active_controllers)
             self.controllers = self.manager.controllers
@@ -37,11 +101,58 @@ class Simulation:
             self.physics.close()
             raise
         self._handle_list = list(self.handles.values())
-        self._efforts = [0.0] * len(self._handle_list)
         self._time_step = time_step
         self._steps = 0
         self._states = self.physics.read_states()
+        self._apply_actuators()
+        self.manager.add_switch_listener(self._apply_actuators)
+        self._speed_limit = AT_CAP * self.physics.velocity_cap
+        self._last_warning: dict[str, float] = {}
+        self.startup_report = self._startup_report(description, starts, load_messages)
+
+    def _apply_actuators(self) -> None:
+        """Drive every joint as its active controller says (a joint without one: passive)."""
+        actuators = {}
+        for controller in self.manager.active:
+            actuators.update(controller.actuators())
+        for handle in self._handle_list:
+            handle.actuator = actuators.get(handle.name) or idle_actuator(handle.spec)
+        velocity_driven = [handle.drive is Drive.VELOCITY for handle in self._handle_list]
+        self.physics.set_drives(velocity_driven)
+        self._effort_handles = [handle for handle, driven in zip(
+            self._handle_list, velocity_driven, strict=True) if not driven]
+        self._velocity_handles = [handle for handle, driven in zip(
+            self._handle_list, velocity_driven, strict=True) if driven]
+        self._velocity_slots = [slot for slot, driven in enumerate(velocity_driven) if driven]
+        self._efforts = [0.0] * len(self._effort_handles)
+        self._targets = [0.0] * len(self._velocity_handles)
         self._physics_step = self.physics.stepper()
+
+    def report_startup(self) -> None:
+        """Log :attr:`startup_report` (info and warnings), once."""
+        for level, message in self.startup_report:
+            # One call site per severity: rclpy's logger insists on it.
+            if level == WARNING:
+                self._logger.warning(message)
+            else:
+                self._logger.info(message)
+        self.startup_report = []
+
+    def _startup_report(self, description: RobotDescription, starts: Mapping[str, StartPosition],
+                        load_messages: Sequence[str]) -> list[tuple[str, str]]:
+        report = [(WARNING, message) for message in load_messages]
+        for handle in self._handle_list:
+            report.append((INFO, f"joint '{handle.name}': "
+                                 f'{handle.actuator.describe(handle.spec)}'))
+        for handle in self._handle_list:
+            start = starts[handle.name]
+            line = start.describe(handle.spec.lower, handle.spec.upper)
+            if line:
+                report.append((WARNING if start.clamped and start.source != FROM_DEFAULT
+                               else INFO, line))
+        report.extend((WARNING, message) for message in pid_stability_warnings(
+            self.physics, self._handle_list, self._time_step))
+        return report
 
     @property
     def time_step(self) -> float:
@@ -76,7 +187,9 @@ class Simulation:
         # pan/tilt against ~5 us inside PyBullet (see README, Performance).
         handles = self._handle_list
         updates = self.manager.updates
-        efforts = self._efforts
+        effort_handles, efforts = self._effort_handles, self._efforts
+        velocity_handles, targets = self._velocity_handles, self._targets
+        readback = list(zip(velocity_handles, self._velocity_slots, strict=True))
         physics_step = self._physics_step
         dt = self._time_step
         states = self._states
@@ -86,14 +199,34 @@ class Simulation:
             for handle, state in zip(handles, states, strict=False):
                 handle.position = state[STATE_POSITION]
                 handle.velocity = state[STATE_VELOCITY]
+            for handle, slot in readback:  # what the ideal actuators applied
+                handle.effort = states[slot][STATE_MOTOR_TORQUE]
             time = count * dt
             for update in updates:
                 update(time, dt)
-            for index, handle in enumerate(handles):
+            for index, handle in enumerate(effort_handles):
                 efforts[index] = handle.effort
-            states = physics_step(efforts)
+            for index, handle in enumerate(velocity_handles):
+                targets[index] = handle.velocity_target
+            states = physics_step(efforts, targets)
         self._steps = first + steps
         self._states = states
+        self._check_health(states)
+
+    def _check_health(self, states: Sequence[Sequence[float]]) -> None:
+        """Warn about any joint at PyBullet's speed cap or with a non-finite state."""
+        limit = self._speed_limit
+        for handle, state in zip(self._handle_list, states, strict=False):
+            velocity = state[STATE_VELOCITY]
+            if -limit < velocity < limit and math.isfinite(state[STATE_POSITION]):
+                continue
+            now = wall_time.monotonic()
+            if now - self._last_warning.get(handle.name, -math.inf) < WARNING_THROTTLE_S:
+                continue
+            self._last_warning[handle.name] = now
+            self._logger.warning(
+                f'at sim time {self.time:.3f} s: '
+                f'{health_problem(handle.name, state, self.physics.velocity_cap)}')
 
     def reset(self, *, reset_time: bool = True) -> None:
         """Joints back to their initial state, controllers reset; sim time to 0 if asked."""
@@ -141,8 +274,10 @@ class Simulation:
 def make_simulation(description_file: str, controllers_file: str | None, time_step: float, *,
                     xacro_args: Sequence[str] = (), gui: bool = False,
                     controllers_args: Mapping[str, str] | None = None,
-                    active_controllers: Sequence[str] | None = None) -> Simulation:
-    """Load both files and build a :class:`Simulation` (for tools and tests).
+                    active_controllers: Sequence[str] | None = None,
+                    initial_positions: Mapping[str, float] | None = None,
+                    logger: Logger | None = None) -> Simulation:
+    """Load both files and build a :class:`Simulation` (for tools and tests); log its report.
 
     Without ``controllers_file`` the URDF's control plugin names it (see
     :func:`~pan_tilt_sim.model.controller_config.controllers_files_for`).
@@ -155,5 +290,10 @@ def make_simulation(description_file: str, controllers_file: str | None, time_st
 
     description = load_description(description_file, xacro_args)
     files = controllers_files_for(str(controllers_file or ''), description)
-    return Simulation(description, load_controllers_config(files, controllers_args), time_step,
-                      gui=gui, active_controllers=active_controllers)
+    simulation = Simulation(description, load_controllers_config(files, controllers_args),
+                            time_step, gui=gui, active_controllers=active_controllers,
+                            initial_positions=initial_positions, logger=logger)
+    for warning in description.warnings:
+        simulation._logger.warning(warning)
+    simulation.report_startup()
+    return simulation

@@ -1,41 +1,96 @@
-"""The physics layer: one PyBullet client, one robot, joints driven by torque.
+"""The physics layer: one PyBullet client, one robot, joints driven by effort or by a motor.
 
 :class:`Physics` owns its own PyBullet client id (never the global default
 client), so several simulations can live in one process.  The robot is
-loaded with a fixed base and the URDF's inertia; PyBullet's default velocity
-motors are switched off, so every actuated joint moves only by the torque
-the controllers ask for.  URDF ``damping`` is applied by PyBullet itself as
-viscous torque; URDF ``friction`` is modelled as Coulomb friction by a
-velocity motor held at zero speed whose force is capped at the friction
-value, which also gives the static friction Gazebo users know.  A
-``<mimic>`` joint is held at ``multiplier * leader + offset`` by a gear
+loaded with a fixed base and the URDF's inertia (links without
+``<inertial>`` come massless, see :mod:`pan_tilt_sim.model.inertials`);
+what PyBullet says while loading goes to the log, one line per message.
+PyBullet's hidden drag on every link (linear and angular damping 0.04,
+not in the URDF, not in Gazebo) is switched off, and its speed cap
+(``maxJointVelocity``, 100 rad/s) raised to twice the fastest URDF velocity
+limit, so that only an unstable joint ever reaches it.
+
+Each joint is driven one of two ways (:meth:`Physics.set_drives`):
+
+* **effort**: the joint gets the effort the controllers ask for, plus its
+  URDF damping and Coulomb friction (a velocity motor held at zero speed
+  whose force is capped at the friction: static friction included).
+  PyBullet applies damping explicitly, which diverges once ``damping *
+  time_step`` exceeds twice the joint's effective inertia ``J = 1 /
+  (M^-1)_ii``; it is kept only where it is twenty times inside that bound
+  (``d dt <= 0.1 J`` at every pose checked: there explicit and implicit
+  Euler are equally accurate, and it costs nothing per step -- the seed's
+  pan/tilt).  Elsewhere damping is implicit, stable at any time step: the
+  zero-speed motor resists with at most the force that damping and
+  friction give at the speed the joint would have at the end of the step
+  (implicit Euler of ``J v' = tau + g - d v - f sgn v``, with the passive
+  torque ``g`` read back from the previous step), or, for damping alone,
+  with the velocity gain ``d dt / (J + d dt)``.  A joint coupled by a mimic
+  gear always takes the first form; a joint with neither damping nor
+  friction has no motor at all.
+* **velocity** (the ideal actuator, :mod:`pan_tilt_sim.controllers.actuator`):
+  a velocity motor drives the joint to the target the controllers ask for,
+  with at most the joint's URDF effort limit; the torque it applied is read
+  back as the joint's effort.  URDF damping and friction are not applied.
+
+A ``<mimic>`` joint is held at ``multiplier * leader + offset`` by a gear
 constraint (see :mod:`pan_tilt_sim.model.mimic`).
 """
 
 from __future__ import annotations
 
 import contextlib
+import math
 import pathlib
 import tempfile
 import weakref
 from collections.abc import Callable, Sequence
 
+import numpy
+
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.mimic import follow_leaders, mimic_couplings
 from pan_tilt_sim.model.robot import JointSpec
-from pan_tilt_sim.sim.bullet import pybullet, quiet_native_output
+from pan_tilt_sim.sim.bullet import (
+    captured_native_output,
+    message_lines,
+    pybullet,
+    quiet_native_output,
+)
 
 STANDARD_GRAVITY = 9.81  # m/s^2, along -z as in Gazebo's default world
 URDF_FILE_NAME = 'robot.urdf'
-# Index of the position and velocity in one entry of pybullet.getJointStates.
+# Index of the position, velocity and applied motor torque in one entry of
+# pybullet.getJointStates.
 STATE_POSITION = 0
 STATE_VELOCITY = 1
+STATE_MOTOR_TORQUE = 3
 # Gear constraints of mimic joints: force bound high enough to be rigid, and
 # the share of the position error corrected per step (1 would be all at once).
 MIMIC_MAX_FORCE = 1e9
 MIMIC_ERROR_REDUCTION = 0.8
 BASE_LINK_INDEX = -1  # PyBullet's index of a body's base link
+# PyBullet clamps every joint's speed to this (rad/s or m/s); we raise it to
+# twice the fastest URDF velocity limit, never below PyBullet's default.
+DEFAULT_VELOCITY_CAP = 100.0
+VELOCITY_CAP_MARGIN = 2.0
+# A motor force "without limit" (N*m or N): PyBullet needs a finite number.
+UNLIMITED_FORCE = 1e9
+# How often the joints' effective inertias are recomputed for the damping
+# (they change with the pose of an arm), in physics steps.
+INERTIA_REFRESH_STEPS = 100
+# PyBullet's explicit damping is kept where damping * time_step is at most this
+# share of the joint's smallest effective inertia (it diverges at 2).
+EXPLICIT_DAMPING_SHARE = 0.1
+# Poses at which inertias are checked: the start, then every joint at these
+# fractions of its range (0 = lower, 1 = upper), or at these angles without limits.
+RANGE_FRACTIONS = (0.5, 0.25, 0.75)
+FREE_POSES = (0.0, math.pi / 2.0, -math.pi / 2.0)
+NO_MOTOR = 0.0  # force 0 removes a joint's motor row from PyBullet's solver
+MOTOR_VELOCITY_GAIN = 1.0  # a velocity motor that reaches its target in one step if it can
+
+LogFunction = Callable[[str], None]
 
 
 def _disconnect(client: int) -> None:
@@ -43,11 +98,43 @@ def _disconnect(client: int) -> None:
         pybullet.disconnect(physicsClientId=client)
 
 
+def _ignore(message: str) -> None:
+    """Drop ``message`` (the default log function)."""
+
+
+def check_poses(joints: Sequence[JointSpec], start: Sequence[float]) -> list[list[float]]:
+    """Return the poses to check inertias at: the start, then each of RANGE_FRACTIONS."""
+    poses = [list(start)]
+    for number, fraction in enumerate(RANGE_FRACTIONS):
+        pose = []
+        for joint in joints:
+            if joint.has_position_limits and math.isfinite(joint.lower) and math.isfinite(
+                    joint.upper):
+                pose.append(joint.lower + fraction * (joint.upper - joint.lower))
+            else:
+                pose.append(FREE_POSES[number % len(FREE_POSES)])
+        poses.append(pose)
+    return poses
+
+
+def velocity_cap(joints: Sequence[JointSpec]) -> float:
+    """Return the speed cap to give PyBullet: twice the fastest finite limit, at least 100."""
+    limits = [joint.velocity_limit for joint in joints if math.isfinite(joint.velocity_limit)]
+    return max([DEFAULT_VELOCITY_CAP] + [VELOCITY_CAP_MARGIN * limit for limit in limits])
+
+
 class Physics:
-    """A PyBullet world holding one fixed-base robot."""
+    """A PyBullet world holding one fixed-base robot.
+
+    ``initial_positions`` (one per actuated joint; default: each joint's
+    :attr:`~pan_tilt_sim.model.robot.JointSpec.initial_position`) is where
+    the joints start and where :meth:`reset_joints` without arguments puts
+    them.  ``warn`` receives PyBullet's load messages, one line each.
+    """
 
     def __init__(self, description: RobotDescription, time_step: float, *,
-                 gui: bool = False) -> None:
+                 gui: bool = False, initial_positions: Sequence[float] | None = None,
+                 warn: LogFunction = _ignore) -> None:
         self._description = description
         self._time_step = time_step
         self._workdir = tempfile.TemporaryDirectory(prefix='pan_tilt_sim_')
@@ -61,18 +148,22 @@ class Physics:
         # (a signal during start-up) or left behind at interpreter exit.
         self._disconnect = weakref.finalize(self, _disconnect, self._client)
         try:
-            self._body = self._load(description)
+            self._body = self._load(description, warn)
         except BaseException:
             self.close()
             raise
         self._joints = description.actuated_joints
-        index_of, self._link_indices = self._joint_and_link_indices()
+        index_of, self._link_indices, self._dof_indices = self._joint_and_link_indices()
         self._indices = [index_of[joint.name] for joint in self._joints]
         self._mimics = mimic_couplings(self._joints, description.source)
-        self._configure_motors()
+        self.velocity_cap = velocity_cap(self._joints)
+        self._remove_hidden_damping()
         self._couple_mimic_joints(index_of)
-        self._step = self.stepper()
-        self.reset_joints([joint.initial_position for joint in self._joints])
+        if initial_positions is None:
+            initial_positions = [joint.initial_position for joint in self._joints]
+        self._initial_positions = self._with_mimics(initial_positions)
+        self._drives = _Drives(self, [False] * len(self._joints))
+        self.reset_joints()
 
     @property
     def client_id(self) -> int:
@@ -94,6 +185,11 @@ class Physics:
         """The actuated joints, in the order of every array this class takes or gives."""
         return self._joints
 
+    @property
+    def initial_positions(self) -> list[float]:
+        """Where each joint starts (mimic joints where their leaders put them)."""
+        return list(self._initial_positions)
+
     def joint_index(self, name: str) -> int:
         """PyBullet's index of the joint called ``name``."""
         return self._indices[[joint.name for joint in self._joints].index(name)]
@@ -106,32 +202,39 @@ class Physics:
         """``pybullet.getJointStates`` for the actuated joints: (position, velocity, ...)."""
         return pybullet.getJointStates(self._body, self._indices, self._client)
 
-    def step(self, efforts: Sequence[float]) -> list:
-        """Apply ``efforts`` (N*m or N), advance one time step, return the new states."""
-        return self._step(efforts)
+    @property
+    def implicit_damping(self) -> tuple[str, ...]:
+        """The effort-driven joints whose URDF damping is applied implicitly (see the module)."""
+        drives = self._drives
+        return tuple(self._joints[k].name for k in sorted(drives.implicit + drives.damped))
 
-    def stepper(self) -> Callable[[Sequence[float]], list]:
+    def set_drives(self, velocity_driven: Sequence[bool]) -> None:
+        """Say which joints a velocity motor drives (True) and which take efforts (False).
+
+        Arrays given to :meth:`step` and the stepper follow this split: the
+        efforts of the effort-driven joints and the velocity targets of the
+        velocity-driven ones, each in joint order.
+        """
+        self._drives = _Drives(self, velocity_driven)
+
+    def step(self, efforts: Sequence[float], targets: Sequence[float] = ()) -> list:
+        """Apply ``efforts`` and velocity ``targets``, advance one time step, return the states."""
+        drives = self._drives
+        if len(efforts) != len(drives.effort_slots) or len(targets) != len(
+                drives.velocity_slots):
+            raise ValueError(
+                f'{len(efforts)} efforts and {len(targets)} targets for '
+                f'{len(drives.effort_slots)} effort- and {len(drives.velocity_slots)} '
+                'velocity-driven joints')
+        return drives.step(efforts, targets)
+
+    def stepper(self) -> Callable[[Sequence[float], Sequence[float]], list]:
         """Return a function doing what :meth:`step` does, with every argument pre-bound.
 
-        For hot loops: the function reads nothing from ``self``.  All PyBullet
-        arguments are passed by position, because CPython decodes and hashes
-        every keyword name of the C signature on each call with keywords
-        (about 0.5 us of the ~1 us setJointMotorControlArray costs here).  In
-        TORQUE_CONTROL PyBullet reads only the forces; the target and gain
-        sequences in front of them just need the right length.
+        For hot loops: the function reads nothing from ``self``.  It stays
+        valid until the next :meth:`set_drives`.
         """
-        body, indices, client = self._body, self._indices, self._client
-        torque = pybullet.TORQUE_CONTROL
-        unused = [0.0] * len(indices)
-        set_motors = pybullet.setJointMotorControlArray
-        step_simulation = pybullet.stepSimulation
-        get_states = pybullet.getJointStates
-
-        def step(efforts: Sequence[float]) -> list:
-            set_motors(body, indices, torque, unused, unused, efforts, unused, unused, client)
-            step_simulation(client)
-            return get_states(body, indices, client)
-        return step
+        return self._drives.step
 
     def bare_stepper(self) -> Callable[[], None]:
         """Return ``stepSimulation`` bound to this client: a step that applies no efforts.
@@ -144,14 +247,59 @@ class Physics:
             step_simulation(client)
         return step
 
-    def reset_joints(self, positions: Sequence[float]) -> None:
-        """Put every actuated joint at ``positions`` (mimic joints by their leader), at rest."""
-        if self._mimics:
-            positions = follow_leaders(
-                [joint.name for joint in self._joints], positions, self._mimics)
+    def reset_joints(self, positions: Sequence[float] | None = None) -> None:
+        """Put every actuated joint at ``positions`` (default: the initial ones), at rest.
+
+        Mimic joints go where their leaders put them.
+        """
+        positions = self._initial_positions if positions is None else self._with_mimics(
+            positions)
         for index, position in zip(self._indices, positions, strict=True):
             pybullet.resetJointState(
                 self._body, index, position, targetVelocity=0.0, physicsClientId=self._client)
+        self._drives.restart()
+
+    def effective_inertias(self, positions: Sequence[float] | None = None) -> list[float]:
+        """Return each joint's effective inertia at ``positions`` (default: as it is now).
+
+        ``1 / (M^-1)_ii`` (kg m^2, or kg for a prismatic joint): what a force
+        on joint i alone has to accelerate while the other joints move freely
+        -- the inertia that explicit damping and PID gains must respect.
+        """
+        if positions is None:
+            positions = [state[STATE_POSITION] for state in self.read_states()]
+        dofs = [0.0] * len(self._dof_indices)
+        for index, position in zip(self._indices, positions, strict=True):
+            dofs[self._dof_indices[index]] = position
+        matrix = numpy.array(pybullet.calculateMassMatrix(
+            self._body, dofs, physicsClientId=self._client))
+        try:
+            diagonal = numpy.diag(numpy.linalg.inv(matrix))
+            inertias = [1.0 / value if value > 0.0 else 0.0 for value in diagonal]
+        except numpy.linalg.LinAlgError:  # a massless subtree: the locked diagonal at least
+            inertias = list(numpy.diag(matrix))
+        return [float(inertias[self._dof_indices[index]]) for index in self._indices]
+
+    def smallest_inertias(self) -> list[float]:
+        """Return each joint's smallest effective inertia over :func:`check_poses`."""
+        poses = check_poses(self._joints, self._initial_positions)
+        inertias = [self.effective_inertias(pose) for pose in poses]
+        return [min(values) for values in zip(*inertias, strict=True)]
+
+    def gravity_torques(self, positions: Sequence[float] | None = None) -> list[float]:
+        """Return the effort each joint needs to hold still against gravity at ``positions``."""
+        if positions is None:
+            positions = [state[STATE_POSITION] for state in self.read_states()]
+        dofs = [0.0] * len(self._dof_indices)
+        for index, position in zip(self._indices, positions, strict=True):
+            dofs[self._dof_indices[index]] = position
+        zeros = [0.0] * len(dofs)
+        try:
+            torques = pybullet.calculateInverseDynamics(
+                self._body, dofs, zeros, zeros, physicsClientId=self._client)
+        except pybullet.error:
+            return [0.0] * len(self._indices)
+        return [torques[self._dof_indices[index]] for index in self._indices]
 
     def close(self) -> None:
         """Disconnect the PyBullet client and remove temporary files (idempotent)."""
@@ -166,39 +314,53 @@ class Physics:
     def __exit__(self, *exc_info: object) -> None:
         self.close()
 
-    def _load(self, description: RobotDescription) -> int:
+    def _with_mimics(self, positions: Sequence[float]) -> list[float]:
+        if not self._mimics:
+            return list(positions)
+        return list(follow_leaders([joint.name for joint in self._joints], positions,
+                                   self._mimics))
+
+    def _load(self, description: RobotDescription, warn: LogFunction) -> int:
         client = self._client
         pybullet.setGravity(0.0, 0.0, -STANDARD_GRAVITY, physicsClientId=client)
         pybullet.setTimeStep(self._time_step, physicsClientId=client)
         urdf_path = pathlib.Path(self._workdir.name) / URDF_FILE_NAME
         urdf_path.write_text(description.physics_urdf, encoding='utf-8')
+        output: list[str] = []
         try:
-            with quiet_native_output():
-                return pybullet.loadURDF(
+            with captured_native_output(output):
+                body = pybullet.loadURDF(
                     str(urdf_path), useFixedBase=True,
                     flags=pybullet.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client)
         except pybullet.error as err:
+            reasons = '; '.join(message_lines(''.join(output)))
+            because = f' ({reasons})' if reasons else ''
             raise DescriptionError(
-                f'{description.source}: PyBullet cannot load the robot: {err}') from None
+                f'{description.source}: PyBullet cannot load the robot: {err}{because}') from None
+        for line in message_lines(''.join(output)):
+            warn(f'PyBullet, loading {description.source.name}: {line}')
+        return body
 
-    def _joint_and_link_indices(self) -> tuple[dict[str, int], dict[str, int]]:
+    def _joint_and_link_indices(self) -> tuple[dict[str, int], dict[str, int], dict[int, int]]:
         client = self._client
         base = pybullet.getBodyInfo(self._body, physicsClientId=client)[0].decode('utf-8')
-        joints, links = {}, {base: BASE_LINK_INDEX}
+        joints, links, dofs = {}, {base: BASE_LINK_INDEX}, {}
         for index in range(pybullet.getNumJoints(self._body, physicsClientId=client)):
             info = pybullet.getJointInfo(self._body, index, physicsClientId=client)
             joints[info[1].decode('utf-8')] = index
             links[info[12].decode('utf-8')] = index  # a joint's child link has its index
-        return joints, links
+            if info[3] >= 0:  # qIndex: the joint has a degree of freedom
+                dofs[index] = len(dofs)
+        return joints, links, dofs
 
-    def _configure_motors(self) -> None:
-        # Velocity motors at zero speed: force 0 switches PyBullet's default motors
-        # off; a force equal to the URDF friction makes them Coulomb friction.
-        pybullet.setJointMotorControlArray(
-            self._body, self._indices, pybullet.VELOCITY_CONTROL,
-            targetVelocities=[0.0] * len(self._indices),
-            forces=[joint.friction for joint in self._joints],
-            physicsClientId=self._client)
+    def _remove_hidden_damping(self) -> None:
+        client, body = self._client, self._body
+        # PyBullet's per-body drag, and its explicit joint damping (applied
+        # implicitly by _Drives instead); the speed cap raised.
+        pybullet.changeDynamics(body, BASE_LINK_INDEX, linearDamping=0.0, angularDamping=0.0,
+                                maxJointVelocity=self.velocity_cap, physicsClientId=client)
+        for index in self._indices:
+            pybullet.changeDynamics(body, index, jointDamping=0.0, physicsClientId=client)
 
     def _couple_mimic_joints(self, index_of: dict[str, int]) -> None:
         # A gear constraint keeps q_follower - multiplier * q_leader at offset.
@@ -210,3 +372,185 @@ class Physics:
             pybullet.changeConstraint(
                 constraint, gearRatio=-coupling.multiplier, relativePositionTarget=coupling.offset,
                 maxForce=MIMIC_MAX_FORCE, erp=MIMIC_ERROR_REDUCTION, physicsClientId=self._client)
+
+
+class _Drives:
+    """The per-step work for one split of the joints into effort- and velocity-driven.
+
+    Motor rows (one PyBullet velocity motor per joint at most):
+
+    * velocity-driven joint: target from the controllers, force = effort limit,
+      sent every step;
+    * effort joint whose damping is implicit, with friction (or a mimic
+      coupling): target 0, force ``f + d |v_end|`` from the implicit-Euler end
+      speed, sent every step;
+    * effort joint whose damping is implicit, without friction: target 0,
+      velocity gain ``d dt / (J + d dt)``, sent when the inertias are refreshed;
+    * effort joint with friction and no or explicit damping: target 0, force
+      ``f``, sent once;
+    * otherwise: no row.
+
+    Everything the step function touches is bound to locals or to lists that
+    :meth:`restart` and the inertia refresh update in place, so the step
+    reads nothing from ``self``.
+    """
+
+    def __init__(self, physics: Physics, velocity_driven: Sequence[bool]) -> None:
+        joints = physics.joints
+        if len(velocity_driven) != len(joints):
+            raise ValueError(f'{len(velocity_driven)} drives for {len(joints)} joints')
+        self._physics = physics
+        body, client, indices = physics.body_id, physics.client_id, physics._indices
+        dt = physics.time_step
+        self._dt = dt
+        velocity_slots = [k for k, driven in enumerate(velocity_driven) if driven]
+        effort_slots = [k for k, driven in enumerate(velocity_driven) if not driven]
+        self.velocity_slots = velocity_slots
+        self.effort_slots = effort_slots
+        # Effort joints by what their damping and friction need.  Explicit
+        # damping is PyBullet's own, where it is far inside its stability bound.
+        # A velocity gain makes the motor a hard constraint that would override a
+        # mimic gear's forces, so coupled joints always take the force-capped form.
+        damped = [k for k in effort_slots if joints[k].damping > 0.0]
+        smallest = physics.smallest_inertias() if damped else []
+        explicit = [k for k in damped
+                    if joints[k].damping * dt <= EXPLICIT_DAMPING_SHARE * smallest[k]]
+        for k, joint in enumerate(joints):
+            pybullet.changeDynamics(body, indices[k], jointDamping=joint.damping
+                                    if k in explicit else 0.0, physicsClientId=client)
+        coupled = {joint for coupling in physics._mimics
+                   for joint in (coupling.leader, coupling.follower)}
+        self._damped = [k for k in damped if k not in explicit and joints[k].friction <= 0.0
+                        and joints[k].name not in coupled]
+        implicit = [k for k in damped if k not in explicit and k not in self._damped]
+        self.explicit, self.implicit, self.damped = explicit, implicit, self._damped
+        frictional = [k for k in effort_slots
+                      if joints[k].friction > 0.0 and (joints[k].damping <= 0.0 or k in explicit)]
+        plain = [k for k in effort_slots if joints[k].friction <= 0.0
+                 and (joints[k].damping <= 0.0 or k in explicit)]
+        # Static rows: friction-only joints hold with their friction, plain
+        # joints (and every velocity joint until its first step) have none.
+        static = [(k, joints[k].friction) for k in frictional] + [
+            (k, NO_MOTOR) for k in plain + velocity_slots]
+        if static:
+            count = len(static)
+            pybullet.setJointMotorControlArray(
+                body, [indices[k] for k, _ in static], pybullet.VELOCITY_CONTROL,
+                [0.0] * count, [0.0] * count, [force for _, force in static], [0.0] * count,
+                [MOTOR_VELOCITY_GAIN] * count, client)
+        self._damped_indices = [indices[k] for k in self._damped]
+        # Per-step motor rows: velocity joints first, then the implicit ones.
+        motor_indices = [indices[k] for k in velocity_slots + implicit]
+        velocity_count = len(velocity_slots)
+        motor_count = len(motor_indices)
+        motor_targets = [0.0] * motor_count
+        motor_forces = [min(joints[k].effort_limit, UNLIMITED_FORCE) for k in velocity_slots] + [
+            joints[k].friction for k in implicit]
+        motor_zeros = [0.0] * motor_count
+        motor_gains = [MOTOR_VELOCITY_GAIN] * motor_count
+        effort_indices = [indices[k] for k in effort_slots]
+        effort_unused = [0.0] * len(effort_indices)
+        effort_of = {k: position for position, k in enumerate(effort_slots)}
+        # One row per implicit joint, refreshed in place: [state slot, effort slot,
+        # motor slot, J / dt, d dt / (J + d dt), f, g], g being the torque the joint
+        # felt last step besides ours and the motor's (gravity, coupling).
+        rows = [[k, effort_of[k], velocity_count + number, 0.0, 0.0, joints[k].friction, 0.0]
+                for number, k in enumerate(implicit)]
+        self._rows = rows
+        self._countdown = [0]
+
+        set_motors = pybullet.setJointMotorControlArray
+        step_simulation = pybullet.stepSimulation
+        get_states = pybullet.getJointStates
+        velocity_mode, torque_mode = pybullet.VELOCITY_CONTROL, pybullet.TORQUE_CONTROL
+        countdown, refresh = self._countdown, self._refresh
+        states_box = [physics.read_states()]
+        self._states_box = states_box
+        has_efforts = bool(effort_indices)
+
+        if not motor_count and not self._damped:
+            # Nothing to do per step but the efforts: the cheapest step.
+            def step(efforts: Sequence[float], targets: Sequence[float] = ()) -> list:
+                set_motors(body, effort_indices, torque_mode, effort_unused, effort_unused,
+                           efforts, effort_unused, effort_unused, client)
+                step_simulation(client)
+                return get_states(body, indices, client)
+            self.step = step
+            self.restart()
+            return
+
+        def step(efforts: Sequence[float], targets: Sequence[float] = ()) -> list:
+            countdown[0] -= 1
+            if countdown[0] < 0:
+                refresh()
+            before = states_box[0]
+            if motor_count:
+                if velocity_count:
+                    motor_targets[:velocity_count] = targets
+                for row in rows:
+                    # Implicit Euler of J v' = tau + g - d v - f sgn(v), divided by dt:
+                    # the motor may resist with f plus the damping of the end speed.
+                    slot, effort_slot, motor_slot, per_dt, gain, friction, passive = row
+                    drive = per_dt * before[slot][STATE_VELOCITY] + efforts[effort_slot] + passive
+                    excess = (drive if drive >= 0.0 else -drive) - friction
+                    motor_forces[motor_slot] = (friction + gain * excess if excess > 0.0
+                                                else friction)
+                set_motors(body, motor_indices, velocity_mode, motor_zeros, motor_targets,
+                           motor_forces, motor_zeros, motor_gains, client)
+            if has_efforts:
+                set_motors(body, effort_indices, torque_mode, effort_unused, effort_unused,
+                           efforts, effort_unused, effort_unused, client)
+            step_simulation(client)
+            states = get_states(body, indices, client)
+            for row in rows:
+                slot = row[0]
+                state = states[slot]
+                row[6] = (row[3] * (state[STATE_VELOCITY] - before[slot][STATE_VELOCITY])
+                          - state[STATE_MOTOR_TORQUE] - efforts[row[1]])
+            states_box[0] = states
+            return states
+
+        self.step = step
+        self.restart()
+
+    def restart(self) -> None:
+        """Start over from the joints' present state (after a reset, or at the start)."""
+        self._states_box[0] = self._physics.read_states()
+        self._countdown[0] = 0
+        if self._rows:
+            # The passive torque at rest: minus what holding against gravity takes.
+            gravity = self._physics.gravity_torques()
+            for row in self._rows:
+                row[6] = -gravity[row[0]]
+
+    def _refresh(self) -> None:
+        """Recompute the effective inertias the implicit damping uses."""
+        self._countdown[0] = INERTIA_REFRESH_STEPS - 1
+        if not self._rows and not self._damped:
+            return
+        physics, dt = self._physics, self._dt
+        inertias = physics.effective_inertias()
+        joints = physics.joints
+        for row in self._rows:
+            inertia, damping = inertias[row[0]], joints[row[0]].damping
+            row[3] = inertia / dt
+            row[4] = damping * dt / (inertia + damping * dt)
+        if self._damped:
+            count = len(self._damped)
+            gains = [joints[k].damping * dt / (inertias[k] + joints[k].damping * dt)
+                     for k in self._damped]
+            pybullet.setJointMotorControlArray(
+                physics.body_id, self._damped_indices, pybullet.VELOCITY_CONTROL,
+                [0.0] * count, [0.0] * count, [UNLIMITED_FORCE] * count, [0.0] * count, gains,
+                physics.client_id)
+
+
+def health_problem(name: str, state: Sequence[float], cap: float) -> str:
+    """Describe what is wrong with a joint's ``state`` ('' if nothing)."""
+    position, velocity = state[STATE_POSITION], state[STATE_VELOCITY]
+    if not (math.isfinite(position) and math.isfinite(velocity)):
+        return (f"joint '{name}' has a non-finite state (position {position}, velocity "
+                f'{velocity}): the simulation is unstable')
+    return (f"joint '{name}' moves at {velocity:.6g}, PyBullet's speed cap ({cap:g}): it is "
+            'unstable (gains too high for its inertia?)')
+

@@ -28,7 +28,9 @@ stepping controller first).  The metrics:
 * ``steady_state_error`` -- target minus the final position (rad or m);
 * ``peak_effort`` -- the largest absolute effort applied (N*m or N);
 * ``velocity_limit_active`` -- whether the URDF velocity limit ramped the setpoint
-  (joint_limits_interface), and ``setpoint_reached_s``, when the ramp reached the target.
+  (joint_limits_interface), and ``setpoint_reached_s``, when the ramp reached the target;
+* ``actuator`` -- what drives the joint (a position PID on effort, or the ideal
+  actuator when the YAML gives no gains) and ``gains`` (null for the ideal actuator).
 
 ``--plot FILE`` writes a PNG (matplotlib, Agg backend): position and setpoint
 over time, the effort on a second axis, the metrics in the legend.  Errors in
@@ -297,7 +299,8 @@ def record_step(simulation: Simulation, joint: str, target: float,
                       setpoints=tuple(recorded_setpoints), efforts=tuple(efforts))
 
 
-def report(record: StepRecord, metrics: StepMetrics, gains: dict[str, float]) -> dict:
+def report(record: StepRecord, metrics: StepMetrics, gains: dict[str, float] | None,
+           actuator: str = '') -> dict:
     """Return the JSON-ready summary of one step response."""
     def rounded(value: float | None) -> float | None:
         return None if value is None or not math.isfinite(value) else round(value, DIGITS)
@@ -308,7 +311,9 @@ def report(record: StepRecord, metrics: StepMetrics, gains: dict[str, float]) ->
         'initial': rounded(record.initial),
         'target': rounded(record.target),
         'duration_s': rounded(record.times[-1]),
-        'gains': {name: rounded(value) for name, value in gains.items()},
+        'actuator': actuator,
+        'gains': None if gains is None else {
+            name: rounded(value) for name, value in gains.items()},
         'velocity_limit': rounded(record.velocity_limit),
     }
     for field in dataclasses.fields(metrics):
@@ -440,14 +445,15 @@ def run(args: argparse.Namespace) -> dict:
             activate_the_rest(simulation)
         record = record_step(simulation, args.joint, args.target, args.duration, driver.name)
         pid = driver.pids().get(args.joint)
+        actuator = simulation.handles[args.joint].actuator.kind.label
     metrics = step_metrics(record)
     if args.plot is not None:
         try:
             plot(record, metrics, args.plot)
         except OSError as err:
             raise ConfigurationError(f'--plot: cannot write {args.plot}: {err}') from None
-    gains = {} if pid is None else {'p': pid.gains.p, 'i': pid.gains.i, 'd': pid.gains.d}
-    return report(record, metrics, gains)
+    gains = None if pid is None else {'p': pid.gains.p, 'i': pid.gains.i, 'd': pid.gains.d}
+    return report(record, metrics, gains, actuator)
 
 
 def main(argv: Sequence[str] | None = None) -> None:

@@ -17,8 +17,8 @@ from robot_fixtures import (
 )
 
 from pan_tilt_sim.controllers import CommandKind, CommandResult, JointHandle, create_controller
-from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
-from pan_tilt_sim.controllers.joint_velocity_controller import DEFAULT_VELOCITY_GAINS
+from pan_tilt_sim.controllers.actuator import SETPOINT_ACCELERATION, TRACKING_GAIN
+from pan_tilt_sim.controllers.base import ActuatorKind, Drive
 from pan_tilt_sim.controllers.pid import PidGains
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.model.robot import JointKind, JointSpec, Mimic
@@ -75,11 +75,11 @@ def test_group_takes_float64_arrays_on_commands(interface, type_name, extra):
 
 
 def efforts_over_steps(controller, handles, steps, start=0):
-    """Update ``steps`` times (state frozen) and return every step's efforts."""
+    """Update ``steps`` times (state frozen); return every step's efforts and velocity targets."""
     efforts = []
     for step in range(start, start + steps):
         controller.update(step * DT, DT)
-        efforts.append([handle.effort for handle in handles.values()])
+        efforts.append([(handle.effort, handle.velocity_target) for handle in handles.values()])
     return efforts
 
 
@@ -106,17 +106,21 @@ def test_a_non_finite_element_rejects_the_whole_command(interface, type_name, ex
     handles = make_handles()
     controller = group(type_name, handles, **extra)
     controller.update(0.0, DT)
-    idle = [handle.effort for handle in handles.values()]
+    idle = [(handle.effort, handle.velocity_target) for handle in handles.values()]
     assert controller.set_command([0.3, bad]) is CommandResult.REJECTED
     assert "'slide' is not a finite number" in controller.command_problem(
         None, CommandResult.REJECTED)
     controller.update(DT, DT)
-    assert [handle.effort for handle in handles.values()] == idle
+    assert [(handle.effort, handle.velocity_target) for handle in handles.values()] == idle
 
 
-def test_position_group_ramps_each_setpoint_and_pushes_toward_it():
+SEED_GAINS = {'p': 100.0, 'i': 0.01, 'd': 10.0}
+
+
+def test_position_group_with_gains_ramps_each_setpoint_and_pushes_toward_it():
     handles = make_handles()
-    controller = group(GROUP_TYPES['position'], handles)
+    controller = group(GROUP_TYPES['position'], handles,
+                       gains={'shoulder': SEED_GAINS, 'slide': SEED_GAINS})
     assert controller.set_command([0.5, 0.25]) is CommandResult.ACCEPTED
     controller.update(0.0, DT)
     shoulder, slide = controller.members
@@ -125,6 +129,46 @@ def test_position_group_ramps_each_setpoint_and_pushes_toward_it():
     assert slide.setpoint == pytest.approx(0.5 * DT)
     assert handles['shoulder'].effort > 0.0 and handles['slide'].effort > 0.0
     assert handles['follower'].effort == 0.0
+    assert {actuator.drive for actuator in controller.actuators().values()} == {Drive.EFFORT}
+
+
+def test_position_group_without_gains_drives_the_ideal_actuator_within_the_limits():
+    handles = make_handles()
+    controller = group(GROUP_TYPES['position'], handles)
+    assert [actuator.drive for actuator in controller.actuators().values()] == [
+        Drive.VELOCITY] * 2
+    assert controller.pids() == {}
+    assert controller.set_command([0.5, 0.25]) is CommandResult.ACCEPTED
+    targets, setpoints = [], [0.0]
+    for step in range(3000):  # joints frozen at 0: the setpoints still travel to the command
+        controller.update(step * DT, DT)
+        targets.append(handles['shoulder'].velocity_target)
+        setpoints.append(controller.members[0].setpoint)
+    shoulder, slide = controller.members
+    assert (shoulder.setpoint, slide.setpoint) == (0.5, 0.25)
+    # The setpoint speeds up at SETPOINT_ACCELERATION, never beyond the velocity limit (2 rad/s).
+    speeds = [(b - a) / DT for a, b in zip(setpoints, setpoints[1:], strict=False)]
+    assert max(speeds) == pytest.approx(2.0)
+    accelerations = [(b - a) / DT for a, b in zip(speeds, speeds[1:], strict=False)]
+    assert max(map(abs, accelerations)) == pytest.approx(SETPOINT_ACCELERATION)
+    assert speeds[0] == pytest.approx(SETPOINT_ACCELERATION * DT)
+    # The target chases the setpoint (TRACKING_GAIN of the error per step), within +-2 rad/s.
+    assert max(map(abs, targets)) == pytest.approx(2.0)
+    assert targets[-1] == pytest.approx(2.0)  # 0.5 rad behind, the limit holds it
+    assert handles['shoulder'].effort == 0.0 and handles['follower'].velocity_target == 0.0
+
+
+def test_ideal_position_target_is_the_setpoint_rate_plus_a_tenth_of_the_error_per_step():
+    handles = make_handles()
+    controller = group(GROUP_TYPES['position'], handles)
+    controller.set_command([0.0, 0.01])
+    handles['slide'].position = 0.0013  # past the setpoint while it moves
+    controller.update(0.0, DT)
+    slide = controller.members[1]
+    rate = SETPOINT_ACCELERATION * DT
+    assert slide.setpoint == pytest.approx(rate * DT)
+    assert handles['slide'].velocity_target == pytest.approx(
+        rate + TRACKING_GAIN / DT * (rate * DT - 0.0013))
 
 
 def test_position_group_clamps_to_limits_and_says_which_joint():
@@ -137,15 +181,24 @@ def test_position_group_clamps_to_limits_and_says_which_joint():
     assert [member.setpoint for member in controller.members] == pytest.approx([0.5, 0.5])
 
 
-def test_velocity_group_pushes_by_the_velocity_error():
+def test_velocity_group_with_gains_pushes_by_the_velocity_error():
     handles = make_handles()
     handles['slide'].velocity = 0.1
-    controller = group(GROUP_TYPES['velocity'], handles)
+    controller = group(GROUP_TYPES['velocity'], handles,
+                       gains={'shoulder': {'p': 10.0}, 'slide': {'p': 10.0}})
     controller.set_command([1.0, -0.2])
     controller.update(0.0, DT)
-    p = DEFAULT_VELOCITY_GAINS.p
-    assert handles['shoulder'].effort == pytest.approx(p * 1.0)
-    assert handles['slide'].effort == pytest.approx(p * (-0.2 - 0.1))
+    assert handles['shoulder'].effort == pytest.approx(10.0 * 1.0)
+    assert handles['slide'].effort == pytest.approx(10.0 * (-0.2 - 0.1))
+
+
+def test_velocity_group_without_gains_targets_the_clamped_command():
+    handles = make_handles()
+    controller = group(GROUP_TYPES['velocity'], handles)
+    assert controller.set_command([1.0, -0.9]) is CommandResult.CLAMPED  # slide: 0.5 m/s
+    controller.update(0.0, DT)
+    assert (handles['shoulder'].velocity_target, handles['slide'].velocity_target) == (1.0, -0.5)
+    assert controller.actuators()['shoulder'].drive is Drive.VELOCITY
 
 
 def test_effort_group_applies_the_efforts_clamped_to_the_limits():
@@ -167,17 +220,35 @@ def test_reset_forgets_the_commands():
 
 # --- gains and configuration errors --------------------------------------------------------
 
-def test_gains_section_sets_each_joint_pid_and_defaults_fill_the_rest():
-    controller = group(GROUP_TYPES['position'],
+def test_gains_section_sets_each_joint_pid_and_the_ideal_actuator_drives_the_rest():
+    handles = make_handles()
+    controller = group(GROUP_TYPES['position'], handles,
                        gains={'slide': {'p': 500.0, 'i': 2.0, 'd': 20.0, 'i_clamp': 3.0}})
     shoulder, slide = controller.members
-    assert shoulder.pid.gains == DEFAULT_POSITION_GAINS.with_default_clamp(20.0)
+    assert shoulder.pid is None
     assert slide.pid.gains == PidGains(p=500.0, i=2.0, d=20.0, i_clamp_min=-3.0, i_clamp_max=3.0)
+    assert list(controller.pids()) == ['slide']
+    actuators = controller.actuators()
+    assert actuators['shoulder'].kind is ActuatorKind.IDEAL_POSITION
+    assert actuators['slide'].kind is ActuatorKind.POSITION_PID
+    assert actuators['slide'].gains_from == 'grp.gains.slide'
+
+
+def test_gazebo_ros_control_pid_gains_drive_a_joint_without_gains_of_its_own():
+    handles = make_handles()
+    handles['shoulder'].plugin_gains = PidGains(p=7.0)
+    handles['slide'].plugin_gains = PidGains(p=8.0)
+    controller = group(GROUP_TYPES['position'], handles, gains={'slide': {'p': 500.0}})
+    shoulder, slide = controller.members
+    assert (shoulder.pid.gains.p, slide.pid.gains.p) == (7.0, 500.0)
+    assert controller.actuators()['shoulder'].gains_from == (
+        'gazebo_ros_control.pid_gains.shoulder')
 
 
 def test_ros2_controllers_gain_options_are_accepted():
     controller = group(GROUP_TYPES['velocity'], gains={
         'shoulder': {'p': 5.0, 'ff_velocity_scale': 1.0, 'angle_wraparound': False}})
+    assert controller.members[1].pid is None
     assert controller.members[0].pid.gains.p == 5.0
 
 
@@ -266,10 +337,23 @@ def test_position_group_brings_its_joints_to_the_command(tmp_path, type_name):
 
 @pytest.mark.parametrize('type_name', [GROUP_TYPES['velocity'], FORWARD])
 def test_velocity_group_spins_its_joints_at_the_command(tmp_path, type_name):
+    # No gains: the ideal actuator holds the commanded speed, damping or not.
     commands, seconds = [0.5, -0.1], 0.5
     velocities = star_velocities_after(tmp_path, type_name, 'velocity', commands, seconds)
+    assert [velocities['pan'], velocities['slide']] == pytest.approx(commands, abs=1e-6)
+
+
+@pytest.mark.parametrize('type_name', [GROUP_TYPES['velocity'], FORWARD])
+def test_velocity_group_with_gains_lags_like_a_first_order_loop(tmp_path, type_name):
+    commands, seconds, gain = [0.5, -0.1], 0.5, 10.0
+    gains = f'{{pan: {{p: {gain}}}, slide: {{p: {gain}}}}}'
+    with star_simulation(tmp_path, type_name, gains=gains,
+                         **interface_params(type_name, 'velocity')) as sim:
+        sim.controller('group').set_command(commands)
+        sim.advance(round(seconds / DT))
+        velocities = sim.joint_velocities()
     # inertia * v' = p * (command - v) - b * v: a first-order lag toward p * command / (p + b).
-    gain, damping = DEFAULT_VELOCITY_GAINS.p, STAR_JOINTS[0].damping
+    damping = STAR_JOINTS[0].damping
     for (joint, inertia), command in zip(STAR_INERTIAS.items(), commands, strict=True):
         expected = first_order_speed(gain * command, gain + damping, inertia, seconds)
         assert velocities[joint] == pytest.approx(expected, rel=0.03)

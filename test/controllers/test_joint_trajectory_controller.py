@@ -10,6 +10,8 @@ import math
 import pytest
 
 from pan_tilt_sim.controllers import CommandKind, CommandResult, JointHandle, create_controller
+from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
+from pan_tilt_sim.controllers.base import Drive
 from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
 from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPlan, TrajectoryPoint
 from pan_tilt_sim.errors import ControllerConfigError
@@ -248,8 +250,8 @@ def test_bad_trajectories_are_rejected_and_change_nothing(bad, problem):
 
 def test_effort_is_pid_on_position_with_derivative_on_velocity_error():
     handles = make_handles()
-    controller = controller_for(handles, gains={'a': {'p': 50.0, 'd': 5.0,
-                                                      'ff_velocity_scale': 2.0}})
+    controller = controller_for(handles, command_interfaces=['effort'],
+                                gains={'a': {'p': 50.0, 'd': 5.0, 'ff_velocity_scale': 2.0}})
     controller.set_command(trajectory((1.0, (1.0, 0.0))))
     handles['a'].velocity = 0.25
     controller.update(0.0, DT)
@@ -257,7 +259,27 @@ def test_effort_is_pid_on_position_with_derivative_on_velocity_error():
     # Desired 0.1 rad moving at 1 rad/s; measured 0 rad at 0.25 rad/s.
     expected = 50.0 * 0.1 + 5.0 * (1.0 - 0.25) + 2.0 * 1.0
     assert handles['a'].effort == pytest.approx(expected)
+    # On the effort interface a joint without gains gets the default PID.
     assert controller.pids()['b'].gains == DEFAULT_POSITION_GAINS.with_default_clamp(1000.0)
+    assert controller.actuators()['b'].gains_from == ''
+
+
+@pytest.mark.parametrize('interfaces', [['position'], ['position', 'velocity'], ['velocity'], []])
+def test_without_gains_the_ideal_actuator_tracks_the_desired_state(interfaces):
+    handles = make_handles()
+    controller = controller_for(handles, command_interfaces=interfaces,
+                                gains={'a': {'p': 50.0}})
+    assert list(controller.pids()) == ['a']
+    actuators = controller.actuators()
+    assert actuators['b'].drive is Drive.VELOCITY and actuators['a'].drive is Drive.EFFORT
+    controller.set_command(trajectory((1.0, (0.0, 0.4))))
+    handles['b'].position = 0.01
+    for step in range(101):
+        controller.update(step * DT, DT)
+    # Desired 0.04 m moving at 0.4 m/s; measured 0.01 m: the target is the desired
+    # velocity plus a tenth of the position error per step.
+    assert handles['b'].velocity_target == pytest.approx(0.4 + TRACKING_GAIN / DT * 0.03)
+    assert handles['b'].effort == 0.0
 
 
 @pytest.mark.parametrize(('params', 'field'), [

@@ -69,14 +69,15 @@ def test_the_active_ones_run_the_others_are_loaded_inactive_and_vendor_types_ski
 
 
 def test_an_inactive_controller_runs_no_update(arm):
+    # Without gains both drive their joints by the ideal actuator: a velocity target.
     manager, handles = arm(active=[JSB, JTC])
     manager.controller(FORWARD_POSITION).set_command([1.0, 1.0])
     run(manager)
-    assert [handle.effort for handle in handles.values()] == [0.0, 0.0]  # JTC holds at rest
+    assert [handle.velocity_target for handle in handles.values()] == [0.0, 0.0]  # JTC holds
     manager.switch(activate=[FORWARD_POSITION], deactivate=[JTC])
     manager.controller(FORWARD_POSITION).set_command([1.0, 1.0])
     run(manager)
-    assert all(handle.effort > 0.0 for handle in handles.values())
+    assert all(handle.velocity_target > 0.0 for handle in handles.values())
 
 
 def test_a_vendor_type_listed_as_active_is_an_error_listing_the_supported_types(arm):
@@ -213,10 +214,10 @@ def test_a_deactivated_controller_holds_nothing_its_joints_keep_the_last_command
     manager, handles = arm(active=[JSB, FORWARD_POSITION])
     manager.controller(FORWARD_POSITION).set_command([1.0, -1.0])
     run(manager)
-    last = [handle.effort for handle in handles.values()]
-    assert last[0] > 0.0 > last[1]
+    last = [(handle.effort, handle.velocity_target) for handle in handles.values()]
+    assert last[0][1] > 0.0 > last[1][1]
     manager.switch(deactivate=[FORWARD_POSITION])
     handles['joint1'].position = 0.5  # the joint moves; nobody recomputes its command
     run(manager)
-    assert [handle.effort for handle in handles.values()] == last
+    assert [(handle.effort, handle.velocity_target) for handle in handles.values()] == last
     assert [c.name for c in manager.active] == [JSB]

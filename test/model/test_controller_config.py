@@ -345,6 +345,43 @@ def test_ros1_and_ros2_control_yaml_give_the_same_motion(repo_root, write_yaml):
     assert ros1[-1]['shoulder_joint'] == pytest.approx(0.8, abs=0.01)
 
 
+# --- gazebo_ros_control's own PID gains ----------------------------------------------------
+
+@pytest.mark.parametrize('wrapped', [False, True], ids=['top-level', 'in-namespace'])
+def test_gazebo_ros_control_pid_gains_are_kept_beside_the_controllers(write_yaml, wrapped):
+    text = """\
+        pan_controller:
+          type: position_controllers/JointPositionController
+          joint: pan_joint
+        gazebo_ros_control:
+          pid_gains:
+            pan_joint: {p: 50.0, i: 0.1, d: 2.0}
+        """
+    if wrapped:
+        text = 'robot:\n' + textwrap.indent(textwrap.dedent(text), '  ')
+    config = load_controllers_config(write_yaml(text))
+    assert config.pid_gains == {'pan_joint': {'p': 50.0, 'i': 0.1, 'd': 2.0}}
+    assert [spec.name for spec in config.controllers] == ['pan_controller']
+
+
+def test_without_gazebo_ros_control_there_are_no_plugin_gains(repo_root):
+    config = load_controllers_config(repo_root / 'config' / 'pan_tilt_control.yaml')
+    assert config.pid_gains == {}
+
+
+@pytest.mark.parametrize('plugin', ['{pid_gains: [1, 2]}', 'on'])
+def test_pid_gains_that_are_no_mapping_name_the_field(write_yaml, plugin):
+    path = write_yaml(f"""\
+        c:
+          type: effort_controllers/JointEffortController
+          joint: j
+        gazebo_ros_control: {plugin}
+        """)
+    with pytest.raises(ControllerConfigError,
+                       match=r'gazebo_ros_control\.pid_gains: expected a mapping'):
+        load_controllers_config(path)
+
+
 # --- launch substitutions: $(var ...) and friends -------------------------------------------
 
 RRBOT_STYLE = """

@@ -110,3 +110,19 @@ def test_a_paused_value_of_the_wrong_type_is_refused_at_run_time(world):
     assert "'paused' must be a bool" in result.reason
     assert world.node.get_parameter('paused').value is False
     assert not world.node.paused
+
+
+def test_resets_return_to_the_initial_positions_parameter():
+    with sim_node(initial_positions=['pan_joint:=0.5', 'tilt_joint:=-2.0']) as world:
+        simulation = world.node.simulation
+        assert simulation.joint_positions() == pytest.approx(
+            {'pan_joint': 0.5, 'tilt_joint': -2.0})
+        world.command(PAN, Float64(data=1.0))
+        world.run_for(2.0)  # 0.1 rad/s
+        assert _pan_position(world) > 0.6
+        world.node.set_paused(True)
+        for service in ('/reset_world', '/reset_simulation'):
+            world.call(Empty, service)
+            assert simulation.joint_positions() == pytest.approx(
+                {'pan_joint': 0.5, 'tilt_joint': -2.0})
+            assert simulation.controller(PAN).setpoint == pytest.approx(0.5)

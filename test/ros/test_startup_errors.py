@@ -90,6 +90,8 @@ FILES = {
                               'JointPositionController, joint: pan_joint}\n',
     'bad_controller_name.yaml': '"pan controller": {type: position_controllers/'
                                 'JointPositionController, joint: pan_joint}\n',
+    'plugin_gains.yaml': 'a: {type: position_controllers/JointPositionController, '
+                         'joint: pan_joint}\ngazebo_ros_control: {pid_gains: {elbow: {p: 1}}}\n',
 }
 
 
@@ -199,6 +201,20 @@ CASES = [
           ParameterError, "'robot_description_file' must be a string", 'integer 5'),
     _case('robot_namespace a list', {'robot_namespace': ['a', 'b']},
           ParameterError, "'robot_namespace' must be a string"),
+    # Start positions.
+    _case('initial_positions not joint:=value', {'initial_positions': ['pan_joint=1']},
+          ParameterError, "parameter 'initial_positions'", "'pan_joint=1' is not of the form"),
+    _case('initial_positions not a number', {'initial_positions': ['pan_joint:=left']},
+          ParameterError, "parameter 'initial_positions'", "'left' is not a finite number"),
+    _case('initial_positions unknown joint', {'initial_positions': ['elbow:=1']},
+          ParameterError, "parameter 'initial_positions': 'elbow' is not a movable joint",
+          'pan_joint, tilt_joint'),
+    _case('initial_positions a string', {'initial_positions': 'pan_joint:=1'},
+          ParameterError, "'initial_positions' must be a string array"),
+    # gazebo_ros_control's PID gains.
+    _case('pid_gains for a joint the robot lacks', {'controllers_file': '{dir}/plugin_gains.yaml'},
+          ControllerConfigError, '{dir}/plugin_gains.yaml: gazebo_ros_control.pid_gains.elbow: ',
+          'not a movable joint'),
 ]
 
 
@@ -276,6 +292,9 @@ def _assert_one_line_exit_2(result, *expected: str) -> str:
                  id='fixed joint (after PyBullet loaded the robot)'),
     pytest.param(['-p', 'controllers_file:={dir}/bad_controller_name.yaml'],
                  ["'pan controller'"], id='controller name not a ROS name'),
+    pytest.param(['-p', "initial_positions:=['tilt_joint:=-2.0', 'roll:=1']"],
+                 ["parameter 'initial_positions': 'roll' is not a movable joint"],
+                 id='initial position of an unknown joint (after PyBullet loaded the robot)'),
 ])
 def test_the_program_prints_one_line_and_exits_2(files, ros_args, expected):
     result = sim_process.run(*(_fill(arg, files) for arg in ros_args))

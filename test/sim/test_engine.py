@@ -1,8 +1,9 @@
 """The simulation loop with the seed's robot, no ROS: the behaviour Gazebo users expect."""
 
 import pytest
+from robot_fixtures import ros2_control_yaml, two_link_arm_urdf, write_text
 
-from pan_tilt_sim.errors import ControllerConfigError
+from pan_tilt_sim.errors import ControllerConfigError, ParameterError
 from pan_tilt_sim.model.controller_config import ControllersConfig, ControllerSpec
 from pan_tilt_sim.model.description import load_description
 from pan_tilt_sim.sim.engine import Simulation, make_simulation
@@ -91,3 +92,83 @@ def test_a_joint_claimed_by_two_controllers_is_refused(repo_root, tmp_path):
     config = _config(tmp_path, ('a', effort), ('b', effort))
     with pytest.raises(ControllerConfigError, match="'pan_joint' is claimed by both 'a' and 'b'"):
         Simulation(description, config, DT)
+
+
+# --- where the joints start ----------------------------------------------------------------
+
+INITIAL_VALUES = """<ros2_control name="arm" type="system">
+  <hardware><plugin>mock_components/GenericSystem</plugin></hardware>
+  <joint name="joint1"><command_interface name="position"/>
+    <state_interface name="position"><param name="initial_value">-0.4</param></state_interface>
+  </joint>
+  <joint name="joint2"><command_interface name="position"/>
+    <state_interface name="position"><param name="initial_value">7.0</param></state_interface>
+  </joint>
+</ros2_control>
+</robot>"""
+
+
+class Log:
+    def __init__(self):
+        self.infos, self.warnings = [], []
+
+    def info(self, message):
+        self.infos.append(message)
+
+    def warning(self, message):
+        self.warnings.append(message)
+
+
+def arm_with_initial_values(tmp_path, initial_positions=None, log=None):
+    robot = write_text(tmp_path, 'arm.urdf',
+                       two_link_arm_urdf().replace('</robot>', INITIAL_VALUES))
+    yaml = write_text(tmp_path, 'c.yaml', ros2_control_yaml({'arm': (
+        'position_controllers/JointGroupPositionController', {'joints': ['joint1', 'joint2']})}))
+    return make_simulation(str(robot), str(yaml), DT, initial_positions=initial_positions,
+                           logger=log)
+
+
+def test_joints_start_at_the_urdfs_initial_value_clamped_into_their_limits(tmp_path):
+    log = Log()
+    with arm_with_initial_values(tmp_path, log=log) as sim:
+        assert sim.joint_positions() == pytest.approx({'joint1': -0.4, 'joint2': 3.0})
+        sim.advance(STEPS_PER_SECOND)  # the ideal actuators hold the start against gravity
+        assert sim.joint_positions() == pytest.approx({'joint1': -0.4, 'joint2': 3.0}, abs=1e-3)
+    assert "joint 'joint1' starts at -0.4 (<ros2_control> initial_value)" in log.infos
+    assert log.warnings == ["joint 'joint2': initial position 7 (<ros2_control> initial_value) "
+                            'is outside its limits [-3, 3]; starts at 3']
+
+
+def test_the_initial_positions_parameter_overrides_and_reset_returns_there(tmp_path):
+    with arm_with_initial_values(tmp_path, {'joint2': 0.5}) as sim:
+        assert sim.joint_positions() == pytest.approx({'joint1': -0.4, 'joint2': 0.5})
+        sim.controller('arm').set_command([1.0, -1.0])
+        sim.advance(2 * STEPS_PER_SECOND)
+        assert sim.joint_positions()['joint1'] == pytest.approx(1.0, abs=0.005)
+        sim.reset(reset_time=False)
+        assert sim.joint_positions() == pytest.approx({'joint1': -0.4, 'joint2': 0.5})
+        assert sim.controller('arm').setpoints() == pytest.approx({'joint1': -0.4, 'joint2': 0.5})
+        sim.advance(STEPS_PER_SECOND)
+        assert sim.joint_positions() == pytest.approx({'joint1': -0.4, 'joint2': 0.5}, abs=1e-3)
+
+
+def test_an_initial_position_for_a_joint_the_robot_lacks_is_refused(tmp_path):
+    with pytest.raises(ParameterError, match=r"^parameter 'initial_positions': 'elbow' is not a "
+                                             r'movable joint of the robot \(movable joints: '
+                                             r'joint1, joint2\)$'):
+        arm_with_initial_values(tmp_path, {'elbow': 1.0})
+
+
+def test_the_start_up_report_waits_for_report_startup(tmp_path, repo_root):
+    log = Log()
+    description = load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
+    config = _config(tmp_path, ('pan_effort', {
+        'type': 'effort_controllers/JointEffortController', 'joint': 'pan_joint'}))
+    with Simulation(description, config, DT, logger=log) as simulation:
+        assert log.infos == []
+        simulation.report_startup()
+        simulation.report_startup()
+    assert log.infos == ["joint 'pan_joint': effort command (pan_effort)",
+                         "joint 'tilt_joint': passive: no active controller",
+                         "joint 'tilt_joint' starts at -1.5708: 0 is outside its limits "
+                         '[-4.71239, -1.5708]']

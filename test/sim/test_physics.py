@@ -1,9 +1,23 @@
-"""The physics layer: own client ids, fixed base, torque-driven joints."""
+"""The physics layer: own client ids, fixed base, massless frames, PyBullet's messages."""
+
+import dataclasses
+import math
+import re
 
 import pytest
+from robot_fixtures import (
+    JointDef,
+    arm_holding_torques,
+    star_robot_urdf,
+    two_link_arm_urdf,
+    write_text,
+)
 
+from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.description import load_description
-from pan_tilt_sim.sim.physics import Physics, pybullet
+from pan_tilt_sim.model.robot import JointKind, JointSpec
+from pan_tilt_sim.sim.bullet import message_lines
+from pan_tilt_sim.sim.physics import DEFAULT_VELOCITY_CAP, Physics, pybullet, velocity_cap
 
 
 @pytest.fixture
@@ -70,18 +84,110 @@ def test_friction_holds_below_its_value_and_only_resists_above_it(tmp_path):
     assert moving[1] == pytest.approx((3.0 - 1.0) / ARM_INERTIA * 0.1, rel=0.01)
 
 
-def test_the_stepper_applies_the_torques_the_keyword_call_applies(description):
+def test_the_stepper_applies_the_torques_the_keyword_call_applies(tmp_path):
     # The stepper passes PyBullet's arguments by position (target and gain
     # slots filled with zeros): the motion must be that of forces=... alone.
-    efforts = [50.0, -20.0]
+    # (A joint without damping or friction has no motor row: torque only.)
+    efforts = [3.0]
+    description = one_arm(tmp_path, '0 1 0')
     with Physics(description, 0.001) as fast, Physics(description, 0.001) as reference:
         step = fast.stepper()
         indices = [reference.joint_index(joint.name) for joint in reference.joints]
         for _ in range(300):
-            states = step(efforts)
+            states = step(efforts, ())
             pybullet.setJointMotorControlArray(
                 reference.body_id, indices, pybullet.TORQUE_CONTROL, forces=efforts,
                 physicsClientId=reference.client_id)
             pybullet.stepSimulation(physicsClientId=reference.client_id)
         assert states == reference.read_states()
-        assert states[0][1] > 0.5  # the pan turns under its 50 N*m
+        assert states[0][1] != 0.0
+
+
+# --- links without <inertial>, PyBullet's own drag and speed cap --------------------------
+
+def two_link_arm(tmp_path, **options):
+    return load_description(write_text(tmp_path, 'arm.urdf', two_link_arm_urdf(**options)))
+
+
+def test_a_massless_tip_frame_adds_nothing_the_arm_holds_with_the_analytic_torque(tmp_path):
+    # tool0 has no <inertial>: massless, as the URDF spec says (PyBullet alone
+    # would give it 1 kg and the arm would fall with these torques).
+    holding = arm_holding_torques(0.0, 0.0)
+    assert holding == pytest.approx((-12.2625, -2.4525))
+    with Physics(two_link_arm(tmp_path), 0.001) as physics:
+        assert physics.gravity_torques() == pytest.approx(holding, abs=1e-9)
+        for _ in range(1000):  # an unstable equilibrium: any wrong torque shows as drift
+            states = physics.step(list(holding))
+    assert [state[0] for state in states] == pytest.approx([0.0, 0.0], abs=1e-6)
+
+
+def test_pybullets_hidden_drag_is_off(tmp_path):
+    # A vertical hinge, no damping: after a kick the arm turns at a constant
+    # speed.  PyBullet's default linear/angular damping 0.04 would slow it ~8 %.
+    with Physics(one_arm(tmp_path, '0 0 1'), 0.001) as physics:
+        for _ in range(100):
+            (kicked,) = physics.step([1.0])
+        for _ in range(2000):
+            (coasting,) = physics.step([0.0])
+    assert coasting[1] == pytest.approx(kicked[1], rel=1e-9)
+
+
+def test_the_speed_cap_is_twice_the_fastest_velocity_limit_and_never_below_100():
+    def joint(limit):
+        return JointSpec('j', JointKind.REVOLUTE, velocity_limit=limit)
+    assert velocity_cap([joint(2.0), joint(math.inf)]) == DEFAULT_VELOCITY_CAP == 100.0
+    assert velocity_cap([joint(2.0), joint(150.0)]) == 300.0
+
+
+def test_a_joint_may_reach_its_velocity_limit_beyond_pybullets_default_cap(tmp_path):
+    # One arm allowed 150 rad/s (limit="100" in one_arm): an ideal velocity motor gets there.
+    text = one_arm(tmp_path, '0 0 1').source.read_text().replace('velocity="100"',
+                                                                 'velocity="150"')
+    description = load_description(write_text(tmp_path, 'fast.urdf', text))
+    with Physics(description, 0.001) as physics:
+        physics.set_drives([True])
+        for _ in range(1500):  # 100 N*m on 0.5 kg*m^2: 0.75 s to get there
+            (state,) = physics.step([], [150.0])
+    assert state[1] == pytest.approx(150.0)
+
+
+# --- what PyBullet says while loading ------------------------------------------------------
+
+BAD_INERTIA = """<robot name="bad"><link name="base"/>
+  <link name="flat"><inertial><mass value="1"/>
+    <inertia ixx="0.1" iyy="0.1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="j" type="continuous"><parent link="base"/><child link="flat"/>
+    <axis xyz="0 0 1"/></joint></robot>"""
+
+
+def test_pybullets_load_messages_reach_the_log_once_each(tmp_path):
+    # Principal moments 0.1 + 0.1 < 1 break the triangle inequality: PyBullet
+    # zeroes the inertia (and prints it three times).
+    messages = []
+    description = load_description(write_text(tmp_path, 'bad.urdf', BAD_INERTIA))
+    with Physics(description, 0.001, warn=messages.append):
+        pass
+    assert messages == ['PyBullet, loading bad.urdf: Bad inertia tensor properties, setting '
+                        'inertia to zero for link: flat']
+
+
+def test_a_load_failure_says_what_pybullet_said(tmp_path):
+    # PyBullet's XML reader cannot read this file written on one line (the
+    # description layer indents its copy; here it is handed over as it is).
+    text = star_robot_urdf([JointDef(f'j{number}') for number in range(20)])
+    description = dataclasses.replace(
+        load_description(write_text(tmp_path, 'star.urdf', text)),
+        physics_urdf=re.sub(r'>\s+<', '><', text).replace('\n', ' '))
+    with pytest.raises(DescriptionError) as raised:
+        Physics(description, 0.001)
+    assert str(raised.value) == (
+        f'{description.source}: PyBullet cannot load the robot: Cannot load URDF file. '
+        '(Error=XML_ERROR_PARSING_ELEMENT ErrorID=7 (0x7) Line number=1)')
+
+
+def test_message_lines_merge_split_messages_and_drop_repeats_and_the_banner():
+    text = ('pybullet build time: Jan 29 2025\nb3Warning[a.cpp,1]:\nNo inertial data for link, '
+            'using mass=1\nb3Warning[a.cpp,2]:\ntool0\nb3Warning[b.cpp,3]:\nBad inertia\n'
+            'b3Warning[b.cpp,3]:\nBad inertia\nb3Error[c.cpp,4]:\nboom\n')
+    assert message_lines(text) == [
+        "link 'tool0': No inertial data for link, using mass=1", 'Bad inertia', 'boom']

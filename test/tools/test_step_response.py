@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 import pytest
+from robot_fixtures import two_link_arm_urdf, write_text
 from ros2_control_fixtures import write_arm
 
 from pan_tilt_sim.tools import step_response
@@ -138,6 +139,19 @@ def test_the_pan_ends_within_friction_over_p_without_overshoot(pan_step):
     assert 0.0 <= pan_step['steady_state_error'] <= 1.0 / 100.0 + 1e-3
     assert pan_step['overshoot_percent'] < 0.5
     assert pan_step['gains'] == {'p': 100.0, 'i': 0.01, 'd': 10.0}
+    assert pan_step['actuator'] == 'position PID on effort'
+
+
+def test_a_joint_without_gains_steps_through_the_ideal_actuator(tmp_path, capsys):
+    robot = write_text(tmp_path, 'arm.urdf', two_link_arm_urdf())
+    yaml = write_text(tmp_path, 'c.yaml', 'shoulder: {type: position_controllers/'
+                      'JointPositionController, joint: joint1}\n')
+    step_response.main(['--joint', 'joint1', '--target', '0.5', '--model', str(robot),
+                        '--controllers', str(yaml), '--duration', '2'])
+    summary = json.loads(capsys.readouterr().out)
+    assert (summary['actuator'], summary['gains']) == ('ideal position actuator', None)
+    assert abs(summary['steady_state_error']) < 0.001
+    assert summary['overshoot_percent'] < 0.5
 
 
 def test_the_plot_is_a_png(tmp_path):
@@ -186,7 +200,8 @@ def test_the_joint_steps_through_whichever_controller_takes_positions(ur_style_a
     assert summary['controller'] == expected
     assert summary['target'] == 0.5
     assert summary['steady_state_error'] == pytest.approx(0.0, abs=0.01)
-    assert summary['gains'] == {'p': 100.0, 'i': 0.01, 'd': 10.0}
+    # No gains in the file: the ideal actuator, as in Gazebo.
+    assert (summary['actuator'], summary['gains']) == ('ideal position actuator', None)
 
 
 def test_the_other_joints_of_a_group_hold_while_one_steps(ur_style_arm):

@@ -1,0 +1,94 @@
+"""Links without ``<inertial>`` are massless, as the URDF spec says; PyBullet must be told so.
+
+PyBullet gives every link without ``<inertial>`` 1 kg and 1 kg m^2 -- frames
+such as ``tool0``, ``flange`` or ``camera_optical`` then weigh a kilogram each
+(a UR5e carries 3 phantom kg at its flange: 84 instead of 60 N m of gravity
+on its shoulder).  PyBullet's copy of the URDF therefore gets an explicit
+zero inertial for every such link, which PyBullet treats exactly like a
+frame merged into its parent (every link name and index is kept, so the
+camera, TF and link lookups are unchanged).
+
+One case needs more: a moving joint whose whole child subtree is massless
+(a pan joint carrying only a camera frame) would be frozen -- zero inertia
+cannot be accelerated.  Its child link gets a negligible mass and inertia
+instead, so that an actuator can move it, and a warning says so (Gazebo
+classic drops such joints).
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ElementTree
+
+from pan_tilt_sim.model.robot import RobotModel
+
+INERTIA_FIELDS = ('ixx', 'ixy', 'ixz', 'iyy', 'iyz', 'izz')
+# What a massless link that must still move gets: small enough to change no
+# torque measurably, large enough for PyBullet to integrate.
+MOVABLE_MASS = 1e-6  # kg
+MOVABLE_INERTIA = 1e-9  # kg m^2
+
+
+def massless_links(model: RobotModel) -> tuple[str, ...]:
+    """Return the links that have no ``<inertial>``, in file order."""
+    return tuple(link.name for link in model.links if link.inertial is None)
+
+
+def frozen_joints(model: RobotModel) -> dict[str, tuple[str, ...]]:
+    """Return each movable joint whose child subtree has no mass, with that subtree's links."""
+    children: dict[str, list[str]] = {}
+    for joint in model.joints:
+        children.setdefault(joint.parent, []).append(joint.child)
+
+    def subtree(link: str) -> list[str]:
+        links, pending, seen = [], [link], set()
+        while pending:
+            name = pending.pop(0)
+            if name in seen:  # a malformed URDF with a loop: stop, do not spin
+                continue
+            seen.add(name)
+            links.append(name)
+            pending.extend(children.get(name, ()))
+        return links
+
+    def mass(link: str) -> float:
+        inertial = model.link(link).inertial
+        return 0.0 if inertial is None else inertial.mass
+
+    frozen = {}
+    for joint in model.actuated_joints:
+        links = subtree(joint.child)
+        if all(mass(link) <= 0.0 for link in links):
+            frozen[joint.name] = tuple(links)
+    return frozen
+
+
+def complete_inertials(root: ElementTree.Element, model: RobotModel) -> tuple[str, ...]:
+    """Give PyBullet's copy (``root``) explicit inertials; return one warning per frozen joint.
+
+    Links without ``<inertial>`` get mass 0 and inertia 0; the child link of a
+    movable joint that moves no mass gets :data:`MOVABLE_MASS` and
+    :data:`MOVABLE_INERTIA`.
+    """
+    elements = {element.get('name'): element for element in root.findall('link')}
+    for name in massless_links(model):
+        _set_inertial(elements[name], 0.0, 0.0)
+    warnings = []
+    for joint, links in frozen_joints(model).items():
+        child = links[0]
+        _set_inertial(elements[child], MOVABLE_MASS, MOVABLE_INERTIA)
+        warnings.append(
+            f"joint '{joint}' moves only massless links ({', '.join(links)}): "
+            f"'{child}' gets {MOVABLE_MASS:g} kg and {MOVABLE_INERTIA:g} kg*m^2 so that the "
+            'joint can move (Gazebo would drop it); give the link an <inertial> to silence this')
+    return tuple(warnings)
+
+
+def _set_inertial(link: ElementTree.Element, mass: float, inertia: float) -> None:
+    """Replace ``link``'s inertial by a point mass with a diagonal inertia at the link origin."""
+    for old in link.findall('inertial'):
+        link.remove(old)
+    inertial = ElementTree.SubElement(link, 'inertial')
+    ElementTree.SubElement(inertial, 'mass', value=repr(mass))
+    diagonal = {'ixx', 'iyy', 'izz'}
+    ElementTree.SubElement(inertial, 'inertia', {
+        field: repr(inertia if field in diagonal else 0.0) for field in INERTIA_FIELDS})

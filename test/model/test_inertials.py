@@ -1,0 +1,85 @@
+"""PyBullet's copy of the URDF: links without <inertial> are massless, as the URDF spec says."""
+
+import xml.etree.ElementTree as ElementTree
+
+import pytest
+from robot_fixtures import write_text
+
+from pan_tilt_sim.errors import DescriptionError
+from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.model.inertials import MOVABLE_INERTIA, MOVABLE_MASS
+
+INERTIAL = ('<inertial><mass value="{m}"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" '
+            'ixz="0" iyz="0"/></inertial>')
+
+
+def robot(tmp_path, body: str):
+    return load_description(write_text(tmp_path, 'robot.urdf', f'<robot name="r">{body}</robot>'))
+
+
+def physics_inertials(description):
+    """Return {link: (mass, ixx)} of PyBullet's copy (None: no <inertial>)."""
+    root = ElementTree.fromstring(description.physics_urdf)
+    result = {}
+    for link in root.findall('link'):
+        inertial = link.find('inertial')
+        result[link.get('name')] = None if inertial is None else (
+            float(inertial.find('mass').get('value')),
+            float(inertial.find('inertia').get('ixx')))
+    return result
+
+
+ARM = (f'<link name="base"/><link name="upper">{INERTIAL.format(m=2)}</link>'
+       '<link name="tool0"/>'
+       '<joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>'
+       '<limit lower="-1" upper="1" effort="10" velocity="1"/></joint>'
+       '<joint name="flange" type="fixed"><parent link="upper"/><child link="tool0"/></joint>')
+
+
+def test_links_without_inertial_are_massless_in_pybullets_copy_only(tmp_path):
+    description = robot(tmp_path, ARM)
+    assert physics_inertials(description) == {
+        'base': (0.0, 0.0), 'upper': (2.0, 0.1), 'tool0': (0.0, 0.0)}
+    # The model and the URDF as written (robot_description) keep what the user wrote.
+    assert description.model.link('tool0').inertial is None
+    assert '<link name="tool0"/>' in description.urdf_xml.replace(' />', '/>')
+    assert description.warnings == ()
+
+
+def test_a_joint_that_moves_only_massless_links_gets_a_negligible_mass_and_a_warning(tmp_path):
+    body = ARM + ('<link name="camera"/><link name="optical"/>'
+                  '<joint name="cam_pan" type="continuous"><parent link="upper"/>'
+                  '<child link="camera"/></joint>'
+                  '<joint name="cam_optical" type="fixed"><parent link="camera"/>'
+                  '<child link="optical"/></joint>')
+    description = robot(tmp_path, body)
+    inertials = physics_inertials(description)
+    assert inertials['camera'] == (MOVABLE_MASS, MOVABLE_INERTIA)
+    assert inertials['optical'] == (0.0, 0.0)
+    warning, = description.warnings
+    assert "joint 'cam_pan' moves only massless links (camera, optical)" in warning
+    assert "'camera' gets 1e-06 kg" in warning
+
+
+def test_a_massless_subtree_with_mass_zero_written_out_counts_as_massless(tmp_path):
+    body = ARM + (f'<link name="pad">{INERTIAL.format(m=0)}</link>'
+                  '<joint name="slide" type="prismatic"><parent link="upper"/><child link="pad"/>'
+                  '<limit lower="0" upper="0.1" effort="1" velocity="1"/></joint>')
+    description = robot(tmp_path, body)
+    assert physics_inertials(description)['pad'] == (MOVABLE_MASS, MOVABLE_INERTIA)
+    assert len(description.warnings) == 1
+
+
+def test_pybullets_copy_has_one_element_per_line(tmp_path):
+    # PyBullet's XML reader fails on long one-line files ("Cannot load URDF file."):
+    # a minified URDF must still reach it with line breaks.
+    description = robot(tmp_path, ARM)
+    assert '\n' not in ARM
+    assert max(len(line) for line in description.physics_urdf.splitlines()) < 200
+
+
+def test_a_urdf_with_two_root_links_is_refused_by_name(tmp_path):
+    # urdfdom refuses it; PyBullet would crash (segmentation fault) loading it.
+    with pytest.raises(DescriptionError, match=r"links 'base', 'stray' are each the child of "
+                                               'no joint'):
+        robot(tmp_path, ARM + '<link name="stray"/>')

@@ -1,0 +1,144 @@
+"""Instability is never silent: unstable PID gains at start-up, a runaway joint at run time."""
+
+import math
+
+import pytest
+from robot_fixtures import (
+    LINK_LENGTH,
+    LINK_MASS,
+    LINK_WIDTH,
+    JointDef,
+    write_star_robot,
+    write_text,
+)
+
+from pan_tilt_sim.sim.engine import make_simulation
+from pan_tilt_sim.sim.physics import check_poses
+from pan_tilt_sim.sim.stability import largest_stable_time_step
+
+DT = 0.001
+# A star link about its joint's z axis: box about its centre plus m (L / 2)^2.
+STAR_INERTIA = LINK_MASS * (LINK_LENGTH ** 2 + LINK_WIDTH ** 2) / 12 + LINK_MASS * (
+    LINK_LENGTH / 2) ** 2
+
+
+class Log:
+    def __init__(self):
+        self.infos, self.warnings = [], []
+
+    def info(self, message):
+        self.infos.append(message)
+
+    def warning(self, message):
+        self.warnings.append(message)
+
+
+def star(tmp_path, gains, log, damping=0.0):
+    # A huge effort limit: a clamped effort would turn divergence into bounded chatter.
+    robot = write_star_robot(tmp_path, [JointDef('hinge', damping=damping, effort=1e6)])
+    controllers = write_text(tmp_path, 'controllers.yaml', f"""
+        pos:
+          type: effort_controllers/JointPositionController
+          joint: hinge
+          pid: {gains}
+        """)
+    return make_simulation(str(robot), str(controllers), DT, logger=log)
+
+
+def critical_d(p=0.0):
+    """The d at which d dt / 2 + p dt^2 / 4 equals the star link's inertia."""
+    return (4 * STAR_INERTIA - p * DT * DT) / (2 * DT)
+
+
+def test_gains_within_the_rule_give_no_warning_and_stay_bounded(tmp_path):
+    log = Log()
+    d = 0.9 * critical_d(p=1000.0)
+    with star(tmp_path, f'{{p: 1000.0, d: {d}}}', log) as sim:
+        sim.controller('pos').set_command(0.5)
+        sim.advance(2000)
+        assert sim.joint_positions()['hinge'] == pytest.approx(0.5, abs=0.01)
+    assert log.warnings == []
+
+
+def test_gains_beyond_the_rule_are_named_with_the_largest_stable_value(tmp_path):
+    log = Log()
+    d = 1.1 * critical_d(p=100.0)
+    with star(tmp_path, f'{{p: 100.0, d: {d}}}', log) as sim:
+        sim.controller('pos').set_command(0.5)
+        sim.advance(500)
+        # ... and they are unstable indeed: the joint runs away to PyBullet's cap.
+        assert abs(sim.joint_velocities()['hinge']) > 50.0
+    startup = [line for line in log.warnings if 'is unstable at time_step' in line]
+    assert startup == [
+        f"joint 'hinge' (pos): PID p 100 d {d:g} is unstable at time_step 0.001 s for its "
+        f'effective inertia {STAR_INERTIA:.3g} kg*m^2 (needs d * time_step / 2 + '
+        f'p * time_step^2 / 4 = {d * DT / 2 + 100 * DT * DT / 4:.3g} < inertia): use '
+        f'd < {critical_d(100.0):.3g}, a time_step below '
+        f'{largest_stable_time_step(100.0, d, STAR_INERTIA):.3g} s, or no gains '
+        '(the ideal actuator)']
+
+
+def test_urdf_damping_does_not_count_it_is_applied_implicitly(tmp_path):
+    log = Log()
+    with star(tmp_path, '{p: 100.0, d: 10.0}', log, damping=1000.0) as sim:
+        sim.advance(500)
+        assert abs(sim.joint_velocities()['hinge']) < 1e-3
+    assert log.warnings == []
+
+
+def test_a_runaway_joint_is_reported_at_run_time_once_a_second(tmp_path):
+    log = Log()
+    with star(tmp_path, f'{{p: 100.0, d: {3 * critical_d(100.0)}}}', log) as sim:
+        log.warnings.clear()
+        sim.controller('pos').set_command(0.5)
+        for _ in range(100):
+            sim.advance(10)
+    runtime = [line for line in log.warnings if "PyBullet's speed cap" in line]
+    assert len(runtime) == 1  # throttled: the loop took less than a second
+    assert runtime[0].startswith('at sim time ')
+    assert "joint 'hinge' moves at " in runtime[0] and 'unstable' in runtime[0]
+
+
+def test_a_non_finite_state_is_reported(tmp_path, monkeypatch):
+    log = Log()
+    with star(tmp_path, '{p: 1.0}', log) as sim:
+        step = sim._physics_step
+
+        def poisoned(efforts, targets):
+            states = step(efforts, targets)
+            return [(math.nan, math.nan, *state[2:]) for state in states]
+        sim._physics_step = poisoned
+        sim.advance(1)
+    assert any("joint 'hinge' has a non-finite state (position nan" in line
+               for line in log.warnings)
+
+
+def test_the_check_poses_cover_the_range_and_free_joints():
+    from pan_tilt_sim.model.robot import JointKind, JointSpec
+    joints = [JointSpec('a', JointKind.REVOLUTE, -1.0, 3.0), JointSpec('b', JointKind.CONTINUOUS)]
+    assert check_poses(joints, [0.5, 0.25]) == [
+        [0.5, 0.25], [1.0, 0.0], [0.0, math.pi / 2], [2.0, -math.pi / 2]]
+
+
+def test_largest_stable_time_step_solves_the_rule():
+    p, d, inertia = 100.0, 10.0, 0.003
+    dt = largest_stable_time_step(p, d, inertia)
+    assert d * dt / 2 + p * dt * dt / 4 == pytest.approx(inertia)
+    assert largest_stable_time_step(0.0, 4.0, 0.002) == pytest.approx(0.001)
+
+
+@pytest.mark.parametrize('factor', [0.9, 1.1])
+def test_a_stiff_p_alone_is_held_to_p_dt_squared_over_4_below_the_inertia(tmp_path, factor):
+    log = Log()
+    p = factor * 4 * STAR_INERTIA / DT ** 2  # ~1e5: the p term of the rule decides alone
+    with star(tmp_path, f'{{p: {p}}}', log) as sim:
+        sim.controller('pos').set_command(0.01)
+        sim.advance(1000)
+        speed = abs(sim.joint_velocities()['hinge'])
+    startup = [line for line in log.warnings if 'is unstable at time_step' in line]
+    if factor < 1:
+        assert speed < 5.0 and startup == []
+    else:
+        assert speed > 50.0
+        assert len(startup) == 1 and f'use p < {4 * STAR_INERTIA / DT ** 2:.3g} and a ' \
+                                      'smaller d' in startup[0]
