@@ -21,9 +21,11 @@ actuators as the YAML controllers': each commanded joint's interface (see
 :func:`~pan_tilt_sim.model.topic_based.command_interface`, or
 ``topic_based.command_interface`` for all) is driven by a group controller of
 that interface (``topic_based_position`` ...: the ``JointGroup*Controller``
-types, one member per joint), with gains from ``topic_based.pid_gains.<joint>.p``
-(``.i``, ``.d``, ``.i_clamp``, as gazebo_ros_control's ``pid_gains``), tunable
-live as ``topic_based_<interface>.gains.<joint>.*``.
+types, one member per joint): the ideal actuator for position and velocity
+(:mod:`pan_tilt_sim.controllers.actuator`), or a PID where
+``topic_based.pid_gains.<joint>.p`` (``.i``, ``.d``, ``.i_clamp``, named
+after gazebo_ros_control's ``pid_gains``) gives gains, tunable live as
+``topic_based_<interface>.gains.<joint>.*``.
 """
 
 from __future__ import annotations
@@ -123,7 +125,7 @@ def declare(node: Node, description: RobotDescription) -> TopicHardwareSettings 
     for joint in commanded:
         given = {field: _optional_double(
             node, f'{PREFIX}.pid_gains.{joint}.{field}',
-            f'PID gain {field} of {joint} (p given: a PID instead of the default actuator).')
+            f'PID gain {field} of {joint} (p given: a PID instead of the ideal actuator).')
             for field in GAIN_FIELDS}
         if given['p'] is not None:
             gains[joint] = {field: value for field, value in given.items() if value is not None}
