@@ -14,8 +14,9 @@ client:
   and the targets, can be pushed and grasped, and the cameras and lidars see
   them -- they are ordinary bodies in the client those render in.  An object
   whose URDF says ``<gazebo><static>true</static></gazebo>`` is fixed where
-  it is spawned; one whose base link has no mass is static too (PyBullet's
-  rule).  Its joints are passive (PyBullet's default motors off; URDF
+  it is spawned; one whose base link has no mass (no ``<inertial>``) is
+  static too (PyBullet's rule).  PyBullet's hidden drag is off, as for the
+  robot.  Its joints are passive (PyBullet's default motors off; URDF
   friction as a velocity motor capped at the friction, as for the robot).
 
 Poses are those of an entity's URDF root link frame in the world (PyBullet
@@ -430,6 +431,10 @@ class Entities:
                              f'{resource.source}: PyBullet cannot load it: {err}') from None
         finally:
             path.unlink()
+        # No drag that neither the URDF nor Gazebo has (PyBullet's default 0.04), as
+        # for the robot (sim/physics.py).
+        pybullet.changeDynamics(body, BASE_LINK_INDEX, linearDamping=0.0, angularDamping=0.0,
+                                physicsClientId=client)
         joints = pybullet.getNumJoints(body, physicsClientId=client)
         if joints:
             friction = {joint.name: joint.friction for joint in resource.joints}
