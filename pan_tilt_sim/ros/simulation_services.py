@@ -122,10 +122,14 @@ def declare_namespace(node: Node) -> str:
         "Namespace of the simulation_interfaces services: '~' (default) = the node's own "
         "name (/sim_node/step_simulation), '' = the node's namespace (Isaac Sim's names: "
         '/step_simulation; replaces the Empty reset_simulation), or any namespace.')
-    bare = namespace.removeprefix(PRIVATE)
-    if namespace.startswith(PRIVATE) and bare and not bare.startswith(naming.ROOT):
-        bare = 'x'  # '~foo' is not a name
-    if not naming.is_valid_namespace(bare.rstrip(naming.ROOT) or bare):
+    if namespace in (PRIVATE, ''):
+        valid = True
+    elif namespace.startswith(PRIVATE + naming.ROOT):  # '~/sim': under the node's name
+        valid = naming.is_valid_namespace(namespace[len(PRIVATE):].rstrip(naming.ROOT))
+    else:  # '~sim' is no name
+        valid = not namespace.startswith(PRIVATE) and naming.is_valid_namespace(
+            namespace.rstrip(naming.ROOT) or naming.ROOT)
+    if not valid:
         raise ParameterError(
             f"parameter '{NAMESPACE_PARAMETER}': '{namespace}' is not '~', '' or a valid ROS "
             f'namespace ({naming.NAMESPACE_RULE})')

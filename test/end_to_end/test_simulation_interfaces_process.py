@@ -56,3 +56,14 @@ def test_a_paused_program_steps_spawns_and_quits_with_exit_code_0():
     assert process.returncode == 0, stderr
     assert 'Traceback' not in stderr
     assert 'QUITTING' in stderr
+
+
+def test_a_bad_world_file_ends_the_program_with_one_line_and_exit_code_2(tmp_path):
+    world = tmp_path / 'world.yaml'
+    world.write_text('entities:\n  - name: box\n    pose: {position: [0, 0]}\n')
+    result = sim_process.run('-p', f'world:={world}')
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert lines[-1] == (f'sim_node: error: {world}: entities[0]: give a uri or a '
+                         'resource_string')
+    assert 'Traceback' not in result.stderr

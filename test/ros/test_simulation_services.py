@@ -22,6 +22,7 @@ from sim_interfaces_client import (
 )
 from std_srvs.srv import Empty
 
+from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.ros import simulation_services
 
 Features = msg.SimulatorFeatures
@@ -300,3 +301,22 @@ def test_without_simulation_interfaces_the_node_runs_and_says_so_once(capfd, mon
         assert not [name for name in services if 'simulate_steps' in name]
         assert services['/reset_simulation'] == ['std_srvs/srv/Empty']
     assert capfd.readouterr().err.count(simulation_services.OFF_LINE) == 1
+
+
+@pytest.mark.parametrize('namespace, name', [
+    ('~/control', '/sim_node/control/get_simulator_features'),
+    ('/', '/get_simulator_features'),
+    ('/sim/', '/sim/get_simulator_features'),
+    ('sim', '/sim/get_simulator_features'),
+])
+def test_the_namespace_parameter_moves_the_services(namespace, name):
+    with sim_node(**{'simulation_interfaces.namespace': namespace}) as sim:
+        assert name in sim.node.simulation_interfaces.names
+        assert name in _services_of(sim)
+
+
+@pytest.mark.parametrize('namespace', ['~sim', '9sim', 'a b', '/a//b'])
+def test_a_bad_namespace_ends_start_up_naming_the_parameter(namespace):
+    with pytest.raises(ParameterError, match="'simulation_interfaces.namespace'"):
+        with sim_node(**{'simulation_interfaces.namespace': namespace}):
+            pass

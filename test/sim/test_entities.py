@@ -291,3 +291,16 @@ def test_an_object_in_flight_keeps_its_horizontal_speed(seed):
     assert state.linear[0] == pytest.approx(1.0, abs=1e-9)
     assert state.linear[2] == pytest.approx(-9.81 * 0.2, abs=1e-6)
     assert state.angular == pytest.approx((0.0, 0.0, 0.5), abs=1e-9)
+
+
+def test_the_robot_can_be_moved_and_a_reset_puts_it_back(seed):
+    simulation, entities = seed
+    robot = entities.robot_name
+    turned = (0.0, 0.0, math.sin(0.25), math.cos(0.25))
+    entities.set_state(robot, EntityState(Transform((1.0, 2.0, 0.0), turned)))
+    assert entities.state(robot).pose.translation == pytest.approx((1.0, 2.0, 0.0))
+    link = pybullet.getLinkState(simulation.physics.body_id, 0,
+                                 physicsClientId=simulation.physics.client_id)[4]
+    assert link[:2] == pytest.approx((1.0, 2.0), abs=0.05)  # its links went along
+    entities.reset_state()
+    assert entities.state(robot).pose.translation == pytest.approx((0.0, 0.0, 0.0))
