@@ -7,7 +7,9 @@ QUITTING must work there as in-process.
 
 from __future__ import annotations
 
+import signal
 import subprocess
+import sys
 
 import pytest
 import sim_process
@@ -67,3 +69,27 @@ def test_a_bad_world_file_ends_the_program_with_one_line_and_exit_code_2(tmp_pat
     assert lines[-1] == (f'sim_node: error: {world}: entities[0]: give a uri or a '
                          'resource_string')
     assert 'Traceback' not in result.stderr
+
+
+def test_the_spawn_example_drops_the_shipped_box_onto_the_ground(repo_root):
+    process = sim_process.start('-p', 'paused:=true', start_new_session=True)
+    try:
+        result = subprocess.run(
+            [sys.executable, str(repo_root / 'examples' / 'spawn_and_step.py'), '--z', '0.3',
+             '--steps', '1000', '--timeout', str(STARTUP_BUDGET_S)],
+            capture_output=True, text=True, env=sim_process.environment(),
+            timeout=STARTUP_BUDGET_S * 4, check=False)
+    finally:
+        process.send_signal(signal.SIGINT)
+        try:
+            process.communicate(timeout=EXIT_BUDGET_S)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.communicate()
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert 'simulation STOPPED' in result.stdout
+    # The shipped box is a 10 cm cube: it rests with its centre 5 cm up.
+    line = result.stdout.splitlines()[-1]
+    assert line.startswith("after 1000 steps (sim time 1.000 s): 'box' at ("), line
+    x, y, z = (float(value) for value in line.rpartition('(')[2].rstrip(')').split(','))
+    assert (x, y, z) == pytest.approx((-1.2, 0.0, 0.05), abs=3e-3)
