@@ -23,6 +23,8 @@ EXECUTABLES = {
     'sim_node': 'pan_tilt_sim.__main__:main',  # signals handled before rclpy loads
     'bench': 'pan_tilt_sim.tools.bench:main',
     'step_response': 'pan_tilt_sim.tools.step_response:main',
+    'tune': 'pan_tilt_sim.tools.tune:main',
+    'sweep': 'pan_tilt_sim.tools.sweep:main',
 }
 HERE = os.path.dirname(os.path.abspath(__file__))
 SHARE = os.path.join('share', PACKAGE)

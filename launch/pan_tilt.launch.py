@@ -10,6 +10,8 @@ The ROS 2 form of the seed's gazebo_pan_tilt.launch + pan_tilt_gazebo_control.la
         model:=$(ros2 pkg prefix ur_description)/share/ur_description/urdf/ur.urdf.xacro \
         xacro_args:='ur_type:=ur5e name:=ur5e' controllers:=.../ur_controllers.yaml \
         active_controllers:='joint_state_broadcaster joint_trajectory_controller'
+    ros2 launch pan_tilt_sim pan_tilt.launch.py spawners:=true \
+        active_controllers:='joint_state_broadcaster joint_trajectory_controller'
 
 List arguments (``xacro_args``, ``controllers_args``, ``active_controllers``)
 take items separated by spaces or commas, or a YAML list as ``-p`` takes it.
@@ -19,6 +21,12 @@ joint_states, /clock, the camera and robot_description.  With
 robot_state_publisher installed, it turns joint_states into TF (on sim
 time) and sim_node's own TF is off; without it, sim_node publishes TF
 itself.  sim_node stops when this launch process dies, however it dies.
+
+``spawners:=true`` is the mode for ros2_control launch files: sim_node starts
+with no controller loaded (as gz_ros2_control), and spawners -- the
+including launch file's own, or the one this file starts for
+``active_controllers`` (ros2_control's ``controller_manager`` package must be
+installed) -- load and activate them through its controller_manager.
 """
 
 # ruff: noqa: I001 -- this repository's launch/ folder makes ruff take `launch` for first-party
@@ -28,7 +36,9 @@ from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
 from pan_tilt_sim.tools.launch_support import (
+    CONTROLLER_MANAGER_PACKAGE,
     ROBOT_STATE_PUBLISHER,
+    SPAWNER,
     bool_argument,
     has_package,
     list_argument,
@@ -36,6 +46,7 @@ from pan_tilt_sim.tools.launch_support import (
     robot_state_publisher_parameters,
     sim_node_environment,
     sim_node_parameters,
+    spawner_arguments,
 )
 from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
 
@@ -57,7 +68,11 @@ def generate_launch_description() -> LaunchDescription:
                               description="values of the YAML's $(var name), e.g. "
                               "'joint_prefix:=joint'"),
         DeclareLaunchArgument('active_controllers', default_value='',
-                              description='controllers to activate; empty = all of them'),
+                              description='controllers to activate; empty = all of them '
+                              '(with spawners:=true: the ones a spawner here activates)'),
+        DeclareLaunchArgument('spawners', default_value='false',
+                              description='true: no controller starts until a ros2_control '
+                              'spawner loads it, as with gz_ros2_control'),
         DeclareLaunchArgument('time_step', default_value='0.001',
                               description='physics step, s of sim time'),
         DeclareLaunchArgument('robot_namespace', default_value='',
@@ -76,7 +91,7 @@ def generate_launch_description() -> LaunchDescription:
 
 
 def launch_nodes(context, *args, **kwargs) -> list:
-    """Return sim_node, and robot_state_publisher if installed, for the arguments given."""
+    """Return sim_node, robot_state_publisher if installed, and a spawner if asked for."""
     def argument(name: str) -> str:
         return LaunchConfiguration(name).perform(context)
 
@@ -87,14 +102,21 @@ def launch_nodes(context, *args, **kwargs) -> list:
     # Read here first, as sim_node will: a bad file fails the launch before any node starts.
     setup = robot_setup(model, controllers, xacro_args, robot_namespace, controllers_args)
     with_state_publisher = has_package(ROBOT_STATE_PUBLISHER)
+    spawners = bool_argument(argument('spawners'))
+    active = list_argument(argument('active_controllers'))
+    if spawners and active and not has_package(CONTROLLER_MANAGER_PACKAGE):
+        raise RuntimeError(
+            f"spawners:=true with active_controllers needs ros2_control's "
+            f"'{CONTROLLER_MANAGER_PACKAGE}' package (its spawner); it is not installed")
     sim_parameters = sim_node_parameters(
         model, controllers,
         real_time_factor=float(argument('real_time_factor')),
         world=argument('world'), gui=bool_argument(argument('gui')),
         xacro_args=xacro_args, controllers_args=controllers_args,
-        active_controllers=list_argument(argument('active_controllers')),
+        active_controllers=active,
         time_step=float(argument('time_step')), robot_namespace=robot_namespace,
-        publish_tf=not with_state_publisher, paused=bool_argument(argument('paused')))
+        publish_tf=not with_state_publisher, spawners=spawners,
+        paused=bool_argument(argument('paused')))
     nodes = [Node(package=PACKAGE, executable='sim_node', name='sim_node', output='screen',
                   parameters=[sim_parameters], additional_env=sim_node_environment())]
     if with_state_publisher:
@@ -102,4 +124,7 @@ def launch_nodes(context, *args, **kwargs) -> list:
                           name=ROBOT_STATE_PUBLISHER, output='screen',
                           parameters=[robot_state_publisher_parameters(setup)],
                           remappings=[('joint_states', setup.topic('joint_states'))]))
+    if spawners and active:
+        nodes.append(Node(package=CONTROLLER_MANAGER_PACKAGE, executable=SPAWNER,
+                          arguments=spawner_arguments(setup, active), output='screen'))
     return nodes

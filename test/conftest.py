@@ -16,6 +16,11 @@ os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 _DOMAIN_BASE, _DOMAIN_SPAN = 30, 100
 os.environ['ROS_DOMAIN_ID'] = os.environ.get(
     'PAN_TILT_SIM_TEST_DOMAIN', str(_DOMAIN_BASE + os.getpid() % _DOMAIN_SPAN))
+# Ray (tune/sweep tests) on loopback only, and no usage reports: on Linux Ray
+# otherwise puts its nodes on the machine's network address.  Read by Ray at
+# import, so set before any test imports it.
+os.environ['RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER'] = '0'
+os.environ['RAY_USAGE_STATS_ENABLED'] = '0'
 # ament index look-ups find the package installed into this environment.
 _prefixes = [p for p in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if p]
 if sys.prefix not in _prefixes:

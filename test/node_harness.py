@@ -59,8 +59,12 @@ class NodeHarness:
         self._nodes: list[Node] = [self.probe]
 
     def add(self, node: Node) -> Node:
-        """Spin ``node`` on the shared executor; it is destroyed with the harness."""
-        self.executor.add_node(node)
+        """Spin ``node`` (and its ``companion_nodes``) on the shared executor until closed.
+
+        The node is destroyed with the harness (and destroys its companions).
+        """
+        for each in (node, *getattr(node, 'companion_nodes', ())):
+            self.executor.add_node(each)
         self._nodes.append(node)
         return node
 
@@ -124,7 +128,8 @@ class NodeHarness:
     def close(self) -> None:
         """Destroy every node and shut the context down."""
         for node in reversed(self._nodes):
-            self.executor.remove_node(node)
+            for each in (*getattr(node, 'companion_nodes', ()), node):
+                self.executor.remove_node(each)
             node.destroy_node()
         self.executor.shutdown()
         rclpy.try_shutdown(context=self.context)

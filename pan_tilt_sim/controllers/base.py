@@ -50,6 +50,7 @@ class ActuatorKind(enum.Enum):
     """What drives a joint, and through which :class:`Drive`."""
 
     PASSIVE = ('passive: no active controller', Drive.EFFORT)
+    HOLD = ('held where it is until a spawned controller drives it', Drive.VELOCITY)
     MIMIC = ('mimic: follows its leader', Drive.EFFORT)
     EFFORT = ('effort command', Drive.EFFORT)
     POSITION_PID = ('position PID on effort', Drive.EFFORT)
@@ -96,14 +97,23 @@ class Actuator:
             force = 'N' if spec.kind is JointKind.PRISMATIC else 'N*m'
             limit = (f'at most {spec.effort_limit:g} {force}' if math.isfinite(spec.effort_limit)
                      else 'no effort limit in the URDF')
+            if self.kind is ActuatorKind.HOLD:
+                return (f'{self.kind.label}: a zero-velocity motor with {limit} '
+                        "(gz_ros2_control's hold_joints)")
             return (f'{self.kind.label}{owner}, a velocity motor with {limit}: no PID gains '
                     'for it in the YAML')
         return f'{self.kind.label}{owner}'
 
 
-def idle_actuator(spec: JointSpec) -> Actuator:
-    """Return what drives a joint no active controller claims: nothing, or its mimic leader."""
-    return Actuator(ActuatorKind.MIMIC if spec.mimic is not None else ActuatorKind.PASSIVE)
+def idle_actuator(spec: JointSpec, *, hold: bool = False) -> Actuator:
+    """Return what drives a joint no active controller claims: nothing, or its mimic leader.
+
+    ``hold``: a zero-velocity motor capped at the effort limit instead of nothing
+    (gz_ros2_control's ``hold_joints``, for joints that wait for a spawner).
+    """
+    if spec.mimic is not None:
+        return Actuator(ActuatorKind.MIMIC)
+    return Actuator(ActuatorKind.HOLD if hold else ActuatorKind.PASSIVE)
 
 
 class JointHandle:
@@ -206,8 +216,15 @@ class Controller(abc.ABC):
         """
         return {}
 
+    def state_interfaces(self) -> dict[str, tuple[str, ...]]:
+        """Return the state interfaces this controller reads, by joint (none here)."""
+        return {}
+
     def reset(self) -> None:  # noqa: B027 -- stateless controllers need no reset
         """Forget commands and internal state, as after a fresh start."""
+
+    def deactivate(self) -> None:  # noqa: B027 -- most controllers have nothing to end
+        """End what the controller was doing for someone (its updates stop after this)."""
 
     def pids(self) -> dict[str, Pid]:
         """Return the PIDs of this controller by joint (gains may change live); none here."""

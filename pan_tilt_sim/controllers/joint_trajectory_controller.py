@@ -1,8 +1,8 @@
 """``joint_trajectory_controller/JointTrajectoryController``: follow waypoints in sim time.
 
 Takes ``trajectory_msgs/msg/JointTrajectory`` on ``<controller>/joint_trajectory``
-(as ros2_controllers' controller does; its follow_joint_trajectory action
-needs control_msgs, which this simulator does without).
+as ros2_controllers' controller does, and FollowJointTrajectory goals (below;
+the node serves them as ``<controller>/follow_joint_trajectory``).
 
 * The message names every joint of the controller, in any order (partial
   goals are rejected); points need increasing ``time_from_start``, finite
@@ -27,10 +27,35 @@ needs control_msgs, which this simulator does without).
   no ideal actuator) does a joint without gains fall back to the position
   controller's default PID (p 100, i 0.01, d 10).
 * Before the first trajectory every joint holds its position at start.
+
+FollowJointTrajectory goals (:meth:`JointTrajectoryController.check_goal`,
+:meth:`~JointTrajectoryController.start_goal`,
+:meth:`~JointTrajectoryController.cancel_goal`) run as in ros2_controllers:
+
+* a goal is checked before it is accepted (:meth:`check_goal` returns the
+  result code and text of the first problem) -- ros2_controllers rejects such
+  a goal, so the code only reaches the log;
+* while it runs, every step compares desired and measured state with the
+  goal's tolerances (:mod:`~pan_tilt_sim.controllers.trajectory_goal`): a path
+  tolerance broken before the last point aborts it (PATH_TOLERANCE_VIOLATED)
+  and the joints hold where they are; past the last point it succeeds once
+  every goal tolerance holds (then the last point is held), or is aborted
+  (GOAL_TOLERANCE_VIOLATED) once ``goal_time_tolerance`` (if not 0) has
+  passed, holding where they are;
+* a new goal aborts the running one (INVALID_GOAL, "Current goal preempted by
+  new incoming action."), a topic trajectory replaces its trajectory and the
+  goal goes on against it, a cancel holds the joints where they are, and
+  deactivation or a reset of the simulation aborts it (INVALID_GOAL).
+
+The velocity error is measured, as upstream, only with a ``velocity`` state
+interface and a ``velocity`` or ``effort`` command interface; the defaults
+are ``state_interfaces: [position, velocity]``.  Topic trajectories are held
+to the YAML ``constraints`` too (a violation holds the joints where they are).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from typing import Any
@@ -59,10 +84,37 @@ from pan_tilt_sim.controllers.trajectory import (
     TrajectoryPlan,
     TrajectoryPoint,
 )
+from pan_tilt_sim.controllers.trajectory_goal import (
+    DEACTIVATED_TEXT,
+    FLOAT_EPSILON,
+    GOAL_TIME_TEXT,
+    GOAL_TOLERANCE_VIOLATED,
+    INVALID_GOAL,
+    INVALID_JOINTS,
+    OLD_HEADER_TIMESTAMP,
+    PATH_TOLERANCE_VIOLATED,
+    PATH_VIOLATED_TEXT,
+    PREEMPTED_TEXT,
+    RESET_TEXT,
+    SUCCEEDED_TEXT,
+    GoalStatus,
+    Tolerances,
+    TrajectoryGoal,
+    default_tolerances,
+    shortest_angular_distance,
+)
+from pan_tilt_sim.model.robot import JointKind
 
 COMMAND_INTERFACES_FIELD = 'command_interfaces'
 COMMAND_INTERFACES = ('position', 'velocity', 'effort')
 EFFORT_INTERFACE = 'effort'
+STATE_INTERFACES_FIELD = 'state_interfaces'
+STATE_INTERFACES = ('position', 'velocity', 'acceleration')
+DEFAULT_STATE_INTERFACES = ('position', 'velocity')
+MONITOR_RATE_FIELD = 'action_monitor_rate'
+DEFAULT_MONITOR_RATE = 20.0  # Hz: how often a goal's feedback is sent
+PARTIAL_FIELD = 'allow_partial_joints_goal'
+NONZERO_END_FIELD = 'allow_nonzero_velocity_at_trajectory_end'
 # A knot this close after the start is taken as at the start (float stamps).
 TIME_EPSILON = 1e-9
 
@@ -83,14 +135,53 @@ class JointTrajectoryController(MultiJointController):
                              f"{', '.join(COMMAND_INTERFACES)}")
         self._effort_interface = EFFORT_INTERFACE in interfaces
         self._command_interfaces = tuple(interfaces)
+        states = params.get(STATE_INTERFACES_FIELD) or list(DEFAULT_STATE_INTERFACES)
+        if not isinstance(states, list | tuple) or any(
+                interface not in STATE_INTERFACES for interface in states):
+            raise self.error(STATE_INTERFACES_FIELD, f'{states!r} must be a list of '
+                             f"{', '.join(STATE_INTERFACES)}")
+        self._state_interfaces = tuple(states)
+        # ros2_controllers measures the velocity error only in this case.
+        self._velocity_error = 'velocity' in states and bool(
+            {'velocity', 'effort'} & set(self._command_interfaces))
+        self._flags = {field: self._flag(field) for field in (PARTIAL_FIELD, NONZERO_END_FIELD)}
+        rate = params.get(MONITOR_RATE_FIELD, DEFAULT_MONITOR_RATE)
+        if isinstance(rate, bool) or not isinstance(rate, int | float) or not (
+                math.isfinite(rate) and rate > 0.0):
+            raise self.error(MONITOR_RATE_FIELD, f'{rate!r} must be a number of Hz > 0')
+        self.monitor_period = 1.0 / float(rate)
+        self.default_tolerances = default_tolerances(self, params, self._joint_names)
         gains = joint_gains_from_params(self, self._joint_names)
         self._gains = [gains.get(joint) for joint in self._joint_names]
         scales = feedforward_scales(self, self._joint_names)
         self._feedforward = [scales[joint] for joint in self._joint_names]
+        self._goal: TrajectoryGoal | None = None
+        # Events worth a warning that no goal reports (the node logs and clears them).
+        self.notices: list[str] = []
+
+    def _flag(self, field: str) -> bool:
+        value = self.params.get(field, False)
+        if not isinstance(value, bool):
+            raise self.error(field, f'{value!r} must be true or false')
+        return value
 
     def command_interfaces(self) -> dict[str, tuple[str, ...]]:
         """Return the ``command_interfaces`` listed, for every joint."""
         return {joint: self._command_interfaces for joint in self._joint_names}
+
+    def state_interfaces(self) -> dict[str, tuple[str, ...]]:
+        """Return the ``state_interfaces`` listed, for every joint."""
+        return {joint: self._state_interfaces for joint in self._joint_names}
+
+    @property
+    def goal(self) -> TrajectoryGoal | None:
+        """The goal being executed, if any (None once it has ended)."""
+        return self._goal
+
+    @property
+    def following(self) -> bool:
+        """Whether the latest trajectory has started (not waiting for its stamp or next step)."""
+        return self._pending is None
 
     def pids(self) -> dict[str, Pid]:
         """Return the PID of every joint that has one (their gains may be changed live)."""
@@ -115,6 +206,7 @@ class JointTrajectoryController(MultiJointController):
         self._handles = [self.handle(joints, joint, JOINTS_FIELD) for joint in self._joint_names]
         self._limits = [PositionLimits(handle.spec) for handle in self._handles]
         self._effort_limits = [handle.spec.effort_limit for handle in self._handles]
+        self._wraps = [handle.spec.kind is JointKind.CONTINUOUS for handle in self._handles]
         self._max_velocities = [handle.spec.velocity_limit for handle in self._handles]
         self._tracking_gains = [handle.tracking_gain for handle in self._handles]
         default = DEFAULT_POSITION_GAINS if self._effort_interface else None
@@ -139,7 +231,11 @@ class JointTrajectoryController(MultiJointController):
         self.reset()
 
     def reset(self) -> None:
-        """Hold every joint where it is; forget trajectories and integrals."""
+        """Hold every joint where it is; forget trajectories and integrals.
+
+        A goal still running is aborted (INVALID_GOAL): the simulation was reset.
+        """
+        self._end_goal(GoalStatus.ABORTED, INVALID_GOAL, RESET_TEXT)
         for index, handle in enumerate(self._handles):
             self._desired_positions[index] = handle.position
             self._desired_velocities[index] = 0.0
@@ -148,9 +244,166 @@ class JointTrajectoryController(MultiJointController):
                 pid.reset()
         self._plan: TrajectoryPlan | None = None
         self._pending: JointTrajectory | None = None
+        self._start_time = 0.0
+        self._tolerances = self.default_tolerances
+        self._checking = False
+        self._first_sample = False
+
+    def deactivate(self) -> None:
+        """Abort a running goal (INVALID_GOAL), as ros2_controllers does on deactivation."""
+        self._end_goal(GoalStatus.ABORTED, INVALID_GOAL, DEACTIVATED_TEXT)
+
+    def check_goal(self, trajectory: JointTrajectory, now: float) -> tuple[int, str] | None:
+        """Return ``(error code, text)`` of the first reason to reject a goal, or None.
+
+        ros2_controllers' checks in its order (joints, points, end velocity,
+        a start stamp ending in the past, strictly increasing times, sizes,
+        effort without an effort interface), then this controller's own (finite
+        values; velocities in every point or in none).  ``now`` is sim time.
+        """
+        names = trajectory.joint_names
+        if not self._flags[PARTIAL_FIELD] and len(names) != len(self._joint_names):
+            return INVALID_JOINTS, (
+                "Joints on incoming trajectory don't match the controller joints "
+                f"({', '.join(self._joint_names)}); allow_partial_joints_goal is false")
+        if not names:
+            return INVALID_JOINTS, 'Empty joint names on incoming trajectory.'
+        if not trajectory.points:
+            return INVALID_GOAL, 'Empty trajectory received.'
+        for name in names:
+            if name not in self._joint_names:
+                return INVALID_JOINTS, (
+                    f"Incoming joint {name} doesn't match the controller's joints "
+                    f"({', '.join(self._joint_names)}).")
+        if len(set(names)) != len(names):
+            return INVALID_JOINTS, 'A joint is named more than once in the incoming trajectory.'
+        last = trajectory.points[-1]
+        if not self._flags[NONZERO_END_FIELD]:
+            for name, velocity in zip(names, last.velocities, strict=False):
+                if abs(velocity) > FLOAT_EPSILON:
+                    return INVALID_GOAL, (f'Velocity of last trajectory point of joint {name} '
+                                          f'is not zero: {velocity:.15f}')
+        start = trajectory.start_time
+        if start is not None and start + last.time_from_start < now:
+            return OLD_HEADER_TIMESTAMP, (
+                f'Received trajectory with non-zero start time ({start:f}) that ends in the '
+                f'past ({start + last.time_from_start:f})')
+        with_velocities = bool(trajectory.points[0].velocities)
+        previous = -math.inf
+        for number, point in enumerate(trajectory.points):
+            when = point.time_from_start
+            if not (math.isfinite(when) and when >= 0.0 and when > previous):
+                return INVALID_GOAL, (
+                    f'Time between points {number - 1} and {number} is not strictly '
+                    f'increasing, it is {previous:f} and {when:f} respectively'
+                    if number else f'Time of point 0 is {when}: it must be a time >= 0')
+            previous = when
+            for field, values, required in (('positions', point.positions, True),
+                                            ('velocities', point.velocities, False),
+                                            ('accelerations', point.accelerations, False)):
+                if (values or required) and len(values) != len(names):
+                    return INVALID_GOAL, (
+                        f'Mismatch between joint_names size ({len(names)}) and {field} '
+                        f'({len(values)}) at point #{number}.')
+            if bool(point.velocities) != with_velocities:
+                return INVALID_GOAL, ('Velocities must be given in every point or in none '
+                                      f'(point #{number} differs from point #0).')
+            if point.efforts and 'effort' not in self._command_interfaces:
+                return INVALID_GOAL, ("Trajectories with effort fields are only supported for "
+                                      "controllers using the 'effort' command interface.")
+            if not all(map(is_sane_number, (*point.positions, *point.velocities,
+                                            *point.accelerations))):
+                return INVALID_GOAL, (
+                    f'Point #{number}: a position, velocity or acceleration is not a finite '
+                    f'number (within +-{MAX_COMMAND_MAGNITUDE:g}).')
+        return None
+
+    def start_goal(self, trajectory: JointTrajectory, tolerances: Tolerances) -> TrajectoryGoal:
+        """Run ``trajectory`` (checked by :meth:`check_goal`) as a goal; return the goal.
+
+        A goal still running is aborted: preempted (INVALID_GOAL).  Joints the
+        trajectory leaves out (``allow_partial_joints_goal``) hold their
+        present setpoints.
+        """
+        self._end_goal(GoalStatus.ABORTED, INVALID_GOAL, PREEMPTED_TEXT)
+        goal = TrajectoryGoal(tolerances)
+        if self.set_command(self._completed(trajectory)) is CommandResult.REJECTED:
+            goal.end(GoalStatus.ABORTED, INVALID_GOAL, self._problem)
+            return goal
+        self._goal = goal
+        self._tolerances = tolerances
+        self._checking = False  # until its trajectory starts (at its stamp)
+        return goal
+
+    def cancel_goal(self, goal: TrajectoryGoal) -> bool:
+        """Cancel ``goal`` if it is the one running: the joints hold where they are.
+
+        Returns whether it was running (a cancel of another goal changes nothing).
+        """
+        if goal is not self._goal:
+            return False
+        self._end_goal(GoalStatus.CANCELED)
+        self._hold_measured()
+        return True
+
+    def feedback(self) -> tuple[list[float], list[float], list[float], list[float], float]:
+        """Return desired and measured positions and velocities, and the trajectory's start."""
+        return (list(self._desired_positions), list(self._desired_velocities),
+                [handle.position for handle in self._handles],
+                [handle.velocity for handle in self._handles], self._start_time)
+
+    def position_errors(self) -> list[float]:
+        """Return desired minus measured position per joint (wrapped for continuous joints)."""
+        return [self._position_error(index) for index in self._indices]
+
+    @property
+    def measures_velocity_error(self) -> bool:
+        """Whether tolerances see a velocity error (velocity state, velocity/effort command)."""
+        return self._velocity_error
+
+    def _position_error(self, index: int) -> float:
+        desired, measured = self._desired_positions[index], self._handles[index].position
+        if self._wraps[index]:
+            return shortest_angular_distance(measured, desired)
+        return desired - measured
+
+    def _end_goal(self, status: GoalStatus, code: int = 0, text: str = '') -> None:
+        goal = getattr(self, '_goal', None)
+        if goal is not None:
+            goal.end(status, code, text)
+            self._goal = None
+            self._tolerances = self.default_tolerances
+
+    def _hold_measured(self) -> None:
+        """Hold every joint where it is now, at rest (ros2_controllers' set_hold_position)."""
+        for index, handle in enumerate(self._handles):
+            self._desired_positions[index] = handle.position
+            self._desired_velocities[index] = 0.0
+        self._plan = None
+        self._pending = None
+        self._checking = False
+
+    def _completed(self, trajectory: JointTrajectory) -> JointTrajectory:
+        """Fill the joints a partial trajectory leaves out with their present setpoints."""
+        missing = [index for index, joint in enumerate(self._joint_names)
+                   if joint not in trajectory.joint_names]
+        if not missing:
+            return trajectory
+        names = trajectory.joint_names + tuple(self._joint_names[i] for i in missing)
+        held = tuple(self._desired_positions[i] for i in missing)
+        rest = (0.0,) * len(missing)
+        points = tuple(dataclasses.replace(
+            point, positions=point.positions + held,
+            velocities=point.velocities + rest if point.velocities else (),
+            accelerations=point.accelerations + rest if point.accelerations else ())
+            for point in trajectory.points)
+        return JointTrajectory(names, points, trajectory.start_time)
 
     def set_command(self, value: JointTrajectory) -> CommandResult:
-        """Check a trajectory, put it in the controller's joint order and queue it."""
+        """Check a trajectory, put it in the controller's joint order and queue it.
+
+        A running goal goes on against it (ros2_controllers' topic override).
+        """
         problem = self._check(value)
         if problem:
             self._problem = f'ignored trajectory: {problem}'
@@ -185,6 +438,8 @@ class JointTrajectoryController(MultiJointController):
         desired_velocities = self._desired_velocities
         if self._plan is not None:
             self._plan.sample(time, desired_positions, desired_velocities)
+            if self._checking:
+                self._check_tolerances(time)
         handles, pids = self._handles, self._pids
         feedforward, effort_limits = self._feedforward, self._effort_limits
         max_velocities, tracking_gains = self._max_velocities, self._tracking_gains
@@ -215,6 +470,9 @@ class JointTrajectoryController(MultiJointController):
         if self._plan is not None:
             self._plan.sample(time, self._desired_positions, self._desired_velocities)
         start = time if trajectory.start_time is None else trajectory.start_time
+        self._start_time = start
+        self._first_sample = True
+        self._checking = self._goal is not None or self._tolerances.checks_anything
         past = [point for point in trajectory.points
                 if start + point.time_from_start <= time + TIME_EPSILON]
         future = trajectory.points[len(past):]
@@ -233,6 +491,56 @@ class JointTrajectoryController(MultiJointController):
         velocities = ([first_velocities] + [point.velocities for point in future]
                       if cubic else None)
         self._plan = TrajectoryPlan(times, positions, velocities)
+
+    def _check_tolerances(self, time: float) -> None:
+        """Compare desired and measured state with the active tolerances; end or hold.
+
+        ros2_controllers' update(): path tolerances before the last point (and
+        on the first sample), goal tolerances after it.
+        """
+        tolerances = self._tolerances
+        end_time = self._plan.end_time
+        before_last = time < end_time - TIME_EPSILON
+        first, self._first_sample = self._first_sample, False
+        handles, velocities = self._handles, self._desired_velocities
+        path_broken = outside_goal = False
+        for index in self._indices:
+            position_error = self._position_error(index)
+            velocity_error = (velocities[index] - handles[index].velocity
+                              if self._velocity_error else 0.0)
+            if (before_last or first) and not tolerances.path[index].holds(
+                    position_error, velocity_error):
+                path_broken = True
+            if not before_last and not tolerances.goal[index].holds(
+                    position_error, velocity_error):
+                outside_goal = True
+        late = time - end_time
+        goal_time_out = (outside_goal and tolerances.goal_time != 0.0
+                         and late > tolerances.goal_time)
+        goal = self._goal
+        if path_broken:
+            if goal is not None:
+                self._end_goal(GoalStatus.ABORTED, PATH_TOLERANCE_VIOLATED, PATH_VIOLATED_TEXT)
+            else:
+                self.notices.append(
+                    f'path tolerance broken at sim time {time:.3f} s (errors '
+                    f'{_rounded(self.position_errors())}): holding position')
+            self._hold_measured()
+        elif not before_last:
+            if goal is not None and not outside_goal:
+                self._end_goal(GoalStatus.SUCCEEDED, 0, SUCCEEDED_TEXT)
+                self._checking = False  # the last point is held
+            elif goal_time_out:
+                if goal is not None:
+                    self._end_goal(GoalStatus.ABORTED, GOAL_TOLERANCE_VIOLATED,
+                                   GOAL_TIME_TEXT.format(late))
+                else:
+                    self.notices.append(
+                        f'goal_time_tolerance exceeded at sim time {time:.3f} s (errors '
+                        f'{_rounded(self.position_errors())}): holding position')
+                self._hold_measured()
+            elif goal is None and not outside_goal:
+                self._checking = False  # a topic trajectory ended within its goal tolerances
 
     def _check(self, trajectory: Any) -> str:
         """Return what is wrong with ``trajectory``, or '' if it can be followed."""
@@ -273,3 +581,7 @@ class JointTrajectoryController(MultiJointController):
                         f'(within +-{MAX_COMMAND_MAGNITUDE:g})')
         return ''
 
+
+
+def _rounded(values: list[float]) -> str:
+    return '[' + ', '.join(f'{value:.4f}' for value in values) + ']'

@@ -29,12 +29,22 @@ the joints' present state (a position loop holds where the joint is); a
 deactivated one holds nothing: its joints keep the last command applied to
 them (the last effort), as a ros2_control command interface keeps its last
 value when its controller stops writing it.
+
+Each loaded controller has ros2_control's lifecycle state
+(:data:`UNCONFIGURED`, :data:`INACTIVE`, :data:`ACTIVE`): :meth:`load`,
+:meth:`configure`, :meth:`cleanup`, :meth:`unload` and :meth:`switch`
+follow controller_manager's rules, so that its services can be served from
+here.  With ``autostart`` false nothing is loaded at start-up -- as with
+gz_ros2_control, whose controller_manager waits for spawners -- and the
+file's controllers are only :attr:`ControllerManager.declared`, for
+:meth:`load` to take their type and parameters from.
 """
 
 from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable, Iterable, Mapping, Sequence
+from typing import Any
 
 from pan_tilt_sim.controllers.base import CommandController, Controller, JointHandle
 from pan_tilt_sim.controllers.registry import (
@@ -44,10 +54,14 @@ from pan_tilt_sim.controllers.registry import (
     supported_types,
 )
 from pan_tilt_sim.errors import ControllerConfigError, ControllerSwitchError
-from pan_tilt_sim.model.controller_config import ControllersConfig
+from pan_tilt_sim.model.controller_config import ControllersConfig, ControllerSpec
 from pan_tilt_sim.model.robot import RobotModel
 
 ACTIVE_CONTROLLERS = 'active_controllers'
+# ros2_control's lifecycle labels (controller_manager_msgs/ControllerState.state).
+UNCONFIGURED = 'unconfigured'
+INACTIVE = 'inactive'
+ACTIVE = 'active'
 
 
 @dataclasses.dataclass(frozen=True)
@@ -64,10 +78,29 @@ class ControllerManager:
 
     def __init__(self, config: ControllersConfig, handles: Mapping[str, JointHandle],
                  model: RobotModel | None = None, *, active: Sequence[str] | None = None,
-                 active_name: str = f"the parameter '{ACTIVE_CONTROLLERS}'") -> None:
+                 active_name: str = f"the parameter '{ACTIVE_CONTROLLERS}'",
+                 autostart: bool = True) -> None:
         self._source = config.label
         self._model = model
-        specs = config.controllers
+        self._handles = handles
+        # The file's controllers by name: what load() takes a type and parameters from.
+        self.declared: dict[str, ControllerSpec] = {spec.name: spec
+                                                    for spec in config.controllers}
+        self.update_rate = config.update_rate
+        self._unmovable = {joint.name: joint.kind for joint in (model.joints if model else ())
+                           if not joint.kind.is_actuated}
+        self._controllers: list[Controller] = []
+        self._by_name: dict[str, Controller] = {}
+        self._states: dict[str, str] = {}
+        self._switch_listeners: list[Callable[[], None]] = []
+        self._set_active(set())
+        self.skipped: tuple[SkippedController, ...] = ()
+        if autostart:
+            self._start(config.controllers, active, active_name)
+
+    def _start(self, specs: Sequence[ControllerSpec], active: Sequence[str] | None,
+               active_name: str) -> None:
+        """Load and configure the file's controllers; activate ``active`` (None: all)."""
         names = [spec.name for spec in specs]
         wanted = None if active is None else list(dict.fromkeys(active))
         for name in wanted or ():
@@ -91,34 +124,20 @@ class ControllerManager:
         skipped = [SkippedController(spec.name, str(spec.type),
                                      'a controller type this simulator does not have')
                    for spec in unknown]
-        unmovable = {joint.name: joint.kind for joint in (model.joints if model else ())
-                     if not joint.kind.is_actuated}
-        loaded = []
         for spec in specs:
             if spec in unknown:
                 continue
             try:
-                controller = create_controller(spec.name, spec.type, spec.params, self._source)
-                for joint in controller.joint_names:
-                    if joint in unmovable:
-                        raise ControllerConfigError(
-                            f"{self._source}: {spec.name}: joint '{joint}' is a "
-                            f'{unmovable[joint].value} joint; a controller can only drive '
-                            'revolute, continuous and prismatic joints')
-                controller.configure(handles)
+                controller = self._create(spec.name, spec.type, spec.params, self._source)
+                controller.configure(self._handles)
             except ControllerConfigError as err:
                 if wanted is None or spec.name in wanted:
                     raise
                 skipped.append(SkippedController(spec.name, str(spec.type),
                                                  f'cannot be loaded: {err}'))
                 continue
-            loaded.append(controller)
-        # Command controllers first: broadcasters then sample this step's efforts.
-        loaded.sort(key=lambda controller: not isinstance(controller, CommandController))
-        self._controllers = loaded
-        self._by_name = {controller.name: controller for controller in loaded}
-        self.skipped: tuple[SkippedController, ...] = tuple(skipped)
-        self._switch_listeners: list[Callable[[], None]] = []
+            self._add(controller, INACTIVE)
+        self.skipped = tuple(skipped)
         active_names = set(self._by_name) if wanted is None else set(wanted)
         problem = self._problem(active_names)
         if problem is not None:
@@ -137,8 +156,13 @@ class ControllerManager:
 
     @property
     def controllers(self) -> list[Controller]:
-        """Every loaded controller, active or not (command controllers first)."""
+        """Every loaded controller, in any state (command controllers first)."""
         return list(self._controllers)
+
+    @property
+    def configured(self) -> list[Controller]:
+        """The loaded controllers that are configured: inactive or active."""
+        return [c for c in self._controllers if self._states[c.name] != UNCONFIGURED]
 
     @property
     def active(self) -> list[Controller]:
@@ -158,20 +182,112 @@ class ControllerManager:
         """Whether the loaded controller ``name`` is active."""
         return name in self._active_names
 
-    def switch(self, activate: Iterable[str] = (), deactivate: Iterable[str] = ()) -> None:
+    def is_loaded(self, name: str) -> bool:
+        """Whether a controller called ``name`` is loaded (in any state)."""
+        return name in self._by_name
+
+    def state(self, name: str) -> str:
+        """Return the lifecycle state of the loaded controller ``name``; KeyError if none."""
+        return self._states[name]
+
+    # --- lifecycle, as controller_manager's services -------------------------------------
+
+    def load(self, name: str, type_name: Any, params: Mapping[str, Any],
+             source: str = '') -> Controller:
+        """Create controller ``name`` of ``type_name`` from ``params``: it is unconfigured.
+
+        Raises :class:`ControllerConfigError` for a name already loaded, a type
+        the simulator does not have, or parameters the type refuses.
+        """
+        if name in self._by_name:
+            raise ControllerConfigError(f"a controller named '{name}' was already loaded")
+        controller = self._create(name, type_name, params, source or self._source)
+        self._add(controller, UNCONFIGURED)
+        return controller
+
+    def configure(self, name: str) -> Controller:
+        """Bind an unconfigured or inactive controller to its joints: it becomes inactive.
+
+        An inactive one is cleaned up first and configured afresh.  Raises
+        :class:`ControllerConfigError` for an unknown or an active controller,
+        or a joint the robot lacks (the controller is then unconfigured).
+        """
+        controller = self._loaded(name, 'configure')
+        if self._states[name] == ACTIVE:
+            raise ControllerConfigError(
+                f"controller '{name}' can not be configured from '{ACTIVE}' state")
+        self._states[name] = UNCONFIGURED
+        controller.configure(self._handles)
+        self._states[name] = INACTIVE
+        return controller
+
+    def cleanup(self, name: str) -> Controller:
+        """Return an inactive controller to unconfigured (an unconfigured one stays so)."""
+        controller = self._loaded(name, 'cleanup')
+        if self._states[name] == ACTIVE:
+            raise ControllerConfigError(
+                f"controller '{name}' can not be cleaned-up from '{ACTIVE}' state")
+        self._states[name] = UNCONFIGURED
+        return controller
+
+    def unload(self, name: str) -> Controller:
+        """Remove a controller that is not active."""
+        controller = self._loaded(name, 'unload')
+        if self._states[name] == ACTIVE:
+            raise ControllerConfigError(
+                f"could not unload controller with name '{name}' because it is still active")
+        self._controllers.remove(controller)
+        del self._by_name[name], self._states[name]
+        return controller
+
+    def switch(self, activate: Iterable[str] = (), deactivate: Iterable[str] = (), *,
+               strict: bool = True) -> list[str]:
         """Deactivate, then activate, controllers: all or nothing.
 
-        Raises :class:`ControllerSwitchError` (and changes nothing) when a name
-        is not a loaded controller, or when afterwards a joint would be
-        claimed by two active controllers or lack an interface one claims.
-        Activated controllers start from the joints' present state;
-        deactivated ones leave their joints with the last command applied.
+        As controller_manager's switch_controller: every name must be a loaded
+        controller, every one to activate inactive (or active and being
+        deactivated in the same call), every one to deactivate active.
+        ``strict`` (STRICT): any of these problems refuses the whole switch;
+        otherwise (BEST_EFFORT) the controllers concerned are left out -- one
+        line each in the returned list -- and only a list naming no loaded
+        controller at all is refused.  Either way the switch is refused when
+        afterwards a joint would be claimed by two active controllers or lack
+        an interface one claims.  Refusals raise :class:`ControllerSwitchError`
+        and change nothing.  Activated controllers start from the joints'
+        present state; deactivated ones leave their joints with the last
+        command applied.
         """
-        activate, deactivate = list(activate), list(deactivate)
-        for name in (*activate, *deactivate):
-            if name not in self._by_name:
-                raise ControllerSwitchError(
-                    f"no loaded controller '{name}' (loaded: {', '.join(self._by_name)})")
+        activate, deactivate = list(dict.fromkeys(activate)), list(dict.fromkeys(deactivate))
+        dropped: list[str] = []
+
+        def refuse(problem: str) -> None:
+            if strict:
+                raise ControllerSwitchError(problem)
+            dropped.append(problem)
+
+        for action, names in (('deactivate', deactivate), ('activate', activate)):
+            unknown = [name for name in names if name not in self._by_name]
+            for name in unknown:
+                problem = (f"could not {action} controller with name '{name}' because no "
+                           'controller with this name exists (loaded: '
+                           f"{', '.join(self._by_name) or 'none'})")
+                if len(unknown) == len(names):
+                    raise ControllerSwitchError(problem)
+                refuse(problem)
+            names[:] = [name for name in names if name in self._by_name]
+        for name in list(deactivate):
+            if self._states[name] != ACTIVE:
+                deactivate.remove(name)
+                refuse(f"could not deactivate controller '{name}' since it is not active")
+        for name in list(activate):
+            state = self._states[name]
+            if state == ACTIVE and name not in deactivate:
+                activate.remove(name)
+                refuse(f"could not activate controller '{name}' since it is already active")
+            elif state == UNCONFIGURED:
+                activate.remove(name)
+                refuse(f"could not activate controller '{name}': it is unconfigured and must "
+                       "be configured (to 'inactive') first")
         names = (self._active_names - set(deactivate)) | set(activate)
         problem = self._problem(names)
         if problem is not None:
@@ -181,13 +297,17 @@ class ControllerManager:
             raise ControllerSwitchError(
                 f"'{first}' and '{second}' would both claim joint '{joint}'; "
                 'only one active controller can command a joint')
-        started = names - self._active_names
+        stopped = [self._by_name[name] for name in deactivate]
+        started = set(activate)
         self._set_active(names)
+        for controller in stopped:
+            controller.deactivate()
         for controller in self._active:
             if controller.name in started:
                 controller.reset()
         for listener in self._switch_listeners:
             listener()
+        return dropped
 
     def add_switch_listener(self, listener: Callable[[], None]) -> None:
         """Call ``listener()`` after every switch (the simulation re-drives the joints)."""
@@ -195,8 +315,39 @@ class ControllerManager:
 
     def _set_active(self, names: set[str]) -> None:
         self._active_names = frozenset(names)
+        for name, state in self._states.items():
+            if name in names:
+                self._states[name] = ACTIVE
+            elif state == ACTIVE:
+                self._states[name] = INACTIVE
         self._active = [c for c in self._controllers if c.name in self._active_names]
         self._updates = [controller.update for controller in self._active]
+
+    def _loaded(self, name: str, action: str) -> Controller:
+        try:
+            return self._by_name[name]
+        except KeyError:
+            raise ControllerConfigError(
+                f"could not {action} controller with name '{name}' because no controller "
+                'with this name exists') from None
+
+    def _create(self, name: str, type_name: Any, params: Mapping[str, Any],
+                source: str) -> Controller:
+        controller = create_controller(name, type_name, params, source)
+        for joint in controller.joint_names:
+            if joint in self._unmovable:
+                raise ControllerConfigError(
+                    f"{source}: {name}: joint '{joint}' is a "
+                    f'{self._unmovable[joint].value} joint; a controller can only drive '
+                    'revolute, continuous and prismatic joints')
+        return controller
+
+    def _add(self, controller: Controller, state: str) -> None:
+        self._controllers.append(controller)
+        # Command controllers first: broadcasters then sample this step's efforts.
+        self._controllers.sort(key=lambda c: not isinstance(c, CommandController))
+        self._by_name[controller.name] = controller
+        self._states[controller.name] = state
 
     def _problem(self, names: set[str]) -> tuple[str, str, str | None, str | None] | None:
         """Return what is wrong with ``names`` as the active set, or None.

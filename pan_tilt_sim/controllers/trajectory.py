@@ -22,11 +22,17 @@ from collections.abc import MutableSequence, Sequence
 
 @dataclasses.dataclass(frozen=True)
 class TrajectoryPoint:
-    """One waypoint: positions (and optionally velocities) at ``time_from_start`` s."""
+    """One waypoint: positions (and optionally velocities) at ``time_from_start`` s.
+
+    Accelerations and efforts are carried for validation only: interpolation
+    uses positions and velocities.
+    """
 
     time_from_start: float
     positions: tuple[float, ...]
     velocities: tuple[float, ...] = ()
+    accelerations: tuple[float, ...] = ()
+    efforts: tuple[float, ...] = ()
 
 
 @dataclasses.dataclass(frozen=True)

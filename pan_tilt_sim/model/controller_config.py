@@ -444,8 +444,29 @@ def _merge_into(target: dict[str, Any], overrides: Mapping[str, Any]) -> None:
             target[key] = dict(value) if isinstance(value, Mapping) else value
 
 
-def _ros2_control_config(nodes: list[tuple[str, dict[str, Any]]],
-                         path: str) -> ControllersConfig:
+def node_parameters(paths: Sequence[pathlib.Path | str], node: str,
+                    args: Mapping[str, str] | None = None, *,
+                    args_name: str = f"the parameter '{CONTROLLERS_ARGS}'") -> dict[str, Any]:
+    """Return the ``ros__parameters`` the ROS 2 parameter files at ``paths`` give ``node``.
+
+    As rcl reads ``--params-file``: a key names the node (a namespace before
+    it is ignored) or is a wildcard (``/**``) matching it; files are read in
+    order, later ones winning, and a node's own section wins over wildcards
+    of the same file.  Errors name the file; a file without any
+    ``ros__parameters`` gives nothing.
+    """
+    merged: dict[str, Any] = {}
+    for path in paths:
+        path = pathlib.Path(path).expanduser().resolve()
+        document = _read_document(path, args or {}, args_name)
+        patterns, own = _split_nodes(_ros2_nodes(document, path))
+        _merge_into(merged, _parameters_of(node, patterns, own))
+    return merged
+
+
+def _split_nodes(nodes: list[tuple[str, dict[str, Any]]]
+                 ) -> tuple[list[tuple[str, dict[str, Any]]], dict[str, dict[str, Any]]]:
+    """Split ``(node or pattern, parameters)`` into wildcard patterns and named nodes."""
     patterns: list[tuple[str, dict[str, Any]]] = []
     own: dict[str, dict[str, Any]] = {}
     for name, params in nodes:
@@ -453,14 +474,25 @@ def _ros2_control_config(nodes: list[tuple[str, dict[str, Any]]],
             patterns.append((name, params))
         else:
             _merge_into(own.setdefault(name, {}), params)
+    return patterns, own
+
+
+def _parameters_of(node: str, patterns: list[tuple[str, dict[str, Any]]],
+                   own: Mapping[str, dict[str, Any]]) -> dict[str, Any]:
+    merged: dict[str, Any] = {}
+    for pattern, params in patterns:
+        if fnmatch.fnmatchcase(node, pattern):
+            _merge_into(merged, params)
+    _merge_into(merged, own.get(node, {}))
+    return merged
+
+
+def _ros2_control_config(nodes: list[tuple[str, dict[str, Any]]],
+                         path: str) -> ControllersConfig:
+    patterns, own = _split_nodes(nodes)
 
     def parameters_of(node: str) -> dict[str, Any]:
-        merged: dict[str, Any] = {}
-        for pattern, params in patterns:
-            if fnmatch.fnmatchcase(node, pattern):
-                _merge_into(merged, params)
-        _merge_into(merged, own.get(node, {}))
-        return merged
+        return _parameters_of(node, patterns, own)
 
     update_rate = _update_rate(parameters_of(CONTROLLER_MANAGER), path)
     # Controllers are declared as `<name>: {type: ...}` entries (normally the

@@ -70,19 +70,43 @@ def parameter_prefixes(controller: Controller) -> dict[str, Pid]:
 
 
 class GainParameters:
-    """Declares the PID gain parameters of ``controllers`` on ``node`` and applies changes."""
+    """Declares the PID gain parameters of ``controllers`` on ``node`` and applies changes.
 
-    def __init__(self, node: Node, controllers: Iterable[Controller]) -> None:
+    Controllers configured later are added with :meth:`add` and leave with
+    :meth:`remove` (their parameters are undeclared).
+    """
+
+    def __init__(self, node: Node, controllers: Iterable[Controller] = ()) -> None:
+        self._node = node
         self._pids: dict[str, Pid] = {}
-        for controller in controllers:
-            self._pids.update(parameter_prefixes(controller))
+        self._by_controller: dict[str, list[str]] = {}
         # Declare before listening; values given at start-up (-p ...) pass the same check.
-        for prefix, pid in self._pids.items():
-            declared = {field: self._declare(node, prefix, field, value)
-                        for field, value in field_values(pid.gains).items()}
-            pid.gains = self._checked(prefix, declared)
+        for controller in controllers:
+            self.add(controller)
         node.add_on_set_parameters_callback(self.on_set_parameters)
         node.add_post_set_parameters_callback(self.on_parameters_set)
+
+    def add(self, controller: Controller) -> None:
+        """Declare the gain parameters of ``controller`` (values given with -p must pass)."""
+        self.remove(controller.name)
+        prefixes = parameter_prefixes(controller)
+        self._by_controller[controller.name] = list(prefixes)
+        for prefix, pid in prefixes.items():
+            # Known to the on-set check only once declared: a bad start-up value (-p) then
+            # ends here with the one-line ParameterError, not rclpy's exception.
+            declared = {field: self._declare(self._node, prefix, field, value)
+                        for field, value in field_values(pid.gains).items()}
+            self._pids[prefix] = pid
+            pid.gains = self._checked(prefix, declared)
+
+    def remove(self, name: str) -> None:
+        """Undeclare the gain parameters of controller ``name`` (if any)."""
+        for prefix in self._by_controller.pop(name, ()):
+            self._pids.pop(prefix, None)
+            for field in FIELDS:
+                full = f'{prefix}.{field}'
+                if self._node.has_parameter(full):
+                    self._node.undeclare_parameter(full)
 
     def parameter_names(self) -> list[str]:
         """Return the names of every gain parameter."""

@@ -69,6 +69,11 @@ def _specs() -> tuple[_Spec, ...]:
         _Spec('active_controllers', ParameterType.PARAMETER_STRING_ARRAY, None,
               'The controllers to activate (as spawners would); unset or empty = all of them. '
               'The others are loaded but inactive.'),
+        _Spec('autostart_controllers', ParameterType.PARAMETER_BOOL, True,
+              "true: the controllers file's controllers are loaded and active from the start "
+              "(or those in 'active_controllers'); false: none is loaded until ros2_control's "
+              'spawner loads, configures and activates it through /<ns>/controller_manager, '
+              'as with gz_ros2_control.'),
         _Spec('time_step', ParameterType.PARAMETER_DOUBLE, DEFAULT_TIME_STEP,
               'Physics step in seconds of sim time (0 < time_step <= 0.1).'),
         _Spec('real_time_factor', ParameterType.PARAMETER_DOUBLE, DEFAULT_REAL_TIME_FACTOR,
@@ -97,6 +102,7 @@ class SimParameters:
     controllers_args: tuple[str, ...]
     # None: every controller active (unset, or set to an empty list).
     active_controllers: tuple[str, ...] | None
+    autostart_controllers: bool
     time_step: float
     real_time_factor: float
     paused: bool
@@ -118,6 +124,10 @@ def declare_parameters(node: Node) -> SimParameters:
     check_time_step(checked.time_step)
     check_real_time_factor(checked.real_time_factor)
     check_namespace('robot_namespace', checked.robot_namespace)
+    if not checked.autostart_controllers and checked.active_controllers is not None:
+        raise ParameterError(
+            "parameter 'active_controllers' is set but 'autostart_controllers' is false: with "
+            'spawners, the spawners choose the active controllers; leave one of them out')
     return checked
 
 

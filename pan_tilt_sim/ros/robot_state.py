@@ -8,8 +8,8 @@
   (transient local) for the fixed joints and the camera's optical frame, and
   ``/tf`` for the moving joints every ``TF_PERIOD_S`` of sim time, computed
   from the robot model's joint origins and the measured joint positions
-  (mimic joints follow their leader).  Without tf2_msgs, one info line says
-  TF is off.
+  (mimic joints follow their leader).  Without tf2_msgs TF is off (sim_node's
+  start-up line of features off says so).
 
 TF leaves through a :class:`TfSink`, so the computation can be checked
 where tf2_msgs is not installed.
@@ -145,13 +145,10 @@ class RobotStatePublisher:
         self._schedule = PeriodicSchedule(TF_PERIOD_S)
         self._readers = True  # until the first refresh_readers()
         factory = create_tf_sink if tf_sink_factory is None else tf_sink_factory
+        self.tf_wanted = enabled
         self._sink = factory(node) if enabled else None
         if self._sink is None:
-            if enabled:
-                node.get_logger().info(
-                    'TF is off: tf2_msgs is not installed (robot_description is published; '
-                    'robot_state_publisher can publish TF from it and joint_states)')
-            return
+            return  # the node says, with the other features off, why (tf2_msgs missing)
         time = clock()
         self._sink.tf_static([transform_message(*frame, time) for frame in self.static_frames])
         self._messages = [TransformStamped() for _ in model.moving_joints]

@@ -29,7 +29,8 @@ def joint_trajectory(message: JointTrajectoryMessage) -> JointTrajectory:
         joint_names=tuple(message.joint_names),
         points=tuple(
             TrajectoryPoint(seconds(point.time_from_start), tuple(point.positions),
-                            tuple(point.velocities))
+                            tuple(point.velocities), tuple(point.accelerations),
+                            tuple(point.effort))
             for point in message.points),
         start_time=seconds(stamp_) if stamp_.sec or stamp_.nanosec else None)
 

@@ -17,11 +17,9 @@ from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallba
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import JointState
 
-from pan_tilt_sim.controllers import CommandController, CommandResult
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
-from pan_tilt_sim.errors import ConfigurationError
+from pan_tilt_sim.errors import ConfigurationError, ParameterError
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.controller_config import (
     CONTROLLERS_ARGS,
@@ -31,17 +29,19 @@ from pan_tilt_sim.model.controller_config import (
     parse_controllers_args,
 )
 from pan_tilt_sim.model.description import RobotDescription, load_description
-from pan_tilt_sim.ros import parameters, services, simulation_services, topic_hardware
+from pan_tilt_sim.ros import (
+    optional_interfaces,
+    parameters,
+    services,
+    simulation_services,
+    topic_hardware,
+)
+from pan_tilt_sim.ros.controller_bindings import ControllerBindings
 from pan_tilt_sim.ros.features import NodeFeatures
 from pan_tilt_sim.ros.gain_parameters import GainParameters
 from pan_tilt_sim.ros.pacing import Pacer, Throttle
 from pan_tilt_sim.ros.physics_thread import PhysicsThread, Turns
-from pan_tilt_sim.ros.ros_interfaces import (
-    COMMAND_MESSAGES,
-    NANOSECONDS_PER_SECOND,
-    clock_message,
-    joint_state_message,
-)
+from pan_tilt_sim.ros.ros_interfaces import NANOSECONDS_PER_SECOND, clock_message
 from pan_tilt_sim.sim.engine import Simulation
 
 NODE_NAME = 'sim_node'
@@ -56,7 +56,6 @@ CLOCK_MIN_WALL_PERIOD_S = 0.001
 # A tick's worth (20 ms) of bursts: up to ~10x real time every 10 ms stamp leaves.
 CLOCK_BURST = 20
 QUEUE_DEPTH = 10
-WARNING_THROTTLE_S = 1.0
 _OWN_PARAMETERS = {field.name for field in dataclasses.fields(parameters.SimParameters)}
 PAUSED = 'paused'  # the parameter; services and set_paused() go through it
 
@@ -103,11 +102,14 @@ class SimNode(Node):
             description, controllers, self.settings.time_step, gui=self.settings.gui,
             active_controllers=(None if self._topic_settings is not None
                                 else self.settings.active_controllers),
-            initial_positions=self.settings.initial_positions, logger=self.get_logger())
+            initial_positions=self.settings.initial_positions, logger=self.get_logger(),
+            autostart_controllers=(self._topic_settings is not None
+                                   or self.settings.autostart_controllers))
         self._paused = self.settings.paused
         self.steps_run = 0  # physics steps this node has run (never reset; see run_steps)
-        # Commands taken per controller (ignored ones included): a cheap health figure.
-        self.commands_received = {c.name: 0 for c in self.simulation.command_controllers()}
+        # Nodes of this process spun on sim_node's executor and destroyed with it.
+        self.companion_nodes: list[Node] = []
+        self.controller_manager: Node | None = None  # where controller_manager_msgs exists
         self._pacer = Pacer(self.settings.real_time_factor, self.settings.time_step)
         self._clock_every = clock_period_steps(self.settings.time_step)
         self._clock_publisher = self.create_publisher(Clock, '/clock', QUEUE_DEPTH)
@@ -115,16 +117,30 @@ class SimNode(Node):
         self._clock_readers = True  # until the first batch asks
         self._clock_pending = False
         self._clock_throttle = Throttle(CLOCK_MIN_WALL_PERIOD_S, CLOCK_BURST)
-        self._wire_controllers()
         try:
-            self.gain_parameters = GainParameters(self, self.simulation.controllers)
+            self.gain_parameters = GainParameters(self)
+            topic_mode = self._topic_settings is not None
+            self.controllers = ControllerBindings(
+                self, self.simulation,
+                topic_hardware.topics(self._topic_settings, self.topic) if topic_mode
+                else self.topic,
+                self.gain_parameters,
+                actions=not topic_mode and optional_interfaces.available('control_msgs'),
+                command_topics=not topic_mode)
+            self.topic_hardware = topic_hardware.TopicHardware(
+                self, self._topic_settings, description,
+                self.simulation.controllers) if topic_mode else None
+            # Commands taken per controller (ignored ones included): a cheap health figure.
+            self.commands_received = self.controllers.commands_received
             # Sensors follow an explicit namespace (the node's, or robot_namespace) the
             # way Gazebo's spawn -robot_namespace moves every plugin; else their plugins'.
             self.features = NodeFeatures(
                 self, self.simulation, self.robot_namespace, gui=self.settings.gui,
                 sensor_namespace=naming.normalize(self.get_namespace())
                 or naming.normalize(self.settings.robot_namespace))
+            self._start_controller_manager(controllers)
         except BaseException:
+            self._destroy_companions()
             self.simulation.close()
             raise
         self._publish_clock()
@@ -147,10 +163,12 @@ class SimNode(Node):
         try:
             self.simulation_interfaces = simulation_services.create(self, self._world_services)
         except BaseException:
+            self._destroy_companions()
             self.features.close()
             self.simulation.close()
             raise
         self._log_controllers(description, controllers)
+        self._log_missing_interfaces()
         # Actuators, start positions, PyBullet's load messages, unstable gains.
         self.simulation.report_startup()
         clock_period = self._clock_every * self.settings.time_step
@@ -220,6 +238,7 @@ class SimNode(Node):
             self.features.after_steps()
         if self._clock_pending:
             self._publish_clock()
+        self.controllers.after_steps()
 
     @property
     def paused(self) -> bool:
@@ -267,11 +286,13 @@ class SimNode(Node):
         self.features.after_steps()
 
     def destroy_node(self) -> None:
-        """Stop ticking and release PyBullet."""
+        """Stop ticking, destroy the controller_manager node and release PyBullet."""
         if self._physics_thread is not None:
             self._physics_thread.stop()
         if self._timer is not None:
             self._timer.cancel()
+        self.controllers.destroy()
+        self._destroy_companions()
         if self.simulation_interfaces is not None:
             self.simulation_interfaces.close()
         self.features.close()
@@ -317,8 +338,7 @@ class SimNode(Node):
         (within ~5 ms of wall time), well inside DDS's own matching delay.
         """
         self._clock_readers = self._clock_publisher.get_subscription_count() > 0
-        for controller, publisher, sink in self._joint_state_sinks:
-            controller.set_sink(sink if publisher.get_subscription_count() > 0 else None)
+        self.controllers.refresh_readers()
         self.features.refresh_readers()
 
     def _publish_clock(self) -> None:
@@ -329,28 +349,42 @@ class SimNode(Node):
             clock_message(grid_steps * simulation.time_step, self._clock_message))
         self._clock_pending = False
 
-    def _wire_controllers(self) -> None:
-        self.topic_hardware = None
-        if self._topic_settings is not None:
-            self.topic_hardware = topic_hardware.TopicHardware(
-                self, self._topic_settings, self.simulation.description,
-                self.simulation.controllers, self._joint_state_sink)
-            hardware = self.topic_hardware
-            self._joint_state_sinks = [(hardware.broadcaster, hardware.publisher, hardware.sink)]
+    def _start_controller_manager(self, controllers: ControllersConfig) -> None:
+        """Offer ros2_control's controller_manager services, where their messages exist."""
+        if self.topic_hardware is not None:
+            return  # the user's own controller_manager runs, on topic-based hardware
+        if not optional_interfaces.available('controller_manager_msgs'):
+            if not self.settings.autostart_controllers:
+                raise ParameterError(
+                    "parameter 'autostart_controllers' is false, but controller_manager_msgs "
+                    'is not installed: no spawner could load a controller '
+                    '(scripts/build_interfaces.sh builds it)')
             return
-        self._joint_state_sinks = []
-        for controller in self.simulation.controllers:
-            if isinstance(controller, JointStateController):
-                publisher = self.create_publisher(
-                    JointState, self.topic('joint_states'), QUEUE_DEPTH)
-                sink = self._joint_state_sink(publisher, controller.names)
-                self._joint_state_sinks.append((controller, publisher, sink))
-                controller.set_sink(sink)
-            elif isinstance(controller, CommandController):
-                message_type, extract = COMMAND_MESSAGES[controller.command_kind]
-                self.create_subscription(
-                    message_type, self.topic(controller.name, controller.command_topic),
-                    self._command_callback(controller, extract), QUEUE_DEPTH)
+        from pan_tilt_sim.ros.controller_manager import ControllerManagerNode
+
+        self.controller_manager = ControllerManagerNode(
+            self.controllers, self.simulation.manager, self.simulation.description.model,
+            self.robot_namespace, context=self.context,
+            substitutions=parse_controllers_args(self.settings.controllers_args),
+            source=controllers.label)
+        self.companion_nodes.append(self.controller_manager)
+
+    def _destroy_companions(self) -> None:
+        while self.companion_nodes:
+            self.companion_nodes.pop().destroy_node()
+
+    def _log_missing_interfaces(self) -> None:
+        """Say in one line which features are off because an interface package is missing."""
+        missing = [package for package in ('control_msgs', 'controller_manager_msgs')
+                   if self.topic_hardware is None and not optional_interfaces.available(package)]
+        if self.simulation_interfaces is None:
+            missing.append(simulation_services.PACKAGE)
+        robot_state = self.features.robot_state
+        if robot_state.tf_wanted and not robot_state.publishes_tf:
+            missing.insert(0, 'tf2_msgs')
+        line = optional_interfaces.missing_features_line(missing)
+        if line:
+            self.get_logger().info(line)
 
     def _log_controllers(self, description: RobotDescription,
                          controllers: ControllersConfig) -> None:
@@ -359,6 +393,12 @@ class SimNode(Node):
         for warning in description.warnings:
             logger.warning(warning)
         manager = self.simulation.manager
+        if not self.settings.autostart_controllers and self.topic_hardware is None:
+            logger.info(
+                f'no controller loaded: waiting for spawners at '
+                f"{self.controller_manager.get_fully_qualified_name()} (the controllers file "
+                f"declares {', '.join(manager.declared) or 'none'})")
+            return
         for skipped in manager.skipped:
             logger.info(f"controller '{skipped.name}' (type '{skipped.type}') skipped: "
                         f'{skipped.reason}')
@@ -376,36 +416,6 @@ class SimNode(Node):
             logger.warning(
                 f"{', '.join(c.name for c in broadcasters)}: inactive (not in "
                 f"'active_controllers'): nothing will be published on {topic}")
-
-    @staticmethod
-    def _joint_state_sink(publisher, names):
-        message = JointState()
-        message.name = list(names)  # once: the names never change
-
-        def publish(time, names, positions, velocities, efforts) -> None:
-            publisher.publish(
-                joint_state_message(time, positions, velocities, efforts, message))
-        return publish
-
-    def _command_callback(self, controller: CommandController, extract):
-        logger = self.get_logger()
-        name = controller.name
-
-        is_active = self.simulation.manager.is_active
-
-        def store(message) -> None:
-            self.commands_received[name] += 1
-            if not is_active(name):
-                logger.warning(f'{name}: ignored a command: the controller is inactive '
-                               "(not in 'active_controllers')",
-                               throttle_duration_sec=WARNING_THROTTLE_S)
-                return
-            value = extract(message)
-            result = controller.set_command(value)
-            if result is not CommandResult.ACCEPTED:
-                logger.warning(f'{controller.name}: {controller.command_problem(value, result)}',
-                               throttle_duration_sec=WARNING_THROTTLE_S)
-        return store
 
     @staticmethod
     def _own_updates(changed: list[Parameter]) -> dict:

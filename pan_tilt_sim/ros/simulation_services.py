@@ -3,7 +3,8 @@
 ROS 2's ``simulation_interfaces`` (1.5, Jazzy) is what Gazebo (ros_gz_sim),
 Isaac Sim and O3DE serve.  sim_node serves it too, where the package is
 installed (the standalone venv builds it; a ROS install provides it); without
-it, one info line says these services are off and everything else runs.
+it, the node's one line about missing interface packages says these services
+are off, and everything else (the gazebo_ros services, world files) runs.
 
 **Names.**  The services live under the ``simulation_interfaces.namespace``
 parameter, by default ``~`` -- the node's own name, as ros_gz_sim puts them
@@ -92,9 +93,6 @@ QUIT_GRACE_S = 0.1  # wall time between QUITTING's answer and the shutdown (DDS 
 SPAWNABLES_FOLDER = pathlib.PurePosixPath('urdf', 'objects')
 SPAWNABLE_SUFFIXES = ('.urdf', '.xacro')
 SCOPE_BITS = 0b111  # TIME | STATE | SPAWNED
-OFF_LINE = (f'{PACKAGE} is not installed: its services (get_simulator_features, '
-            'step_simulation, spawn_entity, ...) are off; the gazebo_ros services and the '
-            'world file work as before')
 
 SERVICES = ('get_simulator_features', 'get_simulation_state', 'set_simulation_state',
             'step_simulation', 'reset_simulation', 'get_entities', 'get_entities_states',
@@ -137,11 +135,14 @@ def declare_namespace(node: Node) -> str:
 
 
 def create(node: Node, gazebo_services: list[Service]) -> SimulationServices | None:
-    """Serve simulation_interfaces on ``node`` (a SimNode); None where it is not installed."""
+    """Serve simulation_interfaces on ``node`` (a SimNode); None where it is not installed.
+
+    The node says so in its one line about missing interface packages
+    (:mod:`pan_tilt_sim.ros.optional_interfaces`).
+    """
     namespace = declare_namespace(node)
     found = interfaces()
     if found is None:
-        node.get_logger().info(OFF_LINE)
         return None
     return SimulationServices(node, found, namespace, gazebo_services)
 

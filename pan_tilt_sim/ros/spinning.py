@@ -29,6 +29,9 @@ def spin(node: Node, on_ready: Callable[[], None] | None = None,
          make_executor: ExecutorFactory = single_threaded) -> None:
     """Spin ``node`` on ``make_executor(node.context)`` until its context shuts down.
 
+    The nodes in ``node.companion_nodes`` (sim_node's controller_manager), if
+    any, spin on the same executor.
+
     ``on_ready`` is called once the executor exists, just before spinning
     starts: a signal that shuts the context down while the executor is being
     built leaves a half-built executor whose ``__del__`` prints a traceback,
@@ -43,7 +46,9 @@ def spin(node: Node, on_ready: Callable[[], None] | None = None,
         if node.context.ok():
             raise
         return  # a signal shut the context down while the executor was built
-    executor.add_node(node)
+    nodes = [node, *getattr(node, 'companion_nodes', ())]
+    for each in nodes:
+        executor.add_node(each)
     try:
         if on_ready is not None:
             on_ready()
@@ -52,7 +57,8 @@ def spin(node: Node, on_ready: Callable[[], None] | None = None,
     except ExternalShutdownException:
         pass  # the context shut down while waiting: the normal end
     finally:
-        executor.remove_node(node)
+        for each in nodes:
+            executor.remove_node(each)
         executor.shutdown()
         # Also when an exception propagates: its traceback keeps this frame,
         # and so the executor, alive until after the node is destroyed.

@@ -32,15 +32,14 @@ from __future__ import annotations
 
 import dataclasses
 import pathlib
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 
-from pan_tilt_sim.controllers import CommandResult
+from pan_tilt_sim.controllers import CommandResult, Controller
 from pan_tilt_sim.controllers.forward_command_controller import ForwardCommandController
-from pan_tilt_sim.controllers.joint_state_controller import JointStateController
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model.controller_config import ControllersConfig, ControllerSpec
 from pan_tilt_sim.model.description import RobotDescription
@@ -162,37 +161,38 @@ def controllers_config(settings: TopicHardwareSettings) -> ControllersConfig:
     return ControllersConfig(tuple(specs), SOURCE)
 
 
+def topics(settings: TopicHardwareSettings, robot_topic: Callable[..., str]) -> Callable[..., str]:
+    """Return the node's topic namer with ``joint_states`` on the mode's states topic."""
+    def topic(*names: str) -> str:
+        return settings.states_topic if names == ('joint_states',) else robot_topic(*names)
+    return topic
+
+
 class TopicHardware:
-    """The command subscription and the state publisher of the mode, on a SimNode."""
+    """The command subscription of the mode, on a SimNode (the broadcaster publishes states)."""
 
     def __init__(self, node: Node, settings: TopicHardwareSettings, description: RobotDescription,
-                 controllers, joint_state_sink: Callable) -> None:
+                 controllers: Iterable[Controller]) -> None:
         self.settings = settings
         self.commands_received = 0
         self._logger = node.get_logger()
         model = description.model
         self._members = {}
-        broadcaster = None
         for controller in controllers:
             if isinstance(controller, ForwardCommandController):
                 for joint, member in zip(controller.joint_names, controller.members,
                                          strict=True):
                     self._members[joint] = member
-            elif isinstance(controller, JointStateController):
-                broadcaster = controller
         self._reader = CommandReader(
             settings.interfaces,
             {joint.name: declared_interfaces(model, joint.name) for joint in model.joints},
             ignored=[joint for joint in settings.joints if joint not in settings.interfaces])
-        self.publisher = node.create_publisher(JointState, settings.states_topic, QUEUE_DEPTH)
-        self.broadcaster = broadcaster
-        self.sink = joint_state_sink(self.publisher, broadcaster.names)
-        broadcaster.set_sink(self.sink)
         self.subscription = node.create_subscription(
             JointState, settings.commands_topic, self._store, QUEUE_DEPTH)
         node.get_logger().info(
             f'topic-based hardware: commands from {self.subscription.topic_name}, states on '
-            f'{self.publisher.topic_name} at {settings.publish_rate:g} Hz of sim time; '
+            f'{node.resolve_topic_name(settings.states_topic)} at {settings.publish_rate:g} Hz '
+            'of sim time; '
             + ', '.join(f'{joint}: {interface}' for joint, interface
                         in settings.interfaces.items()))
 

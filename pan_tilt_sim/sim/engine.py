@@ -77,7 +77,8 @@ class Simulation:
                  time_step: float, *, gui: bool = False,
                  active_controllers: Sequence[str] | None = None,
                  initial_positions: Mapping[str, float] | None = None,
-                 logger: Logger | None = None) -> None:
+                 logger: Logger | None = None,
+                 autostart_controllers: bool = True) -> None:
         self.description = description
         self._logger: Logger = logger or logging.getLogger(LOGGER_NAME)
         starts = start_positions(description.model, initial_positions)
@@ -95,8 +96,8 @@ class Simulation:
                 for joint, position in zip(self.physics.joints,
                                            self.physics.initial_positions, strict=True)}
             self.manager = ControllerManager(controllers, self.handles, description.model,
-                                             active=active_controllers)
-            self.controllers = self.manager.controllers
+                                             active=active_controllers,
+                                             autostart=autostart_controllers)
         except BaseException:
             self.physics.close()
             raise
@@ -104,6 +105,10 @@ class Simulation:
         self._time_step = time_step
         self._steps = 0
         self._states = self.physics.read_states()
+        # Waiting for spawners, a joint no controller has driven yet is held where it is, as
+        # gz_ros2_control's hold_joints holds it; once driven, it is passive when undriven.
+        self._hold_undriven = not autostart_controllers
+        self._driven: set[str] = set()
         self._apply_actuators()
         self.manager.add_switch_listener(self._apply_actuators)
         self._speed_limit = AT_CAP * self.physics.velocity_cap
@@ -111,12 +116,22 @@ class Simulation:
         self.startup_report = self._startup_report(description, starts, load_messages)
 
     def _apply_actuators(self) -> None:
-        """Drive every joint as its active controller says (a joint without one: passive)."""
+        """Drive every joint as its active controller says (a joint without one: passive).
+
+        While the simulation waits for spawners, a joint that no controller
+        has driven yet is held instead (see ``autostart_controllers``).
+        """
         actuators = {}
         for controller in self.manager.active:
             actuators.update(controller.actuators())
+        self._driven.update(actuators)
         for handle in self._handle_list:
-            handle.actuator = actuators.get(handle.name) or idle_actuator(handle.spec)
+            actuator = actuators.get(handle.name)
+            if actuator is None:
+                actuator = idle_actuator(handle.spec, hold=self._hold_undriven
+                                         and handle.name not in self._driven)
+                handle.velocity_target = 0.0
+            handle.actuator = actuator
         velocity_driven = [handle.drive is Drive.VELOCITY for handle in self._handle_list]
         self.physics.set_drives(velocity_driven)
         self._effort_handles = [handle for handle, driven in zip(
@@ -169,16 +184,18 @@ class Simulation:
         """Sim time in seconds."""
         return self._steps * self._time_step
 
+    @property
+    def controllers(self) -> list[Controller]:
+        """The loaded controllers (the manager's; they change as controllers are loaded)."""
+        return self.manager.controllers
+
     def command_controllers(self) -> list[CommandController]:
         """Return the (loaded) controllers that take commands from topics."""
         return [c for c in self.controllers if isinstance(c, CommandController)]
 
     def controller(self, name: str) -> Controller:
-        """Return the controller called ``name``; KeyError if there is none."""
-        for controller in self.controllers:
-            if controller.name == name:
-                return controller
-        raise KeyError(name)
+        """Return the loaded controller called ``name``; KeyError if there is none."""
+        return self.manager.controller(name)
 
     def advance(self, steps: int) -> None:
         """Run ``steps`` physics steps, updating every active controller at each."""
@@ -234,8 +251,11 @@ class Simulation:
             handle.reset()
         self.physics.reset_joints([handle.position for handle in self._handle_list])
         self._states = self.physics.read_states()
-        for controller in self.controllers:
+        for controller in self.manager.configured:
             controller.reset()
+        if self._hold_undriven:  # undriven joints are held again, as at start
+            self._driven.clear()
+            self._apply_actuators()
         if reset_time:
             self._steps = 0
 
@@ -276,7 +296,8 @@ def make_simulation(description_file: str, controllers_file: str | None, time_st
                     controllers_args: Mapping[str, str] | None = None,
                     active_controllers: Sequence[str] | None = None,
                     initial_positions: Mapping[str, float] | None = None,
-                    logger: Logger | None = None) -> Simulation:
+                    logger: Logger | None = None,
+                    autostart_controllers: bool = True) -> Simulation:
     """Load both files and build a :class:`Simulation` (for tools and tests); log its report.
 
     Without ``controllers_file`` the URDF's control plugin names it (see
@@ -292,7 +313,8 @@ def make_simulation(description_file: str, controllers_file: str | None, time_st
     files = controllers_files_for(str(controllers_file or ''), description)
     simulation = Simulation(description, load_controllers_config(files, controllers_args),
                             time_step, gui=gui, active_controllers=active_controllers,
-                            initial_positions=initial_positions, logger=logger)
+                            initial_positions=initial_positions, logger=logger,
+                            autostart_controllers=autostart_controllers)
     for warning in description.warnings:
         simulation._logger.warning(warning)
     simulation.report_startup()

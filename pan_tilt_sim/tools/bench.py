@@ -38,6 +38,9 @@ than wall time):
   of each sensor of ``urdf/pan_tilt_sensors.xacro`` with every topic watched
   (:mod:`pan_tilt_sim.tools.sensor_cost`, in this process).
 
+``--tune`` measures something else instead: evaluations per second of
+``tune``/``sweep`` on each back end (:mod:`pan_tilt_sim.tools.tune_bench`).
+
 ``--runs N`` repeats everything and prints the median of each figure;
 ``--quick`` is a smoke run of a few seconds (every key present, no timing
 meaningful).
@@ -697,6 +700,9 @@ def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
                         'a temporary folder, removed afterwards)')
     parser.add_argument('--verbose', action='store_true',
                         help="say on stderr what runs, and each run's figures")
+    parser.add_argument('--tune', action='store_true',
+                        help='measure tune/sweep evaluations per second on each back end '
+                        'instead (local processes, a two-node Ray cluster; see tune_bench)')
     args = parser.parse_args(argv)
     if args.runs < 1:
         parser.error('--runs must be at least 1')
@@ -708,6 +714,12 @@ def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
 def main(argv: Sequence[str] | None = None) -> None:
     """Run the benchmark and print its JSON object on stdout."""
     args = parse_args(argv)
+    if args.tune:
+        from pan_tilt_sim.tools import tune_bench
+
+        tune_bench.main(['--runs', str(args.runs)] + ['--quick'] * args.quick
+                        + ['--verbose'] * args.verbose)
+        return
     domain_id = args.domain_id if args.domain_id is not None else default_domain_id()
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')

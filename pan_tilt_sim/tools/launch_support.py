@@ -1,7 +1,8 @@
 """What launch/pan_tilt.launch.py computes, without the ``launch`` package.
 
 The launch file starts sim_node and, where its package is installed,
-robot_state_publisher; this module reads the model and controllers once, as
+robot_state_publisher (and, with ``spawners:=true``, a ros2_control spawner
+for the controllers to activate); this module reads the model and controllers once, as
 sim_node will, to hand robot_state_publisher the processed URDF and the
 joint_states topic in the robot's namespace, and turns the launch arguments
 (strings) into sim_node's parameters.  Kept apart so it can be tested where
@@ -34,6 +35,8 @@ from pan_tilt_sim.ros.runner import PARENT_PID_VARIABLE
 
 ROOT_NAMESPACE = '/'
 ROBOT_STATE_PUBLISHER = 'robot_state_publisher'
+CONTROLLER_MANAGER_PACKAGE = 'controller_manager'  # ros2_control's: it has the spawner
+SPAWNER = 'spawner'
 TRUE_WORDS = ('true', '1', 'yes', 'on')
 
 
@@ -106,7 +109,8 @@ def sim_node_parameters(model: str, controllers: str, *, real_time_factor: float
                         controllers_args: Sequence[str] = (),
                         active_controllers: Sequence[str] = (),
                         time_step: float | None = None, robot_namespace: str = '',
-                        publish_tf: bool = False, paused: bool = False) -> dict[str, Any]:
+                        publish_tf: bool = False, spawners: bool = False,
+                        paused: bool = False) -> dict[str, Any]:
     """Return sim_node's parameters.
 
     With robot_state_publisher beside it (``publish_tf`` False), that node
@@ -114,6 +118,9 @@ def sim_node_parameters(model: str, controllers: str, *, real_time_factor: float
     sim_node publishes TF itself.  sim_node keeps use_sim_time off: it is
     the clock (it publishes /clock).  Empty lists and an empty controllers
     file are left out (sim_node's defaults: none, and the file the URDF names).
+    With ``spawners`` no controller starts: ros2_control's spawners load and
+    activate them (``autostart_controllers`` false; ``active_controllers`` are
+    then the spawners' business, see :func:`spawner_arguments`).
     """
     parameters: dict[str, Any] = {
         'robot_description_file': model,
@@ -122,6 +129,9 @@ def sim_node_parameters(model: str, controllers: str, *, real_time_factor: float
         'gui': gui,
         'publish_tf': publish_tf,
     }
+    if spawners:
+        parameters['autostart_controllers'] = False
+        active_controllers = ()
     if controllers:
         parameters['controllers_file'] = controllers
     for name, values in (('xacro_args', xacro_args), ('controllers_args', controllers_args),
@@ -135,6 +145,19 @@ def sim_node_parameters(model: str, controllers: str, *, real_time_factor: float
     if paused:  # start paused (STOPPED): spawners and tests connect before time moves
         parameters['paused'] = True
     return parameters
+
+
+def controller_manager_name(setup: RobotSetup) -> str:
+    """Return sim_node's controller_manager: ``controller_manager`` in the robot's namespace."""
+    return setup.topic('controller_manager')
+
+
+def spawner_arguments(setup: RobotSetup, controllers: Sequence[str]) -> list[str]:
+    """Return the arguments of one ros2_control spawner that activates ``controllers`` in order.
+
+    The controller_manager is named absolutely, so the spawner needs no namespace.
+    """
+    return [*controllers, '--controller-manager', controller_manager_name(setup)]
 
 
 def sim_node_environment() -> dict[str, str]:

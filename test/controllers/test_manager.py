@@ -11,7 +11,12 @@ import pytest
 from ros2_control_fixtures import UR_STYLE_YAML, write, write_arm
 
 from pan_tilt_sim.controllers import JointHandle
-from pan_tilt_sim.controllers.manager import ControllerManager
+from pan_tilt_sim.controllers.manager import (
+    ACTIVE,
+    INACTIVE,
+    UNCONFIGURED,
+    ControllerManager,
+)
 from pan_tilt_sim.errors import ControllerConfigError, ControllerSwitchError
 from pan_tilt_sim.model.controller_config import load_controllers_config
 from pan_tilt_sim.model.description import load_description
@@ -205,8 +210,9 @@ def test_a_switch_to_an_interface_the_joint_lacks_is_refused(arm):
 
 def test_switching_an_unknown_or_skipped_controller_is_refused(arm):
     manager, _ = arm(active=[JSB, JTC])
-    with pytest.raises(ControllerSwitchError, match="no loaded controller "
-                                                    "'scaled_joint_trajectory_controller'"):
+    with pytest.raises(ControllerSwitchError, match="could not activate controller with name "
+                                                    "'scaled_joint_trajectory_controller' because "
+                                                    'no controller with this name exists'):
         manager.switch(activate=['scaled_joint_trajectory_controller'], deactivate=[JTC])
 
 
@@ -221,3 +227,104 @@ def test_a_deactivated_controller_holds_nothing_its_joints_keep_the_last_command
     run(manager)
     assert [(handle.effort, handle.velocity_target) for handle in handles.values()] == last
     assert [c.name for c in manager.active] == [JSB]
+
+
+# --- the lifecycle, as controller_manager's services drive it ----------------------------
+
+@pytest.fixture
+def idle(tmp_path):
+    """A manager that loaded nothing (autostart off: spawners will), and the arm's handles."""
+    xacro = write_arm(tmp_path)
+    description = load_description(xacro)
+    handles = {joint.name: JointHandle(joint) for joint in description.actuated_joints}
+    config = load_controllers_config(tmp_path / 'arm_controllers.yaml', ARGS)
+    return ControllerManager(config, handles, description.model, autostart=False), handles
+
+
+def load(manager, name):
+    spec = manager.declared[name]
+    return manager.load(name, spec.type, spec.params)
+
+
+def test_without_autostart_nothing_is_loaded_and_the_file_is_only_declared(idle):
+    manager, _ = idle
+    assert manager.controllers == [] and manager.updates == []
+    assert set(manager.declared) >= {JSB, JTC, FORWARD_POSITION, 'io_and_status_controller'}
+    assert manager.skipped == ()
+
+
+def test_load_configure_activate_then_deactivate_cleanup_unload(idle):
+    manager, handles = idle
+    load(manager, JTC)
+    assert manager.state(JTC) == UNCONFIGURED and manager.configured == []
+    manager.configure(JTC)
+    assert manager.state(JTC) == INACTIVE and manager.updates == []
+    assert manager.switch(activate=[JTC]) == []
+    assert manager.state(JTC) == ACTIVE and len(manager.updates) == 1
+    with pytest.raises(ControllerConfigError, match="can not be configured from 'active'"):
+        manager.configure(JTC)
+    with pytest.raises(ControllerConfigError, match='because it is still active'):
+        manager.unload(JTC)
+    with pytest.raises(ControllerConfigError, match="can not be cleaned-up from 'active'"):
+        manager.cleanup(JTC)
+    manager.switch(deactivate=[JTC])
+    manager.cleanup(JTC)
+    assert manager.state(JTC) == UNCONFIGURED
+    manager.unload(JTC)
+    assert not manager.is_loaded(JTC) and manager.controllers == []
+
+
+def test_load_refuses_a_second_controller_of_a_name_and_types_it_lacks(idle):
+    manager, _ = idle
+    load(manager, JSB)
+    with pytest.raises(ControllerConfigError, match=f"a controller named '{JSB}' was already"):
+        load(manager, JSB)
+    with pytest.raises(ControllerConfigError, match="unknown controller type 'acme_controllers"):
+        load(manager, 'io_and_status_controller')
+    with pytest.raises(ControllerConfigError, match="could not configure controller with name "
+                                                    "'nothing' because no controller"):
+        manager.configure('nothing')
+
+
+def test_configuring_an_inactive_controller_again_starts_it_afresh(idle):
+    manager, handles = idle
+    load(manager, FORWARD_POSITION)
+    first = manager.configure(FORWARD_POSITION)
+    handles['joint1'].position = 0.7
+    again = manager.configure(FORWARD_POSITION)
+    assert again is first and manager.state(FORWARD_POSITION) == INACTIVE
+    assert again.setpoints()['joint1'] == 0.7
+
+
+def test_an_unconfigured_controller_cannot_be_activated(idle):
+    manager, _ = idle
+    load(manager, JTC)
+    with pytest.raises(ControllerSwitchError, match='is unconfigured'):
+        manager.switch(activate=[JTC])
+
+
+def test_best_effort_leaves_out_what_strict_refuses(arm):
+    manager, _ = arm(active=[JSB, JTC])
+    with pytest.raises(ControllerSwitchError, match=f"'{JSB}' since it is already active"):
+        manager.switch(activate=[JSB])
+    with pytest.raises(ControllerSwitchError, match=f"'{FORWARD_POSITION}' since it is not "
+                                                    'active'):
+        manager.switch(deactivate=[FORWARD_POSITION, JSB])
+    assert manager.is_active(JSB)
+    dropped = manager.switch(deactivate=[FORWARD_POSITION, JSB, 'nothing'], strict=False)
+    assert not manager.is_active(JSB)
+    assert len(dropped) == 2 and "'nothing'" in dropped[0] and 'not active' in dropped[1]
+    with pytest.raises(ControllerSwitchError, match="'nothing' because no controller"):
+        manager.switch(activate=['nothing'], strict=False)  # the list names nothing loaded
+
+
+def test_a_deactivated_trajectory_controller_ends_its_goal(arm):
+    from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
+    from pan_tilt_sim.controllers.trajectory_goal import GoalStatus
+
+    manager, _ = arm(active=[JSB, JTC])
+    jtc = manager.controller(JTC)
+    goal = jtc.start_goal(JointTrajectory(('joint1', 'joint2'), (
+        TrajectoryPoint(1.0, (0.5, 0.5)),)), jtc.default_tolerances)
+    manager.switch(activate=[FORWARD_POSITION], deactivate=[JTC])
+    assert goal.status is GoalStatus.ABORTED

@@ -20,7 +20,7 @@ import pytest
 from ament_index_python.packages import get_package_prefix, get_package_share_directory
 
 PACKAGE = 'pan_tilt_sim'
-EXECUTABLES = ('sim_node', 'bench', 'step_response')
+EXECUTABLES = ('sim_node', 'bench', 'step_response', 'tune', 'sweep')
 # What setup.py installs from; copied into the colcon workspace.
 PACKAGE_SOURCES = ('setup.py', 'setup.cfg', 'package.xml', 'resource', PACKAGE,
                    'urdf', 'config', 'launch')

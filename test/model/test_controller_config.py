@@ -13,6 +13,7 @@ from pan_tilt_sim.model.controller_config import (
     DEFAULT_UPDATE_RATE,
     controllers_files_for,
     load_controllers_config,
+    node_parameters,
     parse_controllers_args,
 )
 from pan_tilt_sim.model.description import load_description
@@ -595,3 +596,35 @@ def test_a_given_controllers_file_may_be_a_package_uri_and_a_bad_one_names_the_p
                              r"'package://no_such_package_here/c.yaml': package "
                              r"'no_such_package_here' is not in the ament index"):
         controllers_files_for('package://no_such_package_here/c.yaml', description)
+
+
+# --- one node's parameters, as --params-file gives them (the spawner's params_file) --------
+
+def test_node_parameters_merge_wildcards_then_the_nodes_own_section_over_files(write_yaml):
+    first = write_yaml("""
+        /**:
+          ros__parameters: {use_sim_time: true, gains: {j: {p: 1.0}}}
+        arm:
+          ros__parameters: {joints: [j], gains: {j: {d: 2.0}}}
+        other:
+          ros__parameters: {joints: [k]}
+        """, name='first.yaml')
+    second = write_yaml("""
+        /robot/arm:
+          ros__parameters:
+            gains.j.p: 5.0
+        """, name='second.yaml')
+    assert node_parameters([first, second], 'arm') == {
+        'use_sim_time': True, 'joints': ['j'], 'gains': {'j': {'p': 5.0, 'd': 2.0}}}
+    assert node_parameters([first], 'nobody') == {'use_sim_time': True,
+                                                  'gains': {'j': {'p': 1.0}}}
+
+
+def test_node_parameters_expand_substitutions_and_name_the_file(write_yaml):
+    path = write_yaml("""
+        arm:
+          ros__parameters: {joints: ['$(var prefix)j']}
+        """, name='subst.yaml')
+    assert node_parameters([path], 'arm', {'prefix': 'left_'}) == {'joints': ['left_j']}
+    with pytest.raises(ControllerConfigError, match=r'subst.yaml:3: \$\(var prefix\) is not set'):
+        node_parameters([path], 'arm')

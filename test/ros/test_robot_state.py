@@ -7,10 +7,13 @@ import pathlib
 
 import mesh_fixtures as mf
 import pytest
+from builtin_interfaces.msg import Duration
 from geometry_msgs.msg import TransformStamped
-from node_harness import sim_node, stamp_s
+from node_harness import PROBE_QUEUE, sim_node, stamp_s
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64MultiArray, String
+from std_srvs.srv import Empty
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from pan_tilt_sim.model.description import load_description
 from pan_tilt_sim.model.transforms import Transform, quaternion_from_axis_angle, rotate
@@ -26,7 +29,7 @@ from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
 HAS_TF2_MSGS = importlib.util.find_spec('tf2_msgs') is not None
 LATE_SUBSCRIBER_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                                  durability=DurabilityPolicy.TRANSIENT_LOCAL)
-TF_OFF_LINE = 'TF is off: tf2_msgs is not installed'
+TF_OFF_LINE = 'off, for want of their interface packages: TF (/tf, /tf_static'
 
 
 def test_robot_description_reaches_a_subscriber_that_comes_late():
@@ -126,72 +129,108 @@ def test_a_mimic_joint_follows_its_leader_in_tf():
     assert frames['r'].translation == pytest.approx((-0.2, 0.0, 0.0))
 
 
-class RecordingTfSink:
-    """A stand-in for the /tf and /tf_static publishers (tf2_msgs is not on PyPI)."""
-
-    def __init__(self) -> None:
-        self.tf_messages: list[list[TransformStamped]] = []
-        self.static_messages: list[list[TransformStamped]] = []
-
-    def tf(self, transforms):
-        self.tf_messages.append([_copy(t) for t in transforms])
-
-    def tf_static(self, transforms):
-        self.static_messages.append([_copy(t) for t in transforms])
-
-    def has_readers(self):
-        return True
+ARM = package_share() / 'urdf' / 'three_joint_arm.xacro'
+ARM_CONTROLLERS = package_share() / 'config' / 'three_joint_arm_controllers.yaml'
+ARM_JOINTS = ('shoulder_joint', 'extend_joint', 'wrist_joint')
+needs_tf2_msgs = pytest.mark.skipif(not HAS_TF2_MSGS, reason='tf2_msgs is not installed')
 
 
-def _copy(transform: TransformStamped) -> tuple:
-    t, r = transform.transform.translation, transform.transform.rotation
-    return (stamp_s(transform), transform.header.frame_id, transform.child_frame_id,
-            (t.x, t.y, t.z), (r.x, r.y, r.z, r.w))
+def _edge(message: TransformStamped) -> Transform:
+    t, r = message.transform.translation, message.transform.rotation
+    return Transform((t.x, t.y, t.z), (r.x, r.y, r.z, r.w))
 
 
-@pytest.fixture
-def tf_sink(monkeypatch):
-    """Make the node publish TF into a recording stand-in."""
-    sink = RecordingTfSink()
-    monkeypatch.setattr(robot_state, 'create_tf_sink', lambda node: sink)
-    return sink
+def tf_link_poses(static_messages, moving_message) -> dict[str, Transform]:
+    """Chain the TF edges from the root: every link's pose in the root frame, as tf2 would."""
+    edges = {t.child_frame_id: (t.header.frame_id, _edge(t))
+             for message in (*static_messages, moving_message) for t in message.transforms}
+    poses: dict[str, Transform] = {}
+
+    def pose(frame: str) -> Transform:
+        if frame not in poses:
+            parent, edge = edges[frame] if frame in edges else (None, Transform())
+            poses[frame] = edge if parent is None else pose(parent).then(edge)
+        return poses[frame]
+    for frame in edges:
+        pose(frame)
+    return poses
 
 
-def test_tf_edges_match_forward_kinematics_after_commands_mimic_included(tf_sink):
-    arm = package_share() / 'urdf' / 'three_joint_arm.xacro'
-    with sim_node(robot_description_file=str(arm), controllers_file=str(
-            package_share() / 'config' / 'three_joint_arm_controllers.yaml')) as harness:
+def assert_same_pose(got: Transform, expected: Transform, label: str) -> None:
+    assert got.translation == pytest.approx(expected.translation, abs=1e-4), label
+    dot = abs(sum(a * b for a, b in zip(got.rotation, expected.rotation, strict=True)))
+    assert dot == pytest.approx(1.0, abs=1e-6), label
+
+
+def _joint_state_at(states, seconds):
+    return next(m for m in states if abs(stamp_s(m) - seconds) < 1e-6)
+
+
+@needs_tf2_msgs
+def test_tf_gives_every_link_where_forward_kinematics_puts_it_after_commands_mimic_included():
+    from tf2_msgs.msg import TFMessage
+
+    with sim_node(robot_description_file=str(ARM),
+                  controllers_file=str(ARM_CONTROLLERS)) as harness:
+        static = harness.collect(TFMessage, '/tf_static', LATE_SUBSCRIBER_QOS)
+        moving = harness.collect(TFMessage, '/tf', PROBE_QUEUE)
+        harness.wait_for_subscribers('/tf')
+        harness.command('arm_controller', JointTrajectory(
+            joint_names=list(ARM_JOINTS), points=[JointTrajectoryPoint(
+                positions=[0.8, 0.12, 2.0], time_from_start=Duration(sec=1))]))
         harness.command('gripper_controller', Float64MultiArray(data=[0.02]))
-        harness.run_for(1.0)
-        positions = harness.simulation.joint_positions()
-        last = tf_sink.tf_messages[-1]
+        harness.run_for(1.5)
         model = harness.simulation.description.model
-    assert tf_sink.static_messages, 'nothing on /tf_static'
-    assert {child for _, _, child, _, _ in last} == {j.child for j in model.moving_joints}
-    assert positions['right_finger_joint'] == pytest.approx(-0.02, abs=1e-3)  # the mimic
-    expected = {joint.child: joint.transform(model.joint_position(positions, joint.name))
-                for joint in model.moving_joints}
-    for _, parent, child, translation, rotation in last:
-        assert parent == model.joint(next(j.name for j in model.moving_joints
-                                          if j.child == child)).parent
-        # The last /tf is at most one TF period (20 ms) older than `positions`.
-        assert translation == pytest.approx(expected[child].translation, abs=2e-3), child
-        dot = abs(sum(a * b for a, b in zip(rotation, expected[child].rotation, strict=True)))
-        assert dot == pytest.approx(1.0, abs=1e-4), child
+        assert static, 'nothing on /tf_static'
+    last = moving[-1]
+    seconds = stamp_s(last.transforms[0])
+    assert all(stamp_s(t) == seconds for t in last.transforms)
+    measured = _joint_state_at(harness.states, seconds)
+    positions = dict(zip(measured.name, measured.position, strict=True))
+    assert positions['shoulder_joint'] == pytest.approx(0.8, abs=0.02)  # the robot did move
+    assert positions['left_finger_joint'] == pytest.approx(0.02, abs=2e-3)
+    # Forward kinematics from the commanded joints alone: the mimic follows its leader.
+    leaders = {name: value for name, value in positions.items() if name != 'right_finger_joint'}
+    expected = model.link_poses(leaders)
+    got = tf_link_poses(static, last)
+    assert set(got) == set(expected)  # one frame per link: every joint, fixed or moving
+    assert {t.child_frame_id for t in last.transforms} == {j.child for j in model.moving_joints}
+    for link, pose in expected.items():
+        assert_same_pose(got[link], pose, link)
+    # The fingers' frames are 2 x 10 mm apart at rest; each moved 20 mm out, the mimic too.
+    assert math.dist(got['left_finger_link'].translation,
+                     got['right_finger_link'].translation) == pytest.approx(0.06, abs=2e-3)
 
 
-def test_tf_keeps_coming_after_reset_simulation(tf_sink):
-    with sim_node() as harness:
-        harness.run_until_sim_time(1.0)
+@needs_tf2_msgs
+def test_after_reset_simulation_tf_starts_again_at_zero_with_the_initial_pose():
+    from tf2_msgs.msg import TFMessage
+
+    with sim_node(robot_description_file=str(ARM),
+                  controllers_file=str(ARM_CONTROLLERS)) as harness:
+        static = harness.collect(TFMessage, '/tf_static', LATE_SUBSCRIBER_QOS)
+        moving = harness.collect(TFMessage, '/tf', PROBE_QUEUE)
+        harness.wait_for_subscribers('/tf')
+        harness.command('gripper_controller', Float64MultiArray(data=[0.03]))
+        harness.run_for(1.0)
+        moved = tf_link_poses(static, moving[-1])
         harness.node.set_paused(True)
-        before = len(tf_sink.tf_messages)
-        harness.node.reset(reset_time=True)
+        harness.drain()  # every /tf from before the reset is in
+        before = len(moving)
+        harness.call(Empty, '/reset_simulation')
         harness.node.set_paused(False)
-        harness.run_until_sim_time(1.0)
-        stamps = [message[0][0] for message in tf_sink.tf_messages[before:]]
-    # 50 Hz over 1 s of sim time from 0 again (the first one at the reset itself).
-    assert len(stamps) >= 50, stamps
-    assert stamps[0] == 0.0
+        harness.run_for(0.5)
+        after = moving[before:]
+        model = harness.simulation.description.model
+        initial = {j.name: j.initial_position for j in model.actuated_joints
+                   if j.mimic is None}
+    stamps = [stamp_s(message.transforms[0]) for message in after]
+    assert stamps[0] == 0.0 and stamps == sorted(stamps) and len(stamps) >= 25
+    assert moved['left_finger_link'].translation != pytest.approx(
+        model.link_poses(initial)['left_finger_link'].translation, abs=1e-3)
+    got = tf_link_poses(static, after[0])
+    for link, pose in model.link_poses(initial).items():
+        assert_same_pose(got[link], pose, link)
 
 
 def test_the_node_puts_the_camera_optical_frame_on_tf_static():

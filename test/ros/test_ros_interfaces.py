@@ -54,7 +54,7 @@ def test_joint_trajectory_becomes_a_plain_value_in_message_order():
         JointTrajectory(
             joint_names=('b', 'a'),
             points=(TrajectoryPoint(1.0, (0.1, 0.2), ()),
-                    TrajectoryPoint(2.5, (0.3, 0.4), (0.0, 0.5))),
+                    TrajectoryPoint(2.5, (0.3, 0.4), (0.0, 0.5), (1.0, 1.0))),
             start_time=4.5))
 
 

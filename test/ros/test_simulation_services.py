@@ -300,7 +300,10 @@ def test_without_simulation_interfaces_the_node_runs_and_says_so_once(capfd, mon
         assert not [leaf for leaf in SERVICES if f'/sim_node/{leaf}' in services]
         assert not [name for name in services if 'simulate_steps' in name]
         assert services['/reset_simulation'] == ['std_srvs/srv/Empty']
-    assert capfd.readouterr().err.count(simulation_services.OFF_LINE) == 1
+    err = capfd.readouterr().err
+    assert err.count('off, for want of their interface packages:') == 1
+    assert err.count('the simulator services (get_simulator_features, step_simulation, '
+                     'spawn_entity, ...) (simulation_interfaces)') == 1
 
 
 @pytest.mark.parametrize('namespace, name', [

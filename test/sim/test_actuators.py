@@ -238,3 +238,43 @@ def test_switching_controllers_switches_the_actuators(tmp_path):
         sim.manager.switch(deactivate=['arm'])
         assert [sim.handles[joint].actuator.kind for joint in ARM_JOINTS] == [
             ActuatorKind.PASSIVE] * 2
+
+
+def test_waiting_for_spawners_undriven_joints_hold_and_once_driven_are_passive(tmp_path):
+    # gz_ros2_control holds joints no controller commands (hold_joints): before its spawners
+    # run, a gravity-loaded arm stays where it starts.  A controller switched off later holds
+    # nothing: its joints keep the last effort applied (here the motor's holding torque).
+    log = Log()
+    with simulation(tmp_path, two_link_arm_urdf(), ros2_control_yaml({'arm': POSITION_GROUP}),
+                    log=log, autostart_controllers=False) as sim:
+        assert [sim.handles[j].actuator.kind for j in ARM_JOINTS] == [ActuatorKind.HOLD] * 2
+        assert any("joint 'joint1': held where it is until a spawned controller drives it"
+                   in line for line in log.infos)
+        sim.advance(1000)
+        assert sim.joint_positions()['joint1'] == pytest.approx(0.0, abs=0.002)
+        assert sim.handles['joint1'].effort == pytest.approx(
+            arm_holding_torques(0.0, 0.0)[0], rel=0.05)
+        spec = sim.manager.declared['arm']
+        sim.manager.load('arm', spec.type, spec.params)
+        sim.manager.configure('arm')
+        sim.manager.switch(activate=['arm'])
+        sim.controller('arm').set_command([0.3, 0.0])
+        sim.advance(1000)
+        assert sim.joint_positions()['joint1'] == pytest.approx(0.3, abs=0.005)
+        last = sim.handles['joint1'].effort
+        sim.manager.switch(deactivate=['arm'])
+        assert sim.handles['joint1'].actuator.kind is ActuatorKind.PASSIVE
+        sim.advance(10)
+        assert sim.handles['joint1'].effort == last  # the last effort, not a hold
+        sim.reset()
+        assert sim.handles['joint1'].actuator.kind is ActuatorKind.HOLD  # as at start
+        sim.advance(500)
+        assert sim.joint_positions()['joint1'] == pytest.approx(0.0, abs=0.002)
+
+
+def test_started_the_seeds_way_an_undriven_joint_is_passive_and_falls(tmp_path):
+    with simulation(tmp_path, two_link_arm_urdf(), ros2_control_yaml({'arm': POSITION_GROUP}),
+                    active_controllers=[]) as sim:
+        assert sim.handles['joint1'].actuator.kind is ActuatorKind.PASSIVE
+        sim.advance(500)
+        assert sim.joint_positions()['joint1'] > 0.3

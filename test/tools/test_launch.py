@@ -20,12 +20,14 @@ from ros2_control_fixtures import write_arm
 from pan_tilt_sim.ros.runner import PARENT_PID_VARIABLE
 from pan_tilt_sim.tools.launch_support import (
     bool_argument,
+    controller_manager_name,
     has_package,
     list_argument,
     robot_setup,
     robot_state_publisher_parameters,
     sim_node_environment,
     sim_node_parameters,
+    spawner_arguments,
 )
 from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
 
@@ -91,7 +93,7 @@ def test_the_real_launch_starts_sim_node_and_robot_state_publisher_if_installed(
                  if isinstance(entity, DeclareLaunchArgument)]
     assert {argument.name for argument in arguments} >= {
         'model', 'xacro_args', 'controllers', 'controllers_args', 'active_controllers',
-        'time_step', 'robot_namespace', 'real_time_factor', 'world', 'gui'}
+        'spawners', 'time_step', 'robot_namespace', 'real_time_factor', 'world', 'gui'}
     context = LaunchContext()
     for argument in arguments:
         argument.visit(context)
@@ -199,7 +201,8 @@ def _defaults(description):
 def test_the_launch_file_declares_every_argument(stand_in_launch):
     assert set(_defaults(stand_in_launch.generate_launch_description())) == {
         'model', 'xacro_args', 'controllers', 'controllers_args', 'active_controllers',
-        'time_step', 'robot_namespace', 'real_time_factor', 'world', 'gui', 'paused'}
+        'spawners', 'time_step', 'robot_namespace', 'real_time_factor', 'world', 'gui',
+        'paused'}
 
 
 def _launch(module, monkeypatch, prefix, **arguments):
@@ -238,6 +241,50 @@ def test_with_robot_state_publisher_installed_it_publishes_tf_instead(
     assert state_publisher.kwargs['remappings'] == [
         ('joint_states', '/ex_urdf_pan_tilt/joint_states')]
     assert state_publisher.kwargs['parameters'][0]['use_sim_time'] is True
+
+
+# --- spawners:=true, the mode for ros2_control launch files -------------------------------
+
+def test_with_spawners_sim_node_starts_no_controller_and_a_spawner_activates_the_list(
+        stand_in_launch, monkeypatch, tmp_path):
+    xacro = write_arm(tmp_path)
+    prefix = make_ament_prefix(tmp_path, 'controller_manager')
+    sim_node, spawner = _launch(
+        stand_in_launch, monkeypatch, prefix, model=str(xacro), xacro_args='prefix:=left_',
+        controllers_args='prefix:=left_', robot_namespace='arm', spawners='true',
+        active_controllers='joint_state_broadcaster joint_trajectory_controller')
+    (parameters,) = sim_node.kwargs['parameters']
+    assert parameters['autostart_controllers'] is False
+    assert 'active_controllers' not in parameters  # the spawner's business now
+    assert (spawner.kwargs['package'], spawner.kwargs['executable']) == (
+        'controller_manager', 'spawner')
+    assert spawner.kwargs['arguments'] == [
+        'joint_state_broadcaster', 'joint_trajectory_controller',
+        '--controller-manager', '/arm/controller_manager']
+
+
+def test_with_spawners_and_no_list_the_including_launch_file_spawns(
+        stand_in_launch, monkeypatch, tmp_path):
+    (sim_node,) = _launch(stand_in_launch, monkeypatch, tmp_path / 'none', spawners='true')
+    assert sim_node.kwargs['parameters'][0]['autostart_controllers'] is False
+
+
+def test_spawners_with_a_list_but_no_controller_manager_package_fails_the_launch(
+        stand_in_launch, monkeypatch, tmp_path):
+    with pytest.raises(RuntimeError, match="needs ros2_control's 'controller_manager' package"):
+        _launch(stand_in_launch, monkeypatch, tmp_path / 'none', spawners='true',
+                active_controllers='joint_state_controller')
+
+
+def test_the_spawner_names_the_controller_manager_in_the_robots_namespace():
+    share = package_share()
+    setup = robot_setup(str(share / DEFAULT_DESCRIPTION), str(share / DEFAULT_CONTROLLERS))
+    assert controller_manager_name(setup) == '/ex_urdf_pan_tilt/controller_manager'
+    assert spawner_arguments(setup, ['joint_state_controller']) == [
+        'joint_state_controller', '--controller-manager', '/ex_urdf_pan_tilt/controller_manager']
+    parameters = sim_node_parameters('m.urdf', '', real_time_factor=1.0, world='empty',
+                                     gui=False, active_controllers=['a'], spawners=True)
+    assert parameters['autostart_controllers'] is False and 'active_controllers' not in parameters
 
 
 def test_paused_is_passed_only_when_asked_for():

@@ -1,0 +1,401 @@
+"""A ``controller_manager`` node in sim_node's process, so ros2_control's spawner works unchanged.
+
+ros2_control's ``spawner`` and ``unspawner`` (jazzy) talk to a node called
+``controller_manager`` in the robot's namespace (``/controller_manager``, or
+``<ns>/controller_manager``): they set the controller's ``<name>.type`` and
+``<name>.params_file`` (and ``.fallback_controllers``) through its parameter
+services, then call ``load_controller``, ``configure_controller`` and
+``switch_controller`` (STRICT), and treat ``ok == false`` as failure.
+:class:`ControllerManagerNode` offers every service of
+``controller_manager_msgs`` (older spawners wait until all of them exist on
+that node) and answers them with ros2_control's rules:
+
+* ``load_controller``: the type is the node's ``<name>.type`` parameter (the
+  controllers file's types are declared at start-up, so ``spawner <name>``
+  needs no ``-p``); the parameters are the controllers file's section for
+  ``<name>`` with the sections of ``<name>.params_file`` (a string or a
+  string list, read as ``--params-file`` would be) over it.  A missing type,
+  a type this simulator does not have, a name already loaded or parameters
+  the controller refuses: ``ok`` false, with one error line saying why.
+* ``configure_controller`` / ``cleanup_controller`` / ``unload_controller``:
+  an active controller is refused; configuring an inactive one configures it
+  afresh.  The controller's topics and action exist from configure on.
+* ``switch_controller``: STRICT refuses the whole switch on any problem,
+  BEST_EFFORT (and 0, AUTO, FORCE_AUTO, as upstream) leaves the controllers
+  concerned out; two active controllers on one joint, or an interface the
+  URDF's ``<ros2_control>`` block does not give a joint, are refused in
+  both.  The switch happens at once, between physics steps -- also while
+  the simulation is paused (upstream's switch waits for its update loop,
+  and times out while a simulator is paused) -- so ``activate_asap`` and
+  ``timeout`` change nothing.
+* the lists: controllers with their lifecycle state, type, claimed and
+  required interfaces; the types this simulator has; one hardware component
+  per ``<ros2_control>`` block, always active; the joints' interfaces.
+
+All its callbacks run on sim_node's executor; changes to the simulation go
+through :class:`~pan_tilt_sim.ros.controller_bindings.ControllerBindings`.
+"""
+
+from __future__ import annotations
+
+import pathlib
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from lifecycle_msgs.msg import State
+from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from rclpy.context import Context
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+from pan_tilt_sim.controllers import CommandController
+from pan_tilt_sim.controllers.joint_state_controller import JointStateController
+from pan_tilt_sim.controllers.manager import ACTIVE, INACTIVE, ControllerManager
+from pan_tilt_sim.controllers.registry import supported_types
+from pan_tilt_sim.errors import ConfigurationError, ControllerSwitchError
+from pan_tilt_sim.model.controller_config import (
+    DEFAULT_UPDATE_RATE,
+    TYPE_FIELD,
+    UPDATE_RATE_FIELD,
+    node_parameters,
+)
+from pan_tilt_sim.model.robot import RobotModel
+from pan_tilt_sim.ros.controller_bindings import ControllerBindings
+
+NODE_NAME = 'controller_manager'
+PARAMS_FILE = 'params_file'
+FALLBACK = 'fallback_controllers'
+STRICTNESS_PARAMETER = 'defaults.switch_controller.strictness'
+BEST_EFFORT, STRICT = 1, 2  # controller_manager_msgs/srv/SwitchController
+BASE_CLASS = 'controller_interface::ControllerInterface'
+DATA_TYPE = 'double'
+ALL_INTERFACES = ('position', 'velocity', 'effort')
+ACTIVE_STATE = State(id=State.PRIMARY_STATE_ACTIVE, label='active')
+COMPONENT_TYPE = 'system'
+NOTHING_TO_SWITCH = ('After checking the controllers, no controllers need to be activated or '
+                     'deactivated.')
+
+
+class ControllerManagerNode(Node):
+    """ros2_control's controller_manager services over the simulation's controllers."""
+
+    def __init__(self, bindings: ControllerBindings, manager: ControllerManager,
+                 model: RobotModel, namespace: str, *, context: Context | None = None,
+                 substitutions: Mapping[str, str] | None = None, source: str = '') -> None:
+        # Not the process's global arguments: a `-r __node:=...` meant for sim_node
+        # must not rename this node, nor its `-p` parameters land here.
+        super().__init__(NODE_NAME, namespace=namespace or '/', context=context,
+                         use_global_arguments=False, allow_undeclared_parameters=True)
+        from controller_manager_msgs import srv
+
+        self._bindings = bindings
+        self._manager = manager
+        self._model = model
+        self._substitutions = dict(substitutions or {})
+        self._source = source
+        rate = manager.update_rate or DEFAULT_UPDATE_RATE
+        self.update_rate = int(round(rate))
+        self.declare_parameter(UPDATE_RATE_FIELD, self.update_rate, ParameterDescriptor(
+            description='Hz at which controllers update (the controllers file says).',
+            read_only=True))
+        self.declare_parameter(STRICTNESS_PARAMETER, 'best_effort', ParameterDescriptor(
+            description='switch_controller strictness 0 means this: strict or best_effort.'))
+        for name, spec in manager.declared.items():
+            if isinstance(spec.type, str):
+                self.declare_parameter(f'{name}.{TYPE_FIELD}', spec.type)
+        self.add_on_set_parameters_callback(self._check_parameters)
+        self._cm_services = [
+            self.create_service(srv.ListControllers, '~/list_controllers', self._list),
+            self.create_service(srv.ListControllerTypes, '~/list_controller_types',
+                                self._list_types),
+            self.create_service(srv.ListHardwareComponents, '~/list_hardware_components',
+                                self._list_components),
+            self.create_service(srv.ListHardwareInterfaces, '~/list_hardware_interfaces',
+                                self._list_interfaces),
+            self.create_service(srv.LoadController, '~/load_controller', self._load),
+            self.create_service(srv.ConfigureController, '~/configure_controller',
+                                self._configure),
+            self.create_service(srv.CleanupController, '~/cleanup_controller', self._cleanup),
+            self.create_service(srv.UnloadController, '~/unload_controller', self._unload),
+            self.create_service(srv.SwitchController, '~/switch_controller', self._switch),
+            self.create_service(srv.ReloadControllerLibraries, '~/reload_controller_libraries',
+                                self._reload),
+            self.create_service(srv.SetHardwareComponentState,
+                                '~/set_hardware_component_state', self._set_component_state),
+        ]
+        from controller_manager_msgs.msg import (
+            ControllerState,
+            HardwareComponentState,
+            HardwareInterface,
+        )
+
+        self._controller_state = ControllerState
+        self._component_state = HardwareComponentState
+        self._interface = HardwareInterface
+
+    # --- parameters the spawner sets -----------------------------------------------------------
+
+    def _check_parameters(self, changed: Sequence[Parameter]) -> SetParametersResult:
+        """``<name>.type`` must be a string, ``.params_file`` a string or string list, ...."""
+        for parameter in changed:
+            name, _, field = parameter.name.rpartition('.')
+            value = parameter.value
+            if not name:
+                continue
+            if field == TYPE_FIELD and not isinstance(value, str):
+                return SetParametersResult(
+                    successful=False, reason=f"'{parameter.name}' must be a string")
+            if field == PARAMS_FILE and not _is_string_or_strings(value):
+                return SetParametersResult(
+                    successful=False,
+                    reason=f"'{parameter.name}' must be a file name or a list of them")
+            if field == FALLBACK and not _is_strings(value):
+                return SetParametersResult(
+                    successful=False,
+                    reason=f"'{parameter.name}' must be a list of controller names")
+        return SetParametersResult(successful=True)
+
+    def _parameter(self, name: str) -> Any:
+        if not self.has_parameter(name):
+            return None
+        parameter = self.get_parameter(name)
+        return None if parameter.type_ == Parameter.Type.NOT_SET else parameter.value
+
+    # --- load / configure / cleanup / unload ---------------------------------------------------
+
+    def _load(self, request, response):
+        response.ok = False
+        name = request.name
+        if self._manager.is_loaded(name):
+            self.get_logger().error(
+                f"A controller named '{name}' was already loaded inside the controller manager")
+            return response
+        type_name = self._parameter(f'{name}.{TYPE_FIELD}')
+        if not type_name:
+            self.get_logger().error(
+                f"The 'type' param was not defined for '{name}' (set '{name}.{TYPE_FIELD}', "
+                "as the spawner's --param-file does from the file's 'type')")
+            return response
+        fallbacks = self._parameter(f'{name}.{FALLBACK}') or []
+        if name in fallbacks:
+            self.get_logger().error(
+                f"Controller '{name}' cannot be a fallback controller of itself")
+            return response
+        files = self._parameter(f'{name}.{PARAMS_FILE}') or []
+        files = [files] if isinstance(files, str) else list(files)
+        spec = self._manager.declared.get(name)
+        params: dict[str, Any] = dict(spec.params) if spec is not None else {
+            UPDATE_RATE_FIELD: float(self.update_rate)}
+        source = ' + '.join(files) or self._source
+        try:
+            if files:
+                params.update(node_parameters([pathlib.Path(file) for file in files], name,
+                                              self._substitutions,
+                                              args_name="sim_node's 'controllers_args'"))
+            params[TYPE_FIELD] = type_name
+            self._bindings.load(name, type_name, params, source)
+        except ConfigurationError as err:
+            self.get_logger().error(f"Failed to load controller '{name}': {err}")
+            return response
+        self.get_logger().info(f"Loaded controller '{name}' ({type_name})")
+        response.ok = True
+        return response
+
+    def _configure(self, request, response):
+        response.ok = self._lifecycle('configure', request.name, self._bindings.configure)
+        return response
+
+    def _cleanup(self, request, response):
+        response.ok = self._lifecycle('cleanup', request.name, self._bindings.cleanup)
+        return response
+
+    def _unload(self, request, response):
+        response.ok = self._lifecycle('unload', request.name, self._bindings.unload)
+        return response
+
+    def _lifecycle(self, action: str, name: str, change) -> bool:
+        try:
+            change(name)
+        except ConfigurationError as err:
+            self.get_logger().error(f"Failed to {action} controller '{name}': {err}")
+            return False
+        done = {'configure': 'Configured', 'cleanup': 'Cleaned up', 'unload': 'Unloaded'}
+        self.get_logger().info(f"{done[action]} controller '{name}'")
+        return True
+
+    # --- switch --------------------------------------------------------------------------------
+
+    def _switch(self, request, response):
+        strictness = request.strictness
+        if strictness == 0:
+            default = str(self._parameter(STRICTNESS_PARAMETER) or '').lower()
+            strictness = STRICT if default == 'strict' else BEST_EFFORT
+        strict = strictness == STRICT
+        activate = list(request.activate_controllers)
+        deactivate = list(request.deactivate_controllers)
+        before = {c.name for c in self._manager.active}
+        try:
+            dropped = self._bindings.switch(activate, deactivate, strict=strict)
+        except ControllerSwitchError as err:
+            response.ok, response.message = False, str(err)
+            self.get_logger().error(f'switch_controller refused: {err}')
+            return response
+        for problem in dropped:
+            self.get_logger().warning(f'switch_controller (BEST_EFFORT): {problem}')
+        after = {c.name for c in self._manager.active}
+        response.ok = True
+        if before == after and not (set(activate) & set(deactivate) & after):
+            response.message = NOTHING_TO_SWITCH
+        else:
+            changes = [f'activated {", ".join(sorted(after - before))}' if after - before else '',
+                       f'deactivated {", ".join(sorted(before - after))}'
+                       if before - after else '']
+            self.get_logger().info('switch_controller: ' + '; '.join(filter(None, changes)))
+        return response
+
+    # --- lists ---------------------------------------------------------------------------------
+
+    def _list(self, request, response):
+        manager = self._manager
+        states = []
+        for controller in manager.controllers:
+            state = manager.state(controller.name)
+            configured = state in (INACTIVE, ACTIVE)
+            commands = _flatten(controller.command_interfaces())
+            rate = controller.params.get(UPDATE_RATE_FIELD, self.update_rate)
+            states.append(self._controller_state(
+                name=controller.name, state=state, type=controller.type_name, is_async=False,
+                update_rate=int(round(rate)) if isinstance(rate, int | float) else
+                self.update_rate,
+                claimed_interfaces=commands if state == ACTIVE else [],
+                required_command_interfaces=commands if configured else [],
+                required_state_interfaces=self._state_interfaces_of(controller)
+                if configured else []))
+        response.controller = states
+        return response
+
+    def _list_types(self, request, response):
+        response.types = supported_types()
+        response.base_classes = [BASE_CLASS] * len(response.types)
+        return response
+
+    def _list_interfaces(self, request, response):
+        claimed = {name for controller in self._manager.active
+                   for name in _flatten(controller.command_interfaces())}
+        response.command_interfaces = [
+            self._interface(name=name, data_type=DATA_TYPE, is_available=True,
+                            is_claimed=name in claimed)
+            for name in self._command_interface_names()]
+        response.state_interfaces = [
+            self._interface(name=name, data_type=DATA_TYPE, is_available=True, is_claimed=False)
+            for name in self._state_interface_names()]
+        return response
+
+    def _list_components(self, request, response):
+        components = []
+        for name, plugin, joints in self._components():
+            joint_set = set(joints)
+            claimed = {item for controller in self._manager.active
+                       for item in _flatten(controller.command_interfaces())}
+            components.append(self._component_state(
+                name=name, type=COMPONENT_TYPE, is_async=False, rw_rate=self.update_rate,
+                class_type=plugin, plugin_name=plugin, state=ACTIVE_STATE,
+                command_interfaces=[
+                    self._interface(name=item, data_type=DATA_TYPE, is_available=True,
+                                    is_claimed=item in claimed)
+                    for item in self._command_interface_names()
+                    if item.rpartition('/')[0] in joint_set],
+                state_interfaces=[
+                    self._interface(name=item, data_type=DATA_TYPE, is_available=True,
+                                    is_claimed=False)
+                    for item in self._state_interface_names()
+                    if item.rpartition('/')[0] in joint_set]))
+        response.component = components
+        return response
+
+    def _set_component_state(self, request, response):
+        names = [name for name, _plugin, _joints in self._components()]
+        response.state = ACTIVE_STATE
+        if request.name not in names:
+            self.get_logger().error(
+                f"hardware component '{request.name}' does not exist (components: "
+                f"{', '.join(names)})")
+            response.ok = False
+            return response
+        response.ok = request.target_state.id == State.PRIMARY_STATE_ACTIVE or (
+            request.target_state.label == 'active')
+        if not response.ok:
+            self.get_logger().warning(
+                f"hardware component '{request.name}' is the simulation: it stays active")
+        return response
+
+    def _reload(self, request, response):
+        manager = self._manager
+        loaded = [c.name for c in manager.controllers]
+        if loaded and not request.force_kill:
+            self.get_logger().error(
+                f'cannot reload controller libraries: controllers are loaded '
+                f"({', '.join(loaded)}); unload them or ask with force_kill")
+            response.ok = False
+            return response
+        try:
+            self._bindings.switch([], [c.name for c in manager.active], strict=False)
+            for name in loaded:
+                self._bindings.unload(name)
+        except ConfigurationError as err:
+            self.get_logger().error(f'reload_controller_libraries: {err}')
+            response.ok = False
+            return response
+        response.ok = True
+        return response
+
+    # --- the joints' interfaces ----------------------------------------------------------------
+
+    def _components(self) -> list[tuple[str, str, list[str]]]:
+        """(name, plugin, joints) per <ros2_control> block; one for the robot when it has none."""
+        actuated = [joint.name for joint in self._model.actuated_joints]
+        systems = [(system.name, system.plugin, [j.name for j in system.joints])
+                   for system in self._model.ros2_control]
+        listed = {joint for _name, _plugin, joints in systems for joint in joints}
+        rest = [joint for joint in actuated if joint not in listed]
+        if rest or not systems:
+            systems.append((self._model.name, 'pan_tilt_sim/PyBulletSystem', rest))
+        return systems
+
+    def _interfaces_of(self, joint: str, commands: bool) -> tuple[str, ...]:
+        control = self._model.control_joint(joint)
+        if control is None:
+            return ALL_INTERFACES
+        return control.command_interface_names if commands else control.state_interface_names
+
+    def _command_interface_names(self) -> list[str]:
+        return [f'{joint.name}/{interface}' for joint in self._model.actuated_joints
+                if joint.mimic is None for interface in self._interfaces_of(joint.name, True)]
+
+    def _state_interface_names(self) -> list[str]:
+        return [f'{joint.name}/{interface}' for joint in self._model.actuated_joints
+                for interface in self._interfaces_of(joint.name, False)]
+
+    def _state_interfaces_of(self, controller) -> list[str]:
+        if isinstance(controller, JointStateController):
+            return [f'{joint}/{interface}' for joint in controller.names
+                    for interface in self._interfaces_of(joint, False)]
+        interfaces = _flatten(controller.state_interfaces())
+        if not interfaces and isinstance(controller, CommandController) and (
+                controller.pids()):
+            # A PID loop reads the joint's position and velocity.
+            interfaces = [f'{joint}/{interface}' for joint in controller.joint_names
+                          for interface in ('position', 'velocity')]
+        return interfaces
+
+
+def _flatten(interfaces: Mapping[str, Sequence[str]]) -> list[str]:
+    return [f'{joint}/{interface}' for joint, names in interfaces.items() for interface in names]
+
+
+def _is_strings(value: Any) -> bool:
+    return isinstance(value, list | tuple) and all(isinstance(item, str) for item in value)
+
+
+def _is_string_or_strings(value: Any) -> bool:
+    return isinstance(value, str) or _is_strings(value)

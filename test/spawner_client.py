@@ -1,0 +1,91 @@
+"""A test client that calls controller_manager the way jazzy's spawner.py does.
+
+:class:`Spawner` works on anything with ``call``, ``probe`` and
+``spin_until`` (test/node_harness.py's NodeHarness and SimUnderTest).
+"""
+
+from __future__ import annotations
+
+from builtin_interfaces.msg import Duration
+from rclpy.parameter import Parameter, get_parameter_value
+from rclpy.parameter_client import AsyncParameterClient
+
+CM = '/controller_manager'
+STRICT, BEST_EFFORT = 2, 1
+
+
+def srv():
+    from controller_manager_msgs import srv as module
+
+    return module
+
+
+class Spawner:
+    """The calls of jazzy's spawner.py, from the harness's probe node."""
+
+    def __init__(self, sim, manager: str = CM) -> None:
+        self.sim = sim
+        self.manager = manager
+
+    def call(self, service: str, request=None):
+        service_type = {'list_controllers': srv().ListControllers,
+                        'load_controller': srv().LoadController,
+                        'configure_controller': srv().ConfigureController,
+                        'switch_controller': srv().SwitchController,
+                        'unload_controller': srv().UnloadController,
+                        'cleanup_controller': srv().CleanupController,
+                        'list_hardware_interfaces': srv().ListHardwareInterfaces,
+                        'list_hardware_components': srv().ListHardwareComponents,
+                        'list_controller_types': srv().ListControllerTypes,
+                        'reload_controller_libraries': srv().ReloadControllerLibraries,
+                        }[service]
+        return self.sim.call(service_type, f'{self.manager}/{service}', request)
+
+    def controllers(self) -> dict[str, object]:
+        return {c.name: c for c in self.call('list_controllers').controller}
+
+    def set_parameter(self, controller: str, name: str, value) -> bool:
+        """As the spawner's set_controller_parameters: str(value) through yaml, one Parameter."""
+        client = AsyncParameterClient(self.sim.probe, self.manager)
+        assert self.sim.spin_until(client.services_are_ready), 'parameter services not ready'
+        parameter = Parameter(f'{controller}.{name}').to_parameter_msg()
+        parameter.value = get_parameter_value(str(value))
+        future = client.set_parameters([parameter])
+        assert self.sim.spin_until(future.done)
+        (result,) = future.result().results
+        return result.successful
+
+    def load(self, name: str) -> bool:
+        return self.call('load_controller', srv().LoadController.Request(name=name)).ok
+
+    def configure(self, name: str) -> bool:
+        return self.call('configure_controller', srv().ConfigureController.Request(name=name)).ok
+
+    def switch(self, activate=(), deactivate=(), strictness=STRICT):
+        request = srv().SwitchController.Request(
+            activate_controllers=list(activate), deactivate_controllers=list(deactivate),
+            strictness=strictness, activate_asap=True, timeout=Duration(sec=5))
+        return self.call('switch_controller', request)
+
+    def spawn(self, name: str, param_files=()) -> int:
+        """Jazzy spawner.py's main() for one controller; return its exit code."""
+        if name in self.controllers():
+            pass  # "Controller already loaded, skipping load_controller"
+        else:
+            if param_files:
+                files = [str(path) for path in param_files]
+                self.set_parameter(name, 'params_file', files)
+                if not self.set_parameter(name, 'type', _type_in(files[0], name)):
+                    return 1
+            if not self.load(name):
+                return 1
+        if not self.configure(name):
+            return 1
+        return 0 if self.switch(activate=[name]).ok else 1
+
+
+def _type_in(path: str, name: str) -> str:
+    import yaml
+
+    with open(path) as stream:
+        return yaml.safe_load(stream)[name]['ros__parameters']['type']
