@@ -4,7 +4,8 @@ The ROS 2 form of the seed's gazebo_pan_tilt.launch + pan_tilt_gazebo_control.la
 
     ros2 launch pan_tilt_sim pan_tilt.launch.py
     ros2 launch pan_tilt_sim pan_tilt.launch.py model:=/path/robot.xacro \
-        controllers:=/path/controllers.yaml real_time_factor:=1.0 world:=targets gui:=false
+        controllers:=/path/controllers.yaml real_time_factor:=1.0 world:=targets gui:=false \
+        paused:=false
     ros2 launch pan_tilt_sim pan_tilt.launch.py \
         model:=$(ros2 pkg prefix ur_description)/share/ur_description/urdf/ur.urdf.xacro \
         xacro_args:='ur_type:=ur5e name:=ur5e' controllers:=.../ur_controllers.yaml \
@@ -79,7 +80,10 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('real_time_factor', default_value='1.0',
                               description='sim seconds per wall second; 0 = as fast as possible'),
         DeclareLaunchArgument('world', default_value='targets',
-                              description='scenery for the camera: targets or empty'),
+                              description='scenery: targets, ground or empty, or a YAML '
+                              'world file of objects to spawn'),
+        DeclareLaunchArgument('paused', default_value='false',
+                              description='start paused (simulation_interfaces: STOPPED)'),
         DeclareLaunchArgument('gui', default_value='false',
                               description='open a PyBullet window (needs a display)'),
         OpaqueFunction(function=launch_nodes),
@@ -111,7 +115,8 @@ def launch_nodes(context, *args, **kwargs) -> list:
         xacro_args=xacro_args, controllers_args=controllers_args,
         active_controllers=active,
         time_step=float(argument('time_step')), robot_namespace=robot_namespace,
-        publish_tf=not with_state_publisher, spawners=spawners)
+        publish_tf=not with_state_publisher, spawners=spawners,
+        paused=bool_argument(argument('paused')))
     nodes = [Node(package=PACKAGE, executable='sim_node', name='sim_node', output='screen',
                   parameters=[sim_parameters], additional_env=sim_node_environment())]
     if with_state_publisher:

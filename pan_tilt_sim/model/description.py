@@ -158,24 +158,34 @@ def load_description(path: pathlib.Path | str, xacro_args: Sequence[str] = ()) -
     model = read_model(root, path)
     if not model.actuated_joints:
         raise DescriptionError(f'{path}: the robot has no movable joints to control')
-    # PyBullet's copy: the parsed tree with every mesh made loadable and every
-    # massless link explicit.  The model was read before, so it keeps the URIs
-    # as written.
-    try:
-        localize_meshes(root, path.parent, mesh_cache_dir())
-    except DescriptionError as err:
-        raise DescriptionError(f'{path}: {err}') from None
-    warnings += complete_inertials(root, model)
-    # One element per line: PyBullet's reader fails on some long one-line files
-    # ("Cannot load URDF file."), which minified URDFs would be.
-    ElementTree.indent(root)
+    # The model was read before, so it keeps the URIs as written.
+    physics_urdf, physics_warnings = physics_copy(root, model, path.parent, path)
     return RobotDescription(
         model=model,
         urdf_xml=urdf_xml,
-        physics_urdf=ElementTree.tostring(root, encoding='unicode'),
+        physics_urdf=physics_urdf,
         source=path,
-        warnings=warnings,
+        warnings=warnings + physics_warnings,
     )
+
+
+def physics_copy(root: ElementTree.Element, model: RobotModel, base_dir: pathlib.Path,
+                 source: pathlib.Path) -> tuple[str, tuple[str, ...]]:
+    """Turn the parsed tree into PyBullet's copy; return its text and what had to change.
+
+    Every mesh made loadable (relative ones taken from ``base_dir``) and every
+    massless link explicit; errors name ``source``.  Also used for the
+    objects spawned into the world (:mod:`pan_tilt_sim.model.entity_resource`).
+    """
+    try:
+        localize_meshes(root, base_dir, mesh_cache_dir())
+    except DescriptionError as err:
+        raise DescriptionError(f'{source}: {err}') from None
+    warnings = complete_inertials(root, model)
+    # One element per line: PyBullet's reader fails on some long one-line files
+    # ("Cannot load URDF file."), which minified URDFs would be.
+    ElementTree.indent(root)
+    return ElementTree.tostring(root, encoding='unicode'), warnings
 
 
 def mesh_cache_dir() -> pathlib.Path:

@@ -192,7 +192,7 @@ def localize_meshes(robot: ET.Element, base_dir: pathlib.Path,
     """
     done: dict[pathlib.Path, pathlib.Path] = {}
     localized = []
-    for link, role, mesh in _mesh_elements(robot):
+    for link, role, mesh in mesh_elements(robot):
         where = f"link '{link}' {role}: mesh"
         uri = mesh.get('filename')
         if uri is None:
@@ -213,7 +213,8 @@ def localize_meshes(robot: ET.Element, base_dir: pathlib.Path,
     return localized
 
 
-def _mesh_elements(robot: ET.Element) -> Iterator[tuple[str, str, ET.Element]]:
+def mesh_elements(robot: ET.Element) -> Iterator[tuple[str, str, ET.Element]]:
+    """Yield ``(link name, role, <mesh> element)`` for every visual and collision mesh."""
     for link in robot.findall('link'):
         for role in MESH_ROLES:
             for mesh in link.findall(f'{role}/geometry/mesh'):

@@ -31,6 +31,7 @@ from sensor_msgs.msg import CameraInfo, Image
 
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model.transforms import Transform
+from pan_tilt_sim.model.world_file import World, world_from_parameter
 from pan_tilt_sim.ros import parameters as params
 from pan_tilt_sim.ros.ros_interfaces import stamp
 from pan_tilt_sim.schedule import PeriodicSchedule
@@ -47,7 +48,7 @@ from pan_tilt_sim.sim.camera import (
     Renderer,
     intrinsics,
 )
-from pan_tilt_sim.sim.world import DEFAULT_WORLD, WORLDS, check_world
+from pan_tilt_sim.sim.world import DEFAULT_WORLD, WORLDS
 
 IMAGE_ENCODING = 'rgb8'
 BYTES_PER_PIXEL = 3
@@ -57,12 +58,14 @@ IDENTITY_3X3 = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
 QUEUE_DEPTH = 5
 
 
-def declare_world(node: Node) -> str:
-    """Declare the ``world`` parameter and return its checked value."""
-    return check_world(params.declare(
+def declare_world(node: Node) -> World:
+    """Declare the ``world`` parameter and return what it names: a scenery, or a world file."""
+    return world_from_parameter(params.declare(
         node, 'world', params.STRING, DEFAULT_WORLD,
-        f"Scenery around the robot: {' or '.join(WORLDS)} (a ground plane and coloured "
-        'target cubes, static; cameras and lidars see them).'))
+        f"Scenery around the robot: {', '.join(WORLDS)} (ground: a ground plane; targets: "
+        'the ground and coloured target cubes, static; cameras and lidars see them), or a '
+        'YAML world file (path, file:// or package:// URI) naming a scenery and URDF objects '
+        'to spawn at start.'))
 
 
 def declare_camera(node: Node, links: Sequence[str],
@@ -138,6 +141,10 @@ class CameraPublisher:
     def mount(self) -> Transform:
         """Pose of the optical frame in the camera link's frame."""
         return self._renderer.mount
+
+    def optical_axes(self):
+        """Return the camera's eye position, forward and up vectors in the world, as now."""
+        return self._renderer.optical_axes()
 
     @property
     def frames(self) -> int:

@@ -43,8 +43,11 @@ class ControllerBindings:
     """Topics, actions and gain parameters of the configured controllers on ``node``."""
 
     def __init__(self, node: Node, simulation: Simulation, topic: Callable[..., str],
-                 gain_parameters: GainParameters, *, actions: bool) -> None:
+                 gain_parameters: GainParameters, *, actions: bool,
+                 command_topics: bool = True) -> None:
         self._node = node
+        # False: command controllers take no topic (topic-based hardware feeds them).
+        self._command_topics = command_topics
         self._simulation = simulation
         self._manager = simulation.manager
         self._topic = topic
@@ -146,7 +149,7 @@ class ControllerBindings:
             self._joint_state_sinks.append((controller, publisher, sink))
             controller.set_sink(sink)
             entities.append(publisher)
-        elif isinstance(controller, CommandController):
+        elif isinstance(controller, CommandController) and self._command_topics:
             message_type, extract = COMMAND_MESSAGES[controller.command_kind]
             entities.append(node.create_subscription(
                 message_type, self._topic(name, controller.command_topic),

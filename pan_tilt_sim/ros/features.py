@@ -22,7 +22,8 @@ from pan_tilt_sim.ros.robot_state import RobotStatePublisher
 from pan_tilt_sim.ros.sensor_publishers import SensorSet, declare_noise_seed
 from pan_tilt_sim.sim.camera import Renderer
 from pan_tilt_sim.sim.engine import Simulation
-from pan_tilt_sim.sim.world import build_world
+from pan_tilt_sim.sim.entities import Entities, spawn_world_objects
+from pan_tilt_sim.sim.world import build_world, has_ground
 
 
 class NodeFeatures:
@@ -36,13 +37,18 @@ class NodeFeatures:
                  gui: bool = False, sensor_namespace: str = '') -> None:
         description = simulation.description
         model = description.model
-        world = declare_world(node)
+        self.world = declare_world(node)
+        world = self.world.scenery
         urdf_cameras = any(sensor.kind in (SensorKind.CAMERA, SensorKind.DEPTH)
                            for sensor in model.sensors)
         settings = declare_camera(node, model.link_names, urdf_cameras)
         # The scenery lives in the simulation's client: static bodies the cameras
         # see and the lidars hit (their cost to a physics step is within noise).
-        build_world(world, simulation.physics.client_id, ground=gui)
+        targets = build_world(world, simulation.physics.client_id, ground=gui)
+        # The named things in the world, and the world file's objects, spawned now.
+        self.entities = Entities(simulation.physics, description.name, targets=targets,
+                                 ground=has_ground(world))
+        spawn_world_objects(self.entities, self.world)
         self.sensors = SensorSet(node, simulation, world, namespace_override=sensor_namespace,
                                  seed=declare_noise_seed(node))
         self.camera: CameraPublisher | None = None
@@ -73,6 +79,10 @@ class NodeFeatures:
     def refresh_readers(self) -> None:
         """Ask, once per batch of steps, whether anybody reads what is published periodically."""
         self.robot_state.refresh_readers()
+
+    def close(self) -> None:
+        """Release what the features hold beyond the PyBullet client (temporary files)."""
+        self.entities.close()
 
     def reset(self) -> None:
         """Start every schedule again: sim time was reset, or the world put back."""

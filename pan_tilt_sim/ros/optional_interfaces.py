@@ -1,6 +1,7 @@
 """The interface packages some features need, and the one line that says which features are off.
 
-tf2_msgs, control_msgs and controller_manager_msgs are not on PyPI: a ROS
+tf2_msgs, control_msgs, controller_manager_msgs and simulation_interfaces
+are not on PyPI: a ROS
 install has them, and the standalone path builds them into the venv
 (``scripts/build_interfaces.sh``; ``scripts/run_tests.sh`` does it on first
 use, ``scripts/run_sim.sh`` only with ``PAN_TILT_SIM_INTERFACES=build``).
@@ -19,6 +20,8 @@ FEATURES = {
                 'robot_description and joint_states)',
     'control_msgs': 'the follow_joint_trajectory actions',
     'controller_manager_msgs': "the controller_manager services (ros2_control's spawner)",
+    'simulation_interfaces': 'the simulator services (get_simulator_features, '
+                             'step_simulation, spawn_entity, ...)',
 }
 BUILD_HINT = 'scripts/build_interfaces.sh builds them into the venv'
 

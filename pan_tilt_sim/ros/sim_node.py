@@ -29,7 +29,13 @@ from pan_tilt_sim.model.controller_config import (
     parse_controllers_args,
 )
 from pan_tilt_sim.model.description import RobotDescription, load_description
-from pan_tilt_sim.ros import optional_interfaces, parameters, services
+from pan_tilt_sim.ros import (
+    optional_interfaces,
+    parameters,
+    services,
+    simulation_services,
+    topic_hardware,
+)
 from pan_tilt_sim.ros.controller_bindings import ControllerBindings
 from pan_tilt_sim.ros.features import NodeFeatures
 from pan_tilt_sim.ros.gain_parameters import GainParameters
@@ -80,19 +86,27 @@ class SimNode(Node):
         self.settings = parameters.declare_parameters(self)
         description = load_description(
             self.settings.robot_description_file, self.settings.xacro_args)
-        controllers = load_controllers_config(
-            controllers_files_for(self.settings.controllers_file, description),
-            parse_controllers_args(self.settings.controllers_args,
-                                   f"parameter '{CONTROLLERS_ARGS}'"))
+        # Topic-based hardware (topic_based_ros2_control): no YAML controllers run here.
+        self._topic_settings = topic_hardware.declare(self, description)
+        if self._topic_settings is not None:
+            controllers = topic_hardware.controllers_config(self._topic_settings)
+        else:
+            controllers = load_controllers_config(
+                controllers_files_for(self.settings.controllers_file, description),
+                parse_controllers_args(self.settings.controllers_args,
+                                       f"parameter '{CONTROLLERS_ARGS}'"))
         self.robot_namespace = naming.resolve_robot_namespace(
             self.get_namespace(), self.settings.robot_namespace,
             controllers.namespace, description.plugin_namespace)
         self.simulation = Simulation(
             description, controllers, self.settings.time_step, gui=self.settings.gui,
-            active_controllers=self.settings.active_controllers,
+            active_controllers=(None if self._topic_settings is not None
+                                else self.settings.active_controllers),
             initial_positions=self.settings.initial_positions, logger=self.get_logger(),
-            autostart_controllers=self.settings.autostart_controllers)
+            autostart_controllers=(self._topic_settings is not None
+                                   or self.settings.autostart_controllers))
         self._paused = self.settings.paused
+        self.steps_run = 0  # physics steps this node has run (never reset; see run_steps)
         # Nodes of this process spun on sim_node's executor and destroyed with it.
         self.companion_nodes: list[Node] = []
         self.controller_manager: Node | None = None  # where controller_manager_msgs exists
@@ -105,9 +119,17 @@ class SimNode(Node):
         self._clock_throttle = Throttle(CLOCK_MIN_WALL_PERIOD_S, CLOCK_BURST)
         try:
             self.gain_parameters = GainParameters(self)
+            topic_mode = self._topic_settings is not None
             self.controllers = ControllerBindings(
-                self, self.simulation, self.topic, self.gain_parameters,
-                actions=optional_interfaces.available('control_msgs'))
+                self, self.simulation,
+                topic_hardware.topics(self._topic_settings, self.topic) if topic_mode
+                else self.topic,
+                self.gain_parameters,
+                actions=not topic_mode and optional_interfaces.available('control_msgs'),
+                command_topics=not topic_mode)
+            self.topic_hardware = topic_hardware.TopicHardware(
+                self, self._topic_settings, description,
+                self.simulation.controllers) if topic_mode else None
             # Commands taken per controller (ignored ones included): a cheap health figure.
             self.commands_received = self.controllers.commands_received
             # Sensors follow an explicit namespace (the node's, or robot_namespace) the
@@ -137,6 +159,14 @@ class SimNode(Node):
         self.add_post_set_parameters_callback(self._apply_parameters)
         self._world_services = services.create_world_services(
             self, reset=self.reset, set_paused=self.set_paused)
+        # simulation_interfaces (where installed): its own module, its own callback groups.
+        try:
+            self.simulation_interfaces = simulation_services.create(self, self._world_services)
+        except BaseException:
+            self._destroy_companions()
+            self.features.close()
+            self.simulation.close()
+            raise
         self._log_controllers(description, controllers)
         self._log_missing_interfaces()
         # Actuators, start positions, PyBullet's load messages, unstable gains.
@@ -197,6 +227,7 @@ class SimNode(Node):
             if sensor_due is not None:  # a watched sensor samples between /clock messages
                 chunk = min(chunk, sensor_due)
             simulation.advance(chunk)
+            self.steps_run += chunk
             steps -= chunk
             if simulation.steps % every == 0 and clock_wanted:
                 self._clock_pending = True
@@ -231,12 +262,24 @@ class SimNode(Node):
             self._pacer.restart()
             self._retime()
 
-    def reset(self, *, reset_time: bool = True) -> None:
-        """Put the robot back to its initial state; sim time to 0 if asked (/clock says so).
+    def step(self, steps: int) -> None:
+        """Run ``steps`` steps now, paused or not (stepping on request, see stepping.py)."""
+        self._refresh_readers()
+        self.run_steps(steps)
 
-        Every periodic publication (joint states, TF, camera) starts again from now.
+    def reset(self, *, reset_time: bool = True, reset_state: bool = True) -> None:
+        """Put the world back to its initial state; sim time to 0 if asked (/clock says so).
+
+        The state is the robot's joints and controllers and the poses of the
+        entities in the world (spawned objects stay; see simulation_services
+        for more).  Every periodic publication (joint states, TF, camera)
+        starts again from now.
         """
-        self.simulation.reset(reset_time=reset_time)
+        if reset_state:
+            self.simulation.reset(reset_time=reset_time)
+            self.features.entities.reset_state()
+        elif reset_time:
+            self.simulation.reset_time()
         self._pacer.restart()
         self._publish_clock()
         self.features.reset()
@@ -250,6 +293,9 @@ class SimNode(Node):
             self._timer.cancel()
         self.controllers.destroy()
         self._destroy_companions()
+        if self.simulation_interfaces is not None:
+            self.simulation_interfaces.close()
+        self.features.close()
         self.simulation.close()
         logger = self.get_logger()
         super().destroy_node()
@@ -305,6 +351,8 @@ class SimNode(Node):
 
     def _start_controller_manager(self, controllers: ControllersConfig) -> None:
         """Offer ros2_control's controller_manager services, where their messages exist."""
+        if self.topic_hardware is not None:
+            return  # the user's own controller_manager runs, on topic-based hardware
         if not optional_interfaces.available('controller_manager_msgs'):
             if not self.settings.autostart_controllers:
                 raise ParameterError(
@@ -328,7 +376,9 @@ class SimNode(Node):
     def _log_missing_interfaces(self) -> None:
         """Say in one line which features are off because an interface package is missing."""
         missing = [package for package in ('control_msgs', 'controller_manager_msgs')
-                   if not optional_interfaces.available(package)]
+                   if self.topic_hardware is None and not optional_interfaces.available(package)]
+        if self.simulation_interfaces is None:
+            missing.append(simulation_services.PACKAGE)
         robot_state = self.features.robot_state
         if robot_state.tf_wanted and not robot_state.publishes_tf:
             missing.insert(0, 'tf2_msgs')
@@ -343,7 +393,7 @@ class SimNode(Node):
         for warning in description.warnings:
             logger.warning(warning)
         manager = self.simulation.manager
-        if not self.settings.autostart_controllers:
+        if not self.settings.autostart_controllers and self.topic_hardware is None:
             logger.info(
                 f'no controller loaded: waiting for spawners at '
                 f"{self.controller_manager.get_fully_qualified_name()} (the controllers file "

@@ -266,6 +266,17 @@ class Simulation:
         if reset_time:
             self._steps = 0
 
+    def reset_time(self) -> None:
+        """Sim time back to 0, the joints left where they are; controllers hold them there.
+
+        Controllers are reset as after a start (commands and trajectories,
+        timed on the old clock, are dropped; position controllers hold the
+        present position).
+        """
+        for controller in self.controllers:
+            controller.reset()
+        self._steps = 0
+
     def joint_positions(self) -> dict[str, float]:
         """Return the measured position of every movable joint, by name."""
         return {name: state[STATE_POSITION]

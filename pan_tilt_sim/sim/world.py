@@ -1,4 +1,4 @@
-"""Scenery for the camera: a ground plane and a few coloured targets, or nothing.
+"""Scenery for the camera: a ground plane and a few coloured targets, a ground alone, or nothing.
 
 The world is built from PyBullet primitives (no ``pybullet_data`` files)
 and lives in the simulation's PyBullet client, where the cameras render (see
@@ -9,10 +9,17 @@ coordinates (a static btRigidBody each), not as multibodies: four static
 multibodies -- even visual-only ones -- cost the seed's physics step
 +1.1 us (3.5 -> 4.6 us, +31 %), four static rigid bodies with collision
 shapes +0.08 us (within noise; measured by stepping the seed 20,000 times,
-median of 8 interleaved runs).  The ground has no collision shape: a plane at z = 0 would
-touch the seed's pan link (whose collision cylinder reaches below z = 0) and
-change its physics; cameras, depth cameras and lidars meet the ground plane
-analytically instead.
+median of 8 interleaved runs).  Cameras, depth cameras and lidars meet the
+ground plane analytically.  Objects spawned into the world
+(:mod:`pan_tilt_sim.sim.entities`) land on it: :func:`add_ground_plane`
+adds the plane as a collision body when the first object arrives -- so a
+world without objects pays nothing for it.  The robot is fixed to the
+world, and its links that touch the ground or reach below it in the
+initial pose (:func:`grounded_links`: the seed's base and its pan link,
+whose collision cylinder reaches below z = 0; a base sunk into the floor)
+never collide with the plane: they would be held by it (a wheel half in the
+ground turns 0 rad/s instead of 42 under the same torque).  Every other
+link meets the ground as any object does: a gripper cannot go through it.
 
 The ground is the plane z = 0.  TinyRenderer's cost grows with the pixels it
 shades, and a ground body covers half of every horizontal view (measured: 9 ms
@@ -34,12 +41,12 @@ import dataclasses
 import math
 
 from pan_tilt_sim.errors import ParameterError
+from pan_tilt_sim.model.world_file import EMPTY, GROUND, SCENERIES, TARGETS
 from pan_tilt_sim.sim.bullet import pybullet
 
-EMPTY = 'empty'
-TARGETS = 'targets'
-WORLDS = (EMPTY, TARGETS)
+WORLDS = SCENERIES  # empty, ground (the plane alone), targets
 DEFAULT_WORLD = TARGETS
+TARGET_PREFIX = 'target_'  # a target's entity name: target_red, target_green, ...
 
 GROUND_HALF_SIZE = 15.0  # m: the GUI's ground box is a 30 m square ...
 GROUND_HALF_THICKNESS = 0.005  # m: ... whose top face is at z = 0
@@ -47,6 +54,15 @@ GROUND_RGB = (130, 130, 130)  # the ground's colour in camera images (rgb8)
 GROUND_RGBA = (*(channel / 255.0 for channel in GROUND_RGB), 1.0)
 STATIC_MASS = 0.0  # PyBullet: mass 0 makes a body static
 NO_SHAPE = -1
+BASE_LINK = -1  # PyBullet's link index of a body's base
+# A body without a visual shape is drawn by TinyRenderer from its collision
+# shape (a plane: the whole lower half of every view, ~16 ms per frame); a
+# speck of a visual shape, fully transparent, keeps the ground plane unseen.
+INVISIBLE_RADIUS = 1e-6
+INVISIBLE_RGBA = (0.0, 0.0, 0.0, 0.0)
+# A robot link whose box (PyBullet's, with its ~1 mm margin) reaches below this
+# height in the initial pose touches the ground: the plane leaves it alone.
+GROUND_CLEARANCE = 0.002  # m
 
 
 @dataclasses.dataclass(frozen=True)
@@ -88,25 +104,53 @@ def has_ground(name: str) -> bool:
     return check_world(name) != EMPTY
 
 
-def build_world(name: str, client: int, *, ground: bool = False) -> list[int]:
-    """Add the world's bodies to PyBullet ``client``; return their ids.
+def build_world(name: str, client: int, *, ground: bool = False) -> dict[str, int]:
+    """Add the world's bodies to PyBullet ``client``; return the targets' body ids by name.
 
-    The ground plane becomes a body only with ``ground`` (for a GUI window);
-    the camera paints it instead (see the module docstring).
+    The names are the targets' entity names (``target_red``...).  The ground
+    plane becomes a body only with ``ground`` (for a GUI window); the camera
+    paints it instead (see the module docstring).
     """
     check_world(name)
     if name == EMPTY:
-        return []
-    bodies = []
+        return {}
     if ground:
-        bodies.append(_visual_box(
-            client, (GROUND_HALF_SIZE, GROUND_HALF_SIZE, GROUND_HALF_THICKNESS),
-            (0.0, 0.0, -GROUND_HALF_THICKNESS), GROUND_RGBA))
+        _visual_box(client, (GROUND_HALF_SIZE, GROUND_HALF_SIZE, GROUND_HALF_THICKNESS),
+                    (0.0, 0.0, -GROUND_HALF_THICKNESS), GROUND_RGBA)
+    if name == GROUND:
+        return {}
+    targets = {}
     for target in TARGET_SET:
         half = target.half_size
-        bodies.append(_visual_box(client, (half, half, half), target.position, target.rgba,
-                                  collide=True))
-    return bodies
+        targets[TARGET_PREFIX + target.name] = _visual_box(
+            client, (half, half, half), target.position, target.rgba, collide=True)
+    return targets
+
+
+def grounded_links(client: int, robot: int) -> list[int]:
+    """Return the robot's links (-1: the base) within GROUND_CLEARANCE of z = 0 or below it."""
+    return [link for link in range(BASE_LINK, pybullet.getNumJoints(robot, physicsClientId=client))
+            if pybullet.getAABB(robot, link, physicsClientId=client)[0][2] < GROUND_CLEARANCE]
+
+
+def add_ground_plane(client: int, robot: int, grounded: list[int]) -> int:
+    """Add the plane z = 0 as a static collision body, not touching ``grounded`` links; return it.
+
+    ``grounded`` are the robot's links that touched the ground in its initial
+    pose (:func:`grounded_links`).  The camera does not draw the plane (it
+    paints the ground itself) and rays hit it where the analytic ground is
+    anyway.
+    """
+    shape = pybullet.createCollisionShape(pybullet.GEOM_PLANE, physicsClientId=client)
+    speck = pybullet.createVisualShape(pybullet.GEOM_SPHERE, radius=INVISIBLE_RADIUS,
+                                       rgbaColor=INVISIBLE_RGBA, physicsClientId=client)
+    plane = pybullet.createMultiBody(
+        baseMass=STATIC_MASS, baseCollisionShapeIndex=shape, baseVisualShapeIndex=speck,
+        useMaximalCoordinates=True, physicsClientId=client)
+    for link in grounded:
+        pybullet.setCollisionFilterPair(plane, robot, BASE_LINK, link, enableCollision=0,
+                                        physicsClientId=client)
+    return plane
 
 
 def _visual_box(client: int, half_extents: tuple[float, float, float],

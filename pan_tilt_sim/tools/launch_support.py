@@ -30,6 +30,7 @@ from pan_tilt_sim.model.controller_config import (
     parse_controllers_args,
 )
 from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.model.topic_based import topic_based_system
 from pan_tilt_sim.ros.runner import PARENT_PID_VARIABLE
 
 ROOT_NAMESPACE = '/'
@@ -90,13 +91,16 @@ def robot_setup(model: str, controllers: str = '', xacro_args: Sequence[str] = (
                 controllers_args: Sequence[str] = ()) -> RobotSetup:
     """Load the model and controllers as sim_node does (in the root namespace)."""
     description = load_description(model, xacro_args)
-    files = controllers_files_for(controllers, description,
-                                  given_as="the launch argument 'controllers'")
-    config = load_controllers_config(
-        files, parse_controllers_args(controllers_args, "launch argument 'controllers_args'"),
-        args_name="the launch argument 'controllers_args'")
+    controllers_namespace = None
+    if topic_based_system(description.model) is None:  # topic-based hardware runs no YAML
+        files = controllers_files_for(controllers, description,
+                                      given_as="the launch argument 'controllers'")
+        config = load_controllers_config(
+            files, parse_controllers_args(controllers_args, "launch argument 'controllers_args'"),
+            args_name="the launch argument 'controllers_args'")
+        controllers_namespace = config.namespace
     namespace = naming.resolve_robot_namespace(
-        ROOT_NAMESPACE, robot_namespace, config.namespace, description.plugin_namespace)
+        ROOT_NAMESPACE, robot_namespace, controllers_namespace, description.plugin_namespace)
     return RobotSetup(description.urdf_xml, namespace)
 
 
@@ -105,7 +109,8 @@ def sim_node_parameters(model: str, controllers: str, *, real_time_factor: float
                         controllers_args: Sequence[str] = (),
                         active_controllers: Sequence[str] = (),
                         time_step: float | None = None, robot_namespace: str = '',
-                        publish_tf: bool = False, spawners: bool = False) -> dict[str, Any]:
+                        publish_tf: bool = False, spawners: bool = False,
+                        paused: bool = False) -> dict[str, Any]:
     """Return sim_node's parameters.
 
     With robot_state_publisher beside it (``publish_tf`` False), that node
@@ -137,6 +142,8 @@ def sim_node_parameters(model: str, controllers: str, *, real_time_factor: float
         parameters['time_step'] = time_step
     if robot_namespace:
         parameters['robot_namespace'] = robot_namespace
+    if paused:  # start paused (STOPPED): spawners and tests connect before time moves
+        parameters['paused'] = True
     return parameters
 
 

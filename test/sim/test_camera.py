@@ -317,7 +317,7 @@ def test_enabling_a_camera_on_a_missing_link_is_an_error_naming_the_parameter():
 
 
 def test_an_unknown_world_is_an_error_naming_the_choices():
-    with pytest.raises(ParameterError, match="'world'.*empty, targets"), \
+    with pytest.raises(ParameterError, match="'world'.*empty, ground, targets"), \
             sim_node(world='moon'):
         pass
 

@@ -201,7 +201,8 @@ def _defaults(description):
 def test_the_launch_file_declares_every_argument(stand_in_launch):
     assert set(_defaults(stand_in_launch.generate_launch_description())) == {
         'model', 'xacro_args', 'controllers', 'controllers_args', 'active_controllers',
-        'spawners', 'time_step', 'robot_namespace', 'real_time_factor', 'world', 'gui'}
+        'spawners', 'time_step', 'robot_namespace', 'real_time_factor', 'world', 'gui',
+        'paused'}
 
 
 def _launch(module, monkeypatch, prefix, **arguments):
@@ -284,3 +285,24 @@ def test_the_spawner_names_the_controller_manager_in_the_robots_namespace():
     parameters = sim_node_parameters('m.urdf', '', real_time_factor=1.0, world='empty',
                                      gui=False, active_controllers=['a'], spawners=True)
     assert parameters['autostart_controllers'] is False and 'active_controllers' not in parameters
+
+
+def test_paused_is_passed_only_when_asked_for():
+    assert 'paused' not in sim_node_parameters('m.urdf', '', real_time_factor=1.0,
+                                               world='targets', gui=False)
+    assert sim_node_parameters('m.urdf', '', real_time_factor=1.0, world='targets', gui=False,
+                               paused=True)['paused'] is True
+
+
+def test_a_topic_based_robot_needs_no_controllers_file(tmp_path):
+    from topic_based_fixtures import topic_based_urdf_file
+
+    urdf = topic_based_urdf_file(tmp_path, {'a': ['position']})
+    setup = robot_setup(str(urdf), '', robot_namespace='star')
+    assert setup.topic('joint_states') == '/star/joint_states'
+
+
+def test_the_paused_launch_argument_starts_sim_node_paused(stand_in_launch, monkeypatch,
+                                                            tmp_path):
+    (sim_node,) = _launch(stand_in_launch, monkeypatch, tmp_path / 'none', paused='true')
+    assert sim_node.kwargs['parameters'][0]['paused'] is True

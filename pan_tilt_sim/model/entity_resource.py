@@ -1,0 +1,147 @@
+"""What an object to spawn is made of: a URDF from a URI or a string, read once. No ROS.
+
+``simulation_interfaces/srv/SpawnEntity`` names its resource by ``uri``
+(``package://``, ``file://`` or a path; a ``.xacro`` file is expanded without
+arguments) or gives it inline as ``resource_string`` (URDF text).  This
+module reads it with the robot's own parser (:mod:`pan_tilt_sim.model.urdf`)
+and makes PyBullet's copy the same way (:mod:`pan_tilt_sim.model.resources`),
+but an object may have no movable joint at all (a box).  Every failure is an
+:class:`EntityResourceError` whose :attr:`~EntityResourceError.problem` says
+which of the standard's result codes it is:
+
+* ``NOT_FOUND``: the URI names no file (or an unknown package);
+* ``UNSUPPORTED_FORMAT``: not URDF (an ``.sdf``/``.usd`` file, an ``<sdf>`` root);
+* ``PARSE_ERROR``: not well-formed XML, or a URDF the parser refuses;
+* ``MISSING_ASSETS``: a mesh it names does not exist;
+* ``UNSUPPORTED_ASSETS``: a mesh PyBullet cannot be given (unknown format, garbage).
+
+Nothing here touches a simulation, so a refused resource leaves it as it was.
+"""
+
+from __future__ import annotations
+
+import enum
+import os
+import pathlib
+import xml.etree.ElementTree as ElementTree
+
+from pan_tilt_sim.errors import DescriptionError
+from pan_tilt_sim.model.description import (
+    XACRO_SUFFIX,
+    RobotDescription,
+    physics_copy,
+    read_description_xml,
+)
+from pan_tilt_sim.model.resources import mesh_elements, resolve_resource
+from pan_tilt_sim.model.urdf import URDF_ROOT_TAG, parse_xml, read_model
+
+URDF_SUFFIX = '.urdf'
+SUPPORTED_SUFFIXES = (URDF_SUFFIX, XACRO_SUFFIX)
+FORMAT = 'urdf'  # the standard's lower-case name of the one format spawned
+STRING_SOURCE = pathlib.Path('<resource_string>')
+TRUE_TEXTS = ('true', '1')
+
+
+class ResourceProblem(enum.Enum):
+    """Why a resource cannot be spawned (each maps onto a SpawnEntity result code)."""
+
+    NOT_FOUND = 'not found'
+    UNSUPPORTED_FORMAT = 'unsupported format'
+    PARSE_ERROR = 'parse error'
+    MISSING_ASSETS = 'missing assets'
+    UNSUPPORTED_ASSETS = 'unsupported assets'
+
+
+class EntityResourceError(DescriptionError):
+    """A resource to spawn cannot be used; :attr:`problem` says how, the text says why."""
+
+    def __init__(self, problem: ResourceProblem, message: str) -> None:
+        super().__init__(message)
+        self.problem = problem
+
+
+def read_entity_resource(uri: str = '', resource_string: str = '', *,
+                         base_dir: pathlib.Path | None = None) -> RobotDescription:
+    """Read the URDF that ``uri`` names, else ``resource_string``; raise EntityResourceError.
+
+    ``uri`` wins when both are given (as the standard says).  Relative paths,
+    in the URI and in the URDF's meshes, are taken from ``base_dir`` (default:
+    the current folder) -- for a URI's meshes, from the file's own folder.
+    """
+    base = pathlib.Path.cwd() if base_dir is None else base_dir
+    if uri:
+        path = _resolve(uri, base)
+        if path.suffix.lower() not in SUPPORTED_SUFFIXES:
+            raise EntityResourceError(
+                ResourceProblem.UNSUPPORTED_FORMAT,
+                f"'{uri}': only URDF can be spawned (.urdf or .xacro), got "
+                f"'{path.suffix or path.name}'")
+        if not path.is_file():
+            raise EntityResourceError(ResourceProblem.NOT_FOUND,
+                                      f"'{uri}': no such file ({path})")
+        try:
+            text, _warnings = read_description_xml(path)
+        except DescriptionError as err:
+            raise EntityResourceError(ResourceProblem.PARSE_ERROR, str(err)) from None
+        return _describe(text, path, path.parent)
+    if not resource_string.strip():
+        raise EntityResourceError(ResourceProblem.NOT_FOUND, 'neither uri nor resource_string')
+    return _describe(resource_string, STRING_SOURCE, base)
+
+
+def is_static(description: RobotDescription) -> bool:
+    """Whether the URDF says ``<gazebo><static>true</static></gazebo>`` (fixed in the world)."""
+    root = ElementTree.fromstring(description.urdf_xml)
+    return any((element.findtext('static') or '').strip().lower() in TRUE_TEXTS
+               for element in root.findall('gazebo') if element.get('reference') is None)
+
+
+def _resolve(uri: str, base: pathlib.Path) -> pathlib.Path:
+    try:
+        return resolve_resource(uri, base)
+    except DescriptionError as err:  # an unknown package or scheme
+        raise EntityResourceError(ResourceProblem.NOT_FOUND, str(err)) from None
+
+
+def _describe(text: str, source: pathlib.Path, base: pathlib.Path) -> RobotDescription:
+    try:
+        root = ElementTree.fromstring(text)
+    except ElementTree.ParseError:
+        root = None  # parse_xml says where
+    if root is not None and root.tag != URDF_ROOT_TAG:
+        raise EntityResourceError(
+            ResourceProblem.UNSUPPORTED_FORMAT,
+            f'{source}: only URDF can be spawned: the root element is <{root.tag}>, '
+            f'expected <{URDF_ROOT_TAG}>')
+    try:
+        root = parse_xml(text, source)
+        model = read_model(root, source)
+    except DescriptionError as err:
+        raise EntityResourceError(ResourceProblem.PARSE_ERROR, str(err)) from None
+    if not model.name:  # urdfdom and PyBullet refuse it too
+        raise EntityResourceError(ResourceProblem.PARSE_ERROR,
+                                  f'{source}: <robot> has no name attribute (URDF requires one)')
+    if not model.links:
+        raise EntityResourceError(ResourceProblem.PARSE_ERROR, f'{source}: the URDF has no link')
+    for link, role, mesh in mesh_elements(root):
+        uri = mesh.get('filename')
+        if uri is None:
+            raise EntityResourceError(
+                ResourceProblem.PARSE_ERROR,
+                f"{source}: link '{link}' {role}: <mesh> has no filename attribute")
+        try:
+            path = resolve_resource(uri, base)
+        except DescriptionError as err:
+            raise EntityResourceError(ResourceProblem.MISSING_ASSETS,
+                                      f"{source}: link '{link}' {role}: {err}") from None
+        if not os.path.isfile(path):
+            raise EntityResourceError(
+                ResourceProblem.MISSING_ASSETS,
+                f"{source}: link '{link}' {role}: mesh '{uri}' (resolved to {path}): "
+                'file not found')
+    try:
+        physics_urdf, warnings = physics_copy(root, model, base, source)
+    except DescriptionError as err:
+        raise EntityResourceError(ResourceProblem.UNSUPPORTED_ASSETS, str(err)) from None
+    return RobotDescription(model=model, urdf_xml=text, physics_urdf=physics_urdf,
+                            source=source, warnings=warnings)

@@ -1,0 +1,190 @@
+"""The ``world`` parameter: a scenery name, or a YAML world file listing objects to spawn.
+
+A scenery name is one of :data:`SCENERIES`: ``empty`` (nothing), ``ground``
+(a ground plane) or ``targets`` (the ground plane and four coloured cubes).
+Anything else is a world file -- a path, ``file://`` or ``package://`` URI --
+in YAML, one entry per object, each what a ``SpawnEntity`` request would
+give::
+
+    scenery: ground            # empty | ground | targets (default: ground)
+    entities:
+      - name: box              # default: the URDF's <robot name>
+        uri: package://pan_tilt_sim/urdf/objects/box.urdf   # or a path (relative
+                               # to this file), file://..., or resource_string: <robot ...>
+        pose:
+          position: [0.5, 0.3, 0.25]        # m, world frame (default 0 0 0)
+          orientation: [0, 0, 0, 1]         # quaternion x y z w, or rpy: [r, p, y] (rad)
+        description: a box to push          # optional, for GetEntityInfo
+        tags: [pushable]                    # optional, for GetEntities' tag filter
+
+Every problem ends start-up with one line naming the file and the field
+(:class:`WorldFileError`), or the parameter when its value names nothing
+(:class:`~pan_tilt_sim.errors.ParameterError`).  Reading the objects' URDFs is the entity
+resource module's business; this module only checks the file's shape.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import pathlib
+from collections.abc import Mapping
+from typing import Any
+
+import yaml
+
+from pan_tilt_sim.errors import ConfigurationError, ParameterError
+from pan_tilt_sim.model.resources import resolve_resource
+from pan_tilt_sim.model.transforms import (
+    IDENTITY_ROTATION,
+    ZERO_VECTOR,
+    Quaternion,
+    Vector,
+    quaternion_from_rpy,
+)
+
+EMPTY = 'empty'
+GROUND = 'ground'
+TARGETS = 'targets'
+SCENERIES = (EMPTY, GROUND, TARGETS)
+DEFAULT_FILE_SCENERY = GROUND
+WORLD_KEYS = ('scenery', 'entities')
+ENTITY_KEYS = ('name', 'uri', 'resource_string', 'pose', 'description', 'tags')
+POSE_KEYS = ('position', 'orientation', 'rpy')
+NORM_TOLERANCE = 1e-6  # a quaternion whose norm is this close to 0 is no rotation
+
+
+class WorldFileError(ConfigurationError):
+    """The world file cannot be used (a bad ``world`` value itself is a ParameterError)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class EntitySpec:
+    """One object a world file asks for, as a SpawnEntity request would."""
+
+    name: str = ''
+    uri: str = ''
+    resource_string: str = ''
+    position: Vector = ZERO_VECTOR
+    orientation: Quaternion = IDENTITY_ROTATION
+    description: str = ''
+    tags: tuple[str, ...] = ()
+
+
+@dataclasses.dataclass(frozen=True)
+class World:
+    """What the ``world`` parameter asks for: a scenery and the objects to spawn at start."""
+
+    scenery: str
+    entities: tuple[EntitySpec, ...] = ()
+    source: pathlib.Path | None = None  # the world file, if one was given
+
+    @property
+    def base_dir(self) -> pathlib.Path:
+        """The folder relative URIs in the file are taken from."""
+        return self.source.parent if self.source is not None else pathlib.Path.cwd()
+
+
+def world_from_parameter(value: str) -> World:
+    """Return the world a ``world`` parameter value names (a scenery or a world file)."""
+    if value in SCENERIES:
+        return World(value)
+    if not value.strip():
+        raise ParameterError(
+            f"parameter 'world' must be one of {', '.join(SCENERIES)} or a world file, got ''")
+    try:
+        path = resolve_resource(value, pathlib.Path.cwd())
+    except ConfigurationError as err:
+        raise ParameterError(f"parameter 'world': {err}") from None
+    if not path.is_file():
+        raise ParameterError(
+            f"parameter 'world': '{value}' is none of {', '.join(SCENERIES)}, and no world "
+            f'file ({path}: no such file)')
+    return read_world_file(path)
+
+
+def read_world_file(path: pathlib.Path) -> World:
+    """Read and check a YAML world file."""
+    try:
+        document = yaml.safe_load(path.read_text(encoding='utf-8'))
+    except yaml.MarkedYAMLError as err:
+        mark = err.problem_mark or err.context_mark
+        line = f':{mark.line + 1}' if mark is not None else ''
+        raise WorldFileError(
+            f'{path}{line}: YAML syntax error: {err.problem or err.context}') from None
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as err:
+        raise WorldFileError(f'{path}: cannot read: {err}') from None
+    if document is None:
+        document = {}
+    _check_mapping(document, WORLD_KEYS, path, 'the file')
+    scenery = document.get('scenery', DEFAULT_FILE_SCENERY)
+    if scenery not in SCENERIES:
+        raise WorldFileError(
+            f"{path}: scenery: must be one of {', '.join(SCENERIES)}, got {scenery!r}")
+    entries = document.get('entities') or []
+    if not isinstance(entries, list):
+        raise WorldFileError(f'{path}: entities: must be a list, got {_kind(entries)}')
+    entities = tuple(_entity(entry, path, f'entities[{index}]')
+                     for index, entry in enumerate(entries))
+    names = [entity.name for entity in entities if entity.name]
+    for name in names:
+        if names.count(name) > 1:
+            raise WorldFileError(f"{path}: entities: the name '{name}' is used twice")
+    return World(scenery, entities, path)
+
+
+def _entity(entry: Any, path: pathlib.Path, where: str) -> EntitySpec:
+    _check_mapping(entry, ENTITY_KEYS, path, where)
+    texts = {}
+    for key in ('name', 'uri', 'resource_string', 'description'):
+        value = entry.get(key, '')
+        if not isinstance(value, str):
+            raise WorldFileError(f'{path}: {where}.{key}: must be a string, got {_kind(value)}')
+        texts[key] = value
+    if not texts['uri'] and not texts['resource_string']:
+        raise WorldFileError(f'{path}: {where}: give a uri or a resource_string')
+    tags = entry.get('tags', [])
+    if not isinstance(tags, list) or not all(isinstance(tag, str) for tag in tags):
+        raise WorldFileError(f'{path}: {where}.tags: must be a list of strings')
+    position, orientation = _pose(entry.get('pose', {}), path, f'{where}.pose')
+    return EntitySpec(position=position, orientation=orientation, tags=tuple(tags), **texts)
+
+
+def _pose(pose: Any, path: pathlib.Path, where: str) -> tuple[Vector, Quaternion]:
+    _check_mapping(pose, POSE_KEYS, path, where)
+    if 'orientation' in pose and 'rpy' in pose:
+        raise WorldFileError(f'{path}: {where}: give orientation or rpy, not both')
+    position = _numbers(pose.get('position', list(ZERO_VECTOR)), 3, path, f'{where}.position')
+    if 'rpy' in pose:
+        orientation = quaternion_from_rpy(*_numbers(pose['rpy'], 3, path, f'{where}.rpy'))
+    else:
+        x, y, z, w = _numbers(pose.get('orientation', list(IDENTITY_ROTATION)), 4, path,
+                              f'{where}.orientation')
+        norm = math.sqrt(x * x + y * y + z * z + w * w)
+        if norm < NORM_TOLERANCE:
+            raise WorldFileError(f'{path}: {where}.orientation: a quaternion of length 0 is '
+                                 'no rotation')
+        orientation = (x / norm, y / norm, z / norm, w / norm)
+    return position, orientation  # type: ignore[return-value]
+
+
+def _numbers(value: Any, count: int, path: pathlib.Path, where: str) -> tuple[float, ...]:
+    if (not isinstance(value, list) or len(value) != count
+            or not all(isinstance(v, int | float) and not isinstance(v, bool)
+                       and math.isfinite(v) for v in value)):
+        raise WorldFileError(f'{path}: {where}: must be {count} finite numbers, got {value!r}')
+    return tuple(float(v) for v in value)
+
+
+def _check_mapping(value: Any, keys: tuple[str, ...], path: pathlib.Path, where: str) -> None:
+    if not isinstance(value, Mapping):
+        raise WorldFileError(f'{path}: {where}: must be a mapping, got {_kind(value)}')
+    unknown = [key for key in value if key not in keys]
+    if unknown:
+        raise WorldFileError(f"{path}: {where}: unknown key '{unknown[0]}' (known: "
+                             f"{', '.join(keys)})")
+
+
+def _kind(value: Any) -> str:
+    return {dict: 'a mapping', list: 'a list', str: 'a string', bool: 'a bool', int: 'a number',
+            float: 'a number', type(None): 'nothing'}.get(type(value), type(value).__name__)

@@ -1,0 +1,70 @@
+"""URDF objects for spawning tests, written on the fly."""
+
+from __future__ import annotations
+
+import pathlib
+
+BOX_RGBA = (0.9, 0.1, 0.9, 1.0)  # magenta: no target, the ground or the seed is this colour
+
+
+def box_urdf(name: str = 'box', size: tuple[float, float, float] = (0.2, 0.2, 0.2),
+             mass: float = 1.0, rgba: tuple[float, float, float, float] = BOX_RGBA, *,
+             static: bool = False, com: tuple[float, float, float] = (0.0, 0.0, 0.0),
+             mesh: str | None = None) -> str:
+    """Return the URDF of a one-link box (a solid box's inertia about ``com``).
+
+    ``mesh`` replaces the visual geometry with a mesh file name.
+    """
+    x, y, z = size
+    colour = ' '.join(str(c) for c in rgba)
+    geometry = f'<geometry><box size="{x} {y} {z}"/></geometry>'
+    visual = f'<geometry><mesh filename="{mesh}"/></geometry>' if mesh else geometry
+    gazebo = '<gazebo><static>true</static></gazebo>' if static else ''
+    return f"""<?xml version="1.0"?>
+<robot name="{name}">
+  <link name="{name}_link">
+    <inertial>
+      <origin xyz="{com[0]} {com[1]} {com[2]}"/>
+      <mass value="{mass}"/>
+      <inertia ixx="{mass * (y * y + z * z) / 12}" ixy="0" ixz="0"
+               iyy="{mass * (x * x + z * z) / 12}" iyz="0" izz="{mass * (x * x + y * y) / 12}"/>
+    </inertial>
+    <visual>{visual}<material name="{name}_colour"><color rgba="{colour}"/></material></visual>
+    <collision>{geometry}</collision>
+  </link>
+  {gazebo}
+</robot>
+"""
+
+
+def write_box(folder: pathlib.Path, file_name: str = 'box.urdf', **kwargs) -> pathlib.Path:
+    """Write :func:`box_urdf` to ``folder/file_name`` and return the path."""
+    path = folder / file_name
+    path.write_text(box_urdf(**kwargs), encoding='utf-8')
+    return path
+
+
+# A fixed rig: a wheel half in the ground (continuous about y, its axle at z = 0.05)
+# and a plunger (a 0.1 m box on a joint sliding along z) hanging 0.3 m up.
+RIG_URDF = """<?xml version="1.0"?>
+<robot name="rig">
+  <link name="base"><inertial><mass value="10"/>
+    <inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="wheel"><inertial><mass value="1"/>
+    <inertia ixx="0.005" iyy="0.005" izz="0.005" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin rpy="1.5708 0 0"/>
+      <geometry><cylinder radius="0.1" length="0.05"/></geometry></collision></link>
+  <joint name="spin" type="continuous"><parent link="base"/><child link="wheel"/>
+    <origin xyz="0 0 0.05"/><axis xyz="0 1 0"/><limit effort="10" velocity="100"/></joint>
+  <link name="plunger"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <joint name="lift" type="prismatic"><parent link="base"/><child link="plunger"/>
+    <origin xyz="1 0 0.3"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="100" velocity="5"/></joint>
+</robot>
+"""
+RIG_CONTROLLERS = """rig:
+  spin_effort: {type: effort_controllers/JointEffortController, joint: spin}
+  lift_effort: {type: effort_controllers/JointEffortController, joint: lift}
+"""

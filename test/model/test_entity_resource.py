@@ -1,0 +1,89 @@
+"""A URDF to spawn, from a URI or a string: read once, failures sorted into the standard's codes."""
+
+from __future__ import annotations
+
+import pytest
+from entity_fixtures import box_urdf, write_box
+
+from pan_tilt_sim.model.entity_resource import (
+    EntityResourceError,
+    ResourceProblem,
+    is_static,
+    read_entity_resource,
+)
+
+
+def _problem(**kwargs) -> ResourceProblem:
+    with pytest.raises(EntityResourceError) as error:
+        read_entity_resource(**kwargs)
+    assert '\n' not in str(error.value)
+    return error.value.problem
+
+
+def test_a_string_and_a_file_give_the_same_model(tmp_path):
+    path = write_box(tmp_path, name='crate')
+    from_file = read_entity_resource(uri=str(path))
+    from_uri = read_entity_resource(uri=path.as_uri())
+    from_string = read_entity_resource(resource_string=box_urdf(name='crate'))
+    assert from_file.model == from_uri.model == from_string.model
+    assert from_file.name == 'crate'
+    assert from_file.source == path
+    assert not from_file.model.actuated_joints  # an object need not move
+
+
+def test_the_uri_wins_over_the_resource_string(tmp_path):
+    path = write_box(tmp_path, name='from_file')
+    assert read_entity_resource(uri=str(path), resource_string=box_urdf(name='s')).name == (
+        'from_file')
+
+
+def test_a_xacro_file_is_expanded(tmp_path):
+    path = tmp_path / 'thing.urdf.xacro'
+    path.write_text('<robot name="thing" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                    '<xacro:property name="s" value="0.3"/><link name="a"><collision>'
+                    '<geometry><box size="${s} ${s} ${s}"/></geometry></collision></link></robot>')
+    description = read_entity_resource(uri=str(path))
+    assert description.model.link('a').collisions[0].geometry.size == (0.3, 0.3, 0.3)
+
+
+def test_meshes_are_made_loadable_relative_to_the_file(tmp_path, repo_root):
+    meshes = tmp_path / 'meshes'
+    meshes.mkdir()
+    # A one-triangle binary STL (84 + 50 bytes).
+    import struct
+    data = b'\0' * 80 + struct.pack('<I', 1) + struct.pack('<12fH', *([0.0] * 3),
+                                                             0, 0, 0, 1, 0, 0, 0, 1, 0, 0)
+    (meshes / 'tri.stl').write_bytes(data)
+    path = tmp_path / 'm.urdf'
+    path.write_text(box_urdf(mesh='meshes/tri.stl'))
+    description = read_entity_resource(uri=str(path))
+    assert str(meshes / 'tri.stl') in description.physics_urdf
+
+
+def test_each_failure_has_its_problem(tmp_path):
+    sdf = tmp_path / 'model.sdf'
+    sdf.write_text('<sdf/>')
+    garbage = tmp_path / 'garbage.stl'
+    garbage.write_bytes(b'not a mesh')
+    assert _problem() is ResourceProblem.NOT_FOUND
+    assert _problem(uri=str(tmp_path / 'missing.urdf')) is ResourceProblem.NOT_FOUND
+    assert _problem(uri='package://no_such_package/x.urdf') is ResourceProblem.NOT_FOUND
+    assert _problem(uri='http://example.com/x.urdf') is ResourceProblem.NOT_FOUND
+    assert _problem(uri=str(sdf)) is ResourceProblem.UNSUPPORTED_FORMAT
+    assert _problem(resource_string='<sdf version="1.9"/>') is (
+        ResourceProblem.UNSUPPORTED_FORMAT)
+    assert _problem(resource_string='<robot name="x"><link') is ResourceProblem.PARSE_ERROR
+    assert _problem(resource_string='<robot><link name="a"/></robot>') is (
+        ResourceProblem.PARSE_ERROR)  # no name
+    assert _problem(resource_string='<robot name="x"/>') is ResourceProblem.PARSE_ERROR
+    assert _problem(resource_string=box_urdf(mesh=str(tmp_path / 'gone.stl'))) is (
+        ResourceProblem.MISSING_ASSETS)
+    assert _problem(resource_string=box_urdf(mesh='package://no_such_package/m.stl')) is (
+        ResourceProblem.MISSING_ASSETS)
+    assert _problem(resource_string=box_urdf(mesh=str(garbage))) is (
+        ResourceProblem.UNSUPPORTED_ASSETS)
+
+
+def test_gazebo_static_marks_an_object_fixed():
+    assert is_static(read_entity_resource(resource_string=box_urdf(static=True)))
+    assert not is_static(read_entity_resource(resource_string=box_urdf()))

@@ -1,0 +1,104 @@
+"""The world parameter: a scenery name, or a YAML world file whose problems name the field."""
+
+from __future__ import annotations
+
+import math
+import textwrap
+
+import pytest
+
+from pan_tilt_sim.errors import ParameterError
+from pan_tilt_sim.model.world_file import (
+    SCENERIES,
+    EntitySpec,
+    WorldFileError,
+    read_world_file,
+    world_from_parameter,
+)
+
+
+def _world(tmp_path, text: str):
+    path = tmp_path / 'world.yaml'
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+@pytest.mark.parametrize('name', SCENERIES)
+def test_a_scenery_name_is_a_world_without_objects(name):
+    world = world_from_parameter(name)
+    assert (world.scenery, world.entities, world.source) == (name, (), None)
+
+
+def test_a_world_file_lists_objects_with_poses_tags_and_descriptions(tmp_path):
+    path = _world(tmp_path, """\
+        scenery: targets
+        entities:
+          - name: box
+            uri: box.urdf
+            pose: {position: [1, 2, 3], orientation: [0, 0, 2, 0]}
+            description: a box
+            tags: [a, b]
+          - resource_string: <robot name="r"/>
+            pose: {rpy: [0, 0, 1.0]}
+        """)
+    world = world_from_parameter(str(path))
+    assert world.scenery == 'targets'
+    assert world.source == path
+    assert world.base_dir == tmp_path
+    box, inline = world.entities
+    assert box == EntitySpec(name='box', uri='box.urdf', position=(1.0, 2.0, 3.0),
+                             orientation=(0.0, 0.0, 1.0, 0.0), description='a box',
+                             tags=('a', 'b'))
+    assert inline.resource_string == '<robot name="r"/>'
+    assert inline.position == (0.0, 0.0, 0.0)
+    assert inline.orientation == pytest.approx((0.0, 0.0, math.sin(0.5), math.cos(0.5)))
+
+
+def test_a_world_file_by_file_uri_and_its_default_scenery(tmp_path):
+    path = _world(tmp_path, 'entities: []\n')
+    world = world_from_parameter(path.as_uri())
+    assert world.scenery == 'ground'
+    assert world.entities == ()
+
+
+@pytest.mark.parametrize('text, message', [
+    ('scenery: moon\n', r"scenery: must be one of empty, ground, targets, got 'moon'"),
+    ('entities: {a: 1}\n', 'entities: must be a list, got a mapping'),
+    ('entities: [3]\n', r'entities\[0\]: must be a mapping, got a number'),
+    ('entities: [{name: a}]\n', r'entities\[0\]: give a uri or a resource_string'),
+    ('entities: [{uri: a, colour: red}]\n', r"entities\[0\]: unknown key 'colour'"),
+    ('entities: [{uri: a, name: 3}]\n', r'entities\[0\].name: must be a string'),
+    ('entities: [{uri: a, pose: {position: [1, 2]}}]\n',
+     r'entities\[0\].pose.position: must be 3 finite numbers'),
+    ('entities: [{uri: a, pose: {position: [1, 2, .nan]}}]\n',
+     r'entities\[0\].pose.position: must be 3 finite numbers'),
+    ('entities: [{uri: a, pose: {orientation: [0, 0, 0, 0]}}]\n',
+     r'entities\[0\].pose.orientation: a quaternion of length 0'),
+    ('entities: [{uri: a, pose: {rpy: [0, 0, 0], orientation: [0, 0, 0, 1]}}]\n',
+     r'entities\[0\].pose: give orientation or rpy, not both'),
+    ('entities: [{uri: a, tags: a}]\n', r'entities\[0\].tags: must be a list of strings'),
+    ('entities: [{uri: a, name: x}, {uri: b, name: x}]\n', "the name 'x' is used twice"),
+    ('entities: [\n', r'world.yaml:\d+: YAML syntax error'),
+    ('other: 1\n', "the file: unknown key 'other'"),
+])
+def test_every_problem_names_the_file_and_the_field(tmp_path, text, message):
+    path = _world(tmp_path, text)
+    with pytest.raises(WorldFileError, match=message) as error:
+        read_world_file(path)
+    assert str(error.value).startswith(str(path))
+    assert '\n' not in str(error.value)
+
+
+def test_neither_a_scenery_nor_a_file_lists_the_choices(tmp_path):
+    with pytest.raises(ParameterError, match=r"'moon' is none of empty, ground, targets, "
+                                             r'and no world file \(.*moon: no such file\)'):
+        world_from_parameter('moon')
+    with pytest.raises(ParameterError, match="parameter 'world': .*no_such_package"):
+        world_from_parameter('package://no_such_package/world.yaml')
+    with pytest.raises(ParameterError, match="parameter 'world' must be one of"):
+        world_from_parameter('')
+
+
+def test_the_shipped_world_file_reads(repo_root):
+    world = read_world_file(repo_root / 'config' / 'worlds' / 'tabletop.yaml')
+    assert [entity.name for entity in world.entities] == ['table', 'box', 'can']
