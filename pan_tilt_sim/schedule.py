@@ -47,6 +47,10 @@ class PeriodicSchedule:
         self.advance(time)
         return True
 
+    def due_step(self, time_step: float) -> int:
+        """Return the first physics step (of ``time_step`` s) at which something is due."""
+        return math.ceil((self.next_due - DUE_EPSILON) / time_step)
+
     def reset(self) -> None:
         """Start again: the next call is due at once (as at sim time 0)."""
         self.next_due = 0.0

@@ -23,13 +23,14 @@ import abc
 import dataclasses
 import enum
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
 from pan_tilt_sim.controllers.pid import Pid, PidGains
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.model.robot import JointKind, JointSpec
+from pan_tilt_sim.schedule import PeriodicSchedule
 
 # The command interface a ros2_control controller package's controllers claim.
 PACKAGE_INTERFACES = {'position_controllers': 'position', 'velocity_controllers': 'velocity',
@@ -207,6 +208,22 @@ class Controller(abc.ABC):
     @abc.abstractmethod
     def update(self, time: float, period: float) -> None:
         """Run one control step at sim ``time`` (s), ``period`` s after the previous one."""
+
+    def step_updates(self) -> list[Callable[[float, float], None]]:
+        """Return what the stepping loop calls every physics step, in order (default: update).
+
+        A controller made of others returns theirs, so the loop calls them
+        directly; a controller on a :meth:`schedule` returns none.
+        """
+        return [] if self.schedule() is not None else [self.update]
+
+    def schedule(self) -> PeriodicSchedule | None:
+        """Return the schedule :meth:`update` runs on, if not every step.
+
+        The stepping loop then calls ``update`` only when the schedule says a
+        sample is due (it advances the schedule itself).
+        """
+        return None
 
     def command_interfaces(self) -> dict[str, tuple[str, ...]]:
         """Return the command interfaces this controller claims, by joint (ros2_control's claim).

@@ -24,7 +24,7 @@ are this controller with the interface fixed.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.base import (
@@ -139,6 +139,10 @@ class ForwardCommandController(MultiJointController):
                              f"{', '.join(clamped)}; clamped")
             return CommandResult.CLAMPED
         return CommandResult.ACCEPTED
+
+    def step_updates(self) -> list[Callable[[float, float], None]]:
+        """Return every joint's controller's update: the loop calls them directly."""
+        return [update for member in self._members for update in member.step_updates()]
 
     def update(self, time: float, period: float) -> None:
         """Update every joint's controller."""

@@ -80,6 +80,10 @@ class JointStateController(Controller):
         """Publish at the next update, then every period."""
         self._schedule.reset()
 
+    def schedule(self) -> PeriodicSchedule:
+        """Return the sample schedule: the loop calls :meth:`update` only when one is due."""
+        return self._schedule
+
     def time_of_next_sample(self) -> float:
         """Sim time (s) at which the next sample is due."""
         return self._schedule.next_due

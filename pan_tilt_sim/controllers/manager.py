@@ -56,6 +56,7 @@ from pan_tilt_sim.controllers.registry import (
 from pan_tilt_sim.errors import ControllerConfigError, ControllerSwitchError
 from pan_tilt_sim.model.controller_config import ControllersConfig, ControllerSpec
 from pan_tilt_sim.model.robot import RobotModel
+from pan_tilt_sim.schedule import PeriodicSchedule
 
 ACTIVE_CONTROLLERS = 'active_controllers'
 # ros2_control's lifecycle labels (controller_manager_msgs/ControllerState.state).
@@ -171,8 +172,17 @@ class ControllerManager:
 
     @property
     def updates(self) -> list[Callable[[float, float], None]]:
-        """The update methods of the active controllers, in order (for the stepping loop)."""
+        """What the stepping loop calls every step for the active controllers, in order."""
         return self._updates
+
+    @property
+    def scheduled_updates(self) -> list[tuple[PeriodicSchedule, Callable[[float, float], None]]]:
+        """The active controllers on a schedule, each with its update (called when due).
+
+        They run after :attr:`updates` each step (they are the broadcasters,
+        which sample what the command controllers just computed).
+        """
+        return self._scheduled
 
     def controller(self, name: str) -> Controller:
         """Return the loaded controller called ``name``; KeyError if there is none."""
@@ -321,7 +331,10 @@ class ControllerManager:
             elif state == ACTIVE:
                 self._states[name] = INACTIVE
         self._active = [c for c in self._controllers if c.name in self._active_names]
-        self._updates = [controller.update for controller in self._active]
+        self._updates = [update for controller in self._active
+                         for update in controller.step_updates()]
+        self._scheduled = [(schedule, controller.update) for controller in self._active
+                           if (schedule := controller.schedule()) is not None]
 
     def _loaded(self, name: str, action: str) -> Controller:
         try:

@@ -130,6 +130,9 @@ class CameraPublisher:
         self._schedule = PeriodicSchedule(settings.period)
         self._image_publisher = node.create_publisher(Image, image_topic, QUEUE_DEPTH)
         self._info_publisher = node.create_publisher(CameraInfo, info_topic, QUEUE_DEPTH)
+        # Who watches, asked once per batch of steps (refresh_readers): asking
+        # DDS costs ~0.7 us per topic.
+        self.refresh_readers()
         self._info = camera_info_message(intrinsics(settings), settings.optical_frame)
         self._image = Image(height=settings.height, width=settings.width,
                             encoding=IMAGE_ENCODING, is_bigendian=0,
@@ -151,20 +154,31 @@ class CameraPublisher:
         """Images rendered and published so far."""
         return self._frames
 
+    def refresh_readers(self) -> None:
+        """Ask whether anybody watches the image or the camera info."""
+        self._image_watched = self._image_publisher.get_subscription_count() > 0
+        self._info_watched = self._info_publisher.get_subscription_count() > 0
+
+    def next_step(self, step: int, time_step: float) -> int | None:
+        """Return the next step after ``step`` at which a frame is due (None: unwatched)."""
+        if not (self._image_watched or self._info_watched):
+            return None
+        return max(self._schedule.due_step(time_step), step + 1)
+
     def update(self) -> None:
         """Publish a frame if one is due at the present sim time (render it if watched)."""
         now = self._clock()
         if not self._schedule.take(now):
             return
         stamp(now, self._info.header.stamp)
-        if self._image_publisher.get_subscription_count() > 0:
+        if self._image_watched:
             pixels = self._renderer.render()
             image = self._image
             stamp(now, image.header.stamp)
             image.data = array.array('B', pixels)
             self._image_publisher.publish(image)
             self._frames += 1
-        if self._info_publisher.get_subscription_count() > 0:
+        if self._info_watched:
             self._info_publisher.publish(self._info)
 
     def reset(self) -> None:

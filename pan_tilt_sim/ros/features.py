@@ -37,6 +37,7 @@ class NodeFeatures:
                  gui: bool = False, sensor_namespace: str = '') -> None:
         description = simulation.description
         model = description.model
+        self._time_step = simulation.time_step
         self.world = declare_world(node)
         world = self.world.scenery
         urdf_cameras = any(sensor.kind in (SensorKind.CAMERA, SensorKind.DEPTH)
@@ -73,12 +74,25 @@ class NodeFeatures:
         self.sensors.update()
 
     def steps_until_due(self, step: int) -> int | None:
-        """Return how many steps after ``step`` a watched sensor must see the world (or None)."""
-        return self.sensors.steps_until_due(step)
+        """Return how many steps after ``step`` something watched is due (None: nothing).
+
+        /tf, the camera and the sensors, each only while somebody subscribes:
+        the node runs its steps in chunks that end exactly there.
+        """
+        time_step = self._time_step
+        found = [due for due in (self.robot_state.next_step(step, time_step),
+                                 self.camera.next_step(step, time_step)
+                                 if self.camera is not None else None) if due is not None]
+        sensor = self.sensors.steps_until_due(step)
+        if sensor is not None:
+            found.append(step + sensor)
+        return min(found) - step if found else None
 
     def refresh_readers(self) -> None:
         """Ask, once per batch of steps, whether anybody reads what is published periodically."""
         self.robot_state.refresh_readers()
+        if self.camera is not None:
+            self.camera.refresh_readers()
 
     def close(self) -> None:
         """Release what the features hold beyond the PyBullet client (temporary files)."""

@@ -43,14 +43,23 @@ class Throttle:
         self._tokens = self._burst
         self._refilled = clock()
 
+    def ready(self) -> bool:
+        """Whether a token is there now (none is taken)."""
+        self._refill()
+        return self._tokens >= 1.0
+
     def allow(self) -> bool:
         """Take a token if one is there; return whether the event may happen now."""
-        now = self._clock()
-        tokens = min(self._burst, self._tokens + (now - self._refilled) / self._period)
-        self._refilled = now
-        allowed = tokens >= 1.0
-        self._tokens = tokens - 1.0 if allowed else tokens
+        self._refill()
+        allowed = self._tokens >= 1.0
+        if allowed:
+            self._tokens -= 1.0
         return allowed
+
+    def _refill(self) -> None:
+        now = self._clock()
+        self._tokens = min(self._burst, self._tokens + (now - self._refilled) / self._period)
+        self._refilled = now
 
 
 class Pacer:

@@ -162,6 +162,12 @@ class RobotStatePublisher:
         """Ask whether anybody subscribes to /tf (nothing is computed for nobody)."""
         self._readers = self._sink is not None and self._sink.has_readers()
 
+    def next_step(self, step: int, time_step: float) -> int | None:
+        """Return the next step after ``step`` at which /tf is due (None: nobody listens)."""
+        if not self._readers or self._sink is None:
+            return None
+        return max(self._schedule.due_step(time_step), step + 1)
+
     def update(self) -> None:
         """Publish /tf for the moving joints when due (and somebody listens)."""
         if self._sink is None:

@@ -22,7 +22,6 @@ publish): :attr:`SensorPublisher.cost_per_message` -- the benchmark prints it.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Sequence
 
@@ -44,7 +43,7 @@ from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.ros import parameters as params
 from pan_tilt_sim.ros import sensor_messages as messages
 from pan_tilt_sim.ros.ros_interfaces import stamp
-from pan_tilt_sim.schedule import DUE_EPSILON, PeriodicSchedule
+from pan_tilt_sim.schedule import PeriodicSchedule
 from pan_tilt_sim.sim.engine import Simulation
 from pan_tilt_sim.sim.sensors.force_torque import ForceTorque
 from pan_tilt_sim.sim.sensors.imu import Imu as ImuSensor
@@ -116,7 +115,7 @@ class SensorPublisher:
 
     def due_step(self) -> int:
         """Return the physics step at or after the next due time."""
-        return math.ceil((self._schedule.next_due - DUE_EPSILON) / self._time_step)
+        return self._schedule.due_step(self._time_step)
 
     def next_step(self, step: int) -> int | None:
         """Return the next step after ``step`` this sensor must see (None: unwatched)."""

@@ -55,6 +55,9 @@ CLOCK_PERIOD_S = 0.01  # sim seconds between /clock messages (100 Hz of sim time
 CLOCK_MIN_WALL_PERIOD_S = 0.001
 # A tick's worth (20 ms) of bursts: up to ~10x real time every 10 ms stamp leaves.
 CLOCK_BURST = 20
+# Without a token, the stamps a chunk of steps may run past before it looks again
+# (~1 ms of wall time at ~100x real time, when tokens come one per ms).
+CLOCK_STAMPS_SKIPPED = 10
 QUEUE_DEPTH = 10
 _OWN_PARAMETERS = {field.name for field in dataclasses.fields(parameters.SimParameters)}
 PAUSED = 'paused'  # the parameter; services and set_paused() go through it
@@ -218,24 +221,32 @@ class SimNode(Node):
         Nothing is published that nobody reads (see :meth:`_refresh_readers`).
         """
         simulation = self.simulation
+        features = self.features
         every = self._clock_every
         clock_wanted = self._clock_readers
-        allow_clock = self._clock_throttle.allow
+        throttle = self._clock_throttle
         while steps > 0:
-            chunk = min(steps, every - simulation.steps % every)
-            sensor_due = self.features.steps_until_due(simulation.steps)
-            if sensor_due is not None:  # a watched sensor samples between /clock messages
-                chunk = min(chunk, sensor_due)
+            # The steps run in chunks that end where something watched is due: a
+            # /clock stamp that may leave now, /tf, a camera frame, a sensor sample.
+            # Without a /clock token to spend (far above real time) the next few
+            # stamps cannot leave anyway, so the chunk runs past them.
+            step = simulation.steps
+            chunk = steps
+            if clock_wanted:
+                to_stamp = every - step % every
+                chunk = min(chunk, to_stamp if throttle.ready()
+                            else to_stamp + every * CLOCK_STAMPS_SKIPPED)
+            due = features.steps_until_due(step)
+            if due is not None:
+                chunk = min(chunk, due)
             simulation.advance(chunk)
             self.steps_run += chunk
             steps -= chunk
-            if simulation.steps % every == 0 and clock_wanted:
+            if clock_wanted and step % every + chunk >= every:  # a stamp reached or passed
                 self._clock_pending = True
-                if allow_clock():
+                if simulation.steps % every == 0 and throttle.allow():
                     self._publish_clock()
-            # Every /clock period, not once per batch: batches at factor 0 last
-            # ~5 ms of wall time, which may be many frames of sim time.
-            self.features.after_steps()
+            features.after_steps()
         if self._clock_pending:
             self._publish_clock()
         self.controllers.after_steps()

@@ -109,3 +109,13 @@ def test_the_throttle_lets_a_real_time_tick_through_whole():
     for _ in range(50):
         clock.now += 0.02
         assert all(throttle.allow() for _ in range(3))
+
+
+def test_asking_whether_the_throttle_is_ready_takes_no_token():
+    clock = FakeClock()
+    throttle = Throttle(0.001, 2, clock)
+    assert all(throttle.ready() for _ in range(10))
+    assert throttle.allow() and throttle.allow()
+    assert not throttle.ready()
+    clock.now += 0.001
+    assert throttle.ready() and throttle.allow() and not throttle.ready()

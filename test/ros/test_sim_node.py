@@ -208,3 +208,46 @@ def test_the_same_commands_from_a_reset_give_the_same_joint_states_to_the_last_b
                      for m in pan_tilt.states[first:] if stamp_s(m) <= 3.0])
     assert len(runs[0]) == 151  # 0 .. 3 s at 50 Hz
     assert runs[0] == runs[1]
+
+
+# --- steps run in chunks that end only where something watched is due -------------------
+
+def record_chunks(node) -> list[int]:
+    """Record the size of every chunk of steps the node hands the physics."""
+    chunks: list[int] = []
+    advance = node.simulation.advance
+
+    def recording(steps: int) -> None:
+        chunks.append(steps)
+        advance(steps)
+
+    node.simulation.advance = recording
+    return chunks
+
+
+def test_with_nobody_watching_clock_tf_or_camera_a_batch_is_one_chunk():
+    # joint_states is watched, but the joint-state broadcaster runs inside the
+    # physics step: it needs no chunk boundary.
+    with sim_node(paused=True) as pan_tilt:
+        chunks = record_chunks(pan_tilt.node)
+        pan_tilt.node.step(500)
+        assert chunks == [500]
+
+
+def test_a_clock_reader_ends_chunks_at_the_stamps_while_tokens_last():
+    with sim_node(paused=True) as pan_tilt:
+        pan_tilt.collect(Clock, '/clock', PROBE_QUEUE)
+        pan_tilt.wait_for_subscribers('/clock')
+        chunks = record_chunks(pan_tilt.node)
+        pan_tilt.node.step(100)  # a burst of 20 tokens covers these 10 stamps
+        assert chunks == [10] * 10
+
+
+def test_a_tf_reader_ends_chunks_at_the_tf_period():
+    tf2_msgs = pytest.importorskip('tf2_msgs.msg')
+    with sim_node(paused=True) as pan_tilt:
+        pan_tilt.collect(tf2_msgs.TFMessage, '/tf')
+        pan_tilt.wait_for_subscribers('/tf')
+        chunks = record_chunks(pan_tilt.node)
+        pan_tilt.node.step(101)  # /tf was due at step 0 (published at start)
+        assert chunks == [20, 20, 20, 20, 20, 1]
