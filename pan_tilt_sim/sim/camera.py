@@ -118,11 +118,15 @@ class Intrinsics:
         return (self.fx, 0.0, self.cx, 0.0, 0.0, self.fy, self.cy, 0.0, 0.0, 0.0, 1.0, 0.0)
 
 
+def centred_intrinsics(width: int, height: int, focal: float) -> Intrinsics:
+    """Return the intrinsics of square pixels with the principal point at the image centre."""
+    return Intrinsics(width, height, focal, focal, (width - 1) / 2.0, (height - 1) / 2.0)
+
+
 def intrinsics(settings: CameraSettings) -> Intrinsics:
     """Return the intrinsics for the settings' size and horizontal field of view."""
     focal = (settings.width / 2.0) / math.tan(math.radians(settings.fov_deg) / 2.0)
-    return Intrinsics(settings.width, settings.height, focal, focal,
-                      (settings.width - 1) / 2.0, (settings.height - 1) / 2.0)
+    return centred_intrinsics(settings.width, settings.height, focal)
 
 
 def vertical_fov_deg(settings: CameraSettings) -> float:

@@ -28,6 +28,7 @@ import numpy
 from pan_tilt_sim.model.sensors import CameraSpec, SensorSpec, data_frame
 from pan_tilt_sim.model.transforms import Transform, rotation_matrix
 from pan_tilt_sim.sim.bullet import pybullet
+from pan_tilt_sim.sim.camera import Intrinsics, centred_intrinsics
 from pan_tilt_sim.sim.physics import Physics
 from pan_tilt_sim.sim.sensors.mount import LinkReader
 from pan_tilt_sim.sim.sensors.noise import NoiseModel
@@ -39,33 +40,9 @@ BACKGROUND = 1.0  # OpenGL depth where nothing was drawn (the far plane)
 BYTE_MAX = 255.0
 
 
-@dataclasses.dataclass(frozen=True)
-class Intrinsics:
-    """Pinhole intrinsics in pixels."""
-
-    width: int
-    height: int
-    fx: float
-    fy: float
-    cx: float
-    cy: float
-
-    @property
-    def k(self) -> tuple[float, ...]:
-        """The 3x3 camera matrix, row-major."""
-        return (self.fx, 0.0, self.cx, 0.0, self.fy, self.cy, 0.0, 0.0, 1.0)
-
-    @property
-    def p(self) -> tuple[float, ...]:
-        """The 3x4 projection matrix of a monocular camera, row-major."""
-        return (self.fx, 0.0, self.cx, 0.0, 0.0, self.fy, self.cy, 0.0, 0.0, 0.0, 1.0, 0.0)
-
-
 def camera_intrinsics(camera: CameraSpec) -> Intrinsics:
     """Return the intrinsics of a Gazebo camera (square pixels, centred)."""
-    focal = camera.focal_length
-    return Intrinsics(camera.width, camera.height, focal, focal,
-                      (camera.width - 1) / 2.0, (camera.height - 1) / 2.0)
+    return centred_intrinsics(camera.width, camera.height, camera.focal_length)
 
 
 def linear_depth(buffer: numpy.ndarray, near: float, far: float) -> numpy.ndarray:
