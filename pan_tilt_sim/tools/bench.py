@@ -314,6 +314,17 @@ def busiest_thread_cpu_seconds(pid: int) -> float:
                for thread in psutil.Process(pid).threads())
 
 
+def interrupt(process: subprocess.Popen) -> None:
+    """Ctrl-C ``process`` and wait for it; kill it if it does not stop in time."""
+    if process.poll() is None:
+        process.send_signal(signal.SIGINT)
+        try:
+            process.wait(STOP_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
+
+
 class Listener:
     """A subscriber in its own process (``pan_tilt_sim.tools.listener``)."""
 
@@ -330,13 +341,7 @@ class Listener:
 
     def stop(self) -> None:
         """Stop the listener (SIGINT), killing it if it lingers."""
-        if self.process.poll() is None:
-            self.process.send_signal(signal.SIGINT)
-            try:
-                self.process.wait(STOP_TIMEOUT_S)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait()
+        interrupt(self.process)
 
 
 class NodeProcess:
@@ -373,13 +378,7 @@ class NodeProcess:
 
     def stop(self) -> None:
         """Ctrl-C the node and wait for it; kill it if it does not stop."""
-        if self.process.poll() is None:
-            self.process.send_signal(signal.SIGINT)
-            try:
-                self.process.wait(STOP_TIMEOUT_S)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait()
+        interrupt(self.process)
 
 
 class Probe:

@@ -365,15 +365,9 @@ def plot(record: StepRecord, metrics: StepMetrics, path: pathlib.Path) -> None:
     pyplot.close(figure)
 
 
-def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
-    """Read the command line."""
-    share = package_share()
-    parser = argparse.ArgumentParser(
-        prog=PROGRAM, description='Step a joint by position in the simulator (no ROS graph) '
-        'and print rise time, overshoot, settling time, ... as JSON.')
-    parser.add_argument('--joint', required=True, help='joint to step, e.g. pan_joint')
-    parser.add_argument('--target', required=True, type=float, help='position to step to')
-    parser.add_argument('--model', default=str(share / DEFAULT_DESCRIPTION),
+def add_robot_arguments(parser: argparse.ArgumentParser, active_default: str) -> None:
+    """Add the options that say which robot and controllers to load (step_response, tune)."""
+    parser.add_argument('--model', default=str(package_share() / DEFAULT_DESCRIPTION),
                         help='.urdf or .xacro file (default: the pan/tilt model)')
     parser.add_argument('--xacro-args', nargs='*', default=[], metavar='NAME:=VALUE',
                         help='xacro mappings for a .xacro model')
@@ -383,8 +377,17 @@ def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     parser.add_argument('--controllers-args', nargs='*', default=[], metavar='NAME:=VALUE',
                         help="values of the YAML's $(var NAME) substitutions")
     parser.add_argument('--active-controllers', nargs='*', default=None, metavar='NAME',
-                        help='controllers to activate (default: every one that claims no '
-                        'joint an earlier one claims)')
+                        help=f'controllers to activate (default: {active_default})')
+
+
+def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
+    """Read the command line."""
+    parser = argparse.ArgumentParser(
+        prog=PROGRAM, description='Step a joint by position in the simulator (no ROS graph) '
+        'and print rise time, overshoot, settling time, ... as JSON.')
+    parser.add_argument('--joint', required=True, help='joint to step, e.g. pan_joint')
+    parser.add_argument('--target', required=True, type=float, help='position to step to')
+    add_robot_arguments(parser, 'every one that claims no joint an earlier one claims')
     parser.add_argument('--controller', default=None, metavar='NAME',
                         help="the controller to step with (default: the joint's active one "
                         'if it takes positions, else the first that does)')

@@ -601,26 +601,14 @@ def parse_ranges(values: Sequence[str]) -> dict[str, tuple[float, float]]:
 
 def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the robot, specification and back-end options ``tune`` and ``sweep`` share."""
-    from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
-
-    share = package_share()
     parser.add_argument('--joint', action='append', required=True, metavar='NAME',
                         help='joint whose position controller to step (repeatable)')
     parser.add_argument('--target', action='append', required=True, metavar='[JOINT=]VALUE',
                         help='position to step to from the initial position (repeatable; '
                         'JOINT= gives it to one joint only)')
-    parser.add_argument('--model', default=str(share / DEFAULT_DESCRIPTION),
-                        help='.urdf or .xacro file (default: the pan/tilt model)')
-    parser.add_argument('--xacro-args', nargs='*', default=[], metavar='NAME:=VALUE',
-                        help='xacro mappings for a .xacro model')
-    parser.add_argument('--controllers', default='',
-                        help="controllers YAML (default: the one the URDF's control plugin "
-                        'names; for the pan/tilt model its own)')
-    parser.add_argument('--controllers-args', nargs='*', default=[], metavar='NAME:=VALUE',
-                        help="values of the YAML's $(var NAME) substitutions")
-    parser.add_argument('--active-controllers', nargs='*', default=None, metavar='NAME',
-                        help="controllers to activate (default: the stepped joint's position "
-                        'controller, then every one that claims no joint an earlier one claims)')
+    step_response.add_robot_arguments(
+        parser, "the stepped joint's position controller, then every one that claims no "
+        'joint an earlier one claims')
     parser.add_argument('--time-step', type=float, default=step_response.DEFAULT_TIME_STEP,
                         help=f'physics step in s (default {step_response.DEFAULT_TIME_STEP})')
     parser.add_argument('--duration', type=float, default=None,
