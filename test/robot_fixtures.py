@@ -178,3 +178,17 @@ def ros2_control_yaml(controllers: dict, update_rate: int = 100) -> str:
         lines += [f'{name}:', '  ros__parameters:']
         lines += [f'    {key}: {value}' for key, value in params.items()]
     return '\n'.join(lines) + '\n'
+
+
+class Log:
+    """A logger for the simulation that collects what it says."""
+
+    def __init__(self) -> None:
+        self.infos: list[str] = []
+        self.warnings: list[str] = []
+
+    def info(self, message: str) -> None:
+        self.infos.append(message)
+
+    def warning(self, message: str) -> None:
+        self.warnings.append(message)

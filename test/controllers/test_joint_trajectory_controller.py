@@ -8,19 +8,17 @@ trajectories with the shipped three-joint arm in PyBullet.
 import math
 
 import pytest
+from trajectory_fixtures import JOINTS, controller_for, make_handles, trajectory
 
-from pan_tilt_sim.controllers import CommandKind, CommandResult, JointHandle, create_controller
+from pan_tilt_sim.controllers import CommandKind, CommandResult
 from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
 from pan_tilt_sim.controllers.base import Drive
 from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
 from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPlan, TrajectoryPoint
 from pan_tilt_sim.errors import ControllerConfigError
-from pan_tilt_sim.model.robot import JointKind, JointSpec
 from pan_tilt_sim.sim.engine import make_simulation
 
 DT = 0.001
-JTC = 'joint_trajectory_controller/JointTrajectoryController'
-JOINTS = ('a', 'b')
 
 
 # --- TrajectoryPlan ------------------------------------------------------------------------
@@ -72,26 +70,6 @@ def test_plan_sampling_goes_back_after_a_reset_of_time():
 
 
 # --- the controller, without a simulator ---------------------------------------------------
-
-def make_handles():
-    specs = [JointSpec('a', JointKind.REVOLUTE, -2.0, 2.0, effort_limit=1000.0),
-             JointSpec('b', JointKind.PRISMATIC, -0.5, 0.5, effort_limit=1000.0),
-             JointSpec('c', JointKind.CONTINUOUS)]
-    return {spec.name: JointHandle(spec) for spec in specs}
-
-
-def controller_for(handles=None, **params):
-    params.setdefault('joints', list(JOINTS))
-    controller = create_controller('arm', JTC, params, 'test.yaml')
-    controller.configure(handles if handles is not None else make_handles())
-    return controller
-
-
-def trajectory(*points, names=JOINTS, start=None):
-    """Points as (time_from_start, positions[, velocities])."""
-    return JointTrajectory(tuple(names), tuple(TrajectoryPoint(*point) for point in points),
-                           start)
-
 
 class Clock:
     """Steps a controller through sim time, one update per physics step."""

@@ -10,9 +10,8 @@ is aborted, and what the joints hold afterwards.
 import math
 
 import pytest
+from trajectory_fixtures import JOINTS, controller_for, make_handles, trajectory
 
-from pan_tilt_sim.controllers import JointHandle, create_controller
-from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
 from pan_tilt_sim.controllers.trajectory_goal import (
     GOAL_TOLERANCE_VIOLATED,
     INVALID_GOAL,
@@ -27,31 +26,8 @@ from pan_tilt_sim.controllers.trajectory_goal import (
     shortest_angular_distance,
 )
 from pan_tilt_sim.errors import ControllerConfigError
-from pan_tilt_sim.model.robot import JointKind, JointSpec
 
 DT = 0.001
-JTC = 'joint_trajectory_controller/JointTrajectoryController'
-JOINTS = ('a', 'b')
-
-
-def make_handles():
-    specs = [JointSpec('a', JointKind.REVOLUTE, -2.0, 2.0, effort_limit=1000.0),
-             JointSpec('b', JointKind.PRISMATIC, -0.5, 0.5, effort_limit=1000.0),
-             JointSpec('c', JointKind.CONTINUOUS)]
-    return {spec.name: JointHandle(spec) for spec in specs}
-
-
-def controller_for(handles=None, **params):
-    params.setdefault('joints', list(JOINTS))
-    controller = create_controller('arm', JTC, params, 'test.yaml')
-    controller.configure(handles if handles is not None else make_handles())
-    return controller
-
-
-def trajectory(*points, names=JOINTS, start=None):
-    """Points as (time_from_start, positions[, velocities[, accelerations[, efforts]]])."""
-    return JointTrajectory(tuple(names), tuple(TrajectoryPoint(*point) for point in points),
-                           start)
 
 
 class Follower:

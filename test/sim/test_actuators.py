@@ -10,6 +10,7 @@ import math
 
 import pytest
 from robot_fixtures import (
+    Log,
     arm_holding_torques,
     ros2_control_yaml,
     two_link_arm_urdf,
@@ -25,19 +26,6 @@ from pan_tilt_sim.sim.engine import make_simulation
 DT = 0.001
 ARM_JOINTS = ['joint1', 'joint2']
 POSITION_GROUP = ('position_controllers/JointGroupPositionController', {'joints': ARM_JOINTS})
-
-
-class Log:
-    """Collects what the simulation logs."""
-
-    def __init__(self):
-        self.infos, self.warnings = [], []
-
-    def info(self, message):
-        self.infos.append(message)
-
-    def warning(self, message):
-        self.warnings.append(message)
 
 
 def simulation(tmp_path, urdf, yaml, log=None, **options):

@@ -1,7 +1,7 @@
 """The simulation loop with the seed's robot, no ROS: the behaviour Gazebo users expect."""
 
 import pytest
-from robot_fixtures import ros2_control_yaml, two_link_arm_urdf, write_text
+from robot_fixtures import Log, ros2_control_yaml, two_link_arm_urdf, write_text
 
 from pan_tilt_sim.errors import ControllerConfigError, ParameterError
 from pan_tilt_sim.model.controller_config import ControllersConfig, ControllerSpec
@@ -106,17 +106,6 @@ INITIAL_VALUES = """<ros2_control name="arm" type="system">
   </joint>
 </ros2_control>
 </robot>"""
-
-
-class Log:
-    def __init__(self):
-        self.infos, self.warnings = [], []
-
-    def info(self, message):
-        self.infos.append(message)
-
-    def warning(self, message):
-        self.warnings.append(message)
 
 
 def arm_with_initial_values(tmp_path, initial_positions=None, log=None):

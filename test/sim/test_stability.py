@@ -8,6 +8,7 @@ from robot_fixtures import (
     LINK_MASS,
     LINK_WIDTH,
     JointDef,
+    Log,
     write_star_robot,
     write_text,
 )
@@ -20,17 +21,6 @@ DT = 0.001
 # A star link about its joint's z axis: box about its centre plus m (L / 2)^2.
 STAR_INERTIA = LINK_MASS * (LINK_LENGTH ** 2 + LINK_WIDTH ** 2) / 12 + LINK_MASS * (
     LINK_LENGTH / 2) ** 2
-
-
-class Log:
-    def __init__(self):
-        self.infos, self.warnings = [], []
-
-    def info(self, message):
-        self.infos.append(message)
-
-    def warning(self, message):
-        self.warnings.append(message)
 
 
 def star(tmp_path, gains, log, damping=0.0):
