@@ -10,8 +10,10 @@ microseconds per physics step:
 * the engine (``Simulation.advance``: PyBullet + controllers, no ROS);
 * sim_node at real_time_factor 0 on an executor, split into the engine,
   /clock and JointState publishing, and the rest (executor, pacing).
+  Nobody subscribes here, so nothing is published (0.00): ``bench`` measures
+  the node with a /clock or JointState subscriber in another process.
 
-Usage: ``python scripts/step_profile.py [--seconds S] [--executor events|single_threaded]``
+Usage: ``python scripts/step_profile.py [--seconds S]``
 (sets ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST; use your own ROS_DOMAIN_ID).
 """
 
