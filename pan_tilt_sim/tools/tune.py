@@ -717,10 +717,7 @@ def main(argv: Sequence[str] | None = None) -> None:
                 print(f'gains written to {args.out}')
             else:
                 print(f'{args.out} not written: the specification is not met')
-    except ConfigurationError as err:
-        print(f'{PROGRAM}: error: {err}', file=sys.stderr)
-        sys.exit(EXIT_CONFIGURATION_ERROR)
-    except BackendError as err:
+    except (ConfigurationError, BackendError) as err:
         print(f'{PROGRAM}: error: {err}', file=sys.stderr)
         sys.exit(EXIT_CONFIGURATION_ERROR)
     sys.stdout.flush()
