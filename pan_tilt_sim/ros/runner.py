@@ -243,6 +243,23 @@ def _ros_is_shut_down() -> bool:
     return rclpy is not None and not rclpy.ok()
 
 
+def shut_down_ros() -> None:
+    """Shut rclpy's default context down unless something else already did.
+
+    rclpy's own signal handler shuts every context down from a thread of its
+    own, without the lock ``try_shutdown`` takes: a signal arriving between
+    that call's "still ok?" check and its shutdown makes rcl refuse the second
+    shutdown ("rcl_shutdown already called").  That is the outcome we asked
+    for, not an error.
+    """
+    rclpy = sys.modules['rclpy']
+    try:
+        rclpy.try_shutdown()
+    except Exception:  # RCLError, which rclpy does not export
+        if rclpy.ok():
+            raise
+
+
 def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
         program: str, make_executor: Callable[[Node], Executor] | None = None) -> int:
     """Build a node with ``make_node``, spin it until stopped; return the exit code.
@@ -285,7 +302,7 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
             if node is not None:
                 node.destroy_node()
             if initialized:
-                sys.modules['rclpy'].try_shutdown()
+                shut_down_ros()
     if failure is not None:
         # Last, after rcl's shutdown chatter when debugging: the line the user reads.
         report_error(program, failure, debug=debug)

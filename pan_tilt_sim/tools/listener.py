@@ -19,6 +19,8 @@ import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
+from pan_tilt_sim.ros.runner import shut_down_ros
+
 
 def message_type(name: str) -> type:
     """Return the message class for ``pkg/msg/Type``."""
@@ -49,7 +51,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         pass
     finally:
         node.destroy_node()
-        rclpy.try_shutdown()
+        shut_down_ros()  # rclpy's signal handler may have shut the context down meanwhile
     print(count[0], flush=True)
 
 

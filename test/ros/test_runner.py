@@ -9,11 +9,18 @@ from __future__ import annotations
 
 import os
 import signal
+import sys
 
 import pytest
 
 from pan_tilt_sim.errors import ArgumentError
-from pan_tilt_sim.ros.runner import StopRequested, StopSignals, debug_requested, init_ros
+from pan_tilt_sim.ros.runner import (
+    StopRequested,
+    StopSignals,
+    debug_requested,
+    init_ros,
+    shut_down_ros,
+)
 
 
 def _python_call() -> None:
@@ -84,3 +91,27 @@ def test_the_previous_handlers_come_back():
     with StopSignals():
         assert signal.getsignal(signal.SIGTERM) is not before[signal.SIGTERM]
     assert {signum: signal.getsignal(signum) for signum in before} == before
+
+
+class RacingRclpy:
+    """rclpy whose try_shutdown fails as when its signal handler shut the context first."""
+
+    def __init__(self, shut_down_by_other: bool) -> None:
+        self._shut_down_by_other = shut_down_by_other
+
+    def try_shutdown(self) -> None:
+        raise RuntimeError('failed to shutdown: rcl_shutdown already called on the given context')
+
+    def ok(self) -> bool:
+        return not self._shut_down_by_other
+
+
+def test_a_shutdown_that_rclpys_signal_handler_won_is_not_an_error(monkeypatch):
+    monkeypatch.setitem(sys.modules, 'rclpy', RacingRclpy(shut_down_by_other=True))
+    shut_down_ros()  # the context is down, as asked: no exception
+
+
+def test_a_shutdown_that_failed_with_the_context_still_up_is_raised(monkeypatch):
+    monkeypatch.setitem(sys.modules, 'rclpy', RacingRclpy(shut_down_by_other=False))
+    with pytest.raises(RuntimeError, match='rcl_shutdown'):
+        shut_down_ros()
