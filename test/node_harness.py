@@ -169,6 +169,32 @@ class SimUnderTest:
         self._collected.append(received)
         return received
 
+    def topics_once_seen(self, *names: str) -> dict[str, list[str]]:
+        """The ROS graph's topics, once ``names`` are all in it.
+
+        The graph learns even the node's own topics through DDS discovery, which
+        lags under load: wait for them (bounded) rather than read it once.
+        """
+        return self._graph_once_seen(self.node.get_topic_names_and_types, names)
+
+    def services_once_seen(self, *names: str) -> dict[str, list[str]]:
+        """The node's own services in the ROS graph, once ``names`` are all in it."""
+        node = self.node
+        return self._graph_once_seen(lambda: node.get_service_names_and_types_by_node(
+            node.get_name(), node.get_namespace()), names)
+
+    def _graph_once_seen(self, read: Callable[[], list], names: tuple[str, ...]) -> dict:
+        graph: dict[str, list[str]] = {}
+
+        def seen() -> bool:
+            graph.clear()
+            graph.update(read())
+            return all(name in graph for name in names)
+
+        assert self.spin_until(seen), (
+            f'not in the ROS graph: {[name for name in names if name not in graph]}')
+        return dict(graph)
+
     def wait_for_subscribers(self, topic: str, count: int = 1) -> None:
         """Spin until the node sees ``count`` subscribers on ``topic``."""
         assert self.spin_until(lambda: self.node.count_subscribers(topic) >= count), (

@@ -30,7 +30,7 @@ def pan_tilt():
 
 
 def test_topics_are_those_of_the_seed(pan_tilt):
-    topics = dict(pan_tilt.node.get_topic_names_and_types())
+    topics = pan_tilt.topics_once_seen(PAN_COMMAND, TILT_COMMAND, f'{NS}/joint_states', '/clock')
     assert topics[PAN_COMMAND] == ['std_msgs/msg/Float64']
     assert topics[TILT_COMMAND] == ['std_msgs/msg/Float64']
     assert topics[f'{NS}/joint_states'] == ['sensor_msgs/msg/JointState']
@@ -141,7 +141,7 @@ def test_an_effort_controller_meets_damping_and_friction(tmp_path):
 def test_the_seeds_own_files_drive_the_same_topics(seeds_dir):
     with sim_node(robot_description_file=str(seeds_dir / 'pan_tilt.xacro'),
                   controllers_file=str(seeds_dir / 'pan_tilt_control.yaml')) as pan_tilt:
-        topics = dict(pan_tilt.node.get_topic_names_and_types())
+        topics = pan_tilt.topics_once_seen(PAN_COMMAND, f'{NS}/joint_states')
         assert topics[PAN_COMMAND] == ['std_msgs/msg/Float64']
         assert topics[f'{NS}/joint_states'] == ['sensor_msgs/msg/JointState']
         pan_tilt.command(PAN, Float64(data=-0.3))

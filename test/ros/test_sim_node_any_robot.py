@@ -53,7 +53,7 @@ def test_seed2_arm_joint_reaches_its_command_under_the_plugin_namespace(seed2_pa
         robot_description_file=str(seed2_package / mf.SEED2_URDF_RELPATH),
         controllers_file=str(seed2_package / 'config' / 'joint_controllers.yaml'))
     assert robot.node.robot_namespace == '/my_robot'
-    topics = dict(robot.node.get_topic_names_and_types())
+    topics = robot.topics_once_seen('/my_robot/arm_controller/command', '/my_robot/joint_states')
     assert topics['/my_robot/arm_controller/command'] == ['std_msgs/msg/Float64']
     assert topics['/my_robot/joint_states'] == ['sensor_msgs/msg/JointState']
     robot.command('arm_controller', Float64(data=1.57))
@@ -88,7 +88,8 @@ def arm(repo_root, start_node):
 
 
 def test_arm_topics_are_at_the_root_with_ros2_control_names(arm):
-    topics = dict(arm.node.get_topic_names_and_types())
+    topics = arm.topics_once_seen('/joint_states', '/arm_controller/joint_trajectory',
+                                  '/gripper_controller/commands')
     assert topics['/joint_states'] == ['sensor_msgs/msg/JointState']
     assert topics['/arm_controller/joint_trajectory'] == [
         'trajectory_msgs/msg/JointTrajectory']
@@ -161,7 +162,7 @@ def test_group_controller_moves_its_joints_through_its_commands_topic(
         """)
     robot = start_node(robot_namespace='star', robot_description_file=str(robot_file),
                        controllers_file=str(controllers))
-    topics = dict(robot.node.get_topic_names_and_types())
+    topics = robot.topics_once_seen('/star/group/commands', '/star/joint_states')
     assert topics['/star/group/commands'] == ['std_msgs/msg/Float64MultiArray']
     assert topics['/star/joint_states'] == ['sensor_msgs/msg/JointState']
     robot.command('group', Float64MultiArray(data=[1.0, 1.0, 1.0]))

@@ -43,15 +43,12 @@ def playing():
         yield SimInterfaces(sim)
 
 
-def _services_of(sim) -> dict[str, list[str]]:
-    return dict(sim.node.get_service_names_and_types_by_node(
-        sim.node.get_name(), sim.node.get_namespace()))
-
-
 # --- names and features --------------------------------------------------------------------
 
 def test_services_are_under_the_node_name_and_gazebo_ros_empty_reset_stays(paused):
-    services = _services_of(paused.sim)
+    services = paused.sim.services_once_seen(
+        *(f'/sim_node/{leaf}' for leaf in SERVICES), '/reset_simulation',
+        '/sim_node/simulate_steps/_action/send_goal')
     for leaf, (kind, _harmless) in SERVICES.items():
         assert services[f'/sim_node/{leaf}'] == [f'simulation_interfaces/srv/{kind.__name__}']
     action_services = [name for name in services if name.startswith('/sim_node/simulate_steps/')]
@@ -63,7 +60,7 @@ def test_services_are_under_the_node_name_and_gazebo_ros_empty_reset_stays(pause
 
 def test_an_empty_namespace_gives_isaac_names_and_replaces_the_empty_reset():
     with sim_node(**{'simulation_interfaces.namespace': '', 'paused': True}) as sim:
-        services = _services_of(sim)
+        services = sim.services_once_seen('/reset_simulation', '/step_simulation', '/reset_world')
         assert services['/reset_simulation'] == ['simulation_interfaces/srv/ResetSimulation']
         assert services['/step_simulation'] == ['simulation_interfaces/srv/StepSimulation']
         assert services['/reset_world'] == ['std_srvs/srv/Empty']
@@ -296,7 +293,7 @@ def test_without_simulation_interfaces_the_node_runs_and_says_so_once(capfd, mon
     with sim_node() as sim:
         sim.run_until_sim_time(0.2)
         assert sim.node.simulation_interfaces is None
-        services = _services_of(sim)
+        services = sim.services_once_seen('/reset_simulation')
         assert not [leaf for leaf in SERVICES if f'/sim_node/{leaf}' in services]
         assert not [name for name in services if 'simulate_steps' in name]
         assert services['/reset_simulation'] == ['std_srvs/srv/Empty']
@@ -315,7 +312,7 @@ def test_without_simulation_interfaces_the_node_runs_and_says_so_once(capfd, mon
 def test_the_namespace_parameter_moves_the_services(namespace, name):
     with sim_node(**{'simulation_interfaces.namespace': namespace}) as sim:
         assert name in sim.node.simulation_interfaces.names
-        assert name in _services_of(sim)
+        sim.services_once_seen(name)
 
 
 @pytest.mark.parametrize('namespace', ['~sim', '9sim', 'a b', '/a//b'])
