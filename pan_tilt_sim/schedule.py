@@ -51,6 +51,10 @@ class PeriodicSchedule:
         """Return the first physics step (of ``time_step`` s) at which something is due."""
         return math.ceil((self.next_due - DUE_EPSILON) / time_step)
 
+    def next_step(self, step: int, time_step: float) -> int:
+        """Return the first step after ``step`` at or past the next due time."""
+        return max(self.due_step(time_step), step + 1)
+
     def reset(self) -> None:
         """Start again: the next call is due at once (as at sim time 0)."""
         self.next_due = 0.0

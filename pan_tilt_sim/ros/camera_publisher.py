@@ -163,7 +163,7 @@ class CameraPublisher:
         """Return the next step after ``step`` at which a frame is due (None: unwatched)."""
         if not (self._image_watched or self._info_watched):
             return None
-        return max(self._schedule.due_step(time_step), step + 1)
+        return self._schedule.next_step(step, time_step)
 
     def update(self) -> None:
         """Publish a frame if one is due at the present sim time (render it if watched)."""

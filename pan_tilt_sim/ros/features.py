@@ -82,10 +82,8 @@ class NodeFeatures:
         time_step = self._time_step
         found = [due for due in (self.robot_state.next_step(step, time_step),
                                  self.camera.next_step(step, time_step)
-                                 if self.camera is not None else None) if due is not None]
-        sensor = self.sensors.steps_until_due(step)
-        if sensor is not None:
-            found.append(step + sensor)
+                                 if self.camera is not None else None,
+                                 self.sensors.next_step(step)) if due is not None]
         return min(found) - step if found else None
 
     def refresh_readers(self) -> None:

@@ -166,7 +166,7 @@ class RobotStatePublisher:
         """Return the next step after ``step`` at which /tf is due (None: nobody listens)."""
         if not self._readers or self._sink is None:
             return None
-        return max(self._schedule.due_step(time_step), step + 1)
+        return self._schedule.next_step(step, time_step)
 
     def update(self) -> None:
         """Publish /tf for the moving joints when due (and somebody listens)."""

@@ -121,7 +121,7 @@ class SensorPublisher:
         """Return the next step after ``step`` this sensor must see (None: unwatched)."""
         if not self._watched:
             return None
-        return max(self.due_step(), step + 1)
+        return self._schedule.next_step(step, self._time_step)
 
     def update(self) -> None:
         """Measure and publish if due at the present sim time and watched."""
@@ -384,11 +384,11 @@ class SensorSet:
         for publisher in self.publishers:
             publisher.update()
 
-    def steps_until_due(self, step: int) -> int | None:
-        """Return the steps from ``step`` to the next one a watched sensor must see (or None)."""
+    def next_step(self, step: int) -> int | None:
+        """Return the next step after ``step`` a watched sensor must see (None: none is)."""
         steps = [found for publisher in self.publishers
                  if (found := publisher.next_step(step)) is not None]
-        return min(steps) - step if steps else None
+        return min(steps) if steps else None
 
     def reset(self) -> None:
         """Start every sensor's schedule again."""
