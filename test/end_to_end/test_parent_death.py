@@ -77,10 +77,18 @@ def wait_for(condition, budget_s: float) -> bool:
 
 @pytest.fixture
 def cleanup():
+    """Stop what a test leaves running: SIGTERM (a clean DDS exit), SIGKILL if that fails.
+
+    A SIGKILLed DDS participant leaves its shared-memory ports behind in
+    /dev/shm, where the next tests in this domain would meet them.
+    """
     pids: list[int] = []
     yield pids
-    for pid in pids:
-        if is_running(pid):
+    running = [pid for pid in pids if is_running(pid)]
+    for pid in running:
+        os.kill(pid, signal.SIGTERM)
+    for pid in running:
+        if not wait_for(lambda pid=pid: not is_running(pid), GONE_BUDGET_S):
             os.kill(pid, signal.SIGKILL)
 
 

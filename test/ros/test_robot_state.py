@@ -178,6 +178,10 @@ def test_tf_gives_every_link_where_forward_kinematics_puts_it_after_commands_mim
         harness.run_for(1.5)
         model = harness.simulation.description.model
         assert static, 'nothing on /tf_static'
+        # Named if the frames are wrong: a foreign node in this domain would show here.
+        static_publishers = sorted(
+            f'{info.node_namespace.rstrip("/")}/{info.node_name}'
+            for info in harness.probe.get_publishers_info_by_topic('/tf_static'))
     # The newest /tf message whose JointState (same stamp) also arrived: under load the
     # probe's queues may drop a few of either at factor 0.
     stamped = {round(stamp_s(m), 6): m for m in harness.states}
@@ -195,7 +199,8 @@ def test_tf_gives_every_link_where_forward_kinematics_puts_it_after_commands_mim
     leaders = {name: value for name, value in positions.items() if name != 'right_finger_joint'}
     expected = model.link_poses(leaders)
     got = tf_link_poses(static, last)
-    assert set(got) == set(expected)  # one frame per link: every joint, fixed or moving
+    # One frame per link: every joint, fixed or moving.
+    assert set(got) == set(expected), f'/tf_static publishers: {static_publishers}'
     assert {t.child_frame_id for t in last.transforms} == {j.child for j in model.moving_joints}
     for link, pose in expected.items():
         assert_same_pose(got[link], pose, link)
