@@ -41,6 +41,12 @@ SAME_STAMP_S = 1e-6  # two stamps this close are the same instant
 SIM_TIME_EPSILON_S = 1e-9
 
 
+def interface_name(interface: type) -> str:
+    """ROS's name of a message or service class, as the graph gives it: ``std_msgs/msg/Float64``."""
+    package, kind, _module = interface.__module__.split('.')
+    return f'{package}/{kind}/{interface.__name__}'
+
+
 def stamp_s(message) -> float:
     """Return a message's time in seconds: a Clock's ``clock``, else its header stamp."""
     stamp = message.clock if isinstance(message, Clock) else message.header.stamp
@@ -178,10 +184,29 @@ class SimUnderTest:
         return self._graph_once_seen(self.node.get_topic_names_and_types, names)
 
     def services_once_seen(self, *names: str) -> dict[str, list[str]]:
-        """The node's own services in the ROS graph, once ``names`` are all in it."""
-        node = self.node
-        return self._graph_once_seen(lambda: node.get_service_names_and_types_by_node(
-            node.get_name(), node.get_namespace()), names)
+        """The ROS graph's services, once ``names`` are all in it.
+
+        The whole graph, not the node's share of it looked up by node name: a
+        second node of the same name in the domain would make that look-up
+        answer for the other one.
+        """
+        return self._graph_once_seen(self.node.get_service_names_and_types, names)
+
+    def own_topics(self) -> tuple[dict[str, str], dict[str, str]]:
+        """The topics the node publishes and subscribes to, from its own endpoints.
+
+        What the node created, with no DDS discovery in between: a negative
+        check ("no camera topic") on the discovered graph would pass while
+        discovery lags.
+        """
+        def named(endpoints) -> dict[str, str]:
+            return {e.topic_name: interface_name(e.msg_type) for e in endpoints}
+        return named(self.node.publishers), named(self.node.subscriptions)
+
+    def own_services(self) -> dict[str, str]:
+        """The services the node serves (actions aside), from its own endpoints, no discovery."""
+        return {service.service_name: interface_name(service.srv_type)
+                for service in self.node.services}
 
     def _graph_once_seen(self, read: Callable[[], list], names: tuple[str, ...]) -> dict:
         graph: dict[str, list[str]] = {}

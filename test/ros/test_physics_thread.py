@@ -96,11 +96,21 @@ def threaded(context):
     executor = TurnTakingExecutor(node.turns, context=context)
     executor.add_node(node)
     executor.add_node(probe)
-    spinning = threading.Thread(target=lambda: executor.spin(), daemon=True)
+    stop = threading.Event()
+
+    def spin() -> None:
+        while not stop.is_set():
+            executor.spin_once(timeout_sec=0.05)
+
+    # Stopped by its own loop, not by executor.shutdown() from here: rclpy's
+    # shutdown drops the guard condition a wait in the spinning thread may be using.
+    spinning = threading.Thread(target=spin, daemon=True)
     spinning.start()
     yield node, probe
-    executor.shutdown()
+    stop.set()
     spinning.join(BUDGET_S)
+    assert not spinning.is_alive(), 'the spinning thread did not stop'
+    executor.shutdown()
     probe.destroy_node()
     node.destroy_node()
 

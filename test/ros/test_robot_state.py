@@ -267,10 +267,10 @@ def without_tf2_msgs(monkeypatch):
 def test_without_tf2_msgs_tf_is_off_and_said_so_once(capfd, without_tf2_msgs):
     with sim_node() as harness:
         harness.run_until_sim_time(0.5)
-        publishers = dict(harness.node.get_publisher_names_and_types_by_node(
-            harness.node.get_name(), harness.node.get_namespace()))
+        publishers, _subscribed = harness.own_topics()
         assert not harness.node.features.robot_state.publishes_tf
     assert '/tf' not in publishers and '/tf_static' not in publishers
+    assert '/clock' in publishers  # the look-up does see the node's topics
     assert capfd.readouterr().err.count(TF_OFF_LINE) == 1
 
 

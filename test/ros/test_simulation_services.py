@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import pytest
 from node_harness import PROBE_QUEUE, sim_node, stamp_s
+from rclpy.action import ActionServer
 from rosgraph_msgs.msg import Clock
 from sim_interfaces_client import (
     OK,
@@ -46,24 +47,24 @@ def playing():
 # --- names and features --------------------------------------------------------------------
 
 def test_services_are_under_the_node_name_and_gazebo_ros_empty_reset_stays(paused):
-    services = paused.sim.services_once_seen(
-        *(f'/sim_node/{leaf}' for leaf in SERVICES), '/reset_simulation',
-        '/sim_node/simulate_steps/_action/send_goal')
+    services = paused.sim.own_services()
     for leaf, (kind, _harmless) in SERVICES.items():
-        assert services[f'/sim_node/{leaf}'] == [f'simulation_interfaces/srv/{kind.__name__}']
-    action_services = [name for name in services if name.startswith('/sim_node/simulate_steps/')]
-    assert action_services  # the action's send_goal, cancel_goal, get_result
-    assert services['/reset_simulation'] == ['std_srvs/srv/Empty']
+        assert services[f'/sim_node/{leaf}'] == f'simulation_interfaces/srv/{kind.__name__}'
+    assert services['/reset_simulation'] == 'std_srvs/srv/Empty'
+    # The action's send_goal, cancel_goal and get_result, as `ros2 action list` finds them.
+    graph = paused.sim.services_once_seen('/sim_node/simulate_steps/_action/send_goal')
+    assert graph['/sim_node/simulate_steps/_action/send_goal'] == [
+        'simulation_interfaces/action/SimulateSteps_SendGoal']
     paused.sim.call(Empty, '/reset_simulation')  # still works as gazebo_ros's
     assert paused.state() == State.STATE_STOPPED
 
 
 def test_an_empty_namespace_gives_isaac_names_and_replaces_the_empty_reset():
     with sim_node(**{'simulation_interfaces.namespace': '', 'paused': True}) as sim:
-        services = sim.services_once_seen('/reset_simulation', '/step_simulation', '/reset_world')
-        assert services['/reset_simulation'] == ['simulation_interfaces/srv/ResetSimulation']
-        assert services['/step_simulation'] == ['simulation_interfaces/srv/StepSimulation']
-        assert services['/reset_world'] == ['std_srvs/srv/Empty']
+        services = sim.own_services()
+        assert services['/reset_simulation'] == 'simulation_interfaces/srv/ResetSimulation'
+        assert services['/step_simulation'] == 'simulation_interfaces/srv/StepSimulation'
+        assert services['/reset_world'] == 'std_srvs/srv/Empty'
         client = SimInterfaces(sim, namespace='/')
         assert client.reset(msg_scope('SCOPE_ALL')).result == OK
 
@@ -293,10 +294,10 @@ def test_without_simulation_interfaces_the_node_runs_and_says_so_once(capfd, mon
     with sim_node() as sim:
         sim.run_until_sim_time(0.2)
         assert sim.node.simulation_interfaces is None
-        services = sim.services_once_seen('/reset_simulation')
+        services = sim.own_services()
         assert not [leaf for leaf in SERVICES if f'/sim_node/{leaf}' in services]
-        assert not [name for name in services if 'simulate_steps' in name]
-        assert services['/reset_simulation'] == ['std_srvs/srv/Empty']
+        assert not [w for w in sim.node.waitables if isinstance(w, ActionServer)]  # no action
+        assert services['/reset_simulation'] == 'std_srvs/srv/Empty'
     err = capfd.readouterr().err
     assert err.count('off, for want of their interface packages:') == 1
     assert err.count('the simulator services (get_simulator_features, step_simulation, '
@@ -312,7 +313,7 @@ def test_without_simulation_interfaces_the_node_runs_and_says_so_once(capfd, mon
 def test_the_namespace_parameter_moves_the_services(namespace, name):
     with sim_node(**{'simulation_interfaces.namespace': namespace}) as sim:
         assert name in sim.node.simulation_interfaces.names
-        sim.services_once_seen(name)
+        assert name in sim.own_services()
 
 
 @pytest.mark.parametrize('namespace', ['~sim', '9sim', 'a b', '/a//b'])

@@ -90,18 +90,9 @@ def test_partial_messages_by_name_on_the_plugins_default_topics():
 def test_the_yaml_controllers_do_not_run_in_topic_mode():
     with sim_node(**{'topic_based.enabled': True}) as sim:
         sim.run_until_sim_time(0.1)
-        node = sim.node
-
-        def graph() -> tuple[dict, dict]:
-            return (dict(node.get_publisher_names_and_types_by_node(node.get_name(), '/')),
-                    dict(node.get_subscriber_names_and_types_by_node(node.get_name(), '/')))
-
-        # The ROS graph learns even the node's own topics through discovery: wait for it.
-        assert sim.spin_until(lambda: '/robot_joint_states' in graph()[0]
-                              and '/robot_joint_commands' in graph()[1])
-        published, subscribed = graph()
-        assert published['/robot_joint_states'] == ['sensor_msgs/msg/JointState']
-        assert subscribed['/robot_joint_commands'] == ['sensor_msgs/msg/JointState']
+        published, subscribed = sim.own_topics()
+        assert published['/robot_joint_states'] == 'sensor_msgs/msg/JointState'
+        assert subscribed['/robot_joint_commands'] == 'sensor_msgs/msg/JointState'
         assert f'{NS}/joint_states' not in published
         assert not [topic for topic in subscribed if 'controller' in topic]
 
