@@ -21,8 +21,8 @@ than wall time):
   subscriber in its own process).  Each gives ``steps_per_s`` (sim time over
   wall time between two JointStates the probe takes at the ends of the
   window, subscribing only for them), ``ratio_to_raw`` (over
-  ``raw.steps_per_s``), ``node_cpu_us_per_step`` (the node's busiest
-  thread: the one stepping the physics) and, with a subscriber,
+  ``raw.steps_per_s``), ``node_cpu_us_per_step`` (the thread that used
+  the most CPU over the window: the one stepping the physics) and, with a subscriber,
   ``subscriber_cpu_percent`` (% of one core);
 * ``factor_1``: at real_time_factor 1 with a /clock subscriber:
   ``cpu_percent`` (the node process, % of one core),
@@ -300,18 +300,27 @@ def cpu_seconds(pid: int) -> float:
     return times.user + times.system
 
 
-def busiest_thread_cpu_seconds(pid: int) -> float:
-    """CPU time (user + system) of the process's busiest thread so far (psutil, else /proc)."""
+def thread_cpu_seconds(pid: int) -> dict[int, float]:
+    """CPU time (user + system) each of the process's threads has used so far, by thread id."""
     try:
         import psutil
     except ImportError:
-        best = 0.0
+        times = {}
         for task in pathlib.Path(f'/proc/{pid}/task').iterdir():
             fields = (task / 'stat').read_text().rpartition(')')[2].split()
-            best = max(best, (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK'))
-        return best
-    return max(thread.user_time + thread.system_time
-               for thread in psutil.Process(pid).threads())
+            times[int(task.name)] = (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+        return times
+    return {thread.id: thread.user_time + thread.system_time
+            for thread in psutil.Process(pid).threads()}
+
+
+def busiest_thread_delta(before: dict[int, float], after: dict[int, float]) -> float:
+    """Return the most CPU seconds one thread used between two ``thread_cpu_seconds`` readings.
+
+    Per thread, not the busiest thread's total at each end: the thread with
+    the most CPU so far may be the one that did the start-up, not the physics.
+    """
+    return max(seconds - before.get(thread, 0.0) for thread, seconds in after.items())
 
 
 def interrupt(process: subprocess.Popen) -> None:
@@ -372,9 +381,9 @@ class NodeProcess:
         """CPU seconds the node has used so far."""
         return cpu_seconds(self.process.pid)
 
-    def busiest_thread_cpu_seconds(self) -> float:
-        """CPU seconds the node's busiest thread (the physics) has used so far."""
-        return busiest_thread_cpu_seconds(self.process.pid)
+    def thread_cpu_seconds(self) -> dict[int, float]:
+        """CPU seconds each of the node's threads has used so far."""
+        return thread_cpu_seconds(self.process.pid)
 
     def stop(self) -> None:
         """Ctrl-C the node and wait for it; kill it if it does not stop."""
@@ -505,11 +514,11 @@ class Bench:
             self.joint_state_sample(node, model)  # it runs
             self._wait(node, commander, self.plan.warmup_s)
             wall_start, sim_start = self.joint_state_sample(node, model)
-            node_cpu = node.busiest_thread_cpu_seconds()
+            node_threads = node.thread_cpu_seconds()
             listener_cpu = listener.cpu_seconds() if listener else 0.0
             self._wait(node, commander, duration)
             wall_end, sim_end = self.joint_state_sample(node, model)
-            node_cpu = node.busiest_thread_cpu_seconds() - node_cpu
+            node_cpu = busiest_thread_delta(node_threads, node.thread_cpu_seconds())
             listener_cpu = (listener.cpu_seconds() - listener_cpu) if listener else 0.0
         steps = (sim_end - sim_start) / self.time_step
         if steps <= 0 or wall_end <= wall_start:

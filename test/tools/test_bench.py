@@ -78,6 +78,24 @@ def test_quick_keeps_pybullet_and_node_output_off_stdout(quick_run):
     assert stdout.count('\n') == 1 and stdout.lstrip().startswith('{')
 
 
+def test_node_cpu_is_the_busiest_thread_over_the_window_not_the_busiest_so_far():
+    # Thread 1 did the start-up (10 s so far) and idles; thread 2 steps the physics.
+    before = {1: 10.0, 2: 0.5}
+    after = {1: 10.01, 2: 1.5, 3: 0.2}  # thread 3 started during the window
+    assert bench.busiest_thread_delta(before, after) == pytest.approx(1.0)
+
+
+@pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
+def test_quick_measures_the_physics_thread_at_factor_0(quick_run):
+    # At least the bare step's CPU per step, whoever listens: the physics thread was measured.
+    figures = json.loads(quick_run[0])
+    raw = figures['raw']['step_us_cpu']
+    for case, values in figures['factor_0'].items():
+        assert values['node_cpu_us_per_step'] > raw, case
+    for joints, values in figures['scaling'].items():
+        assert values['node_cpu_us_per_step'] > raw, joints
+
+
 def test_rounded_gives_integer_rates_and_four_significant_digits_at_any_depth():
     figures = bench.rounded({'raw': {'steps_per_s': 123456.7, 'step_us_cpu': 3.14159},
                              'scaling': {'2': {'steps_per_s': 9876.4}}})
