@@ -17,6 +17,7 @@ from collections.abc import Callable, Iterator
 from typing import Any
 
 import rclpy
+from rclpy.action import ActionClient
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -132,10 +133,19 @@ class NodeHarness:
             self.probe.destroy_client(client)
 
     def close(self) -> None:
-        """Destroy every node and shut the context down."""
+        """Destroy every node, and the tests' action clients; shut the context down.
+
+        rclpy's destroy_node leaves a node's action clients alone, and they keep
+        the node -- and its DDS participant, with its endpoints -- alive until
+        garbage collection, where the next test's nodes would still meet them.
+        (sim_node destroys its own action servers.)
+        """
         for node in reversed(self._nodes):
             for each in (*getattr(node, 'companion_nodes', ()), node):
                 self.executor.remove_node(each)
+                for waitable in list(each.waitables):
+                    if isinstance(waitable, ActionClient):
+                        waitable.destroy()
             node.destroy_node()
         self.executor.shutdown()
         rclpy.try_shutdown(context=self.context)

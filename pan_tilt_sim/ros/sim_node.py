@@ -85,7 +85,25 @@ class SimNode(Node):
     """
 
     def __init__(self, *, physics_thread: bool = False, **kwargs) -> None:
+        # What destroy_node releases, empty until built: a start-up error
+        # destroys whatever was made before it (the rclpy node included), so an
+        # in-process caller is left with no live DDS endpoints and no PyBullet.
+        self.simulation: Simulation | None = None
+        self.controllers: ControllerBindings | None = None
+        self.features: NodeFeatures | None = None
+        self.simulation_interfaces = None
+        self.companion_nodes: list[Node] = []
+        self._physics_thread: PhysicsThread | None = None
+        self._timer = None
         super().__init__(NODE_NAME, **kwargs)
+        try:
+            self._build(physics_thread)
+        except BaseException:
+            self.destroy_node()
+            raise
+
+    def _build(self, physics_thread: bool) -> None:
+        """Everything sim_node is, from its parameters; the last step starts the physics."""
         self.settings = parameters.declare_parameters(self)
         description = load_description(
             self.settings.robot_description_file, self.settings.xacro_args)
@@ -110,8 +128,6 @@ class SimNode(Node):
                                    or self.settings.autostart_controllers))
         self._paused = self.settings.paused
         self.steps_run = 0  # physics steps this node has run (never reset; see run_steps)
-        # Nodes of this process spun on sim_node's executor and destroyed with it.
-        self.companion_nodes: list[Node] = []
         self.controller_manager: Node | None = None  # where controller_manager_msgs exists
         self._pacer = Pacer(self.settings.real_time_factor, self.settings.time_step)
         self._clock_every = clock_period_steps(self.settings.time_step)
@@ -120,37 +136,30 @@ class SimNode(Node):
         self._clock_readers = True  # until the first batch asks
         self._clock_pending = False
         self._clock_throttle = Throttle(CLOCK_MIN_WALL_PERIOD_S, CLOCK_BURST)
-        try:
-            self.gain_parameters = GainParameters(self)
-            topic_mode = self._topic_settings is not None
-            self.controllers = ControllerBindings(
-                self, self.simulation,
-                topic_hardware.topics(self._topic_settings, self.topic) if topic_mode
-                else self.topic,
-                self.gain_parameters,
-                actions=not topic_mode and optional_interfaces.available('control_msgs'),
-                command_topics=not topic_mode)
-            self.topic_hardware = topic_hardware.TopicHardware(
-                self, self._topic_settings, description,
-                self.simulation.controllers) if topic_mode else None
-            # Commands taken per controller (ignored ones included): a cheap health figure.
-            self.commands_received = self.controllers.commands_received
-            # Sensors follow an explicit namespace (the node's, or robot_namespace) the
-            # way Gazebo's spawn -robot_namespace moves every plugin; else their plugins'.
-            self.features = NodeFeatures(
-                self, self.simulation, self.robot_namespace, gui=self.settings.gui,
-                sensor_namespace=naming.normalize(self.get_namespace())
-                or naming.normalize(self.settings.robot_namespace))
-            self._start_controller_manager(controllers)
-        except BaseException:
-            self._destroy_companions()
-            self.simulation.close()
-            raise
+        self.gain_parameters = GainParameters(self)
+        topic_mode = self._topic_settings is not None
+        self.controllers = ControllerBindings(
+            self, self.simulation,
+            topic_hardware.topics(self._topic_settings, self.topic) if topic_mode
+            else self.topic,
+            self.gain_parameters,
+            actions=not topic_mode and optional_interfaces.available('control_msgs'),
+            command_topics=not topic_mode)
+        self.topic_hardware = topic_hardware.TopicHardware(
+            self, self._topic_settings, description,
+            self.simulation.controllers) if topic_mode else None
+        # Commands taken per controller (ignored ones included): a cheap health figure.
+        self.commands_received = self.controllers.commands_received
+        # Sensors follow an explicit namespace (the node's, or robot_namespace) the
+        # way Gazebo's spawn -robot_namespace moves every plugin; else their plugins'.
+        self.features = NodeFeatures(
+            self, self.simulation, self.robot_namespace, gui=self.settings.gui,
+            sensor_namespace=naming.normalize(self.get_namespace())
+            or naming.normalize(self.settings.robot_namespace))
+        self._start_controller_manager(controllers)
         self._publish_clock()
         self.features.after_steps()  # their first samples at t = 0, as /clock's
         self.turns: Turns | None = None
-        self._physics_thread: PhysicsThread | None = None
-        self._timer = None
         if physics_thread:
             self.turns = Turns()
             self._physics_thread = PhysicsThread(self._on_tick, self._thread_period, self.turns)
@@ -163,13 +172,7 @@ class SimNode(Node):
         self._world_services = services.create_world_services(
             self, reset=self.reset, set_paused=self.set_paused)
         # simulation_interfaces (where installed): its own module, its own callback groups.
-        try:
-            self.simulation_interfaces = simulation_services.create(self, self._world_services)
-        except BaseException:
-            self._destroy_companions()
-            self.features.close()
-            self.simulation.close()
-            raise
+        self.simulation_interfaces = simulation_services.create(self, self._world_services)
         self._log_controllers(description, controllers)
         self._log_missing_interfaces()
         # Actuators, start positions, PyBullet's load messages, unstable gains.
@@ -302,12 +305,15 @@ class SimNode(Node):
             self._physics_thread.stop()
         if self._timer is not None:
             self._timer.cancel()
-        self.controllers.destroy()
+        if self.controllers is not None:
+            self.controllers.destroy()
         self._destroy_companions()
         if self.simulation_interfaces is not None:
             self.simulation_interfaces.close()
-        self.features.close()
-        self.simulation.close()
+        if self.features is not None:
+            self.features.close()
+        if self.simulation is not None:
+            self.simulation.close()
         logger = self.get_logger()
         super().destroy_node()
         # Once the node is gone: its rosout publisher may share a dead context.

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pytest
 from node_harness import PROBE_QUEUE, sim_node, stamp_s
-from rclpy.action import ActionServer
+from rclpy.action import ActionClient, ActionServer
 from rosgraph_msgs.msg import Clock
 from sim_interfaces_client import (
     OK,
@@ -285,6 +285,17 @@ def test_simulate_steps_while_playing_is_aborted_with_the_reason(playing):
     assert result.result().status == 6  # GoalStatus.STATUS_ABORTED
     assert result.result().result.result.result == Result.RESULT_OPERATION_FAILED
     assert 'paused' in result.result().result.result.error_message
+
+
+def test_a_closed_harness_leaves_no_action_client_holding_its_probe():
+    # rclpy's destroy_node spares action clients, whose handles keep the node and
+    # its DDS participant alive until garbage collection: the next test's nodes
+    # would meet its endpoints (8 more native threads per such test, measured).
+    with sim_node(paused=True) as sim:
+        SimInterfaces(sim).action_client()
+        probe = sim.probe
+        assert [w for w in probe.waitables if isinstance(w, ActionClient)]
+    assert not [w for w in probe.waitables if isinstance(w, ActionClient)]
 
 
 # --- without the package -------------------------------------------------------------------

@@ -14,6 +14,7 @@ import os
 import pathlib
 
 import pytest
+import rclpy
 import sim_process
 from rclpy.parameter import Parameter
 
@@ -255,6 +256,24 @@ def test_a_bad_start_up_input_raises_one_line_naming_it(context, files, override
     assert '\n' not in message
     for part in expected:
         assert _fill(part, files) in message
+
+
+@pytest.mark.parametrize('overrides', [
+    {'time_step': -1.0},  # the first parameter read
+    {'controllers_file': '/no/such/controllers.yaml'},  # after the description
+    {'simulation_interfaces.namespace': '9sim'},  # the last thing built
+], ids=['parameters', 'controllers file', 'simulation_interfaces'])
+def test_a_start_up_error_leaves_no_node_behind(context, overrides):
+    # An in-process caller (a test, an embedding program) gets the error and
+    # nothing else: no sim_node or controller_manager left on its context, even
+    # while it holds the error (whose traceback holds the half-built node).
+    probe = rclpy.create_node('probe', context=context)
+    try:
+        with pytest.raises(ConfigurationError) as raised:
+            SimNode(context=context, parameter_overrides=_overrides(overrides))
+        assert sorted(probe.get_node_names()) == ['probe'], raised.value
+    finally:
+        probe.destroy_node()
 
 
 @pytest.mark.skipif(os.geteuid() == 0, reason='root reads files whatever their mode')
