@@ -92,6 +92,7 @@ class SimNode(Node):
         self.controllers: ControllerBindings | None = None
         self.features: NodeFeatures | None = None
         self.simulation_interfaces = None
+        # Nodes of this process spun on sim_node's executor and destroyed with it.
         self.companion_nodes: list[Node] = []
         self._physics_thread: PhysicsThread | None = None
         self._timer = None
