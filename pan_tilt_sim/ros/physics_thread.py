@@ -13,8 +13,9 @@ runs between two batches of steps, never during one.  :class:`Turns` is
 that lock; a callback waiting for its turn goes before the next batch, so
 at real_time_factor 0 a command waits at most for the batch in progress
 (~5 ms).  :class:`TurnTakingExecutor` is rclpy's SingleThreadedExecutor
-with each callback run inside its turn.  If the physics thread fails, the
-executor raises its exception, so the program ends with the traceback.
+with each callback run inside its turn.  If the physics thread fails, it
+wakes the executor, which raises its exception, so the program ends with
+the traceback -- the executor never has to poll for it.
 """
 
 from __future__ import annotations
@@ -25,7 +26,12 @@ import time
 from collections.abc import Callable, Iterator
 
 from rclpy.context import Context
-from rclpy.executors import ShutdownException, SingleThreadedExecutor, TimeoutException
+from rclpy.executors import (
+    ConditionReachedException,
+    ShutdownException,
+    SingleThreadedExecutor,
+    TimeoutException,
+)
 
 JOIN_TIMEOUT_S = 5.0
 
@@ -37,7 +43,18 @@ class Turns:
         self._lock = threading.Lock()
         self._condition = threading.Condition()
         self._callbacks_waiting = 0
+        self._on_failure: list[Callable[[], None]] = []
         self.failure: BaseException | None = None
+
+    def on_failure(self, wake: Callable[[], None]) -> None:
+        """Have ``wake()`` called (from the physics thread) when the physics fails."""
+        self._on_failure.append(wake)
+
+    def fail(self, error: BaseException) -> None:
+        """Record why the physics stopped and wake whoever waits to hear of it."""
+        self.failure = error
+        for wake in self._on_failure:
+            wake()
 
     @contextlib.contextmanager
     def callback(self) -> Iterator[None]:
@@ -71,15 +88,27 @@ class TurnTakingExecutor(SingleThreadedExecutor):
     def __init__(self, turns: Turns, *, context: Context | None = None) -> None:
         super().__init__(context=context)
         self._turns = turns
+        turns.on_failure(self._wake_for_failure)
+
+    def _physics_failed(self) -> bool:
+        return self._turns.failure is not None
+
+    def _wake_for_failure(self) -> None:
+        # Shut down meanwhile (its guard condition destroyed): nobody is left to tell.
+        with contextlib.suppress(RuntimeError):
+            self.wake()
 
     def spin_once(self, timeout_sec: float | None = None) -> None:
         """Wait for one ready callback (without holding the turn), then run it in its turn."""
         if self._turns.failure is not None:
             raise self._turns.failure
         try:
-            handler, _entity, _node = self.wait_for_ready_callbacks(timeout_sec)
+            handler, _entity, _node = self.wait_for_ready_callbacks(
+                timeout_sec, condition=self._physics_failed)
         except (ShutdownException, TimeoutException):
             return
+        except ConditionReachedException:  # the physics failed and woke the wait
+            raise self._turns.failure from None
         with self._turns.callback():
             handler()
         if handler.exception() is not None:
@@ -128,7 +157,7 @@ class PhysicsThread:
         try:
             self._loop()
         except BaseException as error:  # handed to the executor, which raises it
-            self._turns.failure = error
+            self._turns.fail(error)
 
     def _loop(self) -> None:
         next_tick = time.monotonic()

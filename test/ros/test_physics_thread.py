@@ -85,6 +85,39 @@ def test_a_failing_tick_makes_the_executor_raise_it(context):
         executor.shutdown()
 
 
+def test_a_failing_tick_wakes_an_executor_that_waits_without_a_timeout(context):
+    """sim_node's executor waits with no timeout, so the physics thread must wake it."""
+    turns, waiting, raised = Turns(), threading.Event(), []
+
+    class Observed(TurnTakingExecutor):
+        def wait_for_ready_callbacks(self, *args, **kwargs):
+            waiting.set()
+            return super().wait_for_ready_callbacks(*args, **kwargs)
+
+    def tick():
+        assert waiting.wait(BUDGET_S)
+        raise RuntimeError('the physics broke')
+
+    def spin():
+        try:
+            executor.spin_once()  # nothing else will ever end this wait
+        except RuntimeError as error:
+            raised.append(error)
+
+    executor = Observed(turns, context=context)
+    spinner = threading.Thread(target=spin, daemon=True)
+    thread = PhysicsThread(tick, lambda: 0.0, turns)
+    spinner.start()
+    thread.start()
+    try:
+        spinner.join(BUDGET_S)
+        assert not spinner.is_alive(), 'the executor slept through the failure'
+        assert [str(error) for error in raised] == ['the physics broke']
+    finally:
+        thread.stop()
+        executor.shutdown()
+
+
 # --- sim_node with its physics thread -------------------------------------------------
 
 @pytest.fixture
