@@ -1,6 +1,5 @@
 """The executor sim_node spins on, and spinning until shutdown."""
 
-import threading
 import time
 
 import pytest
@@ -82,24 +81,3 @@ def test_an_idle_spin_sleeps_until_there_is_work(context):
         node.destroy_node()
     assert 1 <= len(waits) <= 2  # the wait that the timer ends, perhaps one more
 
-
-def test_a_shutdown_from_another_thread_ends_a_spin_that_waits_for_nothing(context):
-    """rclpy wakes the executor when its context shuts down (Ctrl-C does that too)."""
-    node = rclpy.create_node('spinning_test', context=context)
-    waiting = threading.Event()
-
-    class Observed(SingleThreadedExecutor):
-        def wait_for_ready_callbacks(self, *args, **kwargs):
-            waiting.set()
-            return super().wait_for_ready_callbacks(*args, **kwargs)
-
-    spinner = threading.Thread(target=spinning.spin, args=(node,), kwargs={
-        'make_executor': lambda spin_context: Observed(context=spin_context)}, daemon=True)
-    spinner.start()
-    try:
-        assert waiting.wait(SPIN_BUDGET_S)
-        rclpy.try_shutdown(context=context)
-        spinner.join(SPIN_BUDGET_S)
-        assert not spinner.is_alive()
-    finally:
-        node.destroy_node()
