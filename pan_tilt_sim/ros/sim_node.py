@@ -222,21 +222,32 @@ class SimNode(Node):
         batch.  So up to ~10x real time every stamp leaves (at factor 1 nothing
         is dropped); far above it /clock comes about once per wall millisecond
         and use_sim_time timers see sim time advance in jumps of that size.
-        Nothing is published that nobody reads (see :meth:`_refresh_readers`).
+
+        At real_time_factor 0 a batch (~5 ms of wall time) is cut at the stamps,
+        so /clock advances through it; paced, a batch is a few ms of sim time
+        run in a fraction of a wall millisecond, so its stamps leave together
+        after it, back to back with the JointStates it took (see
+        :class:`~pan_tilt_sim.ros.controller_bindings.JointStateSink`): right
+        after the thread slept, the first publish costs ~150 us of CPU and the
+        next ones ~10-20 us.  Up to ~10x real time, /clock reaches a stamp before
+        anything stamped at or after it leaves.  Nothing is published that nobody
+        reads (see :meth:`_refresh_readers`).
         """
         simulation = self.simulation
         features = self.features
+        controllers = self.controllers
         every = self._clock_every
         clock_wanted = self._clock_readers
         throttle = self._clock_throttle
+        cut_at_stamps = clock_wanted and self._pacer.fast
         while steps > 0:
             # The steps run in chunks that end where something watched is due: a
-            # /clock stamp that may leave now, /tf, a camera frame, a sensor sample.
-            # Without a /clock token to spend (far above real time) the next few
-            # stamps cannot leave anyway, so the chunk runs past them.
+            # /clock stamp that may leave now (factor 0), /tf, a camera frame, a
+            # sensor sample.  Without a /clock token to spend (far above real
+            # time) the next few stamps cannot leave anyway, so the chunk runs past them.
             step = simulation.steps
             chunk = steps
-            if clock_wanted:
+            if cut_at_stamps:
                 to_stamp = every - step % every
                 chunk = min(chunk, to_stamp if throttle.ready()
                             else to_stamp + every * CLOCK_STAMPS_SKIPPED)
@@ -246,14 +257,37 @@ class SimNode(Node):
             simulation.advance(chunk)
             self.steps_run += chunk
             steps -= chunk
-            if clock_wanted and step % every + chunk >= every:  # a stamp reached or passed
-                self._clock_pending = True
-                if simulation.steps % every == 0 and throttle.allow():
-                    self._publish_clock()
+            if clock_wanted:
+                self._publish_stamps_reached(step, chunk, cut_at_stamps)
+            controllers.flush_joint_states()
             features.after_steps()
         if self._clock_pending:
             self._publish_clock()
-        self.controllers.after_steps()
+        controllers.after_steps()
+
+    def _publish_stamps_reached(self, step: int, chunk: int, cut_at_stamps: bool) -> None:
+        """Publish, as tokens allow, the /clock stamps the ``chunk`` steps after ``step`` reached.
+
+        Cut at the stamps (factor 0), a chunk ends at one -- or runs past a few
+        for want of tokens -- and only the newest may leave; paced, each stamp
+        it reached may, oldest first.  One held back leaves at the batch's end.
+        """
+        every = self._clock_every
+        end = step + chunk
+        stamp = step - step % every + every  # the first grid stamp after ``step``
+        if stamp > end:
+            return
+        throttle = self._clock_throttle
+        self._clock_pending = True
+        if cut_at_stamps:
+            if end % every == 0 and throttle.allow():
+                self._publish_clock_at(end)
+            return
+        for grid_steps in range(stamp, end + 1, every):
+            if throttle.allow():
+                self._publish_clock_at(grid_steps)
+            else:
+                self._clock_pending = True
 
     @property
     def paused(self) -> bool:
@@ -345,15 +379,18 @@ class SimNode(Node):
             return
         steps = self._pacer.steps_due()
         if steps:
-            self._refresh_readers()
             self.run_steps(steps)
+            self._refresh_readers()  # for the next batch, while DDS's code is warm
 
     def _refresh_readers(self) -> None:
         """Find out, once per batch, which of the periodic topics anybody reads.
 
-        A publish costs 3-5 us even with no subscriber; asking costs ~0.7 us.
-        A subscriber that appears mid-batch is served from the next batch on
-        (within ~5 ms of wall time), well inside DDS's own matching delay.
+        A publish costs 3-5 us even with no subscriber; asking costs ~0.7 us
+        (~60 us right after the physics thread slept: so the ticks ask after
+        their batch, just after publishing).  A subscriber that appears is
+        served from the batch after next (within ~10 ms of wall time at factor
+        0, ~40 ms paced), inside DDS's own matching delay; stepping on request
+        asks before its batch.
         """
         self._clock_readers = self._clock_publisher.get_subscription_count() > 0
         self.controllers.refresh_readers()
@@ -361,10 +398,12 @@ class SimNode(Node):
 
     def _publish_clock(self) -> None:
         """Publish the newest stamp on the /clock grid (at or before the present sim time)."""
-        simulation = self.simulation
-        grid_steps = simulation.steps - simulation.steps % self._clock_every
+        steps = self.simulation.steps
+        self._publish_clock_at(steps - steps % self._clock_every)
+
+    def _publish_clock_at(self, grid_steps: int) -> None:
         self._clock_publisher.publish(
-            clock_message(grid_steps * simulation.time_step, self._clock_message))
+            clock_message(grid_steps * self.simulation.time_step, self._clock_message))
         self._clock_pending = False
 
     def _start_controller_manager(self, controllers: ControllersConfig) -> None:

@@ -247,3 +247,44 @@ def test_a_tf_reader_ends_chunks_at_the_tf_period():
         chunks = record_chunks(pan_tilt.node)
         pan_tilt.node.step(101)  # /tf was due at step 0 (published at start)
         assert chunks == [20, 20, 20, 20, 20, 1]
+
+
+def record_publications(node) -> list[tuple[str, float]]:
+    """Record (topic kind, stamp) of every /clock and JointState the node publishes."""
+    sent: list[tuple[str, float]] = []
+    clock = node._clock_publisher
+
+    class Recording:
+        def __init__(self, kind, publisher) -> None:
+            self._kind, self._publisher = kind, publisher
+
+        def publish(self, message) -> None:
+            sent.append((self._kind, round(stamp_s(message), 9)))
+            self._publisher.publish(message)
+
+        def __getattr__(self, name):
+            return getattr(self._publisher, name)
+
+    node._clock_publisher = Recording('clock', clock)
+    for _controller, _publisher, sink in node.controllers._joint_state_sinks:
+        sink._publisher = Recording('joint_states', sink._publisher)
+    return sent
+
+
+def test_paced_a_batch_is_one_chunk_and_its_stamps_leave_after_it_before_its_joint_states():
+    # At real_time_factor 1 a 20 ms batch runs in well under a wall
+    # millisecond: cutting it at the 10 ms stamps buys nothing, and the
+    # messages leave back to back, /clock first.
+    with sim_node(paused=True, real_time_factor=1.0) as pan_tilt:
+        pan_tilt.collect(Clock, '/clock', PROBE_QUEUE)
+        pan_tilt.wait_for_subscribers('/clock')
+        start = pan_tilt.node.simulation.steps
+        assert start % 20 == 0
+        chunks = record_chunks(pan_tilt.node)
+        sent = record_publications(pan_tilt.node)
+        pan_tilt.node.step(20)
+        assert chunks == [20]
+        t = start * 0.001
+        # The broadcaster (50 Hz) samples the state at the batch's first step.
+        assert sent == [('clock', round(t + 0.01, 9)), ('clock', round(t + 0.02, 9)),
+                        ('joint_states', round(t, 9))]
