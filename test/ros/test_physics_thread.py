@@ -8,7 +8,7 @@ import rclpy
 from rclpy.parameter import Parameter
 from std_msgs.msg import Float64
 
-from pan_tilt_sim.ros.physics_thread import PhysicsThread, Turns, TurnTakingExecutor
+from pan_tilt_sim.ros.physics_thread import PhysicsThread, Turns, TurnTakingExecutor, Wakeup
 from pan_tilt_sim.ros.sim_node import SimNode
 
 BUDGET_S = 10.0
@@ -24,6 +24,28 @@ def wait_for(condition, budget_s=BUDGET_S, step_s=0.005):
 
 
 # --- Turns and the thread, without ROS -------------------------------------------------
+
+def test_a_wakeup_is_a_flag_a_wait_takes_down_or_times_out_without():
+    wakeup = Wakeup()
+    assert wakeup.wait(0.0) is False
+    wakeup.set()
+    wakeup.set()  # a flag, not a count
+    assert wakeup.wait(BUDGET_S) is True
+    started = time.monotonic()
+    assert wakeup.wait(0.05) is False
+    assert time.monotonic() - started >= 0.05
+
+
+def test_a_wakeup_ends_a_wait_without_end_from_another_thread():
+    wakeup, woken = Wakeup(), []
+    waiter = threading.Thread(target=lambda: woken.append(wakeup.wait(None)), daemon=True)
+    waiter.start()
+    waiter.join(0.05)
+    assert waiter.is_alive() and woken == []  # still waiting
+    wakeup.set()
+    waiter.join(BUDGET_S)
+    assert woken == [True]
+
 
 def test_a_waiting_callback_goes_before_the_next_batch():
     turns, order = Turns(), []
