@@ -378,19 +378,25 @@ class SimNode(Node):
         if self._paused:
             return
         steps = self._pacer.steps_due()
-        if steps:
+        if not steps:
+            return
+        if self._pacer.fast:
+            self._refresh_readers()
             self.run_steps(steps)
-            self._refresh_readers()  # for the next batch, while DDS's code is warm
+        else:  # ask for the next batch, after publishing, while DDS's code is warm
+            self.run_steps(steps)
+            self._refresh_readers()
 
     def _refresh_readers(self) -> None:
         """Find out, once per batch, which of the periodic topics anybody reads.
 
-        A publish costs 3-5 us even with no subscriber; asking costs ~0.7 us
-        (~60 us right after the physics thread slept: so the ticks ask after
-        their batch, just after publishing).  A subscriber that appears is
-        served from the batch after next (within ~10 ms of wall time at factor
-        0, ~40 ms paced), inside DDS's own matching delay; stepping on request
-        asks before its batch.
+        A publish costs 3-5 us even with no subscriber; asking costs ~0.7 us,
+        but ~60 us right after the physics thread slept between paced ticks:
+        there the ticks ask after their batch, just after publishing, so a new
+        subscriber is served from the batch after next (~20-40 ms of wall time
+        at factor 1, inside DDS's own matching delay).  At factor 0 and when
+        stepping on request, they ask before the batch: a subscriber that the
+        publisher has matched gets everything due from the next batch on.
         """
         self._clock_readers = self._clock_publisher.get_subscription_count() > 0
         self.controllers.refresh_readers()

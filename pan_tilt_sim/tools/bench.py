@@ -25,8 +25,9 @@ than wall time):
   the most CPU over the window: the one stepping the physics) and, with a subscriber,
   ``subscriber_cpu_percent`` (% of one core);
 * ``factor_1``: at real_time_factor 1 with a /clock subscriber:
-  ``cpu_percent`` (the node process, % of one core),
-  ``clock_subscriber_cpu_percent``, JointState inter-arrival
+  ``cpu_percent`` (the node process, % of one core, while nobody reads
+  JointState), ``cpu_percent_with_joint_states`` (while the probe reads
+  JointState too), ``clock_subscriber_cpu_percent``, JointState inter-arrival
   ``joint_states_p50_ms`` / ``joint_states_p99_ms`` and ``rtf_error``
   (|sim/wall - 1|, the slope of JointState stamps against arrival times);
 * ``startup_s``: process start to the first JointState at the probe, median
@@ -538,25 +539,26 @@ class Bench:
             time.sleep(min(COMMAND_PERIOD_S / 5, max(0.0, deadline - time.monotonic())))
 
     def paced(self, model: Model) -> dict[str, float]:
-        """Measure rtf error, JointState inter-arrival and CPU share at real_time_factor 1."""
+        """Measure CPU shares, rtf error and JointState inter-arrival at real_time_factor 1.
+
+        Two windows on one node: first with only the /clock subscriber (the
+        probe takes a JointState to know the node runs, then leaves the
+        topic), then with the probe's JointState subscription as well.
+        """
         samples: list[tuple[float, float]] = []
-        with self.node(model, 1.0) as node, self.listener(CLOCK_TOPIC, CLOCK_TYPE) as clock, \
-                self.probe.joint_states(model.joint_states_topic, 10,
-                                        lambda wall, sim: samples.append((wall, sim))):
-            self.spin_until(node, lambda: bool(samples), FIRST_MESSAGE_TIMEOUT_S,
-                            f'JointState on {model.joint_states_topic}')
+
+        def on_joint_state(wall: float, sim: float) -> None:
+            samples.append((wall, sim))
+
+        topic = model.joint_states_topic
+        with self.node(model, 1.0) as node, self.listener(CLOCK_TOPIC, CLOCK_TYPE) as clock:
             commander = Commander(self.probe, model)
-            for seconds in (self.plan.warmup_s, self.plan.paced_s):
-                samples.clear()
-                cpu_start, wall_start = node.cpu_seconds(), time.monotonic()
-                clock_start = clock.cpu_seconds()
-                while time.monotonic() < wall_start + seconds:
-                    node.check_alive()
-                    commander.send_when_due()
-                    self.probe.spin_once(SPIN_TIMEOUT_S)
-                wall = time.monotonic() - wall_start
-                cpu = (node.cpu_seconds() - cpu_start) / wall
-                clock_cpu = (clock.cpu_seconds() - clock_start) / wall
+            with self.probe.joint_states(topic, 10, on_joint_state):
+                self.spin_until(node, lambda: bool(samples), FIRST_MESSAGE_TIMEOUT_S,
+                                f'JointState on {topic}')
+            cpu, clock_cpu = self._paced_cpu(node, clock, commander)
+            with self.probe.joint_states(topic, 10, on_joint_state):
+                cpu_with_joint_states, _ = self._paced_cpu(node, clock, commander, samples)
         if len(samples) < 3:
             raise BenchError('too few JointState messages at real_time_factor 1')
         gaps = [later[0] - earlier[0] for earlier, later in zip(samples, samples[1:], strict=False)]
@@ -565,8 +567,30 @@ class Bench:
             'joint_states_p50_ms': statistics.median(gaps) * MILLISECONDS_PER_SECOND,
             'joint_states_p99_ms': percentile_99(gaps) * MILLISECONDS_PER_SECOND,
             'cpu_percent': cpu * PERCENT,
+            'cpu_percent_with_joint_states': cpu_with_joint_states * PERCENT,
             'clock_subscriber_cpu_percent': clock_cpu * PERCENT,
         }
+
+    def _paced_cpu(self, node: NodeProcess, clock: Listener, commander: Commander,
+                   samples: list | None = None) -> tuple[float, float]:
+        """Warm up, then return the node's and the /clock listener's CPU share over a window.
+
+        ``samples`` (JointStates being taken) is emptied at the start of each
+        part, so it ends with the window's messages only.
+        """
+        for duration in (self.plan.warmup_s, self.plan.paced_s):
+            if samples is not None:
+                samples.clear()
+            cpu_start, wall_start = node.cpu_seconds(), time.monotonic()
+            clock_start = clock.cpu_seconds()
+            while time.monotonic() < wall_start + duration:
+                node.check_alive()
+                commander.send_when_due()
+                self.probe.spin_once(SPIN_TIMEOUT_S)
+            wall = time.monotonic() - wall_start
+            cpu = (node.cpu_seconds() - cpu_start) / wall
+            clock_cpu = (clock.cpu_seconds() - clock_start) / wall
+        return cpu, clock_cpu
 
     def startup_s(self, model: Model) -> float:
         """Median wall time from starting sim_node's process to its first JointState here.

@@ -23,8 +23,8 @@ FACTOR_0 = {
     'joint_state_subscriber': {'steps_per_s', 'node_cpu_us_per_step', 'ratio_to_raw',
                                'subscriber_cpu_percent'},
 }
-FACTOR_1 = {'cpu_percent', 'clock_subscriber_cpu_percent', 'joint_states_p50_ms',
-            'joint_states_p99_ms', 'rtf_error'}
+FACTOR_1 = {'cpu_percent', 'cpu_percent_with_joint_states', 'clock_subscriber_cpu_percent',
+            'joint_states_p50_ms', 'joint_states_p99_ms', 'rtf_error'}
 
 
 def leaves(figures: dict, prefix: str = '') -> dict:
