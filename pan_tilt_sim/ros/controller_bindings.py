@@ -216,7 +216,7 @@ class JointStateSink:
     only the moment changes, by at most a batch (at real_time_factor 1 a
     fraction of a millisecond).  Published with the node's other messages,
     while DDS's code is warm: right after a 20 ms sleep the first publish
-    costs ~150 us of CPU on these VMs and the next ~10-20 us.
+    costs ~150-250 us of CPU on these VMs and the next ~10-35 us.
     """
 
     def __init__(self, publisher: Any, names: Iterable[str]) -> None:

@@ -124,8 +124,8 @@ class Wakeup:
 
     As :class:`threading.Event` set/wait/clear, but a wait is one lock
     acquisition: Event's runs a Condition in Python and makes a lock per call,
-    which right after the thread slept costs ~50 us more CPU per wait on
-    these VMs -- 0.2-0.3 % of a core at 50 ticks a second.
+    which right after the thread slept costs ~20-50 us more CPU per wait on
+    these VMs -- 0.1-0.25 % of a core at 50 ticks a second.
     """
 
     def __init__(self) -> None:

@@ -228,8 +228,8 @@ class SimNode(Node):
         run in a fraction of a wall millisecond, so its stamps leave together
         after it, back to back with the JointStates it took (see
         :class:`~pan_tilt_sim.ros.controller_bindings.JointStateSink`): right
-        after the thread slept, the first publish costs ~150 us of CPU and the
-        next ones ~10-20 us.  Up to ~10x real time, /clock reaches a stamp before
+        after the thread slept, the first publish costs ~150-250 us of CPU and
+        the next ones ~10-35 us.  Up to ~10x real time, /clock reaches a stamp before
         anything stamped at or after it leaves.  Nothing is published that nobody
         reads (see :meth:`_refresh_readers`).
         """
