@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import pathlib
+import signal
 import subprocess
 import sys
 
@@ -17,6 +18,7 @@ import pan_tilt_sim
 PACKAGE_ROOT = pathlib.Path(pan_tilt_sim.__file__).resolve().parents[1]
 # The program's one entry (the console script calls the same main()).
 MODULE_ENTRY = ('-m', 'pan_tilt_sim')
+DUMP_BUDGET_S = 5.0  # for a process that did not stop to print its threads' stacks
 
 
 def environment() -> dict[str, str]:
@@ -24,6 +26,8 @@ def environment() -> dict[str, str]:
     env = dict(os.environ)
     paths = [str(PACKAGE_ROOT), *filter(None, env.get('PYTHONPATH', '').split(os.pathsep))]
     env['PYTHONPATH'] = os.pathsep.join(paths)
+    # A child that hangs can be made to print every thread's Python stack (see stop()).
+    env['PYTHONFAULTHANDLER'] = '1'
     return env
 
 
@@ -45,3 +49,24 @@ def start(*ros_args: str, entry: tuple[str, ...] = MODULE_ENTRY,
     return subprocess.Popen(command(*ros_args, entry=entry), env=environment(),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             **popen_kwargs)
+
+
+def stop(process: subprocess.Popen, budget_s: float, *,
+         interrupt: bool = True) -> tuple[bool, str]:
+    """SIGINT ``process`` (unless already sent); return (ended within ``budget_s``, stderr).
+
+    One that does not is sent SIGABRT, on which Python's faulthandler (see
+    environment()) prints every thread's stack to stderr before it dies, so
+    the failure says where it hung; then it is killed if it still lives.
+    """
+    if interrupt:
+        process.send_signal(signal.SIGINT)
+    try:
+        return True, process.communicate(timeout=budget_s)[1]
+    except subprocess.TimeoutExpired:
+        process.send_signal(signal.SIGABRT)
+    try:
+        return False, process.communicate(timeout=DUMP_BUDGET_S)[1]
+    except subprocess.TimeoutExpired:
+        process.kill()
+        return False, process.communicate()[1]

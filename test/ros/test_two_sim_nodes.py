@@ -9,7 +9,6 @@ absolute by ROS convention, as with two Gazebos: each process remaps it
 from __future__ import annotations
 
 import signal
-import subprocess
 
 import pytest
 import sim_process
@@ -39,13 +38,10 @@ def two_sims():
     finally:
         harness.close()
         for process in processes.values():
-            process.send_signal(signal.SIGINT)
+            process.send_signal(signal.SIGINT)  # both at once
         for side, process in processes.items():
-            try:
-                _out, err = process.communicate(timeout=STOP_BUDGET_S)
-            except subprocess.TimeoutExpired:
-                process.kill()
-                _out, err = process.communicate()
+            stopped, err = sim_process.stop(process, STOP_BUDGET_S, interrupt=False)
+            assert stopped, f'{side} did not stop within {STOP_BUDGET_S} s of SIGINT: {err}'
             assert process.returncode == 0, f'{side}: {err}'
 
 
