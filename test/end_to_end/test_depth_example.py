@@ -6,7 +6,6 @@ the client turns the pan to face a target, saves the depth image as a PNG
 and describes the point cloud.
 """
 
-import signal
 import subprocess
 import sys
 
@@ -26,12 +25,7 @@ def sensor_sim():
     process = sim_process.start('-p', f'robot_description_file:={description}',
                                 '-p', 'real_time_factor:=0', start_new_session=True)
     yield process
-    process.send_signal(signal.SIGINT)
-    try:
-        process.communicate(timeout=SHUTDOWN_BUDGET_S)
-    except subprocess.TimeoutExpired:
-        process.kill()
-        process.communicate()
+    sim_process.stop(process, SHUTDOWN_BUDGET_S)
 
 
 def test_the_depth_example_saves_a_png_and_sees_the_yellow_target_2_m_ahead(

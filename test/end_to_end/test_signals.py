@@ -58,12 +58,10 @@ def _stop(process: subprocess.Popen, signum: int, *, group: bool = False) -> tup
         os.killpg(process.pid, signum)
     else:
         process.send_signal(signum)
-    try:
-        _stdout, stderr = process.communicate(timeout=STOP_BUDGET_S)
-    except subprocess.TimeoutExpired:
-        process.kill()
-        process.communicate()
-        pytest.fail(f'still running {STOP_BUDGET_S} s after {signal.Signals(signum).name}')
+    stopped, stderr = sim_process.stop(process, STOP_BUDGET_S, interrupt=False)
+    if not stopped:
+        pytest.fail(f'still running {STOP_BUDGET_S} s after {signal.Signals(signum).name}: '
+                    f'{stderr}')
     return time.monotonic() - start, stderr
 
 

@@ -7,10 +7,10 @@ same, then commands the pan joint from the test process over DDS.
 
 import os
 import pathlib
-import signal
 import subprocess
 
 import pytest
+import sim_process
 from node_harness import PROBE_QUEUE, NodeHarness
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
@@ -41,7 +41,8 @@ def sim_node_executable():
 def test_installed_sim_node_moves_the_pan_and_stops_cleanly_on_sigint(sim_node_executable):
     process = subprocess.Popen(
         [str(sim_node_executable), '--ros-args', '-p', 'real_time_factor:=0'],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+        env=dict(os.environ, PYTHONFAULTHANDLER='1'))  # a hang prints its stacks (stop())
     harness = NodeHarness()
     try:
         states = []
@@ -56,12 +57,8 @@ def test_installed_sim_node_moves_the_pan_and_stops_cleanly_on_sigint(sim_node_e
             lambda: abs(states[-1].position[0] - TARGET) < 0.015, STARTUP_BUDGET_S)
     finally:
         harness.close()
-        process.send_signal(signal.SIGINT)
-        try:
-            _stdout, stderr = process.communicate(timeout=SHUTDOWN_BUDGET_S)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            _stdout, stderr = process.communicate()
-            pytest.fail(f'sim_node did not stop within {SHUTDOWN_BUDGET_S} s of SIGINT')
+        stopped, stderr = sim_process.stop(process, SHUTDOWN_BUDGET_S)
+        if not stopped:
+            pytest.fail(f'sim_node did not stop within {SHUTDOWN_BUDGET_S} s of SIGINT: {stderr}')
     assert process.returncode == 0, stderr
     assert 'Traceback' not in stderr

@@ -7,7 +7,6 @@ QUITTING must work there as in-process.
 
 from __future__ import annotations
 
-import signal
 import subprocess
 import sys
 
@@ -80,12 +79,7 @@ def test_the_spawn_example_drops_the_shipped_box_onto_the_ground(repo_root):
             capture_output=True, text=True, env=sim_process.environment(),
             timeout=STARTUP_BUDGET_S * 4, check=False)
     finally:
-        process.send_signal(signal.SIGINT)
-        try:
-            process.communicate(timeout=EXIT_BUDGET_S)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.communicate()
+        sim_process.stop(process, EXIT_BUDGET_S)
     assert result.returncode == 0, result.stdout + result.stderr
     assert 'simulation STOPPED' in result.stdout
     # The shipped box is a 10 cm cube: it rests with its centre 5 cm up.

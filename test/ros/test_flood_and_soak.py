@@ -115,12 +115,8 @@ class SimUnderTest:
     def close(self) -> None:
         self.harness.close()
         self.process.terminate()
-        try:
-            self.process.communicate(timeout=STOP_BUDGET_S)
-        except subprocess.TimeoutExpired:
-            self.process.kill()
-            self.process.communicate()
-        assert self.process.returncode == 0
+        stopped, stderr = sim_process.stop(self.process, STOP_BUDGET_S, interrupt=False)
+        assert stopped and self.process.returncode == 0, stderr
 
 
 def _flood_window(output: str) -> tuple[int, float, float]:
