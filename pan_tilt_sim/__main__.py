@@ -4,11 +4,22 @@ Both start here, so both behave the same: the signal handlers are in place
 before rclpy and PyBullet are imported (about half a second), so a Ctrl-C
 at any moment stops the program cleanly; a configuration error exits with
 code 2 and one line (see :mod:`pan_tilt_sim.ros.runner`).
+
+OpenBLAS runs single-threaded here unless the environment says otherwise:
+numpy (which rclpy's message packages import) otherwise starts a worker per
+core that spins for ~0.1 s of CPU as it loads -- 555 -> 440 ms of CPU in
+sim_node's first second on a 2-core machine -- and sim_node's matrices are
+3x3 and 4x4, far too small for threads to help.
 """
 
 from __future__ import annotations
 
-from pan_tilt_sim.ros import runner
+import os
+
+# Before anything imports numpy; a user's own setting wins.
+os.environ.setdefault('OPENBLAS_NUM_THREADS', '1')
+
+from pan_tilt_sim.ros import runner  # noqa: E402 (after the line above, on purpose)
 
 PROGRAM = 'sim_node'
 
