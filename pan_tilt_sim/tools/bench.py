@@ -31,7 +31,10 @@ than wall time):
   ``joint_states_p50_ms`` / ``joint_states_p99_ms`` and ``rtf_error``
   (|sim/wall - 1|, the slope of JointState stamps against arrival times);
 * ``startup_s``: process start to the first JointState at the probe, median
-  of ``STARTUP_RUNS``;
+  of ``STARTUP_RUNS``; ``startup_floor_s``: the same for a bare rclpy
+  JointState publisher (:mod:`pan_tilt_sim.tools.bare_publisher`), run by
+  run in turn with sim_node -- what Python, rclpy and DDS discovery alone
+  take on the machine;
 * ``scaling``: serial chains of 2, 8 and 32 revolute joints, each with a
   position controller, at real_time_factor 0 with no subscriber:
   ``steps_per_s`` and ``node_cpu_us_per_step`` (keys are the joint counts).
@@ -335,35 +338,12 @@ def interrupt(process: subprocess.Popen) -> None:
             process.wait()
 
 
-class Listener:
-    """A subscriber in its own process (``pan_tilt_sim.tools.listener``)."""
+class ChildProcess:
+    """A program of the bench's in a child process; its output goes to a log file."""
 
-    def __init__(self, topic: str, type_name: str, env: dict[str, str],
+    def __init__(self, name: str, command: list[str], env: dict[str, str],
                  log_file: pathlib.Path) -> None:
-        with open(log_file, 'wb') as log:
-            self.process = subprocess.Popen(
-                [sys.executable, '-m', 'pan_tilt_sim.tools.listener', topic, type_name],
-                stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT, env=env)
-
-    def cpu_seconds(self) -> float:
-        """CPU seconds the listener has used so far."""
-        return cpu_seconds(self.process.pid)
-
-    def stop(self) -> None:
-        """Stop the listener (SIGINT), killing it if it lingers."""
-        interrupt(self.process)
-
-
-class NodeProcess:
-    """sim_node in a child process; its output goes to a log file, never to our stdout."""
-
-    def __init__(self, model: Model, parameters: dict[str, str], env: dict[str, str],
-                 log_file: pathlib.Path) -> None:
-        arguments = {'robot_description_file': str(model.description_file),
-                     'controllers_file': str(model.controllers_file), **parameters}
-        command = [sys.executable, '-m', 'pan_tilt_sim', '--ros-args']
-        for name, value in arguments.items():
-            command += ['-p', f'{name}:={value}']
+        self.name = name
         self._log_file = log_file
         with open(log_file, 'wb') as log:
             self.started = time.monotonic()
@@ -372,23 +352,53 @@ class NodeProcess:
                 env=env)
 
     def check_alive(self) -> None:
-        """Raise BenchError, with the end of its log, if the node has exited."""
+        """Raise BenchError, with the end of its log, if the program has exited."""
         code = self.process.poll()
         if code is not None:
             log = self._log_file.read_text(errors='replace')[-LOG_TAIL_CHARS:]
-            raise BenchError(f'sim_node exited with code {code}:\n{log}')
+            raise BenchError(f'{self.name} exited with code {code}:\n{log}')
 
     def cpu_seconds(self) -> float:
-        """CPU seconds the node has used so far."""
+        """CPU seconds the program has used so far."""
         return cpu_seconds(self.process.pid)
+
+    def stop(self) -> None:
+        """Ctrl-C the program and wait for it; kill it if it does not stop."""
+        interrupt(self.process)
+
+
+class Listener(ChildProcess):
+    """A subscriber in its own process (``pan_tilt_sim.tools.listener``)."""
+
+    def __init__(self, topic: str, type_name: str, env: dict[str, str],
+                 log_file: pathlib.Path) -> None:
+        super().__init__('listener', [sys.executable, '-m', 'pan_tilt_sim.tools.listener',
+                                      topic, type_name], env, log_file)
+
+
+class BarePublisher(ChildProcess):
+    """A bare rclpy JointState publisher (``pan_tilt_sim.tools.bare_publisher``)."""
+
+    def __init__(self, topic: str, env: dict[str, str], log_file: pathlib.Path) -> None:
+        super().__init__('bare_publisher', [
+            sys.executable, '-m', 'pan_tilt_sim.tools.bare_publisher', topic], env, log_file)
+
+
+class NodeProcess(ChildProcess):
+    """sim_node in a child process."""
+
+    def __init__(self, model: Model, parameters: dict[str, str], env: dict[str, str],
+                 log_file: pathlib.Path) -> None:
+        arguments = {'robot_description_file': str(model.description_file),
+                     'controllers_file': str(model.controllers_file), **parameters}
+        command = [sys.executable, '-m', 'pan_tilt_sim', '--ros-args']
+        for name, value in arguments.items():
+            command += ['-p', f'{name}:={value}']
+        super().__init__('sim_node', command, env, log_file)
 
     def thread_cpu_seconds(self) -> dict[int, float]:
         """CPU seconds each of the node's threads has used so far."""
         return thread_cpu_seconds(self.process.pid)
-
-    def stop(self) -> None:
-        """Ctrl-C the node and wait for it; kill it if it does not stop."""
-        interrupt(self.process)
 
 
 class Probe:
@@ -469,7 +479,7 @@ class Bench:
         finally:
             process.stop()
 
-    def spin_until(self, node: NodeProcess, done: Callable[[], bool], timeout: float,
+    def spin_until(self, node: ChildProcess, done: Callable[[], bool], timeout: float,
                    what: str, probe: Probe | None = None) -> None:
         """Spin the probe until ``done()``; BenchError if the node dies or time runs out."""
         probe = probe or self.probe
@@ -479,6 +489,17 @@ class Bench:
             if time.monotonic() > deadline:
                 raise BenchError(f'no {what} within {timeout} s')
             probe.spin_once(SPIN_TIMEOUT_S)
+
+    @contextlib.contextmanager
+    def bare_publisher(self, topic: str) -> Iterator[BarePublisher]:
+        """Run a bare rclpy JointState publisher on ``topic`` for the duration of the block."""
+        self._node_count += 1
+        publisher = BarePublisher(topic, self.env,
+                                  self.folder / f'bare_publisher_{self._node_count}.log')
+        try:
+            yield publisher
+        finally:
+            publisher.stop()
 
     @contextlib.contextmanager
     def listener(self, topic: str, type_name: str) -> Iterator[Listener]:
@@ -592,31 +613,35 @@ class Bench:
             clock_cpu = (clock.cpu_seconds() - clock_start) / wall
         return cpu, clock_cpu
 
-    def startup_s(self, model: Model) -> float:
-        """Median wall time from starting sim_node's process to its first JointState here.
+    def startup_s(self, model: Model) -> tuple[float, float]:
+        """Median wall times from a process start to its first JointState here.
 
-        Each run listens with a fresh probe: a DDS participant that saw the
-        previous run's node took ~2.5 s to match the next one in most runs
-        (the node itself is ready in ~0.3 s), which would measure discovery
-        of a restarted peer rather than start-up.
+        Returns (sim_node, bare rclpy publisher): the second is the floor,
+        what Python, rclpy and DDS discovery alone take on this machine.  The
+        two alternate, run by run, so both see the same machine.  Each run
+        listens with a fresh probe: a DDS participant that saw the previous
+        run's node took ~2.5 s to match the next one in most runs (the node
+        itself is ready in ~0.3 s), which would measure discovery of a
+        restarted peer rather than start-up.
         """
-        times = []
+        times: dict[bool, list[float]] = {False: [], True: []}
         for _ in range(self.plan.startup_runs):
-            probe = Probe(self.domain_id)
-            try:
-                times.append(self._first_joint_state_after_start(probe, model))
-            finally:
-                probe.close()
-        return statistics.median(times)
+            for bare in (False, True):
+                probe = Probe(self.domain_id)
+                try:
+                    times[bare].append(self._first_joint_state_after_start(probe, model, bare))
+                finally:
+                    probe.close()
+        return statistics.median(times[False]), statistics.median(times[True])
 
-    def _first_joint_state_after_start(self, probe: Probe, model: Model) -> float:
+    def _first_joint_state_after_start(self, probe: Probe, model: Model, bare: bool) -> float:
         first: list[float] = []
-        with probe.joint_states(model.joint_states_topic, 1,
-                                lambda wall, sim: first.append(wall)):
-            with self.node(model, None) as node:
-                self.spin_until(node, lambda: bool(first), FIRST_MESSAGE_TIMEOUT_S,
-                                f'JointState on {model.joint_states_topic}', probe)
-                return first[0] - node.started
+        topic = model.joint_states_topic
+        with probe.joint_states(topic, 1, lambda wall, sim: first.append(wall)):
+            with self.bare_publisher(topic) if bare else self.node(model, None) as process:
+                self.spin_until(process, lambda: bool(first), FIRST_MESSAGE_TIMEOUT_S,
+                                f'JointState on {topic}', probe)
+                return first[0] - process.started
 
 
 class Commander:
@@ -659,7 +684,7 @@ def run_once(bench: Bench, model: Model) -> dict:
     bench.log('sim_node at real_time_factor 1 with a /clock subscriber')
     paced = bench.paced(model)
     bench.log('start-up')
-    startup = bench.startup_s(model)
+    startup, startup_floor = bench.startup_s(model)
     scaling = {}
     for joints in CHAIN_JOINTS:
         bench.log(f'chain of {joints} joints at real_time_factor 0')
@@ -673,6 +698,7 @@ def run_once(bench: Bench, model: Model) -> dict:
         'factor_0': factor_0,
         'factor_1': paced,
         'startup_s': startup,
+        'startup_floor_s': startup_floor,
         'scaling': scaling,
         'sensor_us_per_message': sensors,
     }

@@ -51,8 +51,8 @@ def quick_run():
 @pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
 def test_quick_prints_exactly_one_json_object_with_every_figure(quick_run):
     figures = json.loads(quick_run[0])
-    assert set(figures) == {'raw', 'factor_0', 'factor_1', 'startup_s', 'scaling',
-                            'sensor_us_per_message'}
+    assert set(figures) == {'raw', 'factor_0', 'factor_1', 'startup_s', 'startup_floor_s',
+                            'scaling', 'sensor_us_per_message'}
     assert set(figures['raw']) == RAW
     assert {case: set(values) for case, values in figures['factor_0'].items()} == FACTOR_0
     assert set(figures['factor_1']) == FACTOR_1

@@ -1,0 +1,29 @@
+"""bare_publisher: the bench's start-up floor publishes JointState and stops on SIGINT."""
+
+import subprocess
+import sys
+
+import sim_process
+from node_harness import NodeHarness
+from sensor_msgs.msg import JointState
+
+TOPIC = '/bare_publisher_test/joint_states'
+STOP_BUDGET_S = 10.0
+
+
+def test_publishes_joint_state_on_its_topic_until_interrupted():
+    harness = NodeHarness()
+    received: list[JointState] = []
+    harness.probe.create_subscription(JointState, TOPIC, received.append, 10)
+    process = subprocess.Popen(
+        [sys.executable, '-m', 'pan_tilt_sim.tools.bare_publisher', TOPIC],
+        env=sim_process.environment(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        text=True)
+    try:
+        assert harness.spin_until(lambda: len(received) >= 3, budget_s=30.0), \
+            'no JointStates from bare_publisher'
+    finally:
+        ended, stderr = sim_process.stop(process, STOP_BUDGET_S)
+        harness.close()
+    assert ended, stderr
+    assert process.returncode == 0, stderr
