@@ -56,6 +56,11 @@ class Throttle:
             self._tokens -= 1.0
         return allowed
 
+    def take(self) -> None:
+        """Take a token, there or not: a debt that later refills pay off first."""
+        self._refill()
+        self._tokens -= 1.0
+
     def _refill(self) -> None:
         now = self._clock()
         self._tokens = min(self._burst, self._tokens + (now - self._refilled) / self._period)

@@ -51,7 +51,7 @@ TICK_PERIOD_S = 0.02
 CLOCK_PERIOD_S = 0.01  # sim seconds between /clock messages (100 Hz of sim time)
 # /clock leaves at most once per this much wall time on average (Gazebo's clock
 # publisher throttles the same way), in bursts of up to CLOCK_BURST messages;
-# the newest stamp always leaves at the end of each batch.
+# the newest stamp always leaves at the end of each batch, on a token borrowed if need be.
 CLOCK_MIN_WALL_PERIOD_S = 0.001
 # A tick's worth (20 ms) of bursts: up to ~10x real time every 10 ms stamp leaves.
 CLOCK_BURST = 20
@@ -219,7 +219,9 @@ class SimNode(Node):
         /clock stamps stay on the 10 ms grid of sim time.  They leave through a
         token bucket -- one token per wall millisecond, at most CLOCK_BURST held
         -- and the newest grid stamp reached always leaves at the end of the
-        batch.  So up to ~10x real time every stamp leaves (at factor 1 nothing
+        batch, taking a token even if none is there (a debt the next stamps
+        wait for), so on average /clock never leaves more than once per wall
+        millisecond.  So up to ~10x real time every stamp leaves (at factor 1 nothing
         is dropped); far above it /clock comes about once per wall millisecond
         and use_sim_time timers see sim time advance in jumps of that size.
 
@@ -262,6 +264,7 @@ class SimNode(Node):
             controllers.flush_joint_states()
             features.after_steps()
         if self._clock_pending:
+            throttle.take()  # counts against the cap too: the next stamps wait for it
             self._publish_clock()
         controllers.after_steps()
 

@@ -111,6 +111,17 @@ def test_the_throttle_lets_a_real_time_tick_through_whole():
         assert all(throttle.allow() for _ in range(3))
 
 
+def test_a_token_taken_without_one_there_is_a_debt_refills_pay_first():
+    clock = FakeClock()
+    throttle = Throttle(0.001, 2, clock)
+    assert throttle.allow() and throttle.allow()
+    throttle.take()  # one more than the bucket held
+    clock.now += 0.0015
+    assert not throttle.ready()  # 1.5 tokens came: 1 paid the debt
+    clock.now += 0.0005
+    assert throttle.allow() and not throttle.ready()
+
+
 def test_asking_whether_the_throttle_is_ready_takes_no_token():
     clock = FakeClock()
     throttle = Throttle(0.001, 2, clock)

@@ -12,7 +12,7 @@ from node_harness import PROBE_QUEUE, sim_node, stamp_s
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
 
-from pan_tilt_sim.ros.sim_node import clock_period_steps
+from pan_tilt_sim.ros.sim_node import CLOCK_BURST, clock_period_steps
 
 NS = '/ex_urdf_pan_tilt'
 PAN = 'joint1_position_controller'
@@ -105,6 +105,20 @@ def test_clock_stamps_are_on_the_10_ms_grid_and_the_newest_one_always_leaves(pan
     newest_grid = math.floor(pan_tilt.simulation.time / 0.01 + 1e-6) * 0.01
     assert times[-1] == pytest.approx(newest_grid, abs=1e-9)
     assert len(times) <= wall_ms + 20 + wall_ms / 4  # one per wall ms, a burst, one per batch
+
+
+def test_far_above_real_time_clock_averages_at_most_one_message_per_wall_ms(pan_tilt):
+    # The newest stamp leaves at the end of every batch even without a token,
+    # but it borrows one: over many batches the cap holds, a burst aside.
+    pan_tilt.collect(Clock, '/clock', PROBE_QUEUE)
+    pan_tilt.wait_for_subscribers('/clock')
+    sent = record_publications(pan_tilt.node)
+    start, started = pan_tilt.simulation.time, time.monotonic()
+    pan_tilt.run_until_sim_time(start + 30.0)
+    wall_ms = (time.monotonic() - started) * 1e3
+    clocks = sum(kind == 'clock' for kind, _ in sent)
+    assert clocks > wall_ms / 2  # the cap binds: far more stamps (3000) were reached
+    assert clocks <= wall_ms + CLOCK_BURST + 1
 
 
 @pytest.mark.parametrize(('time_step', 'steps'), [
