@@ -21,6 +21,11 @@
   the launch process is the parent; a watcher thread when something stands
   between them (``--launch-prefix``) or off Linux.  Without the variable
   (``nohup sim_node &``) the program outlives its shell, as any program does.
+* Python's cyclic garbage collector is held off while the program starts
+  (imports and building the node: ~50,000 objects, ~125 collections, 25-35 ms
+  of a ~0.37 s build on a 2-core VM); once the node is built, what start-up
+  made is frozen (``gc.freeze``: later full collections skip it; the ~700
+  unreachable objects it holds are never freed) and the collector runs again.
 * Importing rclpy and PyBullet takes about half a second, so this module
   imports neither until the handlers are in place, and knows no node: the
   program (``pan_tilt_sim.__main__``) hands :func:`run` a factory that
@@ -32,6 +37,7 @@ from __future__ import annotations
 import ast
 import contextlib
 import ctypes
+import gc
 import os
 import re
 import signal
@@ -260,6 +266,19 @@ def shut_down_ros() -> None:
             raise
 
 
+@contextlib.contextmanager
+def collector_held_off() -> Iterator[None]:
+    """Hold the cyclic garbage collector off in the block; freeze what it made if it succeeds."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+        gc.freeze()
+    finally:
+        if was_enabled:
+            gc.enable()
+
+
 def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
         program: str, make_executor: Callable[[Node], Executor] | None = None) -> int:
     """Build a node with ``make_node``, spin it until stopped; return the exit code.
@@ -273,7 +292,7 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
     failure: ConfigurationError | None = None
     with StopSignals() as stop:
         try:
-            with stop.interruptible():
+            with stop.interruptible(), collector_held_off():
                 stop_with_parent()
                 init_ros(args, debug=debug)
                 initialized = True

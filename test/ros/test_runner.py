@@ -7,16 +7,20 @@ the pieces, in-process.
 
 from __future__ import annotations
 
+import gc
 import os
 import signal
+import subprocess
 import sys
 
 import pytest
+import sim_process
 
-from pan_tilt_sim.errors import ArgumentError
+from pan_tilt_sim.errors import ArgumentError, ConfigurationError
 from pan_tilt_sim.ros.runner import (
     StopRequested,
     StopSignals,
+    collector_held_off,
     debug_requested,
     init_ros,
     shut_down_ros,
@@ -115,3 +119,57 @@ def test_a_shutdown_that_failed_with_the_context_still_up_is_raised(monkeypatch)
     monkeypatch.setitem(sys.modules, 'rclpy', RacingRclpy(shut_down_by_other=False))
     with pytest.raises(RuntimeError, match='rcl_shutdown'):
         shut_down_ros()
+
+
+# --- the garbage collector while the program starts ----------------------------------------
+
+@pytest.fixture
+def collector():
+    """Leave the test process's collector as it was found: on, nothing frozen."""
+    yield
+    gc.unfreeze()
+    gc.enable()
+
+
+def test_the_collector_is_held_off_in_the_block_then_runs_with_what_it_made_frozen(collector):
+    frozen = gc.get_freeze_count()
+    with collector_held_off():
+        assert not gc.isenabled()
+        made = [[] for _ in range(1000)]
+    assert gc.isenabled()
+    assert gc.get_freeze_count() >= frozen + len(made)
+
+
+def test_a_failed_start_freezes_nothing_and_turns_the_collector_back_on(collector):
+    frozen = gc.get_freeze_count()
+    with pytest.raises(ConfigurationError), collector_held_off():
+        raise ConfigurationError('bad file')
+    assert gc.isenabled() and gc.get_freeze_count() == frozen
+
+
+def test_a_collector_that_was_off_stays_off(collector):
+    gc.disable()
+    with collector_held_off():
+        pass
+    assert not gc.isenabled()
+
+
+RUN_PROBE = """
+import gc
+from pan_tilt_sim.errors import ConfigurationError
+from pan_tilt_sim.ros import runner
+
+def make_node():
+    print('building, collector on:', gc.isenabled())
+    raise ConfigurationError('stop here')
+
+code = runner.run(make_node, ['probe'], program='probe')
+print('after, collector on:', gc.isenabled(), 'exit code', code)
+"""
+
+
+def test_a_program_builds_its_node_with_the_collector_held_off():
+    result = subprocess.run([sys.executable, '-c', RUN_PROBE], env=sim_process.environment(),
+                            capture_output=True, text=True, timeout=60, check=True)
+    assert result.stdout.splitlines() == [
+        'building, collector on: False', 'after, collector on: True exit code 2']
