@@ -45,6 +45,9 @@ than wall time):
 ``--tune`` measures something else instead: evaluations per second of
 ``tune``/``sweep`` on each back end (:mod:`pan_tilt_sim.tools.tune_bench`).
 
+If the two raw rates (thread CPU, wall) are more than ``RAW_AGREEMENT``
+apart, a warning on stderr says the run's ratios are not to be trusted.
+
 ``--runs N`` repeats everything and prints the median of each figure;
 ``--quick`` is a smoke run of a few seconds (every key present, no timing
 meaningful).
@@ -117,6 +120,9 @@ STOP_TIMEOUT_S = 10.0
 SPIN_TIMEOUT_S = 0.01
 RAW_CALIBRATION_STEPS = 1000
 LOG_TAIL_CHARS = 2000
+# The raw rate from thread CPU and the bare wall rate normally agree within ~5 %;
+# further apart than this, the run's ratios are not to be trusted (a warning says so).
+RAW_AGREEMENT = 0.25
 # A domain derived from the process id, when neither option nor environment gives one:
 # 150..229 keeps DDS ports valid and away from the low ids people use by hand.
 PID_DOMAIN_BASE = 150
@@ -290,6 +296,22 @@ def raw_figures(model: Model, time_step: float, sim_seconds: float,
         'calls_us_cpu': calls_us,
         'wall_steps_per_s': bare_steps_per_s(model.description_file, time_step, wall_seconds),
     }
+
+
+def raw_rates_disagree(raw: dict[str, float]) -> str | None:
+    """Say so if the raw rates from thread CPU and from wall time are more than RAW_AGREEMENT apart.
+
+    Both time the same ``stepSimulation``, one after the other; on a shared VM
+    a burst of neighbours' load (or the hypervisor's CPU accounting) can
+    inflate one of them, and every ``ratio_to_raw`` of the run with it.
+    """
+    cpu, wall = raw['steps_per_s'], raw['wall_steps_per_s']
+    gap = abs(cpu - wall) / max(cpu, wall)
+    if gap <= RAW_AGREEMENT:
+        return None
+    return (f'raw steps/s from thread CPU ({cpu:,.0f}) and from wall time ({wall:,.0f}) are '
+            f'{gap:.0%} apart: the machine was busy or its CPU accounting drifted, so this '
+            "run's ratio_to_raw figures are not to be trusted")
 
 
 def cpu_seconds(pid: int) -> float:
@@ -676,6 +698,9 @@ def run_once(bench: Bench, model: Model) -> dict:
     plan = bench.plan
     bench.log("PyBullet alone on the node's physics")
     raw = raw_figures(model, bench.time_step, plan.raw_sim_s, plan.raw_s)
+    problem = raw_rates_disagree(raw)
+    if problem is not None:
+        print(f'bench: warning: {problem}', file=sys.stderr, flush=True)
     factor_0 = {}
     for case in SUBSCRIBER_CASES:
         bench.log(f'sim_node at real_time_factor 0, {case.replace("_", " ")}')

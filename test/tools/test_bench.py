@@ -96,6 +96,19 @@ def test_quick_measures_the_physics_thread_at_factor_0(quick_run):
         assert values['node_cpu_us_per_step'] > raw, joints
 
 
+def test_raw_rates_that_agree_raise_no_warning():
+    assert bench.raw_rates_disagree({'steps_per_s': 293748, 'wall_steps_per_s': 305937}) is None
+    assert bench.raw_rates_disagree({'steps_per_s': 300000, 'wall_steps_per_s': 240000}) is None
+
+
+def test_raw_rates_far_apart_say_the_ratios_are_not_to_be_trusted():
+    # Seen here: stepSimulation read 5.68 us of thread CPU while the wall rate was normal.
+    problem = bench.raw_rates_disagree({'steps_per_s': 176154, 'wall_steps_per_s': 290148})
+    assert problem is not None
+    assert '176,154' in problem and '290,148' in problem and '39% apart' in problem
+    assert 'ratio_to_raw' in problem
+
+
 def test_rounded_gives_integer_rates_and_four_significant_digits_at_any_depth():
     figures = bench.rounded({'raw': {'steps_per_s': 123456.7, 'step_us_cpu': 3.14159},
                              'scaling': {'2': {'steps_per_s': 9876.4}}})
