@@ -635,7 +635,7 @@ class Bench:
             clock_cpu = (clock.cpu_seconds() - clock_start) / wall
         return cpu, clock_cpu
 
-    def startup_s(self, model: Model) -> tuple[float, float]:
+    def startup_times(self, model: Model) -> tuple[float, float]:
         """Median wall times from a process start to its first JointState here.
 
         Returns (sim_node, bare rclpy publisher): the second is the floor,
@@ -709,7 +709,7 @@ def run_once(bench: Bench, model: Model) -> dict:
     bench.log('sim_node at real_time_factor 1 with a /clock subscriber')
     paced = bench.paced(model)
     bench.log('start-up')
-    startup, startup_floor = bench.startup_s(model)
+    startup, startup_floor = bench.startup_times(model)
     scaling = {}
     for joints in CHAIN_JOINTS:
         bench.log(f'chain of {joints} joints at real_time_factor 0')
