@@ -61,10 +61,14 @@ class Turns:
         """Hold the simulation for one executor callback."""
         with self._condition:
             self._callbacks_waiting += 1
-        self._lock.acquire()
-        with self._condition:
-            self._callbacks_waiting -= 1
-            self._condition.notify_all()
+        try:
+            # A stop signal can end this wait with StopRequested (in the main
+            # thread): the physics must not wait for this callback then.
+            self._lock.acquire()
+        finally:
+            with self._condition:
+                self._callbacks_waiting -= 1
+                self._condition.notify_all()
         try:
             yield
         finally:

@@ -1,5 +1,7 @@
 """The physics in a thread of its own, taking turns with the executor's callbacks."""
 
+import os
+import signal
 import threading
 import time
 
@@ -9,6 +11,7 @@ from rclpy.parameter import Parameter
 from std_msgs.msg import Float64
 
 from pan_tilt_sim.ros.physics_thread import PhysicsThread, Turns, TurnTakingExecutor, Wakeup
+from pan_tilt_sim.ros.runner import StopRequested, StopSignals
 from pan_tilt_sim.ros.sim_node import SimNode
 
 BUDGET_S = 10.0
@@ -66,6 +69,36 @@ def test_a_waiting_callback_goes_before_the_next_batch():
     finally:
         thread.stop()
     assert order.index('callback') <= 2
+
+
+def test_a_callback_stopped_while_it_waits_for_its_turn_does_not_hold_up_the_physics():
+    # A stop signal ends the main thread's wait for its turn with StopRequested;
+    # the physics thread must still get its next turns (and so stop when asked).
+    turns, batches = Turns(), []
+    in_batch, release = threading.Event(), threading.Event()
+
+    def tick():
+        batches.append(time.monotonic())
+        in_batch.set()
+        release.wait(BUDGET_S)  # the first batch holds the turn until released
+
+    thread = PhysicsThread(tick, lambda: 0.0, turns)
+    thread.start()
+    try:
+        assert in_batch.wait(BUDGET_S)
+        # The signal comes while the callback waits; it is handled in this thread.
+        threading.Timer(0.05, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+        threading.Timer(0.1, release.set).start()
+        with StopSignals() as stop, stop.interruptible(), pytest.raises(StopRequested):
+            with turns.callback():
+                pytest.fail('the callback ran: its wait was not cut short')
+        count = len(batches)
+        assert wait_for(lambda: len(batches) > count + 3, budget_s=2.0), \
+            'the physics waits for a callback that will never come'
+    finally:
+        release.set()
+        thread.stop()
+    assert not thread.alive
 
 
 def test_ticks_keep_their_period_and_a_paused_thread_waits_until_woken():
