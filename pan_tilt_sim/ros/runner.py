@@ -84,7 +84,8 @@ class StopSignals:
 
     Every signal is recorded in :attr:`received`; the first one raises
     :class:`StopRequested` only inside :meth:`interruptible` (the node's
-    start-up), so that destroying the node is never cut short.  Previous
+    start-up, and the spin's loop: see :func:`~pan_tilt_sim.ros.spinning.spin`),
+    so that destroying the node is never cut short.  Previous
     handlers come back on exit.  Outside the main thread nothing is installed.
     """
 
@@ -307,7 +308,8 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
                 spinning.spin(node, on_ready=lambda: node.get_logger().debug(
                     'started; spinning until SIGINT or SIGTERM'), make_executor=(
                     spinning.single_threaded if make_executor is None
-                    else lambda context: make_executor(node)))
+                    else lambda context: make_executor(node)),
+                    interrupts=stop.interruptible())
         except ConfigurationError as err:
             failure = err
         except KeyboardInterrupt:

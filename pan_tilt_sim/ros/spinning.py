@@ -7,7 +7,9 @@ The program spins sim_node on a :class:`~pan_tilt_sim.ros.physics_thread.TurnTak
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Callable
+from contextlib import AbstractContextManager
 
 from rclpy.context import Context
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
@@ -22,7 +24,8 @@ def single_threaded(context: Context) -> Executor:
 
 
 def spin(node: Node, on_ready: Callable[[], None] | None = None,
-         make_executor: ExecutorFactory = single_threaded) -> None:
+         make_executor: ExecutorFactory = single_threaded, *,
+         interrupts: AbstractContextManager | None = None) -> None:
     """Spin ``node`` on ``make_executor(node.context)`` until its context shuts down.
 
     The nodes in ``node.companion_nodes`` (sim_node's controller_manager), if
@@ -35,6 +38,14 @@ def spin(node: Node, on_ready: Callable[[], None] | None = None,
     build ends the spin like any other.  Ctrl-C raises KeyboardInterrupt as
     usual.  The executor is shut down and released here, before the caller
     destroys the node.
+
+    ``interrupts`` (the program's
+    :meth:`~pan_tilt_sim.ros.runner.StopSignals.interruptible`) is entered
+    around the loop alone, so that a stop signal raises there.  Relying on
+    the context's shutdown is not enough: rclpy's signal thread wakes the
+    executor first and shuts the context down after, without waking it, so
+    an executor that woke in between and saw the context still up went back
+    to waiting with no timeout, and for good.
     """
     try:
         executor = make_executor(node.context)
@@ -48,12 +59,14 @@ def spin(node: Node, on_ready: Callable[[], None] | None = None,
     try:
         if on_ready is not None:
             on_ready()
-        while node.context.ok():
-            # No timeout: the executor sleeps until there is work.  rclpy wakes
-            # it when the context shuts down and when SIGINT/SIGTERM arrives
-            # (its handler runs ours too); a wake-up every 0.1 s "just in case"
-            # cost ~0.9 % of a core, ~1 ms each to rebuild the wait set.
-            executor.spin_once()
+        with interrupts if interrupts is not None else contextlib.nullcontext():
+            while node.context.ok():
+                # No timeout: the executor sleeps until there is work.  rclpy
+                # wakes it when SIGINT/SIGTERM arrives (its handler runs ours
+                # too, which raises in ``interrupts``) and when Python shuts the
+                # context down; a wake-up every 0.1 s "just in case" cost
+                # ~0.9 % of a core, ~1 ms each to rebuild the wait set.
+                executor.spin_once()
     except ExternalShutdownException:
         pass  # the context shut down while waiting: the normal end
     finally:

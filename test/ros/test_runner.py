@@ -173,3 +173,56 @@ def test_a_program_builds_its_node_with_the_collector_held_off():
                             capture_output=True, text=True, timeout=60, check=True)
     assert result.stdout.splitlines() == [
         'building, collector on: False', 'after, collector on: True exit code 2']
+
+
+SPIN_PROBE = """
+import os
+import signal
+
+import rclpy
+from rclpy.signals import uninstall_signal_handlers
+
+from pan_tilt_sim.ros import runner
+
+BOUND = 20
+
+
+class WokenExecutor:
+    '''Wakes as on a signal, before anything has shut the context down.'''
+
+    def __init__(self):
+        self.spins_after_signal = -1
+
+    def add_node(self, node):
+        pass
+
+    remove_node = add_node
+
+    def shutdown(self):
+        pass
+
+    def spin_once(self):
+        self.spins_after_signal += 1
+        if self.spins_after_signal == 0:
+            os.kill(os.getpid(), signal.SIGINT)
+        elif self.spins_after_signal == BOUND:
+            rclpy.try_shutdown()  # the stop was missed: end the test's spin here
+
+
+def make_node():
+    uninstall_signal_handlers()  # the program's own handler alone takes the signal
+    return rclpy.create_node('probe')
+
+
+executor = WokenExecutor()
+code = runner.run(make_node, ['probe'], program='probe', make_executor=lambda node: executor)
+print('spins after the signal:', executor.spins_after_signal, 'exit code', code)
+"""
+
+
+def test_a_program_stops_on_a_signal_even_if_its_executor_wakes_before_the_shutdown():
+    # rclpy's signal thread wakes the executor, then shuts the context down
+    # without waking it: the program must not depend on seeing that shutdown.
+    result = subprocess.run([sys.executable, '-c', SPIN_PROBE], env=sim_process.environment(),
+                            capture_output=True, text=True, timeout=60, check=True)
+    assert result.stdout.splitlines() == ['spins after the signal: 0 exit code 0']
