@@ -40,8 +40,8 @@ def spin(node: Node, on_ready: Callable[[], None] | None = None,
     destroys the node.
 
     ``interrupts`` (the program's
-    :meth:`~pan_tilt_sim.ros.runner.StopSignals.interruptible`) is entered
-    around the loop alone, so that a stop signal raises there.  Relying on
+    :func:`~pan_tilt_sim.ros.runner.interruptible_spin`) is entered around
+    the loop alone, so that a stop signal raises there.  Relying on
     the context's shutdown is not enough: rclpy's signal thread wakes the
     executor first and shuts the context down after, without waking it, so
     an executor that woke in between and saw the context still up went back

@@ -82,16 +82,19 @@ def test_a_callback_stopped_while_it_waits_for_its_turn_does_not_hold_up_the_phy
         in_batch.set()
         release.wait(BUDGET_S)  # the first batch holds the turn until released
 
+    def signal_the_waiting_callback():
+        if wait_for(lambda: turns._callbacks_waiting == 1):
+            os.kill(os.getpid(), signal.SIGINT)  # handled in the main thread, as in the program
+
     thread = PhysicsThread(tick, lambda: 0.0, turns)
     thread.start()
     try:
         assert in_batch.wait(BUDGET_S)
-        # The signal comes while the callback waits; it is handled in this thread.
-        threading.Timer(0.05, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
-        threading.Timer(0.1, release.set).start()
+        threading.Thread(target=signal_the_waiting_callback, daemon=True).start()
         with StopSignals() as stop, stop.interruptible(), pytest.raises(StopRequested):
             with turns.callback():
                 pytest.fail('the callback ran: its wait was not cut short')
+        release.set()  # the batch in progress ends only now
         count = len(batches)
         assert wait_for(lambda: len(batches) > count + 3, budget_s=2.0), \
             'the physics waits for a callback that will never come'

@@ -178,13 +178,16 @@ def test_a_program_builds_its_node_with_the_collector_held_off():
 SPIN_PROBE = """
 import os
 import signal
+import sys
 
 import rclpy
-from rclpy.signals import uninstall_signal_handlers
+from rclpy.signals import SignalHandlerGuardCondition, uninstall_signal_handlers
 
 from pan_tilt_sim.ros import runner
 
 BOUND = 20
+SLOWING_GUARDS = 2000
+RCLPY_HANDLES_SIGNALS = sys.argv[1] == 'rclpy-handlers'
 
 
 class WokenExecutor:
@@ -192,6 +195,7 @@ class WokenExecutor:
 
     def __init__(self):
         self.spins_after_signal = -1
+        self.context_up_at_shutdown = None
 
     def add_node(self, node):
         pass
@@ -199,7 +203,7 @@ class WokenExecutor:
     remove_node = add_node
 
     def shutdown(self):
-        pass
+        self.context_up_at_shutdown = rclpy.ok()
 
     def spin_once(self):
         self.spins_after_signal += 1
@@ -210,19 +214,38 @@ class WokenExecutor:
 
 
 def make_node():
-    uninstall_signal_handlers()  # the program's own handler alone takes the signal
-    return rclpy.create_node('probe')
+    if not RCLPY_HANDLES_SIGNALS:
+        uninstall_signal_handlers()  # the program's own handler alone takes the signal
+    node = rclpy.create_node('probe')
+    # Guard conditions that rclpy's signal thread triggers before it shuts the
+    # context down: they make that thread slower than this one.
+    node.slowing = [SignalHandlerGuardCondition() for _ in range(SLOWING_GUARDS)]
+    return node
 
 
 executor = WokenExecutor()
 code = runner.run(make_node, ['probe'], program='probe', make_executor=lambda node: executor)
 print('spins after the signal:', executor.spins_after_signal, 'exit code', code)
+print('context up when the executor shut down:', executor.context_up_at_shutdown)
 """
+
+
+def run_spin_probe(mode: str) -> list[str]:
+    result = subprocess.run([sys.executable, '-c', SPIN_PROBE, mode],
+                            env=sim_process.environment(),
+                            capture_output=True, text=True, timeout=60, check=True)
+    return result.stdout.splitlines()
 
 
 def test_a_program_stops_on_a_signal_even_if_its_executor_wakes_before_the_shutdown():
     # rclpy's signal thread wakes the executor, then shuts the context down
     # without waking it: the program must not depend on seeing that shutdown.
-    result = subprocess.run([sys.executable, '-c', SPIN_PROBE], env=sim_process.environment(),
-                            capture_output=True, text=True, timeout=60, check=True)
-    assert result.stdout.splitlines() == ['spins after the signal: 0 exit code 0']
+    assert run_spin_probe('own-handler-only')[0] == 'spins after the signal: 0 exit code 0'
+
+
+def test_leaving_the_spin_on_a_signal_lets_rclpys_signal_thread_finish_first():
+    # That thread still works on the executor's guard condition until it has
+    # shut the context down: the executor is torn down only after that.
+    assert run_spin_probe('rclpy-handlers') == [
+        'spins after the signal: 0 exit code 0',
+        'context up when the executor shut down: False']

@@ -86,7 +86,6 @@ def test_an_idle_spin_sleeps_until_there_is_work(context):
     assert 1 <= len(waits) <= 2  # the wait that the timer ends, perhaps one more
 
 
-
 def test_a_stop_signal_ends_the_spin_though_nobody_shuts_the_context_down(context):
     # As when rclpy's signal thread has woken the executor but not yet shut the
     # context down: the executor must not go back to waiting for good.
