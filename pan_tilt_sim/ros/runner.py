@@ -279,10 +279,9 @@ def interruptible_spin(stop: StopSignals, context: Context) -> Iterator[None]:
     executor woken in between went back to waiting for good, so the loop may
     not rely on that shutdown.  Leaving at once, though, would tear the
     executor down while that thread may still be triggering its guard
-    condition (leaving at once segfaulted in 3 of 15 runs of the signal
-    tests), so on the way out this
-    waits -- up to RCLPY_SIGNAL_BUDGET_S, and only where rclpy handles that
-    signal -- for the shutdown that thread makes after it.
+    condition (3 of 15 runs of the signal tests segfaulted so), so on the way
+    out this waits -- up to RCLPY_SIGNAL_BUDGET_S, and only where rclpy
+    handles that signal -- for the shutdown that thread makes after it.
     """
     try:
         with stop.interruptible():

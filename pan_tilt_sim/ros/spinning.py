@@ -7,9 +7,8 @@ The program spins sim_node on a :class:`~pan_tilt_sim.ros.physics_thread.TurnTak
 
 from __future__ import annotations
 
-import contextlib
 from collections.abc import Callable
-from contextlib import AbstractContextManager
+from contextlib import AbstractContextManager, nullcontext
 
 from rclpy.context import Context
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
@@ -59,7 +58,7 @@ def spin(node: Node, on_ready: Callable[[], None] | None = None,
     try:
         if on_ready is not None:
             on_ready()
-        with interrupts if interrupts is not None else contextlib.nullcontext():
+        with interrupts if interrupts is not None else nullcontext():
             while node.context.ok():
                 # No timeout: the executor sleeps until there is work.  rclpy
                 # wakes it when SIGINT/SIGTERM arrives (its handler runs ours
