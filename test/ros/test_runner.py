@@ -168,10 +168,15 @@ print('after, collector on:', gc.isenabled(), 'exit code', code)
 """
 
 
-def test_a_program_builds_its_node_with_the_collector_held_off():
-    result = subprocess.run([sys.executable, '-c', RUN_PROBE], env=sim_process.environment(),
+def run_probe(code: str, *args: str) -> list[str]:
+    """Run ``code`` as a program of its own; return the lines it printed."""
+    result = subprocess.run([sys.executable, '-c', code, *args], env=sim_process.environment(),
                             capture_output=True, text=True, timeout=60, check=True)
-    assert result.stdout.splitlines() == [
+    return result.stdout.splitlines()
+
+
+def test_a_program_builds_its_node_with_the_collector_held_off():
+    assert run_probe(RUN_PROBE) == [
         'building, collector on: False', 'after, collector on: True exit code 2']
 
 
@@ -230,22 +235,15 @@ print('context up when the executor shut down:', executor.context_up_at_shutdown
 """
 
 
-def run_spin_probe(mode: str) -> list[str]:
-    result = subprocess.run([sys.executable, '-c', SPIN_PROBE, mode],
-                            env=sim_process.environment(),
-                            capture_output=True, text=True, timeout=60, check=True)
-    return result.stdout.splitlines()
-
-
 def test_a_program_stops_on_a_signal_even_if_its_executor_wakes_before_the_shutdown():
     # rclpy's signal thread wakes the executor, then shuts the context down
     # without waking it: the program must not depend on seeing that shutdown.
-    assert run_spin_probe('own-handler-only')[0] == 'spins after the signal: 0 exit code 0'
+    assert run_probe(SPIN_PROBE, 'own-handler-only')[0] == 'spins after the signal: 0 exit code 0'
 
 
 def test_leaving_the_spin_on_a_signal_lets_rclpys_signal_thread_finish_first():
     # That thread still works on the executor's guard condition until it has
     # shut the context down: the executor is torn down only after that.
-    assert run_spin_probe('rclpy-handlers') == [
+    assert run_probe(SPIN_PROBE, 'rclpy-handlers') == [
         'spins after the signal: 0 exit code 0',
         'context up when the executor shut down: False']
