@@ -389,21 +389,33 @@ class ChildProcess:
         interrupt(self.process)
 
 
+def module_command(module: str, *args: str) -> list[str]:
+    """Return the command that runs ``python -m module args`` on the installed package.
+
+    ``-P`` keeps the working directory off ``sys.path``: run from a source
+    checkout, ``-m`` would otherwise import ``./pan_tilt_sim`` -- not the code
+    that ``ros2 run`` starts, and, where bytecode is not written
+    (``PYTHONDONTWRITEBYTECODE``), compiled afresh at every start: ~0.1 s on
+    every start-up measured.
+    """
+    return [sys.executable, '-P', '-m', module, *args]
+
+
 class Listener(ChildProcess):
     """A subscriber in its own process (``pan_tilt_sim.tools.listener``)."""
 
     def __init__(self, topic: str, type_name: str, env: dict[str, str],
                  log_file: pathlib.Path) -> None:
-        super().__init__('listener', [sys.executable, '-m', 'pan_tilt_sim.tools.listener',
-                                      topic, type_name], env, log_file)
+        super().__init__('listener', module_command('pan_tilt_sim.tools.listener', topic,
+                                                    type_name), env, log_file)
 
 
 class BarePublisher(ChildProcess):
     """A bare rclpy JointState publisher (``pan_tilt_sim.tools.bare_publisher``)."""
 
     def __init__(self, topic: str, env: dict[str, str], log_file: pathlib.Path) -> None:
-        super().__init__('bare_publisher', [
-            sys.executable, '-m', 'pan_tilt_sim.tools.bare_publisher', topic], env, log_file)
+        super().__init__('bare_publisher', module_command(
+            'pan_tilt_sim.tools.bare_publisher', topic), env, log_file)
 
 
 class NodeProcess(ChildProcess):
@@ -413,7 +425,7 @@ class NodeProcess(ChildProcess):
                  log_file: pathlib.Path) -> None:
         arguments = {'robot_description_file': str(model.description_file),
                      'controllers_file': str(model.controllers_file), **parameters}
-        command = [sys.executable, '-m', 'pan_tilt_sim', '--ros-args']
+        command = module_command('pan_tilt_sim', '--ros-args')
         for name, value in arguments.items():
             command += ['-p', f'{name}:={value}']
         super().__init__('sim_node', command, env, log_file)
@@ -641,10 +653,13 @@ class Bench:
         Returns (sim_node, bare rclpy publisher): the second is the floor,
         what Python, rclpy and DDS discovery alone take on this machine.  The
         two alternate, run by run, so both see the same machine.  Each run
-        listens with a fresh probe: a DDS participant that saw the previous
-        run's node took ~2.5 s to match the next one in most runs (the node
-        itself is ready in ~0.3 s), which would measure discovery of a
-        restarted peer rather than start-up.
+        listens with a fresh probe.  Fast DDS announces a new participant
+        before it listens, so the answer to its first announcement can be
+        lost; the two then meet at the older one's next announcement, every
+        0.1 s in a participant's first half second and every 3 s after that
+        (the README's "Tried with real robots" note).  A probe older than
+        half a second would time that 3 s wait in some runs, not start-up;
+        a fresh one bounds it to ~0.1 s steps, hence the steps in the figures.
         """
         times: dict[bool, list[float]] = {False: [], True: []}
         for _ in range(self.plan.startup_runs):

@@ -96,6 +96,21 @@ def test_quick_measures_the_physics_thread_at_factor_0(quick_run):
         assert values['node_cpu_us_per_step'] > raw, joints
 
 
+def test_children_run_the_installed_package_not_one_in_the_working_directory(tmp_path):
+    # A bench started from a source checkout must time what `ros2 run` starts.
+    decoy = tmp_path / 'pan_tilt_sim'
+    decoy.mkdir()
+    (decoy / '__init__.py').write_text("raise SystemExit('decoy pan_tilt_sim imported')\n")
+    env = {name: value for name, value in sim_process.environment().items()
+           if name != 'PYTHONSAFEPATH'}
+    result = subprocess.run(bench.module_command('pan_tilt_sim.tools.bench', '--help'),
+                            cwd=tmp_path, env=env, capture_output=True, text=True,
+                            timeout=60, check=False)
+    assert result.returncode == 0, result.stderr
+    assert 'decoy' not in result.stdout + result.stderr
+    assert '--runs' in result.stdout
+
+
 def test_raw_rates_that_agree_raise_no_warning():
     assert bench.raw_rates_disagree({'steps_per_s': 293748, 'wall_steps_per_s': 305937}) is None
     assert bench.raw_rates_disagree({'steps_per_s': 300000, 'wall_steps_per_s': 240000}) is None
