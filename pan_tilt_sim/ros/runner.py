@@ -26,6 +26,13 @@
   of a ~0.37 s build on a 2-core VM); once the node is built, what start-up
   made is frozen (``gc.freeze``: later full collections skip it; the ~700
   unreachable objects it holds are never freed) and the collector runs again.
+* The process's DDS participant is made right after ``rclpy.init``, before
+  the node's imports: a hidden placeholder node (``_<program>_starting``,
+  no global arguments, no endpoints of its own) holds it until the node is
+  built.  Fast DDS discovers peers in threads of its own, so discovery
+  runs while PyBullet and the rest load instead of starting ~0.13 s later;
+  a listener already running gets the first JointState ~0.1 s sooner
+  whenever the two miss each other's first announcement (README, Start-up).
 * Importing rclpy and PyBullet takes about half a second, so this module
   imports neither until the handlers are in place, and knows no node: the
   program (``pan_tilt_sim.__main__``) hands :func:`run` a factory that
@@ -304,6 +311,28 @@ def _rclpy_handles(signum: signal.Signals | None) -> bool:
 
 
 @contextlib.contextmanager
+def participant_made_first(program: str) -> Iterator[None]:
+    """Make the default context's DDS participant now; keep it until the block ends.
+
+    rmw_fastrtps makes a context's participant with its first node and
+    releases it with its last: a hidden node with nothing of its own
+    (``ros2 node list`` shows it only with ``--all``) holds it while the
+    block builds the real node.
+    """
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+
+    placeholder = Node(
+        f"_{re.sub(r'[^A-Za-z0-9_]', '_', program)}_starting", use_global_arguments=False,
+        enable_rosout=False, start_parameter_services=False, parameter_overrides=[
+            Parameter('start_type_description_service', value=False)])
+    try:
+        yield
+    finally:
+        placeholder.destroy_node()
+
+
+@contextlib.contextmanager
 def collector_held_off() -> Iterator[None]:
     """Hold the cyclic garbage collector off in the block; freeze what it made if it succeeds."""
     was_enabled = gc.isenabled()
@@ -333,7 +362,8 @@ def run(make_node: Callable[[], Node], args: list[str] | None = None, *,
                 stop_with_parent()
                 init_ros(args, debug=debug)
                 initialized = True
-                node = make_node()
+                with participant_made_first(program):
+                    node = make_node()
             import rclpy
 
             from pan_tilt_sim.ros import spinning

@@ -180,6 +180,49 @@ def test_a_program_builds_its_node_with_the_collector_held_off():
         'building, collector on: False', 'after, collector on: True exit code 2']
 
 
+GRAPH_PROBE = """
+import rclpy
+
+from pan_tilt_sim.ros import runner
+
+
+def names(node):
+    return sorted(name for name, _ in node.get_node_names_and_namespaces())
+
+
+class OneSpin:
+    def add_node(self, node):
+        self.node = node
+
+    def remove_node(self, node):
+        pass
+
+    def shutdown(self):
+        pass
+
+    def spin_once(self):
+        print('spinning:', names(self.node))
+        rclpy.try_shutdown()
+
+
+def make_node():
+    node = rclpy.create_node('probe')
+    print('building:', names(node))
+    return node
+
+
+runner.run(make_node, ['probe', '--ros-args', '-r', '__node:=renamed'], program='my-probe',
+           make_executor=lambda node: OneSpin())
+"""
+
+
+def test_a_program_has_its_dds_participant_before_it_builds_its_node():
+    # A hidden node holds it, untouched by the program's remappings, until the
+    # node is built: discovery runs while the node's imports load.
+    assert run_probe(GRAPH_PROBE) == [
+        "building: ['_my_probe_starting', 'renamed']", "spinning: ['renamed']"]
+
+
 SPIN_PROBE = """
 import os
 import signal
