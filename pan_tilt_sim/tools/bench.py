@@ -657,7 +657,7 @@ class Bench:
         before it listens, so the answer to its first announcement can be
         lost; the two then meet at the older one's next announcement, every
         0.1 s in a participant's first half second and every 3 s after that
-        (the README's "Tried with real robots" note).  A probe older than
+        (the end of the README's Performance section).  A probe older than
         half a second would time that 3 s wait in some runs, not start-up;
         a fresh one bounds it to ~0.1 s steps, hence the steps in the figures.
         """
