@@ -31,7 +31,7 @@
   no global arguments, no endpoints of its own) holds it until the node is
   built.  Fast DDS discovers peers in threads of its own, so discovery
   runs while PyBullet and the rest load (the participant exists at
-  0.17-0.22 s after the process starts instead of 0.24-0.30 s), and a
+  0.17-0.22 s after the process starts instead of 0.23-0.33 s), and a
   listener already running gets the first JointState ~0.1 s sooner
   whenever the two miss each other's first announcement (README, Start-up).
 * Importing rclpy and PyBullet takes about half a second, so this module
