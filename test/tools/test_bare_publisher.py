@@ -1,11 +1,12 @@
 """bare_publisher: the bench's start-up floor publishes JointState and stops on SIGINT."""
 
 import subprocess
-import sys
 
 import sim_process
 from node_harness import NodeHarness
 from sensor_msgs.msg import JointState
+
+from pan_tilt_sim.tools.bench import module_command
 
 TOPIC = '/bare_publisher_test/joint_states'
 STOP_BUDGET_S = 10.0
@@ -16,7 +17,7 @@ def test_publishes_joint_state_on_its_topic_until_interrupted():
     received: list[JointState] = []
     harness.probe.create_subscription(JointState, TOPIC, received.append, 10)
     process = subprocess.Popen(
-        [sys.executable, '-m', 'pan_tilt_sim.tools.bare_publisher', TOPIC],
+        module_command('pan_tilt_sim.tools.bare_publisher', TOPIC),  # as the bench starts it
         env=sim_process.environment(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
         text=True)
     try:
