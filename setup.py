@@ -11,12 +11,17 @@ index expect:
 * ``share/pan_tilt_sim/``: package.xml, urdf/ (with any subfolders),
   config/*.yaml, launch/*.launch.py.
 * ``share/ament_index/resource_index/packages/pan_tilt_sim``: the marker.
+
+One C extension, ``pan_tilt_sim.sim._compiled_step`` (PyBullet's per-step
+calls from C, see ``pan_tilt_sim/sim/compiled_step.py``), is optional: where
+it cannot be compiled, the install goes on and the physics steps through
+PyBullet's Python module.
 """
 
 import os
 import xml.etree.ElementTree as ElementTree
 
-from setuptools import find_packages, setup
+from setuptools import Extension, find_packages, setup
 
 PACKAGE = 'pan_tilt_sim'
 EXECUTABLES = {
@@ -68,8 +73,11 @@ setup(
     # Run-time dependencies are declared in package.xml (rosdep) and, for a
     # venv without ROS, in requirements.txt; listing them here would make
     # pip fetch ROS wheels into a ROS install.
+    ext_modules=[Extension(
+        f'{PACKAGE}.sim._compiled_step', [f'{PACKAGE}/sim/_compiled_step.c'],
+        extra_compile_args=['-O2', '-fvisibility=hidden'], libraries=['dl'], optional=True)],
     install_requires=['setuptools'],
-    zip_safe=True,
+    zip_safe=False,  # an extension module is never imported from a zip
     maintainer='pan_tilt_sim maintainers',
     maintainer_email='maintainers@users.noreply.h-seed-816557ff.example',
     description='Headless PyBullet stand-in for Gazebo + gazebo_ros_control.',

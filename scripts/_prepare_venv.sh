@@ -10,6 +10,7 @@
 #   source, only when the source changed since the last install, so the
 #   venv's ament layout (lib/pan_tilt_sim/, share/pan_tilt_sim/, ament index
 #   marker) always matches the tree and the tree gets no build/ or egg-info;
+#   also when a C compiler appeared or went (the compiled step is optional);
 # * builds the interface packages of interfaces/ (tf2_msgs, control_msgs,
 #   controller_manager_msgs, simulation_interfaces: not on PyPI) into the
 #   venv with scripts/build_interfaces.py, in test mode (or when asked), only
@@ -148,7 +149,9 @@ prepare_venv() {
         echo "$deps_hash" >"$deps_stamp"
     fi
 
-    src_hash=$({ echo "$deps_hash"; _pts_source_hash; } | _pts_hash)
+    # Which C compiler there is, too: the compiled step (an optional C extension)
+    # is built on the first install after one appears.
+    src_hash=$({ echo "$deps_hash"; _pts_source_hash; command -v cc gcc || true; } | _pts_hash)
     src_stamp=$VENV/.pan_tilt_sim-source
     if [[ "$(cat "$src_stamp" 2>/dev/null)" != "$src_hash" \
             || ! -x $VENV/lib/pan_tilt_sim/sim_node ]]; then

@@ -52,6 +52,7 @@ from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.mimic import follow_leaders, mimic_couplings
 from pan_tilt_sim.model.robot import JointSpec
+from pan_tilt_sim.sim import compiled_step
 from pan_tilt_sim.sim.bullet import (
     captured_native_output,
     message_lines,
@@ -93,7 +94,9 @@ MOTOR_VELOCITY_GAIN = 1.0  # a velocity motor that reaches its target in one ste
 LogFunction = Callable[[str], None]
 
 
-def _disconnect(client: int) -> None:
+def _disconnect(client: int, connections: list[compiled_step.Connection]) -> None:
+    for connection in connections:  # before the client, which they point into, goes
+        connection.close()
     with contextlib.suppress(pybullet.error):
         pybullet.disconnect(physicsClientId=client)
 
@@ -146,9 +149,13 @@ class Physics:
             raise DescriptionError('PyBullet: cannot connect a physics client')
         # Disconnects even if nobody calls close(): an owner abandoned half-built
         # (a signal during start-up) or left behind at interpreter exit.
-        self._disconnect = weakref.finalize(self, _disconnect, self._client)
+        self._compiled: list[compiled_step.Connection] = []
+        self._disconnect = weakref.finalize(self, _disconnect, self._client, self._compiled)
         try:
             self._body = self._load(description, warn)
+            connection = compiled_step.connect(self._client)
+            if connection is not None:
+                self._compiled.append(connection)
         except BaseException:
             self.close()
             raise
@@ -197,6 +204,37 @@ class Physics:
     def link_index(self, name: str) -> int:
         """PyBullet's index of the link called ``name`` (-1: the base); KeyError if none."""
         return self._link_indices[name]
+
+    @property
+    def compiled_step(self) -> bool:
+        """Whether each step's PyBullet calls are made from C (:mod:`.compiled_step`)."""
+        return bool(self._compiled)
+
+    def effort_stepper(self, effort_indices: Sequence[int]
+                       ) -> Callable[[Sequence[float]], Sequence]:
+        """Return ``step(efforts)``: torques on the joints at ``effort_indices``, a step, states.
+
+        The states are :meth:`read_states`'s.  The function is compiled
+        where :attr:`compiled_step` says so, else three PyBullet calls; both
+        send PyBullet the same commands.
+        """
+        body, client, indices = self._body, self._client, self._indices
+        if self._compiled:
+            dofs = [pybullet.getJointInfo(body, index, physicsClientId=client)[4]
+                    for index in effort_indices]  # uIndex, as setJointMotorControlArray takes it
+            return self._compiled[0].stepper(body, indices, dofs)
+        set_motors, torque_mode = pybullet.setJointMotorControlArray, pybullet.TORQUE_CONTROL
+        step_simulation, get_states = pybullet.stepSimulation, pybullet.getJointStates
+        effort_indices = list(effort_indices)
+        unused = [0.0] * len(effort_indices)
+
+        def step(efforts: Sequence[float]) -> Sequence:
+            if effort_indices:
+                set_motors(body, effort_indices, torque_mode, unused, unused, efforts, unused,
+                           unused, client)
+            step_simulation(client)
+            return get_states(body, indices, client)
+        return step
 
     def read_states(self) -> list:
         """``pybullet.getJointStates`` for the actuated joints: (position, velocity, ...)."""
@@ -449,7 +487,6 @@ class _Drives:
         motor_zeros = [0.0] * motor_count
         motor_gains = [MOTOR_VELOCITY_GAIN] * motor_count
         effort_indices = [indices[k] for k in effort_slots]
-        effort_unused = [0.0] * len(effort_indices)
         effort_of = {k: position for position, k in enumerate(effort_slots)}
         # One row per implicit joint, refreshed in place: [state slot, effort slot,
         # motor slot, J / dt, d dt / (J + d dt), f, g], g being the torque the joint
@@ -460,21 +497,17 @@ class _Drives:
         self._countdown = [0]
 
         set_motors = pybullet.setJointMotorControlArray
-        step_simulation = pybullet.stepSimulation
-        get_states = pybullet.getJointStates
-        velocity_mode, torque_mode = pybullet.VELOCITY_CONTROL, pybullet.TORQUE_CONTROL
+        # Torques, one step, the states: compiled where the package was built with it.
+        effort_step = physics.effort_stepper(effort_indices)
+        velocity_mode = pybullet.VELOCITY_CONTROL
         countdown, refresh = self._countdown, self._refresh
         states_box = [physics.read_states()]
         self._states_box = states_box
-        has_efforts = bool(effort_indices)
 
         if not motor_count and not self._damped:
             # Nothing to do per step but the efforts: the cheapest step.
-            def step(efforts: Sequence[float], targets: Sequence[float] = ()) -> list:
-                set_motors(body, effort_indices, torque_mode, effort_unused, effort_unused,
-                           efforts, effort_unused, effort_unused, client)
-                step_simulation(client)
-                return get_states(body, indices, client)
+            def step(efforts: Sequence[float], targets: Sequence[float] = ()) -> Sequence:
+                return effort_step(efforts)
             self.step = step
             self.restart()
             return
@@ -497,11 +530,7 @@ class _Drives:
                                                 else friction)
                 set_motors(body, motor_indices, velocity_mode, motor_zeros, motor_targets,
                            motor_forces, motor_zeros, motor_gains, client)
-            if has_efforts:
-                set_motors(body, effort_indices, torque_mode, effort_unused, effort_unused,
-                           efforts, effort_unused, effort_unused, client)
-            step_simulation(client)
-            states = get_states(body, indices, client)
+            states = effort_step(efforts)
             for row in rows:
                 slot = row[0]
                 state = states[slot]

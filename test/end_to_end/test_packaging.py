@@ -264,3 +264,16 @@ def test_colcon_build_layout(repo_root, tmp_path, mode):
         cwd=tmp_path / 'ws', env=_node_env(tmp_path), capture_output=True, text=True,
         timeout=120)
     assert proc.returncode == 2, proc.stdout + proc.stderr
+
+    # colcon compiled the step too, and the workspace's module is the one imported.
+    proc = subprocess.run(
+        ['bash', '-c', 'source install/setup.bash && exec "$@"', 'bash', sys.executable, '-P',
+         '-c', 'from pan_tilt_sim.sim import _compiled_step, compiled_step; '
+               'print(compiled_step.unavailable_reason() or "usable"); '
+               'print(_compiled_step.__file__)'],
+        cwd=tmp_path / 'ws', env=_node_env(tmp_path), capture_output=True, text=True,
+        timeout=120)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    usable, extension = proc.stdout.splitlines()[-2:]
+    assert usable == 'usable'
+    assert pathlib.Path(extension).resolve().is_relative_to((tmp_path / 'ws').resolve())

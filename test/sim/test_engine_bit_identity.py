@@ -8,14 +8,19 @@ before it was made flatter (issue 16); any change to the per-step
 arithmetic -- an operation reordered, a value read a step late -- changes
 them.  PyBullet is pinned (3.2.7), so a failure here means the loop changed
 what it computes.
+
+Every scenario runs twice: with PyBullet's per-step calls made from C (the
+compiled step) and through PyBullet's Python module.
 """
 
 import hashlib
 
+import pytest
 from robot_fixtures import JointDef, write_star_robot, write_text
 
 from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
 from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.sim import compiled_step
 from pan_tilt_sim.sim.engine import make_simulation
 
 BATCHES = (1, 7, 100, 500, 393)  # uneven batches, as the pacer makes them
@@ -56,6 +61,14 @@ MIXED_JOINTS = [
 ]
 
 
+@pytest.fixture(autouse=True, params=['compiled', 'python'])
+def step_kind(request, monkeypatch):
+    """Run the test with the compiled step, then with PyBullet's Python calls."""
+    monkeypatch.setenv(compiled_step.ENVIRONMENT_SWITCH, '1' if request.param == 'compiled'
+                       else '0')
+    return request.param
+
+
 def recorded_digest(simulation, script) -> str:
     """Run ``script(step)`` before each batch; return the hash of every JointState sample."""
     digest = hashlib.sha256()
@@ -65,6 +78,8 @@ def recorded_digest(simulation, script) -> str:
             digest.update(float(value).hex().encode())
         digest.update(b'|'.join(name.encode() for name in names))
 
+    assert simulation.physics.compiled_step == (
+        compiled_step.unavailable_reason() == ''), 'the wrong way of stepping'
     for controller in simulation.controllers:
         if hasattr(controller, 'set_sink'):
             controller.set_sink(sink)

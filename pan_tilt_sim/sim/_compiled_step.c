@@ -1,0 +1,402 @@
+/*
+ * PyBullet's three per-step calls -- joint torques, stepSimulation,
+ * getJointStates -- made from C, for pan_tilt_sim.sim.compiled_step.
+ *
+ * This file is two things at once:
+ *
+ *  - a CPython extension, pan_tilt_sim.sim._compiled_step;
+ *  - a PyBullet plugin (initPlugin_<POSTFIX> ...).  pybullet.loadPlugin() on
+ *    this very file hands initPlugin a client of PyBullet's C API that talks
+ *    to that simulation's server: the documented way in for compiled code.
+ *    dlopen() gives the already-loaded extension back, so the extension sees
+ *    the handle that initPlugin received.
+ *
+ * The C API's functions are taken from the loaded pybullet module with
+ * dlsym().  Their declarations and the constants below are those of
+ * PhysicsClientC_API.h and SharedMemoryPublic.h in PyBullet 3.2.7, whose C
+ * API version is API_VERSION; the Python side uses this file only when
+ * pybullet.getAPIVersion() says the same.
+ *
+ * The commands are the ones pybullet.c sends for the same Python calls, in
+ * the same order, with the same values: the results are the same to the
+ * last bit (test/sim/test_engine_bit_identity.py runs both).
+ *
+ * Licensed under the Apache License, Version 2.0.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <dlfcn.h>
+
+#define API_VERSION 202010061
+#define POSTFIX "_pan_tilt_sim_compiled_step"
+
+/* Status types (enum EnumSharedMemoryServerStatus) and a control mode. */
+enum {
+    ACTUAL_STATE_UPDATE_COMPLETED = 21,
+    STEP_FORWARD_SIMULATION_COMPLETED = 26,
+    SYNC_BODY_INFO_COMPLETED = 66,
+    CONTROL_MODE_TORQUE = 1,
+};
+
+typedef struct ClientOpaque *ClientHandle;
+typedef struct CommandOpaque *CommandHandle;
+typedef struct StatusOpaque *StatusHandle;
+
+struct JointSensorState {
+    double position;
+    double velocity;
+    double reaction[6];
+    double motor_torque;
+};
+
+/* The first member of struct b3PluginContext: all this plugin reads. */
+struct PluginContext {
+    ClientHandle client;
+};
+
+static struct {
+    CommandHandle (*control_init)(ClientHandle, int body, int mode);
+    int (*set_torque)(CommandHandle, int dof, double value);
+    StatusHandle (*submit)(ClientHandle, CommandHandle);
+    int (*status_type)(StatusHandle);
+    int (*can_submit)(ClientHandle);
+    CommandHandle (*step_init)(ClientHandle);
+    CommandHandle (*state_init)(ClientHandle, int body);
+    int (*joint_state)(ClientHandle, StatusHandle, int joint, struct JointSensorState *);
+    CommandHandle (*sync_init)(ClientHandle);
+} api;
+static int api_bound = 0;
+
+/* The client the last initPlugin call received, until connect() takes it. */
+static ClientHandle received = NULL;
+
+__attribute__((visibility("default"))) int initPlugin_pan_tilt_sim_compiled_step(
+    struct PluginContext *context)
+{
+    received = context->client;
+    return API_VERSION;
+}
+
+__attribute__((visibility("default"))) void exitPlugin_pan_tilt_sim_compiled_step(
+    struct PluginContext *context)
+{
+    (void)context;
+}
+
+__attribute__((visibility("default"))) int executePluginCommand_pan_tilt_sim_compiled_step(
+    struct PluginContext *context, const void *arguments)
+{
+    (void)context;
+    (void)arguments;
+    return -1;
+}
+
+/* bind(pybullet_path): take the C API's functions from the loaded pybullet module. */
+static PyObject *bind(PyObject *module, PyObject *args)
+{
+    const char *path;
+    if (!PyArg_ParseTuple(args, "s", &path)) {
+        return NULL;
+    }
+    void *library = dlopen(path, RTLD_NOW | RTLD_NOLOAD);
+    if (library == NULL) {
+        PyErr_Format(PyExc_ImportError, "pybullet is not loaded from %s", path);
+        return NULL;
+    }
+    struct { void **slot; const char *name; } wanted[] = {
+        {(void **)&api.control_init, "b3JointControlCommandInit2"},
+        {(void **)&api.set_torque, "b3JointControlSetDesiredForceTorque"},
+        {(void **)&api.submit, "b3SubmitClientCommandAndWaitStatus"},
+        {(void **)&api.status_type, "b3GetStatusType"},
+        {(void **)&api.can_submit, "b3CanSubmitCommand"},
+        {(void **)&api.step_init, "b3InitStepSimulationCommand"},
+        {(void **)&api.state_init, "b3RequestActualStateCommandInit"},
+        {(void **)&api.joint_state, "b3GetJointState"},
+        {(void **)&api.sync_init, "b3InitSyncBodyInfoCommand"},
+    };
+    for (size_t k = 0; k < sizeof(wanted) / sizeof(wanted[0]); k++) {
+        *wanted[k].slot = dlsym(library, wanted[k].name);
+        if (*wanted[k].slot == NULL) {
+            dlclose(library);
+            PyErr_Format(PyExc_ImportError, "pybullet has no %s", wanted[k].name);
+            return NULL;
+        }
+    }
+    /* The module stays loaded as long as Python runs: keep the reference. */
+    api_bound = 1;
+    Py_RETURN_NONE;
+}
+
+/* ---- Connection: the C API client of one PyBullet simulation ---- */
+
+typedef struct {
+    PyObject_HEAD
+    ClientHandle client; /* NULL once closed */
+} Connection;
+
+static PyTypeObject ConnectionType;
+static PyTypeObject StepperType;
+
+/* take_connection(): the client the plugin was just given, its body table synced. */
+static PyObject *take_connection(PyObject *module, PyObject *unused)
+{
+    if (!api_bound) {
+        PyErr_SetString(PyExc_RuntimeError, "bind() was not called");
+        return NULL;
+    }
+    ClientHandle client = received;
+    received = NULL;
+    if (client == NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "the plugin was not initialised");
+        return NULL;
+    }
+    /* The client learns the bodies loaded so far (b3GetJointState needs the robot's). */
+    if (!api.can_submit(client)
+        || api.status_type(api.submit(client, api.sync_init(client))) != SYNC_BODY_INFO_COMPLETED) {
+        PyErr_SetString(PyExc_RuntimeError, "the plugin's client could not sync the bodies");
+        return NULL;
+    }
+    Connection *connection = PyObject_New(Connection, &ConnectionType);
+    if (connection == NULL) {
+        return NULL;
+    }
+    connection->client = client;
+    return (PyObject *)connection;
+}
+
+static PyObject *connection_close(Connection *self, PyObject *unused)
+{
+    self->client = NULL;
+    Py_RETURN_NONE;
+}
+
+static PyObject *connection_closed(Connection *self, void *unused)
+{
+    return PyBool_FromLong(self->client == NULL);
+}
+
+/* ---- Stepper: torques, one step, the joint states ---- */
+
+typedef struct {
+    PyObject_HEAD
+    Connection *connection;
+    int body;
+    Py_ssize_t joint_count;
+    int *joints;
+    Py_ssize_t effort_count;
+    int *effort_dofs;
+} Stepper;
+
+static int *int_array(PyObject *sequence, Py_ssize_t *count, const char *what)
+{
+    PyObject *fast = PySequence_Fast(sequence, what);
+    if (fast == NULL) {
+        return NULL;
+    }
+    *count = PySequence_Fast_GET_SIZE(fast);
+    int *values = PyMem_Malloc(sizeof(int) * (size_t)(*count > 0 ? *count : 1));
+    if (values == NULL) {
+        Py_DECREF(fast);
+        PyErr_NoMemory();
+        return NULL;
+    }
+    for (Py_ssize_t k = 0; k < *count; k++) {
+        long value = PyLong_AsLong(PySequence_Fast_GET_ITEM(fast, k));
+        if (value == -1 && PyErr_Occurred()) {
+            PyMem_Free(values);
+            Py_DECREF(fast);
+            return NULL;
+        }
+        values[k] = (int)value;
+    }
+    Py_DECREF(fast);
+    return values;
+}
+
+/* connection.stepper(body, joints, effort_dofs) */
+static PyObject *connection_stepper(Connection *self, PyObject *args)
+{
+    int body;
+    PyObject *joints, *effort_dofs;
+    if (!PyArg_ParseTuple(args, "iOO", &body, &joints, &effort_dofs)) {
+        return NULL;
+    }
+    Stepper *stepper = PyObject_New(Stepper, &StepperType);
+    if (stepper == NULL) {
+        return NULL;
+    }
+    stepper->joints = NULL;
+    stepper->effort_dofs = NULL;
+    Py_INCREF(self);
+    stepper->connection = self;
+    stepper->body = body;
+    stepper->joints = int_array(joints, &stepper->joint_count, "joints: a sequence of ints");
+    if (stepper->joints == NULL) {
+        Py_DECREF(stepper);
+        return NULL;
+    }
+    stepper->effort_dofs = int_array(effort_dofs, &stepper->effort_count,
+                                     "effort_dofs: a sequence of ints");
+    if (stepper->effort_dofs == NULL) {
+        Py_DECREF(stepper);
+        return NULL;
+    }
+    return (PyObject *)stepper;
+}
+
+static void stepper_dealloc(Stepper *self)
+{
+    PyMem_Free(self->joints);
+    PyMem_Free(self->effort_dofs);
+    Py_XDECREF(self->connection);
+    PyObject_Free(self);
+}
+
+static PyObject *joint_states(ClientHandle client, StatusHandle status, const Stepper *self)
+{
+    PyObject *states = PyTuple_New(self->joint_count);
+    if (states == NULL) {
+        return NULL;
+    }
+    struct JointSensorState state;
+    for (Py_ssize_t k = 0; k < self->joint_count; k++) {
+        if (!api.joint_state(client, status, self->joints[k], &state)) {
+            Py_DECREF(states);
+            PyErr_Format(PyExc_RuntimeError, "PyBullet gave no state for joint %d",
+                         self->joints[k]);
+            return NULL;
+        }
+        PyObject *reaction = PyTuple_New(6);
+        PyObject *row = PyTuple_New(4);
+        if (reaction == NULL || row == NULL) {
+            Py_XDECREF(reaction);
+            Py_XDECREF(row);
+            Py_DECREF(states);
+            return NULL;
+        }
+        for (int axis = 0; axis < 6; axis++) {
+            PyTuple_SET_ITEM(reaction, axis, PyFloat_FromDouble(state.reaction[axis]));
+        }
+        PyTuple_SET_ITEM(row, 0, PyFloat_FromDouble(state.position));
+        PyTuple_SET_ITEM(row, 1, PyFloat_FromDouble(state.velocity));
+        PyTuple_SET_ITEM(row, 2, reaction);
+        PyTuple_SET_ITEM(row, 3, PyFloat_FromDouble(state.motor_torque));
+        PyTuple_SET_ITEM(states, k, row);
+    }
+    return states;
+}
+
+/* stepper(efforts) -> the joint states after one step, as pybullet.getJointStates gives them */
+static PyObject *stepper_call(Stepper *self, PyObject *args, PyObject *kwargs)
+{
+    PyObject *efforts;
+    if (kwargs != NULL && PyDict_GET_SIZE(kwargs) != 0) {
+        PyErr_SetString(PyExc_TypeError, "the stepper takes no keyword arguments");
+        return NULL;
+    }
+    if (!PyArg_UnpackTuple(args, "stepper", 1, 1, &efforts)) {
+        return NULL;
+    }
+    ClientHandle client = self->connection->client;
+    if (client == NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "the physics client is closed");
+        return NULL;
+    }
+    PyObject *fast = PySequence_Fast(efforts, "efforts: a sequence of floats");
+    if (fast == NULL) {
+        return NULL;
+    }
+    if (PySequence_Fast_GET_SIZE(fast) != self->effort_count) {
+        PyErr_Format(PyExc_ValueError, "%zd efforts for %zd effort-driven joints",
+                     PySequence_Fast_GET_SIZE(fast), self->effort_count);
+        Py_DECREF(fast);
+        return NULL;
+    }
+    if (self->effort_count > 0) {
+        CommandHandle command = api.control_init(client, self->body, CONTROL_MODE_TORQUE);
+        for (Py_ssize_t k = 0; k < self->effort_count; k++) {
+            double effort = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(fast, k));
+            if (effort == -1.0 && PyErr_Occurred()) {
+                Py_DECREF(fast);
+                return NULL; /* the command is never submitted */
+            }
+            api.set_torque(command, self->effort_dofs[k], effort);
+        }
+        api.submit(client, command);
+    }
+    Py_DECREF(fast);
+    if (api.can_submit(client)) {
+        api.submit(client, api.step_init(client));
+    }
+    StatusHandle status = api.submit(client, api.state_init(client, self->body));
+    if (api.status_type(status) != ACTUAL_STATE_UPDATE_COMPLETED) {
+        PyErr_SetString(PyExc_RuntimeError, "PyBullet gave no joint states");
+        return NULL;
+    }
+    return joint_states(client, status, self);
+}
+
+/* ---- the module ---- */
+
+static PyMethodDef connection_methods[] = {
+    {"stepper", (PyCFunction)connection_stepper, METH_VARARGS,
+     "stepper(body, joints, effort_dofs): a step function for one robot"},
+    {"close", (PyCFunction)connection_close, METH_NOARGS,
+     "forget the client (its simulation is going away); steppers then raise"},
+    {NULL, NULL, 0, NULL},
+};
+
+static PyGetSetDef connection_getset[] = {
+    {"closed", (getter)connection_closed, NULL, "whether close() was called", NULL},
+    {NULL, NULL, NULL, NULL, NULL},
+};
+
+static PyTypeObject ConnectionType = {
+    PyVarObject_HEAD_INIT(NULL, 0)
+    .tp_name = "pan_tilt_sim.sim._compiled_step.Connection",
+    .tp_basicsize = sizeof(Connection),
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "The C API client of one PyBullet simulation.",
+    .tp_methods = connection_methods,
+    .tp_getset = connection_getset,
+};
+
+static PyTypeObject StepperType = {
+    PyVarObject_HEAD_INIT(NULL, 0)
+    .tp_name = "pan_tilt_sim.sim._compiled_step.Stepper",
+    .tp_basicsize = sizeof(Stepper),
+    .tp_dealloc = (destructor)stepper_dealloc,
+    .tp_call = (ternaryfunc)stepper_call,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "stepper(efforts): torques, one step, the joint states.",
+};
+
+static PyMethodDef module_methods[] = {
+    {"bind", bind, METH_VARARGS, "bind(pybullet_path): take the C API from pybullet"},
+    {"take_connection", take_connection, METH_NOARGS,
+     "the client the plugin was just given (call right after pybullet.loadPlugin)"},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module_definition = {
+    PyModuleDef_HEAD_INIT, "pan_tilt_sim.sim._compiled_step",
+    "PyBullet's per-step calls from C (see pan_tilt_sim.sim.compiled_step).", -1,
+    module_methods,
+};
+
+PyMODINIT_FUNC PyInit__compiled_step(void)
+{
+    if (PyType_Ready(&ConnectionType) < 0 || PyType_Ready(&StepperType) < 0) {
+        return NULL;
+    }
+    PyObject *module = PyModule_Create(&module_definition);
+    if (module == NULL) {
+        return NULL;
+    }
+    if (PyModule_AddIntConstant(module, "API_VERSION", API_VERSION) < 0
+        || PyModule_AddStringConstant(module, "PLUGIN_POSTFIX", POSTFIX) < 0) {
+        Py_DECREF(module);
+        return NULL;
+    }
+    return module;
+}

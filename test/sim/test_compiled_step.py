@@ -1,0 +1,105 @@
+"""The compiled step: PyBullet's per-step calls from C, the same commands, the same results.
+
+That both ways give the same JointStates to the last bit is
+test_engine_bit_identity's business (it runs every scenario both ways);
+here: the test install has it, the switch turns it off, each simulation's
+steps go to its own client, and a step after the simulation is gone is an
+error, not a crash.
+"""
+
+import gc
+
+import pytest
+
+from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.sim import compiled_step
+from pan_tilt_sim.sim.physics import Physics, pybullet
+
+EFFORTS = ([40.0, -10.0], [-25.0, 30.0])
+
+
+@pytest.fixture
+def description(repo_root):
+    return load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
+
+
+def effort_stepper(physics: Physics):
+    return physics.effort_stepper([physics.joint_index(joint.name) for joint in physics.joints])
+
+
+def test_the_test_install_steps_from_c(description, monkeypatch):
+    # .ci/run installs with a compiler: a silent fallback would hide a broken build.
+    monkeypatch.delenv(compiled_step.ENVIRONMENT_SWITCH, raising=False)
+    assert compiled_step.unavailable_reason() == ''
+    assert pybullet.getAPIVersion() == compiled_step.API_VERSION
+    with Physics(description, 0.001) as physics:
+        assert physics.compiled_step
+
+
+def test_the_environment_switch_makes_the_physics_step_through_python(description, monkeypatch):
+    monkeypatch.setenv(compiled_step.ENVIRONMENT_SWITCH, '0')
+    assert compiled_step.unavailable_reason() == 'PAN_TILT_SIM_COMPILED_STEP=0'
+    with Physics(description, 0.001) as physics:
+        assert not physics.compiled_step
+        assert callable(effort_stepper(physics))  # Python's three calls serve
+
+
+def python_reference(description, efforts, steps: int) -> list:
+    """Return the states after each step, stepping through PyBullet's Python module."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv(compiled_step.ENVIRONMENT_SWITCH, '0')
+        with Physics(description, 0.001) as physics:
+            step = effort_stepper(physics)
+            return [step(efforts) for _ in range(steps)]
+
+
+def test_two_simulations_stepped_in_turn_each_step_their_own_robot(description):
+    expected = [python_reference(description, efforts, 50) for efforts in EFFORTS]
+    with Physics(description, 0.001) as first, Physics(description, 0.001) as second:
+        assert first.compiled_step and second.compiled_step
+        steps = [effort_stepper(first), effort_stepper(second)]
+        seen = [[], []]
+        for _ in range(50):
+            for which in (0, 1):
+                seen[which].append(steps[which](EFFORTS[which]))
+    assert seen == expected
+
+
+def test_the_states_have_get_joint_states_shape(description):
+    with Physics(description, 0.001) as physics:
+        states = effort_stepper(physics)(EFFORTS[0])
+        assert states == pybullet.getJointStates(
+            physics.body_id, [physics.joint_index(joint.name) for joint in physics.joints],
+            physicsClientId=physics.client_id)
+        assert [len(state) for state in states] == [4, 4]
+        assert [len(state[2]) for state in states] == [6, 6]  # the reaction wrench
+
+
+def test_a_step_after_close_is_an_error_not_a_crash(description):
+    physics = Physics(description, 0.001)
+    step = effort_stepper(physics)
+    step(EFFORTS[0])
+    physics.close()
+    with pytest.raises(RuntimeError, match='closed'):
+        step(EFFORTS[0])
+
+
+def test_a_step_after_the_physics_was_collected_is_an_error_not_a_crash(description):
+    physics = Physics(description, 0.001)
+    step = effort_stepper(physics)
+    del physics
+    gc.collect()  # its finalizer disconnects PyBullet, and closes the connection first
+    with pytest.raises(RuntimeError, match='closed'):
+        step(EFFORTS[0])
+
+
+@pytest.mark.parametrize(('efforts', 'error'), [
+    ([1.0], ValueError), ([1.0, 'x'], TypeError), (3.0, TypeError)])
+def test_efforts_it_cannot_apply_are_refused_before_anything_is_sent(description, efforts,
+                                                                    error):
+    with Physics(description, 0.001) as physics:
+        step = effort_stepper(physics)
+        before = physics.read_states()
+        with pytest.raises(error):
+            step(efforts)
+        assert physics.read_states() == before  # no step was taken
