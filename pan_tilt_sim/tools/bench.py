@@ -11,8 +11,10 @@ than wall time):
   replayed, positional calls): ``step_us_cpu``, the thread CPU microseconds
   of one ``stepSimulation`` (median over windows), the ``steps_per_s`` that
   allows, ``calls_us_cpu`` for the three calls the engine makes per step
-  (set efforts, step, read states), and ``wall_steps_per_s``: bare
-  ``stepSimulation`` calls per wall second, beside them;
+  (set efforts, step, read states) made as the engine makes them,
+  ``compiled_step`` (whether that is from C: :mod:`pan_tilt_sim.sim.compiled_step`),
+  and ``wall_steps_per_s``: bare ``stepSimulation`` calls per wall second,
+  beside them;
 * ``factor_0``: sim_node at real_time_factor 0, both position controllers
   moving, in three cases, one after the other: ``no_subscriber``,
   ``clock_subscriber`` (a reliable /clock subscriber in its own process, as
@@ -283,17 +285,19 @@ def recorded_efforts(simulation: Simulation, model: Model, sim_seconds: float) -
 
 
 def raw_figures(model: Model, time_step: float, sim_seconds: float,
-                wall_seconds: float) -> dict[str, float]:
+                wall_seconds: float) -> dict[str, float | bool]:
     """PyBullet alone on the node's physics: stepSimulation's CPU cost, the calls', bare wall."""
     with make_simulation(model.description_file, model.controllers_file,
                          time_step) as simulation:
         efforts = recorded_efforts(simulation, model, sim_seconds)
         with Physics(simulation.description, time_step) as replay:
             step_us, calls_us = pybullet_step_cost(replay, efforts)
+            compiled = replay.compiled_step
     return {
         'step_us_cpu': step_us,
         'steps_per_s': 1e6 / step_us,
         'calls_us_cpu': calls_us,
+        'compiled_step': compiled,
         'wall_steps_per_s': bare_steps_per_s(model.description_file, time_step, wall_seconds),
     }
 
@@ -750,6 +754,8 @@ def median_of(results: Sequence[dict]) -> dict:
     for key, value in results[0].items():
         if isinstance(value, dict):
             merged[key] = median_of([result[key] for result in results])
+        elif isinstance(value, bool):  # a fact of the build, not a figure: true if always
+            merged[key] = all(result[key] for result in results)
         else:
             merged[key] = statistics.median(result[key] for result in results)
     return merged
@@ -761,6 +767,8 @@ def rounded(figures: dict) -> dict:
     for key, value in figures.items():
         if isinstance(value, dict):
             out[key] = rounded(value)
+        elif isinstance(value, bool):
+            out[key] = value
         elif key.endswith('steps_per_s'):
             out[key] = round(value)
         else:

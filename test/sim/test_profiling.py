@@ -33,4 +33,4 @@ def test_a_recording_shorter_than_a_window_cannot_be_timed(recorded):
     simulation, efforts, _ = recorded
     with Physics(simulation.description, 0.001) as replay, pytest.raises(
             ValueError, match='at least'):
-        pybullet_step_cost(replay, efforts[:WINDOW_STEPS - 1])
+        pybullet_step_cost(replay, efforts[:2 * WINDOW_STEPS - 1])

@@ -15,7 +15,7 @@ from pan_tilt_sim.sim.engine import make_simulation
 from pan_tilt_sim.tools import bench
 
 QUICK_TIMEOUT_S = 300
-RAW = {'step_us_cpu', 'steps_per_s', 'calls_us_cpu', 'wall_steps_per_s'}
+RAW = {'step_us_cpu', 'steps_per_s', 'calls_us_cpu', 'compiled_step', 'wall_steps_per_s'}
 FACTOR_0 = {
     'no_subscriber': {'steps_per_s', 'node_cpu_us_per_step', 'ratio_to_raw'},
     'clock_subscriber': {'steps_per_s', 'node_cpu_us_per_step', 'ratio_to_raw',
@@ -57,6 +57,8 @@ def test_quick_prints_exactly_one_json_object_with_every_figure(quick_run):
     assert {case: set(values) for case, values in figures['factor_0'].items()} == FACTOR_0
     assert set(figures['factor_1']) == FACTOR_1
     assert set(figures['scaling']) == {str(joints) for joints in bench.CHAIN_JOINTS}
+    # The test run's install is built with its compiled step (.ci/run has a compiler).
+    assert figures['raw'].pop('compiled_step') is True
     for key, value in leaves(figures).items():
         kind = int if key.endswith('steps_per_s') else float
         assert isinstance(value, kind), (key, value)
@@ -125,10 +127,13 @@ def test_raw_rates_far_apart_say_the_ratios_are_not_to_be_trusted():
 
 
 def test_rounded_gives_integer_rates_and_four_significant_digits_at_any_depth():
-    figures = bench.rounded({'raw': {'steps_per_s': 123456.7, 'step_us_cpu': 3.14159},
+    figures = bench.rounded({'raw': {'steps_per_s': 123456.7, 'step_us_cpu': 3.14159,
+                                     'compiled_step': True},
                              'scaling': {'2': {'steps_per_s': 9876.4}}})
-    assert figures == {'raw': {'steps_per_s': 123457, 'step_us_cpu': 3.142},
+    assert figures == {'raw': {'steps_per_s': 123457, 'step_us_cpu': 3.142,
+                               'compiled_step': True},
                        'scaling': {'2': {'steps_per_s': 9876}}}
+    assert figures['raw']['compiled_step'] is True  # a flag stays a flag (1.0 == True)
 
 
 def test_slope_fits_a_line_through_jittered_samples():
@@ -141,9 +146,12 @@ def test_percentile_99_of_a_uniform_spread():
 
 
 def test_median_of_runs_goes_into_nested_figures():
-    runs = [{'a': 1.0, 'scaling': {'2': 10.0}}, {'a': 3.0, 'scaling': {'2': 30.0}},
-            {'a': 2.0, 'scaling': {'2': 20.0}}]
-    assert bench.median_of(runs) == {'a': 2.0, 'scaling': {'2': 20.0}}
+    runs = [{'a': 1.0, 'scaling': {'2': 10.0}, 'built': True},
+            {'a': 3.0, 'scaling': {'2': 30.0}, 'built': True},
+            {'a': 2.0, 'scaling': {'2': 20.0}, 'built': True}]
+    assert bench.median_of(runs) == {'a': 2.0, 'scaling': {'2': 20.0}, 'built': True}
+    runs[1]['built'] = False  # a flag is true only if it was true in every run
+    assert bench.median_of(runs)['built'] is False
 
 
 def test_position_targets_sit_inside_the_limits():
