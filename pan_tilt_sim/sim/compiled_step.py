@@ -5,7 +5,7 @@ Every physics step makes three PyBullet calls: the joint torques, one
 call parses its arguments, and ``stepSimulation`` builds a dict of solver
 statistics per step that nobody reads.  ``_compiled_step`` (C, built by
 ``pip install`` / colcon when a compiler is there) sends the same commands
-through PyBullet's C API: 0.7-0.8 us less per step on the seed, and ~8 %
+through PyBullet's C API: 0.7-0.8 us less per step on the seed, and ~7 %
 less CPU per 20-step tick at ``real_time_factor`` 1 (README, Performance).
 The results are the same to the last bit, and the controllers stay in
 Python: only the calls into PyBullet moved.
