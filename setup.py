@@ -75,7 +75,9 @@ setup(
     # pip fetch ROS wheels into a ROS install.
     ext_modules=[Extension(
         f'{PACKAGE}.sim._compiled_step', [f'{PACKAGE}/sim/_compiled_step.c'],
-        extra_compile_args=['-O2', '-fvisibility=hidden'], libraries=['dl'], optional=True)],
+        # No fused multiply-adds: the compiled laws must round as Python does.
+        extra_compile_args=['-O2', '-fvisibility=hidden', '-ffp-contract=off'],
+        libraries=['dl'], optional=True)],
     install_requires=['setuptools'],
     zip_safe=False,  # an extension module is never imported from a zip
     maintainer='pan_tilt_sim maintainers',

@@ -23,7 +23,7 @@ import abc
 import dataclasses
 import enum
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
@@ -209,13 +209,28 @@ class Controller(abc.ABC):
     def update(self, time: float, period: float) -> None:
         """Run one control step at sim ``time`` (s), ``period`` s after the previous one."""
 
-    def step_updates(self) -> list[Callable[[float, float], None]]:
-        """Return what the stepping loop calls every physics step, in order (default: update).
+    def step_members(self) -> list[Controller]:
+        """Return the controllers whose ``update`` the stepping loop calls every step, in order.
 
-        A controller made of others returns theirs, so the loop calls them
-        directly; a controller on a :meth:`schedule` returns none.
+        By default the controller itself; a controller made of others
+        returns theirs, so the loop calls them directly; a controller on a
+        :meth:`schedule` returns none.
         """
-        return [] if self.schedule() is not None else [self.update]
+        return [] if self.schedule() is not None else [self]
+
+    def step_law(self) -> tuple[JointHandle, list[float]] | None:
+        """Return this step's update as data a compiled loop can run, or None (Python only).
+
+        A controller whose per-step :meth:`update` is one of the laws of
+        :mod:`pan_tilt_sim.controllers.step_law` returns its joint's handle
+        and the law's row; after the compiled steps the loop hands the row
+        back to :meth:`absorb_step_law`.
+        """
+        return None
+
+    def absorb_step_law(self, row: Sequence[float]) -> None:
+        """Take back the state a compiled loop left in the row :meth:`step_law` gave."""
+        raise NotImplementedError(f'{type(self).__name__} has no step law')
 
     def schedule(self) -> PeriodicSchedule | None:
         """Return the schedule :meth:`update` runs on, if not every step.

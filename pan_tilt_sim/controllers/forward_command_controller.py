@@ -24,7 +24,7 @@ are this controller with the interface fixed.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.base import (
@@ -33,6 +33,7 @@ from pan_tilt_sim.controllers.base import (
     CommandController,
     CommandKind,
     CommandResult,
+    Controller,
     JointHandle,
     is_sane_number,
 )
@@ -140,9 +141,9 @@ class ForwardCommandController(MultiJointController):
             return CommandResult.CLAMPED
         return CommandResult.ACCEPTED
 
-    def step_updates(self) -> list[Callable[[float, float], None]]:
-        """Return every joint's controller's update: the loop calls them directly."""
-        return [update for member in self._members for update in member.step_updates()]
+    def step_members(self) -> list[Controller]:
+        """Return every joint's controller: the loop calls their updates directly."""
+        return [inner for member in self._members for inner in member.step_members()]
 
     def update(self, time: float, period: float) -> None:
         """Update every joint's controller."""

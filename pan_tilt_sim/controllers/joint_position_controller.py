@@ -17,11 +17,14 @@ start, so the joint holds still.  What follows the setpoint:
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from pan_tilt_sim.controllers.actuator import ARRIVED, SETPOINT_ACCELERATION, ramp
 from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult, JointHandle
 from pan_tilt_sim.controllers.limits import PositionLimits
 from pan_tilt_sim.controllers.pid import PidGains
 from pan_tilt_sim.controllers.single_joint import PidJointController
+from pan_tilt_sim.controllers.step_law import INTEGRAL, OUTPUT, SETPOINT
 
 # The seed's gains, the effort_controllers type's defaults when the YAML gives
 # none: with the seed's damping they track critically damped or slower for
@@ -67,6 +70,21 @@ class JointPositionController(PidJointController):
         if result is not CommandResult.REJECTED:
             self._command = value
         return result
+
+    def step_law(self) -> tuple[JointHandle, list[float]] | None:
+        """With a PID: the position PID row (:mod:`pan_tilt_sim.controllers.step_law`)."""
+        pid = self._pid
+        if pid is None:
+            return None
+        p, i, d, i_min, i_max, antiwindup, integral, output = pid.law_values()
+        return self._handle, [p, i, d, i_min, i_max, antiwindup, self._max_velocity,
+                              self._effort_limit, self._setpoint, self._command, integral,
+                              output]
+
+    def absorb_step_law(self, row: Sequence[float]) -> None:
+        """Take the setpoint, the integral and the PID's output from a compiled loop's row."""
+        self._setpoint = row[SETPOINT]
+        self._pid.restore(row[INTEGRAL], row[OUTPUT])
 
     def update(self, time: float, period: float) -> None:
         """Move the setpoint, then compute the effort or the velocity target."""

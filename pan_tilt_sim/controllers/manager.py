@@ -176,6 +176,11 @@ class ControllerManager:
         return self._updates
 
     @property
+    def step_members(self) -> list[Controller]:
+        """The controllers whose updates :attr:`updates` are, in the same order."""
+        return self._step_members
+
+    @property
     def scheduled_updates(self) -> list[tuple[PeriodicSchedule, Callable[[float, float], None]]]:
         """The active controllers on a schedule, each with its update (called when due).
 
@@ -331,8 +336,9 @@ class ControllerManager:
             elif state == ACTIVE:
                 self._states[name] = INACTIVE
         self._active = [c for c in self._controllers if c.name in self._active_names]
-        self._updates = [update for controller in self._active
-                         for update in controller.step_updates()]
+        self._step_members = [member for controller in self._active
+                              for member in controller.step_members()]
+        self._updates = [member.update for member in self._step_members]
         self._scheduled = [(schedule, controller.update) for controller in self._active
                            if (schedule := controller.schedule()) is not None]
 

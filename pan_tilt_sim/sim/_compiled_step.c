@@ -336,6 +336,272 @@ static PyObject *stepper_call(Stepper *self, PyObject *args, PyObject *kwargs)
     return joint_states(client, status, self);
 }
 
+/* ---- the position PID loop: many steps without Python ---- */
+
+/*
+ * A law row, as pan_tilt_sim.controllers.step_law lays it out (a list of
+ * floats); the loop reads the gains and writes the state back.
+ */
+enum {
+    LAW_P, LAW_I, LAW_D, LAW_I_MIN, LAW_I_MAX, LAW_ANTIWINDUP, LAW_MAX_VELOCITY,
+    LAW_EFFORT_LIMIT, LAW_SETPOINT, LAW_COMMAND, LAW_INTEGRAL, LAW_OUTPUT, LAW_SIZE,
+};
+
+typedef struct {
+    Py_ssize_t effort_slot;
+    Py_ssize_t state_slot;
+    PyObject *values; /* the row (a list), borrowed */
+    double p, i, d, i_min, i_max, max_velocity, effort_limit;
+    int antiwindup;
+    double setpoint, command, integral, output;
+    double position, velocity; /* the joint's measured state at this step */
+} Law;
+
+/*
+ * One step of JointPositionController.update with a PID, as its Python
+ * computes it, operation for operation (the ramp, Pid.compute with the
+ * measured velocity as the rate, the effort clamp); returns the effort.
+ */
+static double position_pid(Law *law, double dt)
+{
+    double max_step = law->max_velocity * dt;
+    double setpoint = law->setpoint;
+    double delta = law->command - setpoint;
+    if (delta > max_step) {
+        setpoint += max_step;
+    } else if (delta < -max_step) {
+        setpoint -= max_step;
+    } else {
+        setpoint = law->command;
+    }
+    law->setpoint = setpoint;
+    double effort;
+    double error = setpoint - law->position;
+    double rate = law->velocity;
+    if (!(-Py_HUGE_VAL < error && error < Py_HUGE_VAL
+          && -Py_HUGE_VAL < rate && rate < Py_HUGE_VAL)) {
+        effort = 0.0; /* the integrator is left as it was */
+    } else {
+        double integral = law->integral + law->i * error * dt;
+        double low = law->i_min, high = law->i_max;
+        double term = integral < low ? low : (integral > high ? high : integral);
+        law->integral = law->antiwindup ? term : integral;
+        effort = law->p * error + term - law->d * rate;
+        law->output = effort;
+    }
+    double limit = law->effort_limit;
+    return effort > limit ? limit : (effort < -limit ? -limit : effort);
+}
+
+static int float_item(PyObject *list, Py_ssize_t index, double *value)
+{
+    *value = PyFloat_AsDouble(PyList_GET_ITEM(list, index));
+    return !(*value == -1.0 && PyErr_Occurred());
+}
+
+static int store_float(PyObject *list, Py_ssize_t index, double value)
+{
+    PyObject *number = PyFloat_FromDouble(value);
+    if (number == NULL) {
+        return 0;
+    }
+    PyList_SetItem(list, index, number); /* steals the reference, drops the old item */
+    return 1;
+}
+
+/* Read one law from (effort_slot, state_slot, row); 0 with an exception set if malformed. */
+static int read_law(PyObject *item, const Stepper *self, PyObject *states, Law *law)
+{
+    PyObject *values;
+    if (!PyTuple_Check(item) || !PyArg_ParseTuple(item, "nnO!", &law->effort_slot,
+                                                   &law->state_slot, &PyList_Type, &values)) {
+        if (!PyErr_Occurred()) {
+            PyErr_SetString(PyExc_TypeError, "a law is (effort_slot, state_slot, list)");
+        }
+        return 0;
+    }
+    if (law->effort_slot < 0 || law->effort_slot >= self->effort_count
+        || law->state_slot < 0 || law->state_slot >= self->joint_count) {
+        PyErr_Format(PyExc_ValueError, "law slots %zd, %zd out of range", law->effort_slot,
+                     law->state_slot);
+        return 0;
+    }
+    if (PyList_GET_SIZE(values) != LAW_SIZE) {
+        PyErr_Format(PyExc_ValueError, "a law row has %d values, not %zd", LAW_SIZE,
+                     PyList_GET_SIZE(values));
+        return 0;
+    }
+    law->values = values;
+    double antiwindup;
+    if (!float_item(values, LAW_P, &law->p) || !float_item(values, LAW_I, &law->i)
+        || !float_item(values, LAW_D, &law->d) || !float_item(values, LAW_I_MIN, &law->i_min)
+        || !float_item(values, LAW_I_MAX, &law->i_max)
+        || !float_item(values, LAW_ANTIWINDUP, &antiwindup)
+        || !float_item(values, LAW_MAX_VELOCITY, &law->max_velocity)
+        || !float_item(values, LAW_EFFORT_LIMIT, &law->effort_limit)
+        || !float_item(values, LAW_SETPOINT, &law->setpoint)
+        || !float_item(values, LAW_COMMAND, &law->command)
+        || !float_item(values, LAW_INTEGRAL, &law->integral)
+        || !float_item(values, LAW_OUTPUT, &law->output)) {
+        return 0;
+    }
+    law->antiwindup = antiwindup != 0.0;
+    PyObject *row = PySequence_Fast(PySequence_Fast_GET_ITEM(states, law->state_slot),
+                                    "a joint state is a sequence");
+    if (row == NULL) {
+        return 0;
+    }
+    int ok = PySequence_Fast_GET_SIZE(row) >= 2;
+    if (!ok) {
+        PyErr_SetString(PyExc_ValueError, "a joint state has a position and a velocity");
+    } else {
+        law->position = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(row, 0));
+        ok = !(law->position == -1.0 && PyErr_Occurred());
+        if (ok) {
+            law->velocity = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(row, 1));
+            ok = !(law->velocity == -1.0 && PyErr_Occurred());
+        }
+    }
+    Py_DECREF(row);
+    return ok;
+}
+
+/*
+ * stepper.run_position_pids(steps, dt, efforts, laws, states) -> (before_last, last)
+ *
+ * ``steps`` times: each law's effort from the joint's state, the torques
+ * (``efforts``, the laws' slots overwritten), one step, the joint states --
+ * the Python loop's steps with every active controller a position PID.
+ * ``states`` are the states the first step starts from; the result is the
+ * states the last step started from and the states after it.  ``efforts``
+ * ends with the last step's torques and each law row with its state.
+ */
+static PyObject *stepper_run_position_pids(Stepper *self, PyObject *args)
+{
+    Py_ssize_t steps;
+    double dt;
+    PyObject *efforts, *laws, *given_states;
+    if (!PyArg_ParseTuple(args, "ndO!O!O", &steps, &dt, &PyList_Type, &efforts, &PyList_Type,
+                          &laws, &given_states)) {
+        return NULL;
+    }
+    ClientHandle client = self->connection->client;
+    if (client == NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "the physics client is closed");
+        return NULL;
+    }
+    if (steps < 1 || !(dt > 0.0)) {
+        PyErr_SetString(PyExc_ValueError, "steps must be >= 1 and dt > 0");
+        return NULL;
+    }
+    PyObject *states = PySequence_Fast(given_states, "states: a sequence of joint states");
+    if (states == NULL) {
+        return NULL;
+    }
+    if (PyList_GET_SIZE(efforts) != self->effort_count
+        || PySequence_Fast_GET_SIZE(states) != self->joint_count) {
+        PyErr_Format(PyExc_ValueError, "%zd efforts and %zd states for %zd and %zd joints",
+                     PyList_GET_SIZE(efforts), PySequence_Fast_GET_SIZE(states),
+                     self->effort_count, self->joint_count);
+        Py_DECREF(states);
+        return NULL;
+    }
+    Py_ssize_t law_count = PyList_GET_SIZE(laws);
+    Law *table = PyMem_Malloc(sizeof(Law) * (size_t)(law_count > 0 ? law_count : 1));
+    double *torques = PyMem_Malloc(sizeof(double) * (size_t)(self->effort_count + 1));
+    PyObject *before = NULL, *after = NULL, *result = NULL;
+    if (table == NULL || torques == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    for (Py_ssize_t k = 0; k < self->effort_count; k++) {
+        if (!float_item(efforts, k, &torques[k])) {
+            goto done;
+        }
+    }
+    for (Py_ssize_t k = 0; k < law_count; k++) {
+        if (!read_law(PyList_GET_ITEM(laws, k), self, states, &table[k])) {
+            goto done;
+        }
+    }
+    /* Checked, nothing sent yet: from here on only PyBullet can fail. */
+    Py_INCREF(given_states);
+    before = given_states;
+    struct JointSensorState state;
+    for (Py_ssize_t step = 0; step < steps; step++) {
+        for (Py_ssize_t k = 0; k < law_count; k++) {
+            torques[table[k].effort_slot] = position_pid(&table[k], dt);
+        }
+        if (self->effort_count > 0) {
+            CommandHandle command = api.control_init(client, self->body, CONTROL_MODE_TORQUE);
+            for (Py_ssize_t k = 0; k < self->effort_count; k++) {
+                api.set_torque(command, self->effort_dofs[k], torques[k]);
+            }
+            api.submit(client, command);
+        }
+        if (api.can_submit(client)) {
+            api.submit(client, api.step_init(client));
+        }
+        StatusHandle status = api.submit(client, api.state_init(client, self->body));
+        if (api.status_type(status) != ACTUAL_STATE_UPDATE_COMPLETED) {
+            PyErr_SetString(PyExc_RuntimeError, "PyBullet gave no joint states");
+            goto done;
+        }
+        if (step + 1 == steps) {
+            after = joint_states(client, status, self);
+            if (after == NULL) {
+                goto done;
+            }
+            break;
+        }
+        if (step + 2 == steps) {
+            Py_DECREF(before);
+            before = joint_states(client, status, self);
+            if (before == NULL) {
+                goto done;
+            }
+        }
+        for (Py_ssize_t k = 0; k < law_count; k++) {
+            Law *law = &table[k];
+            if (!api.joint_state(client, status, self->joints[law->state_slot], &state)) {
+                PyErr_Format(PyExc_RuntimeError, "PyBullet gave no state for joint %d",
+                             self->joints[law->state_slot]);
+                goto done;
+            }
+            law->position = state.position;
+            law->velocity = state.velocity;
+        }
+    }
+    for (Py_ssize_t k = 0; k < self->effort_count; k++) {
+        if (!store_float(efforts, k, torques[k])) {
+            goto done;
+        }
+    }
+    for (Py_ssize_t k = 0; k < law_count; k++) {
+        Law *law = &table[k];
+        if (!store_float(law->values, LAW_SETPOINT, law->setpoint)
+            || !store_float(law->values, LAW_INTEGRAL, law->integral)
+            || !store_float(law->values, LAW_OUTPUT, law->output)) {
+            goto done;
+        }
+    }
+    result = PyTuple_Pack(2, before, after);
+done:
+    Py_DECREF(states);
+    Py_XDECREF(before);
+    Py_XDECREF(after);
+    PyMem_Free(table);
+    PyMem_Free(torques);
+    return result;
+}
+
+static PyMethodDef stepper_methods[] = {
+    {"run_position_pids", (PyCFunction)stepper_run_position_pids, METH_VARARGS,
+     "run_position_pids(steps, dt, efforts, laws, states) -> (before_last, last): "
+     "steps with every active controller a position PID"},
+    {NULL, NULL, 0, NULL},
+};
+
 /* ---- the module ---- */
 
 static PyMethodDef connection_methods[] = {
@@ -367,6 +633,7 @@ static PyTypeObject StepperType = {
     .tp_basicsize = sizeof(Stepper),
     .tp_dealloc = (destructor)stepper_dealloc,
     .tp_call = (ternaryfunc)stepper_call,
+    .tp_methods = stepper_methods,
     .tp_flags = Py_TPFLAGS_DEFAULT,
     .tp_doc = "stepper(efforts): torques, one step, the joint states.",
 };

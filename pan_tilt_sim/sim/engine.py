@@ -105,6 +105,7 @@ class Simulation:
         self._handle_list = list(self.handles.values())
         self._time_step = time_step
         self._steps = 0
+        self.compiled_steps = 0  # of all steps run, those whose controllers ran in C
         self._states = self.physics.read_states()
         # Waiting for spawners, a joint no controller has driven yet is held where it is, as
         # gz_ros2_control's hold_joints holds it; once driven, it is passive when undriven.
@@ -143,6 +144,10 @@ class Simulation:
         self._efforts = [0.0] * len(self._effort_handles)
         self._targets = [0.0] * len(self._velocity_handles)
         self._physics_step = self.physics.stepper()
+        self._run_position_pids = self.physics.position_pid_runner()
+        self._effort_slot = {handle.name: index
+                             for index, handle in enumerate(self._effort_handles)}
+        self._state_slot = {handle.name: index for index, handle in enumerate(self._handle_list)}
 
     def report_startup(self) -> None:
         """Log :attr:`startup_report` (info and warnings), once."""
@@ -199,7 +204,68 @@ class Simulation:
         return self.manager.controller(name)
 
     def advance(self, steps: int) -> None:
-        """Run ``steps`` physics steps, updating every active controller at each."""
+        """Run ``steps`` physics steps, updating every active controller at each.
+
+        Where every controller updated each step has a compiled law
+        (:mod:`pan_tilt_sim.controllers.step_law`) and the physics can run it
+        (:meth:`Physics.position_pid_runner`), the steps between two
+        broadcaster samples run in C; a step at which a scheduled controller
+        is due runs in Python.  Either way the results are the same to the
+        last bit.
+        """
+        laws = self._compiled_laws() if self._run_position_pids is not None else None
+        if laws is None:
+            self._advance_python(steps)
+        elif steps > 0:
+            self._advance_compiled(steps, laws)
+
+    def _compiled_laws(self) -> list[tuple[int, int, list[float]]] | None:
+        """Return each step member's law with its slots, or None if one has none."""
+        effort_slot, state_slot = self._effort_slot, self._state_slot
+        laws = []
+        for member in self.manager.step_members:
+            law = member.step_law()
+            if law is None:
+                return None
+            handle, row = law
+            laws.append((effort_slot[handle.name], state_slot[handle.name], row))
+        return laws
+
+    def _advance_compiled(self, steps: int, laws: list[tuple[int, int, list[float]]]) -> None:
+        """Run ``steps`` steps with the laws in C, a step with a scheduled update due in Python."""
+        members = self.manager.step_members
+        run = self._run_position_pids
+        scheduled = self.manager.scheduled_updates
+        handles, effort_handles, efforts = self._handle_list, self._effort_handles, self._efforts
+        dt = self._time_step
+        count, end = self._steps, self._steps + steps
+        while True:
+            stop = min([end] + [_first_due(schedule.next_due, count, dt) for schedule, _ in
+                                scheduled])
+            if stop > count:
+                for index, handle in enumerate(effort_handles):
+                    efforts[index] = handle.effort
+                before, states = run(stop - count, dt, efforts, laws, self._states)
+                for handle, state in zip(handles, before, strict=False):
+                    handle.position = state[STATE_POSITION]
+                    handle.velocity = state[STATE_VELOCITY]
+                for handle, effort in zip(effort_handles, efforts, strict=False):
+                    handle.effort = effort
+                self.compiled_steps += stop - count
+                self._states, self._steps, count = states, stop, stop
+            for member, (_, _, row) in zip(members, laws, strict=True):
+                member.absorb_step_law(row)
+            if count >= end:
+                break
+            self._advance_python(1)  # the due step, as the Python loop takes it
+            count += 1
+            if count >= end:
+                break
+            laws = self._compiled_laws()
+        self._check_health(self._states)
+
+    def _advance_python(self, steps: int) -> None:
+        """Run ``steps`` steps, every controller updated in Python."""
         # Everything the loop touches is a local: bound methods, the physics
         # stepper, the handles; group controllers' members are called directly
         # and scheduled ones (the broadcasters) only when due.  Per step this
@@ -296,6 +362,18 @@ class Simulation:
 
     def __exit__(self, *exc_info: object) -> None:
         self.close()
+
+
+def _first_due(next_due: float, first: int, dt: float) -> int:
+    """Return the first step count >= ``first`` whose time the stepping loop finds due.
+
+    The loop's own test (``count * dt + DUE_EPSILON >= next_due``), so that
+    both loops run a scheduled update at the same step.
+    """
+    count = max(first, math.ceil((next_due - DUE_EPSILON) / dt) - 1)
+    while count * dt + DUE_EPSILON < next_due:
+        count += 1
+    return count
 
 
 def make_simulation(description_file: str, controllers_file: str | None, time_step: float, *,

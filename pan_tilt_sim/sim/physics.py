@@ -236,6 +236,19 @@ class Physics:
             return get_states(body, indices, client)
         return step
 
+    def position_pid_runner(self) -> Callable[..., tuple] | None:
+        """Return the compiled loop of position PIDs for the present drives, or None.
+
+        ``run(steps, dt, efforts, laws, states) -> (before_last, last)`` runs
+        ``steps`` steps in C, each law being ``(effort slot, state slot,
+        row)`` with the row of :mod:`pan_tilt_sim.controllers.step_law`; see
+        ``_compiled_step.c``.  None without the compiled step, or when a step
+        sends PyBullet more than the efforts (velocity motors, implicit
+        damping): those steps stay in Python.  Valid until the next
+        :meth:`set_drives`.
+        """
+        return self._drives.run_position_pids
+
     def read_states(self) -> list:
         """``pybullet.getJointStates`` for the actuated joints: (position, velocity, ...)."""
         return pybullet.getJointStates(self._body, self._indices, self._client)
@@ -504,8 +517,11 @@ class _Drives:
         states_box = [physics.read_states()]
         self._states_box = states_box
 
+        # Many steps of position PIDs in C: only where a step is nothing but the efforts.
+        self.run_position_pids = None
         if not motor_count and not self._damped:
             # Nothing to do per step but the efforts: the cheapest step.
+            self.run_position_pids = getattr(effort_step, 'run_position_pids', None)
             def step(efforts: Sequence[float], targets: Sequence[float] = ()) -> Sequence:
                 return effort_step(efforts)
             self.step = step

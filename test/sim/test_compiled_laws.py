@@ -1,0 +1,179 @@
+"""Position PIDs stepped in C: the Python loop's results, to the last bit, many steps per call.
+
+When every controller updated each step is a position PID (the seed's
+case) and a step sends PyBullet nothing but the torques, the simulation
+runs the steps between two broadcaster samples in C
+(``run_position_pids``); the sampled step runs in Python.  The seed's and
+the other scenarios' digests are test_engine_bit_identity's; here: the C
+law is the Python update for any input, a robot with group members, clamps,
+a passive joint holding an effort and an uneven broadcaster rate gives the same samples both
+ways, and what cannot be run that way is not.
+"""
+
+import math
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from robot_fixtures import JointDef, write_star_robot, write_text
+
+from pan_tilt_sim.controllers import step_law
+from pan_tilt_sim.controllers.base import JointHandle
+from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
+from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
+from pan_tilt_sim.sim import compiled_step
+from pan_tilt_sim.sim.engine import make_simulation
+from pan_tilt_sim.sim.physics import Physics
+
+TIME_STEP = 0.001
+CONTROLLERS = """
+jsb:
+  type: joint_state_broadcaster/JointStateBroadcaster
+  publish_rate: 300
+single:
+  type: effort_controllers/JointPositionController
+  joint: a
+  pid: {p: 400.0, i: 30.0, d: 4.0, i_clamp: 0.5, antiwindup: true}
+group:
+  type: position_controllers/JointGroupPositionController
+  joints: [b, c]
+  gains:
+    b: {p: 60.0, i: 5.0, d: 2.0, i_clamp_min: -0.2, i_clamp_max: 1.0}
+    c: {p: 900.0, i: 0.0, d: 0.5}
+"""
+JOINTS = [
+    JointDef('a', damping=0.0, friction=0.1, effort=8.0, velocity=3.0),
+    JointDef('b', 'prismatic', -0.3, 0.3, damping=0.0, velocity=0.4),
+    JointDef('c', damping=0.0, friction=0.05, effort=2.0),
+    JointDef('passive', damping=0.0),
+]
+BATCHES = (1, 2, 3, 17, 250, 729)  # cut across the 300 Hz samples
+
+
+def run_script(folder, switch: str) -> tuple[list, dict, int]:
+    """Drive the robot through the batches; return the samples, the final PID states, C steps."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv(compiled_step.ENVIRONMENT_SWITCH, switch)
+        urdf = write_star_robot(folder, JOINTS)
+        controllers = write_text(folder, 'controllers.yaml', CONTROLLERS)
+        with make_simulation(str(urdf), str(controllers), TIME_STEP) as simulation:
+            samples = []
+            simulation.controller('jsb').set_sink(
+                lambda time, names, *values: samples.append(
+                    (time, *(tuple(value) for value in values))))
+            single, group = simulation.controller('single'), simulation.controller('group')
+            simulation.handles['passive'].effort = 0.3  # the last effort applied, kept
+            for round_number in range(2):
+                for batch in BATCHES:
+                    sign = 1.0 if (round_number + batch) % 2 else -1.0
+                    single.set_command(1.2 * sign)
+                    group.set_command([0.25 * sign, -1.0 * sign])
+                    simulation.advance(batch)
+            states = {name: (pid.integral_term, pid.compute(0.0, 0.0, 0.0))
+                      for name, pid in {**single.pids(), **group.pids()}.items()}
+            states['setpoints'] = {**single.setpoints(), **group.setpoints()}
+            states['handles'] = [(handle.position, handle.velocity, handle.effort)
+                                 for handle in simulation.handles.values()]
+            return samples, states, simulation.compiled_steps
+
+
+def test_group_members_clamps_and_a_passive_joint_give_the_python_samples(tmp_path):
+    compiled = run_script(tmp_path, '1')
+    python = run_script(tmp_path, '0')
+    assert python[2] == 0
+    total = 2 * sum(BATCHES)
+    # All steps but the ~300 sampled ones (plus one per batch at most) ran in C.
+    assert total * 0.6 < compiled[2] < total
+    assert len(compiled[0]) == len(python[0]) > 500
+    assert compiled[0] == python[0]  # every sample, float for float
+    assert compiled[1] == python[1]  # integrals, last outputs, setpoints, the joint handles
+
+
+def test_the_seed_steps_its_position_pids_in_c(monkeypatch):
+    share = package_share()
+    monkeypatch.delenv(compiled_step.ENVIRONMENT_SWITCH, raising=False)
+    with make_simulation(str(share / DEFAULT_DESCRIPTION), str(share / DEFAULT_CONTROLLERS),
+                         TIME_STEP) as simulation:
+        simulation.advance(1000)
+        # 50 Hz broadcaster: 50 of the 1000 steps sample in Python.
+        assert simulation.compiled_steps == 950
+
+
+def test_a_controller_without_a_law_keeps_every_step_in_python(tmp_path):
+    # Without gains a position controller is the ideal actuator: a velocity motor.
+    urdf = write_star_robot(tmp_path, JOINTS[:1])
+    controllers = write_text(tmp_path, 'controllers.yaml', """
+        ideal:
+          type: position_controllers/JointPositionController
+          joint: a
+        """)
+    with make_simulation(str(urdf), str(controllers), TIME_STEP) as simulation:
+        assert simulation.controller('ideal').step_law() is None
+        simulation.advance(200)
+        assert simulation.compiled_steps == 0
+
+
+# --- one law step in C against JointPositionController.update ------------------------------
+
+finite = st.floats(-50.0, 50.0, allow_nan=False)
+measured = st.one_of(finite, st.sampled_from([math.nan, math.inf, -math.inf]))
+gain = st.floats(0.0, 500.0)
+
+
+@pytest.fixture(scope='module')
+def one_joint_runner(tmp_path_factory):
+    folder = tmp_path_factory.mktemp('one_joint')
+    description = load_description(write_star_robot(folder, JOINTS[:1]))
+    with Physics(description, TIME_STEP) as physics:
+        physics.set_drives([False])
+        run = physics.position_pid_runner()
+        assert run is not None
+        yield physics, run
+
+
+def python_controller(physics: Physics, gains: dict, start: float) -> JointPositionController:
+    controller = JointPositionController('c', {'joint': 'a', 'pid': gains})
+    handle = JointHandle(physics.joints[0], start)
+    controller.configure({'a': handle})  # the setpoint starts at ``start``
+    return controller
+
+
+@settings(max_examples=300, deadline=None)
+@given(start=finite, command=finite, position=measured, velocity=measured,
+       p=gain, i=gain, d=gain, clamp=st.floats(0.0, 10.0), antiwindup=st.booleans(),
+       integral=st.floats(-20.0, 20.0))
+def test_one_step_of_the_c_law_is_the_python_update(one_joint_runner, start, command, position,
+                                                    velocity, p, i, d, clamp, antiwindup,
+                                                    integral):
+    physics, run = one_joint_runner
+    gains = {'p': p, 'i': i, 'd': d, 'i_clamp': clamp, 'antiwindup': antiwindup}
+    python, in_c = (python_controller(physics, gains, start) for _ in range(2))
+    for controller in (python, in_c):
+        controller.set_command(command)
+        controller.pid.restore(integral, 1.5)
+    handle, row = in_c.step_law()
+    assert len(row) == step_law.POSITION_PID_SIZE
+    efforts = [0.0]
+    run(1, TIME_STEP, efforts, [(0, 0, row)], [(position, velocity, (0.0,) * 6, 0.0)])
+    in_c.absorb_step_law(row)
+
+    python._handle.position, python._handle.velocity = position, velocity
+    python.update(0.0, TIME_STEP)
+    assert efforts[0].hex() == python._handle.effort.hex()
+    assert row[step_law.SETPOINT].hex() == python.setpoint.hex()
+    assert in_c.pid.law_values() == python.pid.law_values()
+
+
+@pytest.mark.parametrize(('laws', 'error'), [
+    ([(0, 0, [0.0] * 5)], ValueError),  # a short row
+    ([(0, 3, [0.0] * step_law.POSITION_PID_SIZE)], ValueError),  # no such joint
+    ([(0, 0, [0.0] * 11 + ['x'])], TypeError),
+    ([[0, 0, [0.0] * step_law.POSITION_PID_SIZE]], TypeError),  # not a tuple
+])
+def test_a_malformed_law_is_refused_before_anything_is_sent(one_joint_runner, laws, error):
+    physics, run = one_joint_runner
+    before = physics.read_states()
+    with pytest.raises(error):
+        run(5, TIME_STEP, [30.0], laws, before)
+    assert physics.read_states() == before  # no torque, no step
