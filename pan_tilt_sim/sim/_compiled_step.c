@@ -286,6 +286,35 @@ static PyObject *joint_states(ClientHandle client, StatusHandle status, const St
     return states;
 }
 
+/* Efforts for up to this many joints are converted on the stack. */
+#define LOCAL_TORQUES 64
+
+/*
+ * The torques on the effort joints, one step, the request for the joint
+ * states: the commands pybullet.c sends for setJointMotorControlArray
+ * (TORQUE_CONTROL), stepSimulation and getJointStates.  Returns the status
+ * holding the states, or NULL with an exception set.
+ */
+static StatusHandle step_once(const Stepper *self, ClientHandle client, const double *torques)
+{
+    if (self->effort_count > 0) {
+        CommandHandle command = api.control_init(client, self->body, CONTROL_MODE_TORQUE);
+        for (Py_ssize_t k = 0; k < self->effort_count; k++) {
+            api.set_torque(command, self->effort_dofs[k], torques[k]);
+        }
+        api.submit(client, command);
+    }
+    if (api.can_submit(client)) {
+        api.submit(client, api.step_init(client));
+    }
+    StatusHandle status = api.submit(client, api.state_init(client, self->body));
+    if (api.status_type(status) != ACTUAL_STATE_UPDATE_COMPLETED) {
+        PyErr_SetString(PyExc_RuntimeError, "PyBullet gave no joint states");
+        return NULL;
+    }
+    return status;
+}
+
 /* stepper(efforts) -> the joint states after one step, as pybullet.getJointStates gives them */
 static PyObject *stepper_call(Stepper *self, PyObject *args, PyObject *kwargs)
 {
@@ -312,25 +341,25 @@ static PyObject *stepper_call(Stepper *self, PyObject *args, PyObject *kwargs)
         Py_DECREF(fast);
         return NULL;
     }
-    if (self->effort_count > 0) {
-        CommandHandle command = api.control_init(client, self->body, CONTROL_MODE_TORQUE);
-        for (Py_ssize_t k = 0; k < self->effort_count; k++) {
-            double effort = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(fast, k));
-            if (effort == -1.0 && PyErr_Occurred()) {
-                Py_DECREF(fast);
-                return NULL; /* the command is never submitted */
-            }
-            api.set_torque(command, self->effort_dofs[k], effort);
-        }
-        api.submit(client, command);
+    double local[LOCAL_TORQUES];
+    double *torques = self->effort_count <= LOCAL_TORQUES
+        ? local : PyMem_Malloc(sizeof(double) * (size_t)self->effort_count);
+    if (torques == NULL) {
+        Py_DECREF(fast);
+        return PyErr_NoMemory();
+    }
+    int ok = 1;
+    for (Py_ssize_t k = 0; ok && k < self->effort_count; k++) {
+        torques[k] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(fast, k));
+        ok = !(torques[k] == -1.0 && PyErr_Occurred());
     }
     Py_DECREF(fast);
-    if (api.can_submit(client)) {
-        api.submit(client, api.step_init(client));
+    /* Nothing is sent unless every effort is a number. */
+    StatusHandle status = ok ? step_once(self, client, torques) : NULL;
+    if (torques != local) {
+        PyMem_Free(torques);
     }
-    StatusHandle status = api.submit(client, api.state_init(client, self->body));
-    if (api.status_type(status) != ACTUAL_STATE_UPDATE_COMPLETED) {
-        PyErr_SetString(PyExc_RuntimeError, "PyBullet gave no joint states");
+    if (status == NULL) {
         return NULL;
     }
     return joint_states(client, status, self);
@@ -532,19 +561,8 @@ static PyObject *stepper_run_position_pids(Stepper *self, PyObject *args)
         for (Py_ssize_t k = 0; k < law_count; k++) {
             torques[table[k].effort_slot] = position_pid(&table[k], dt);
         }
-        if (self->effort_count > 0) {
-            CommandHandle command = api.control_init(client, self->body, CONTROL_MODE_TORQUE);
-            for (Py_ssize_t k = 0; k < self->effort_count; k++) {
-                api.set_torque(command, self->effort_dofs[k], torques[k]);
-            }
-            api.submit(client, command);
-        }
-        if (api.can_submit(client)) {
-            api.submit(client, api.step_init(client));
-        }
-        StatusHandle status = api.submit(client, api.state_init(client, self->body));
-        if (api.status_type(status) != ACTUAL_STATE_UPDATE_COMPLETED) {
-            PyErr_SetString(PyExc_RuntimeError, "PyBullet gave no joint states");
+        StatusHandle status = step_once(self, client, torques);
+        if (status == NULL) {
             goto done;
         }
         if (step + 1 == steps) {
