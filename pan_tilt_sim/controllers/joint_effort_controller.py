@@ -6,9 +6,12 @@ first command the effort is zero.
 
 from __future__ import annotations
 
-from pan_tilt_sim.controllers.base import Actuator, ActuatorKind, CommandResult
+from collections.abc import Sequence
+
+from pan_tilt_sim.controllers.base import Actuator, ActuatorKind, CommandResult, JointHandle
 from pan_tilt_sim.controllers.limits import check_effort
 from pan_tilt_sim.controllers.single_joint import SingleJointController
+from pan_tilt_sim.controllers.step_law import effort_row
 
 
 class JointEffortController(SingleJointController):
@@ -31,6 +34,13 @@ class JointEffortController(SingleJointController):
         if result is not CommandResult.REJECTED:
             self._command = value
         return result
+
+    def step_law(self) -> tuple[JointHandle, list[float]]:
+        """Return the effort law's row (:mod:`pan_tilt_sim.controllers.step_law`)."""
+        return self._handle, effort_row(self._command)
+
+    def absorb_step_law(self, row: Sequence[float]) -> None:
+        """Nothing to take back: the effort law has no state."""
 
     def update(self, time: float, period: float) -> None:
         """Apply the commanded effort."""

@@ -24,7 +24,14 @@ from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult, JointHand
 from pan_tilt_sim.controllers.limits import PositionLimits
 from pan_tilt_sim.controllers.pid import PidGains
 from pan_tilt_sim.controllers.single_joint import PidJointController
-from pan_tilt_sim.controllers.step_law import INTEGRAL, OUTPUT, SETPOINT
+from pan_tilt_sim.controllers.step_law import (
+    INTEGRAL,
+    LAST_MEASUREMENT,
+    OUTPUT,
+    POSITION_PID,
+    SETPOINT,
+    pid_row,
+)
 
 # The seed's gains, the effort_controllers type's defaults when the YAML gives
 # none: with the seed's damping they track critically damped or slower for
@@ -72,19 +79,17 @@ class JointPositionController(PidJointController):
         return result
 
     def step_law(self) -> tuple[JointHandle, list[float]] | None:
-        """With a PID: the position PID row (:mod:`pan_tilt_sim.controllers.step_law`)."""
+        """With a PID: the position PID's row (:mod:`pan_tilt_sim.controllers.step_law`)."""
         pid = self._pid
         if pid is None:
             return None
-        p, i, d, i_min, i_max, antiwindup, integral, output = pid.law_values()
-        return self._handle, [p, i, d, i_min, i_max, antiwindup, self._max_velocity,
-                              self._effort_limit, self._setpoint, self._command, integral,
-                              output]
+        return self._handle, pid_row(POSITION_PID, pid.law_values(), self._max_velocity,
+                                     self._effort_limit, self._setpoint, self._command)
 
     def absorb_step_law(self, row: Sequence[float]) -> None:
-        """Take the setpoint, the integral and the PID's output from a compiled loop's row."""
+        """Take the setpoint and the PID's state from a compiled loop's row."""
         self._setpoint = row[SETPOINT]
-        self._pid.restore(row[INTEGRAL], row[OUTPUT])
+        self._pid.restore(row[INTEGRAL], row[OUTPUT], row[LAST_MEASUREMENT])
 
     def update(self, time: float, period: float) -> None:
         """Move the setpoint, then compute the effort or the velocity target."""

@@ -14,10 +14,19 @@ Before the first command the target velocity is zero.  What follows it:
 
 from __future__ import annotations
 
-from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult
+from collections.abc import Sequence
+
+from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult, JointHandle
 from pan_tilt_sim.controllers.limits import check_velocity
 from pan_tilt_sim.controllers.pid import PidGains
 from pan_tilt_sim.controllers.single_joint import PidJointController
+from pan_tilt_sim.controllers.step_law import (
+    INTEGRAL,
+    LAST_MEASUREMENT,
+    OUTPUT,
+    VELOCITY_PID,
+    pid_row,
+)
 
 # The effort_controllers type's defaults: effort = 10 N*m per rad/s of error,
 # a first-order loop, stable while 10 * time_step < 2 * the joint's inertia.
@@ -46,6 +55,18 @@ class JointVelocityController(PidJointController):
         if result is not CommandResult.REJECTED:
             self._command = value
         return result
+
+    def step_law(self) -> tuple[JointHandle, list[float]] | None:
+        """With a PID: the velocity PID's row (:mod:`pan_tilt_sim.controllers.step_law`)."""
+        pid = self._pid
+        if pid is None:
+            return None
+        return self._handle, pid_row(VELOCITY_PID, pid.law_values(), 0.0, self._effort_limit,
+                                     0.0, self._command)
+
+    def absorb_step_law(self, row: Sequence[float]) -> None:
+        """Take the PID's state from a compiled loop's row."""
+        self._pid.restore(row[INTEGRAL], row[OUTPUT], row[LAST_MEASUREMENT])
 
     def update(self, time: float, period: float) -> None:
         """Compute and clamp the effort for the velocity error, or set the velocity target."""

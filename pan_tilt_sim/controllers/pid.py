@@ -141,18 +141,20 @@ class Pid:
             self._i_max if integral > self._i_max else integral)
 
     def law_values(self) -> list[float]:
-        """Return the gains as a step law row lays them out, then the integral and the output.
+        """Return the gains and the state, for a step law row (:mod:`.step_law`).
 
-        ``[p, i, d, i_clamp_min, i_clamp_max, antiwindup (0.0 / 1.0), integral, output]``
-        (see :mod:`pan_tilt_sim.controllers.step_law`).
+        ``[p, i, d, i_clamp_min, i_clamp_max, antiwindup (0.0 / 1.0),
+        integral, output, last_measurement]``.
         """
         return [self._p, self._i, self._d, self._i_min, self._i_max,
-                1.0 if self._antiwindup else 0.0, self._integral, self._output]
+                1.0 if self._antiwindup else 0.0, self._integral, self._output,
+                self._last_measurement]
 
-    def restore(self, integral: float, output: float) -> None:
-        """Take the integral and the last output a compiled loop computed (see law_values)."""
+    def restore(self, integral: float, output: float, last_measurement: float) -> None:
+        """Take the state a compiled loop computed (see :meth:`law_values`)."""
         self._integral = integral
         self._output = output
+        self._last_measurement = last_measurement
 
     def reset(self) -> None:
         """Zero the integral and the last output, and forget the last measurement."""

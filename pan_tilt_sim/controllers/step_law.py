@@ -9,16 +9,44 @@ controller offers its law with ``step_law()`` -- its joint's handle and a
 row of floats laid out as below -- and takes the row back, with the state
 the compiled steps left in it, with ``absorb_step_law(row)``.
 
-The one law so far is the position PID (``JointPositionController`` with
-gains, alone or as a member of a group): the setpoint ramps toward the
-command at most ``max_velocity * dt`` per step, a :class:`~.pid.Pid` on the
-position error with the measured velocity as the rate gives the effort,
-which is clamped to the effort limit.
+The laws (``KIND``):
+
+* ``POSITION_PID`` (``JointPositionController`` with gains, alone or as a
+  group's member): the setpoint ramps toward the command at most
+  ``max_velocity * dt`` per step; a :class:`~.pid.Pid` on the position
+  error, with the measured velocity as the rate, gives the effort, clamped
+  to the effort limit;
+* ``VELOCITY_PID`` (``JointVelocityController`` with gains): a Pid on the
+  velocity error, the rate being the finite difference of the measured
+  velocity (``last_measurement`` NaN before the first step), the effort
+  clamped to the effort limit;
+* ``EFFORT`` (``JointEffortController``): the command is the effort.
+
+A row has every field; a law reads the ones it needs (the gains are a
+Pid's, the antiwindup flag as 0.0 / 1.0).
 """
 
 from __future__ import annotations
 
-# The position PID's row: the gains (antiwindup as 0.0 / 1.0), the limits, then the state.
-(P_GAIN, I_GAIN, D_GAIN, I_CLAMP_MIN, I_CLAMP_MAX, ANTIWINDUP, MAX_VELOCITY, EFFORT_LIMIT,
- SETPOINT, COMMAND, INTEGRAL, OUTPUT) = range(12)
-POSITION_PID_SIZE = 12
+(KIND, P_GAIN, I_GAIN, D_GAIN, I_CLAMP_MIN, I_CLAMP_MAX, ANTIWINDUP, MAX_VELOCITY, EFFORT_LIMIT,
+ SETPOINT, COMMAND, INTEGRAL, OUTPUT, LAST_MEASUREMENT) = range(14)
+ROW_SIZE = 14
+
+POSITION_PID, VELOCITY_PID, EFFORT = 0.0, 1.0, 2.0
+_UNUSED = 0.0
+
+
+def pid_row(kind: float, pid_values: list[float], max_velocity: float, effort_limit: float,
+            setpoint: float, command: float) -> list[float]:
+    """Return a PID law's row from :meth:`~.pid.Pid.law_values` and the controller's state."""
+    p, i, d, i_min, i_max, antiwindup, integral, output, last = pid_values
+    return [kind, p, i, d, i_min, i_max, antiwindup, max_velocity, effort_limit, setpoint,
+            command, integral, output, last]
+
+
+def effort_row(command: float) -> list[float]:
+    """Return the effort law's row."""
+    row = [_UNUSED] * ROW_SIZE
+    row[KIND] = EFFORT
+    row[COMMAND] = command
+    return row

@@ -365,61 +365,85 @@ static PyObject *stepper_call(Stepper *self, PyObject *args, PyObject *kwargs)
     return joint_states(client, status, self);
 }
 
-/* ---- the position PID loop: many steps without Python ---- */
+/* ---- the controller laws: many steps without Python ---- */
 
 /*
  * A law row, as pan_tilt_sim.controllers.step_law lays it out (a list of
  * floats); the loop reads the gains and writes the state back.
  */
 enum {
-    LAW_P, LAW_I, LAW_D, LAW_I_MIN, LAW_I_MAX, LAW_ANTIWINDUP, LAW_MAX_VELOCITY,
-    LAW_EFFORT_LIMIT, LAW_SETPOINT, LAW_COMMAND, LAW_INTEGRAL, LAW_OUTPUT, LAW_SIZE,
+    LAW_KIND, LAW_P, LAW_I, LAW_D, LAW_I_MIN, LAW_I_MAX, LAW_ANTIWINDUP, LAW_MAX_VELOCITY,
+    LAW_EFFORT_LIMIT, LAW_SETPOINT, LAW_COMMAND, LAW_INTEGRAL, LAW_OUTPUT, LAW_LAST_MEASUREMENT,
+    LAW_SIZE,
 };
+enum { POSITION_PID, VELOCITY_PID, EFFORT, LAW_KINDS };
 
 typedef struct {
+    int kind;
     Py_ssize_t effort_slot;
     Py_ssize_t state_slot;
     PyObject *values; /* the row (a list), borrowed */
     double p, i, d, i_min, i_max, max_velocity, effort_limit;
     int antiwindup;
-    double setpoint, command, integral, output;
+    double setpoint, command, integral, output, last_measurement;
     double position, velocity; /* the joint's measured state at this step */
 } Law;
 
 /*
- * One step of JointPositionController.update with a PID, as its Python
- * computes it, operation for operation (the ramp, Pid.compute with the
- * measured velocity as the rate, the effort clamp); returns the effort.
+ * Pid.compute: the integral (clamped, and held at the clamp with
+ * antiwindup), then p * error + term - d * rate; a non-finite error or rate
+ * gives 0 and leaves the integrator and the last output as they were.
  */
-static double position_pid(Law *law, double dt)
+static double pid(Law *law, double error, double rate, double dt)
 {
-    double max_step = law->max_velocity * dt;
-    double setpoint = law->setpoint;
-    double delta = law->command - setpoint;
-    if (delta > max_step) {
-        setpoint += max_step;
-    } else if (delta < -max_step) {
-        setpoint -= max_step;
-    } else {
-        setpoint = law->command;
-    }
-    law->setpoint = setpoint;
-    double effort;
-    double error = setpoint - law->position;
-    double rate = law->velocity;
     if (!(-Py_HUGE_VAL < error && error < Py_HUGE_VAL
           && -Py_HUGE_VAL < rate && rate < Py_HUGE_VAL)) {
-        effort = 0.0; /* the integrator is left as it was */
-    } else {
-        double integral = law->integral + law->i * error * dt;
-        double low = law->i_min, high = law->i_max;
-        double term = integral < low ? low : (integral > high ? high : integral);
-        law->integral = law->antiwindup ? term : integral;
-        effort = law->p * error + term - law->d * rate;
-        law->output = effort;
+        return 0.0;
     }
+    double integral = law->integral + law->i * error * dt;
+    double low = law->i_min, high = law->i_max;
+    double term = integral < low ? low : (integral > high ? high : integral);
+    law->integral = law->antiwindup ? term : integral;
+    double output = law->p * error + term - law->d * rate;
+    law->output = output;
+    return output;
+}
+
+static double clamp_effort(const Law *law, double effort)
+{
     double limit = law->effort_limit;
     return effort > limit ? limit : (effort < -limit ? -limit : effort);
+}
+
+/*
+ * One step of the controller's update, as its Python computes it,
+ * operation for operation; returns the effort.
+ */
+static double law_effort(Law *law, double dt)
+{
+    if (law->kind == POSITION_PID) {
+        /* JointPositionController: the ramp, then the PID with the measured velocity. */
+        double max_step = law->max_velocity * dt;
+        double setpoint = law->setpoint;
+        double delta = law->command - setpoint;
+        if (delta > max_step) {
+            setpoint += max_step;
+        } else if (delta < -max_step) {
+            setpoint -= max_step;
+        } else {
+            setpoint = law->command;
+        }
+        law->setpoint = setpoint;
+        return clamp_effort(law, pid(law, setpoint - law->position, law->velocity, dt));
+    }
+    if (law->kind == VELOCITY_PID) {
+        /* JointVelocityController: the rate is the finite difference of the velocity. */
+        double last = law->last_measurement;
+        double rate = last != last ? 0.0 : (law->velocity - last) / dt;
+        law->last_measurement = law->velocity;
+        return clamp_effort(law, pid(law, law->command - law->velocity, rate, dt));
+    }
+    return law->command; /* JointEffortController */
 }
 
 static int float_item(PyObject *list, Py_ssize_t index, double *value)
@@ -461,7 +485,15 @@ static int read_law(PyObject *item, const Stepper *self, PyObject *states, Law *
         return 0;
     }
     law->values = values;
-    double antiwindup;
+    double antiwindup, kind;
+    if (!float_item(values, LAW_KIND, &kind)) {
+        return 0;
+    }
+    if (!(kind >= 0.0 && kind < LAW_KINDS) || (double)(int)kind != kind) {
+        PyErr_Format(PyExc_ValueError, "no law of kind %R", PyList_GET_ITEM(values, LAW_KIND));
+        return 0;
+    }
+    law->kind = (int)kind;
     if (!float_item(values, LAW_P, &law->p) || !float_item(values, LAW_I, &law->i)
         || !float_item(values, LAW_D, &law->d) || !float_item(values, LAW_I_MIN, &law->i_min)
         || !float_item(values, LAW_I_MAX, &law->i_max)
@@ -471,7 +503,8 @@ static int read_law(PyObject *item, const Stepper *self, PyObject *states, Law *
         || !float_item(values, LAW_SETPOINT, &law->setpoint)
         || !float_item(values, LAW_COMMAND, &law->command)
         || !float_item(values, LAW_INTEGRAL, &law->integral)
-        || !float_item(values, LAW_OUTPUT, &law->output)) {
+        || !float_item(values, LAW_OUTPUT, &law->output)
+        || !float_item(values, LAW_LAST_MEASUREMENT, &law->last_measurement)) {
         return 0;
     }
     law->antiwindup = antiwindup != 0.0;
@@ -496,16 +529,16 @@ static int read_law(PyObject *item, const Stepper *self, PyObject *states, Law *
 }
 
 /*
- * stepper.run_position_pids(steps, dt, efforts, laws, states) -> (before_last, last)
+ * stepper.run_laws(steps, dt, efforts, laws, states) -> (before_last, last)
  *
  * ``steps`` times: each law's effort from the joint's state, the torques
  * (``efforts``, the laws' slots overwritten), one step, the joint states --
- * the Python loop's steps with every active controller a position PID.
+ * the Python loop's steps with every controller updated each step one of the laws.
  * ``states`` are the states the first step starts from; the result is the
  * states the last step started from and the states after it.  ``efforts``
  * ends with the last step's torques and each law row with its state.
  */
-static PyObject *stepper_run_position_pids(Stepper *self, PyObject *args)
+static PyObject *stepper_run_laws(Stepper *self, PyObject *args)
 {
     Py_ssize_t steps;
     double dt;
@@ -559,7 +592,7 @@ static PyObject *stepper_run_position_pids(Stepper *self, PyObject *args)
     struct JointSensorState state;
     for (Py_ssize_t step = 0; step < steps; step++) {
         for (Py_ssize_t k = 0; k < law_count; k++) {
-            torques[table[k].effort_slot] = position_pid(&table[k], dt);
+            torques[table[k].effort_slot] = law_effort(&table[k], dt);
         }
         StatusHandle status = step_once(self, client, torques);
         if (status == NULL) {
@@ -599,7 +632,8 @@ static PyObject *stepper_run_position_pids(Stepper *self, PyObject *args)
         Law *law = &table[k];
         if (!store_float(law->values, LAW_SETPOINT, law->setpoint)
             || !store_float(law->values, LAW_INTEGRAL, law->integral)
-            || !store_float(law->values, LAW_OUTPUT, law->output)) {
+            || !store_float(law->values, LAW_OUTPUT, law->output)
+            || !store_float(law->values, LAW_LAST_MEASUREMENT, law->last_measurement)) {
             goto done;
         }
     }
@@ -614,9 +648,9 @@ done:
 }
 
 static PyMethodDef stepper_methods[] = {
-    {"run_position_pids", (PyCFunction)stepper_run_position_pids, METH_VARARGS,
-     "run_position_pids(steps, dt, efforts, laws, states) -> (before_last, last): "
-     "steps with every active controller a position PID"},
+    {"run_laws", (PyCFunction)stepper_run_laws, METH_VARARGS,
+     "run_laws(steps, dt, efforts, laws, states) -> (before_last, last): "
+     "steps with every per-step controller one of the laws"},
     {NULL, NULL, 0, NULL},
 };
 

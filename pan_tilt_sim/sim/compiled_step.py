@@ -9,15 +9,15 @@ through PyBullet's C API: 0.7-0.8 us less per step on the seed, and ~7 %
 less CPU per 20-step tick at ``real_time_factor`` 1 (README, Performance).
 The results are the same to the last bit.
 
-Where every controller updated each step is a position PID and a step sends
-PyBullet nothing but the torques (the seed's case), the same extension also
-runs the steps between two broadcaster samples without returning to Python
-(``Stepper.run_position_pids``, driven by
-:meth:`pan_tilt_sim.sim.engine.Simulation.advance`): the PID law of
+Where every controller updated each step is a position or velocity PID or
+an effort controller and a step sends PyBullet nothing but the torques (the
+seed's case), the same extension also runs the steps between two
+broadcaster samples without returning to Python (``Stepper.run_laws``,
+driven by :meth:`pan_tilt_sim.sim.engine.Simulation.advance`): the laws of
 :mod:`pan_tilt_sim.controllers.step_law`, computed operation for operation
-as the Python controller computes it.  ~1.6 us less per step again on the
-seed.  The Python controllers stay the reference and every other controller
-type runs only in Python.
+as the Python controllers compute them.  ~1.6 us less per step again on the
+seed.  The Python controllers stay the reference; the others (trajectories,
+ideal actuators) run only in Python.
 
 The C side gets its PyBullet client the documented way, as a PyBullet
 plugin (:func:`pybullet.loadPlugin` on the extension's own file).  It is

@@ -144,7 +144,7 @@ class Simulation:
         self._efforts = [0.0] * len(self._effort_handles)
         self._targets = [0.0] * len(self._velocity_handles)
         self._physics_step = self.physics.stepper()
-        self._run_position_pids = self.physics.position_pid_runner()
+        self._run_laws = self.physics.law_runner()
         self._effort_slot = {handle.name: index
                              for index, handle in enumerate(self._effort_handles)}
         self._state_slot = {handle.name: index for index, handle in enumerate(self._handle_list)}
@@ -208,12 +208,12 @@ class Simulation:
 
         Where every controller updated each step has a compiled law
         (:mod:`pan_tilt_sim.controllers.step_law`) and the physics can run it
-        (:meth:`Physics.position_pid_runner`), the steps between two
+        (:meth:`Physics.law_runner`), the steps between two
         broadcaster samples run in C; a step at which a scheduled controller
         is due runs in Python.  Either way the results are the same to the
         last bit.
         """
-        laws = self._compiled_laws() if self._run_position_pids is not None else None
+        laws = self._compiled_laws() if self._run_laws is not None else None
         if laws is None:
             self._advance_python(steps)
         elif steps > 0:
@@ -234,7 +234,7 @@ class Simulation:
     def _advance_compiled(self, steps: int, laws: list[tuple[int, int, list[float]]]) -> None:
         """Run ``steps`` steps with the laws in C, a step with a scheduled update due in Python."""
         members = self.manager.step_members
-        run = self._run_position_pids
+        run = self._run_laws
         scheduled = self.manager.scheduled_updates
         handles, effort_handles, efforts = self._handle_list, self._effort_handles, self._efforts
         dt = self._time_step

@@ -236,8 +236,8 @@ class Physics:
             return get_states(body, indices, client)
         return step
 
-    def position_pid_runner(self) -> Callable[..., tuple] | None:
-        """Return the compiled loop of position PIDs for the present drives, or None.
+    def law_runner(self) -> Callable[..., tuple] | None:
+        """Return the compiled loop of controller laws for the present drives, or None.
 
         ``run(steps, dt, efforts, laws, states) -> (before_last, last)`` runs
         ``steps`` steps in C, each law being ``(effort slot, state slot,
@@ -247,7 +247,7 @@ class Physics:
         damping): those steps stay in Python.  Valid until the next
         :meth:`set_drives`.
         """
-        return self._drives.run_position_pids
+        return self._drives.run_laws
 
     def read_states(self) -> list:
         """``pybullet.getJointStates`` for the actuated joints: (position, velocity, ...)."""
@@ -517,11 +517,11 @@ class _Drives:
         states_box = [physics.read_states()]
         self._states_box = states_box
 
-        # Many steps of position PIDs in C: only where a step is nothing but the efforts.
-        self.run_position_pids = None
+        # Many steps of controller laws in C: only where a step is nothing but the efforts.
+        self.run_laws = None
         if not motor_count and not self._damped:
             # Nothing to do per step but the efforts: the cheapest step.
-            self.run_position_pids = getattr(effort_step, 'run_position_pids', None)
+            self.run_laws = getattr(effort_step, 'run_laws', None)
             def step(efforts: Sequence[float], targets: Sequence[float] = ()) -> Sequence:
                 return effort_step(efforts)
             self.step = step

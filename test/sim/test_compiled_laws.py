@@ -1,13 +1,14 @@
-"""Position PIDs stepped in C: the Python loop's results, to the last bit, many steps per call.
+"""Controller laws stepped in C: the Python loop's results, to the last bit, many steps per call.
 
-When every controller updated each step is a position PID (the seed's
-case) and a step sends PyBullet nothing but the torques, the simulation
-runs the steps between two broadcaster samples in C
-(``run_position_pids``); the sampled step runs in Python.  The seed's and
-the other scenarios' digests are test_engine_bit_identity's; here: the C
-law is the Python update for any input, a robot with group members, clamps,
-a passive joint holding an effort and an uneven broadcaster rate gives the same samples both
-ways, and what cannot be run that way is not.
+When every controller updated each step is a position or velocity PID or an
+effort controller (the seed's case) and a step sends PyBullet nothing but
+the torques, the simulation runs the steps between two broadcaster samples
+in C (``run_laws``); the sampled step runs in Python.  The seed's and the
+other scenarios' digests are test_engine_bit_identity's; here: each C law is
+its controller's Python update for any input, a robot with every law, group
+members, clamps, a passive joint holding an effort and an uneven
+broadcaster rate gives the same samples both ways, and what cannot be run
+that way is not.
 """
 
 import math
@@ -19,7 +20,9 @@ from robot_fixtures import JointDef, write_star_robot, write_text
 
 from pan_tilt_sim.controllers import step_law
 from pan_tilt_sim.controllers.base import JointHandle
+from pan_tilt_sim.controllers.joint_effort_controller import JointEffortController
 from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
+from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
 from pan_tilt_sim.model.description import load_description
 from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
 from pan_tilt_sim.sim import compiled_step
@@ -41,12 +44,21 @@ group:
   gains:
     b: {p: 60.0, i: 5.0, d: 2.0, i_clamp_min: -0.2, i_clamp_max: 1.0}
     c: {p: 900.0, i: 0.0, d: 0.5}
+roller:
+  type: effort_controllers/JointVelocityController
+  joint: v
+  pid: {p: 3.0, i: 40.0, d: 0.01, i_clamp: 0.4}
+push:
+  type: effort_controllers/JointEffortController
+  joint: e
 """
 JOINTS = [
     JointDef('a', damping=0.0, friction=0.1, effort=8.0, velocity=3.0),
     JointDef('b', 'prismatic', -0.3, 0.3, damping=0.0, velocity=0.4),
     JointDef('c', damping=0.0, friction=0.05, effort=2.0),
     JointDef('passive', damping=0.0),
+    JointDef('v', 'continuous', None, None, damping=0.0, friction=0.02, effort=1.5),
+    JointDef('e', 'prismatic', -0.2, 0.2, damping=0.0),
 ]
 BATCHES = (1, 2, 3, 17, 250, 729)  # cut across the 300 Hz samples
 
@@ -63,22 +75,26 @@ def run_script(folder, switch: str) -> tuple[list, dict, int]:
                 lambda time, names, *values: samples.append(
                     (time, *(tuple(value) for value in values))))
             single, group = simulation.controller('single'), simulation.controller('group')
+            roller, push = simulation.controller('roller'), simulation.controller('push')
             simulation.handles['passive'].effort = 0.3  # the last effort applied, kept
             for round_number in range(2):
                 for batch in BATCHES:
                     sign = 1.0 if (round_number + batch) % 2 else -1.0
                     single.set_command(1.2 * sign)
                     group.set_command([0.25 * sign, -1.0 * sign])
+                    roller.set_command(4.0 * sign)
+                    push.set_command(-3.0 * sign)
                     simulation.advance(batch)
-            states = {name: (pid.integral_term, pid.compute(0.0, 0.0, 0.0))
-                      for name, pid in {**single.pids(), **group.pids()}.items()}
+            pids = {**single.pids(), **group.pids(), **roller.pids()}
+            states = {name: [value.hex() for value in pid.law_values()]
+                      for name, pid in pids.items()}
             states['setpoints'] = {**single.setpoints(), **group.setpoints()}
             states['handles'] = [(handle.position, handle.velocity, handle.effort)
                                  for handle in simulation.handles.values()]
             return samples, states, simulation.compiled_steps
 
 
-def test_group_members_clamps_and_a_passive_joint_give_the_python_samples(tmp_path):
+def test_every_law_group_members_and_a_passive_joint_give_the_python_samples(tmp_path):
     compiled = run_script(tmp_path, '1')
     python = run_script(tmp_path, '0')
     assert python[2] == 0
@@ -87,7 +103,8 @@ def test_group_members_clamps_and_a_passive_joint_give_the_python_samples(tmp_pa
     assert total * 0.6 < compiled[2] < total
     assert len(compiled[0]) == len(python[0]) > 500
     assert compiled[0] == python[0]  # every sample, float for float
-    assert compiled[1] == python[1]  # integrals, last outputs, setpoints, the joint handles
+    # The PIDs' states (integral, last output, last measurement), setpoints, the joint handles.
+    assert compiled[1] == python[1]
 
 
 def test_the_seed_steps_its_position_pids_in_c(monkeypatch):
@@ -114,11 +131,13 @@ def test_a_controller_without_a_law_keeps_every_step_in_python(tmp_path):
         assert simulation.compiled_steps == 0
 
 
-# --- one law step in C against JointPositionController.update ------------------------------
+# --- one law step in C against the controller's update -------------------------------------
 
 finite = st.floats(-50.0, 50.0, allow_nan=False)
 measured = st.one_of(finite, st.sampled_from([math.nan, math.inf, -math.inf]))
 gain = st.floats(0.0, 500.0)
+gains = st.fixed_dictionaries({'p': gain, 'i': gain, 'd': gain, 'i_clamp': st.floats(0.0, 10.0),
+                               'antiwindup': st.booleans()})
 
 
 @pytest.fixture(scope='module')
@@ -127,49 +146,97 @@ def one_joint_runner(tmp_path_factory):
     description = load_description(write_star_robot(folder, JOINTS[:1]))
     with Physics(description, TIME_STEP) as physics:
         physics.set_drives([False])
-        run = physics.position_pid_runner()
+        run = physics.law_runner()
         assert run is not None
         yield physics, run
 
 
-def python_controller(physics: Physics, gains: dict, start: float) -> JointPositionController:
-    controller = JointPositionController('c', {'joint': 'a', 'pid': gains})
+def bound(controller, physics: Physics, start: float):
     handle = JointHandle(physics.joints[0], start)
-    controller.configure({'a': handle})  # the setpoint starts at ``start``
+    controller.configure({'a': handle})  # a position controller's setpoint starts at ``start``
     return controller
 
 
-@settings(max_examples=300, deadline=None)
-@given(start=finite, command=finite, position=measured, velocity=measured,
-       p=gain, i=gain, d=gain, clamp=st.floats(0.0, 10.0), antiwindup=st.booleans(),
-       integral=st.floats(-20.0, 20.0))
-def test_one_step_of_the_c_law_is_the_python_update(one_joint_runner, start, command, position,
-                                                    velocity, p, i, d, clamp, antiwindup,
-                                                    integral):
-    physics, run = one_joint_runner
-    gains = {'p': p, 'i': i, 'd': d, 'i_clamp': clamp, 'antiwindup': antiwindup}
-    python, in_c = (python_controller(physics, gains, start) for _ in range(2))
-    for controller in (python, in_c):
-        controller.set_command(command)
-        controller.pid.restore(integral, 1.5)
+def one_step_both_ways(run, make, position: float, velocity: float) -> tuple:
+    """Step a fresh controller once in C and once in Python; return (effort, controller) each."""
+    python, in_c = make(), make()
     handle, row = in_c.step_law()
-    assert len(row) == step_law.POSITION_PID_SIZE
+    assert len(row) == step_law.ROW_SIZE
     efforts = [0.0]
     run(1, TIME_STEP, efforts, [(0, 0, row)], [(position, velocity, (0.0,) * 6, 0.0)])
     in_c.absorb_step_law(row)
-
     python._handle.position, python._handle.velocity = position, velocity
     python.update(0.0, TIME_STEP)
-    assert efforts[0].hex() == python._handle.effort.hex()
-    assert row[step_law.SETPOINT].hex() == python.setpoint.hex()
-    assert in_c.pid.law_values() == python.pid.law_values()
+    return (efforts[0], in_c), (python._handle.effort, python)
+
+
+def pid_state(controller) -> list[str]:
+    return [value.hex() for value in controller.pid.law_values()]  # NaN too
+
+
+@settings(max_examples=300, deadline=None)
+@given(start=finite, command=finite, position=measured, velocity=measured, gains=gains,
+       integral=st.floats(-20.0, 20.0))
+def test_one_step_of_the_position_law_is_the_python_update(one_joint_runner, start, command,
+                                                            position, velocity, gains, integral):
+    physics, run = one_joint_runner
+
+    def make():
+        controller = bound(JointPositionController('c', {'joint': 'a', 'pid': gains}), physics,
+                           start)
+        controller.set_command(command)
+        controller.pid.restore(integral, 1.5, math.nan)
+        return controller
+    (c_effort, in_c), (effort, python) = one_step_both_ways(run, make, position, velocity)
+    assert c_effort.hex() == effort.hex()
+    assert in_c.setpoint.hex() == python.setpoint.hex()
+    assert pid_state(in_c) == pid_state(python)
+
+
+@settings(max_examples=300, deadline=None)
+@given(command=finite, velocity=measured, last=measured, gains=gains,
+       integral=st.floats(-20.0, 20.0))
+def test_one_step_of_the_velocity_law_is_the_python_update(one_joint_runner, command, velocity,
+                                                            last, gains, integral):
+    physics, run = one_joint_runner
+
+    def make():
+        controller = bound(JointVelocityController('c', {'joint': 'a', 'pid': gains}), physics,
+                           0.0)
+        controller.set_command(command)
+        controller.pid.restore(integral, 1.5, last)  # last: NaN before the first step
+        return controller
+    (c_effort, in_c), (effort, python) = one_step_both_ways(run, make, 0.25, velocity)
+    assert c_effort.hex() == effort.hex()
+    assert pid_state(in_c) == pid_state(python)
+
+
+@pytest.mark.parametrize('command', [0.0, -0.0, 7.25, -8.0])  # within the limit
+def test_one_step_of_the_effort_law_is_the_python_update(one_joint_runner, command):
+    physics, run = one_joint_runner
+
+    def make():
+        controller = bound(JointEffortController('c', {'joint': 'a'}), physics, 0.0)
+        controller.set_command(command)
+        return controller
+    (c_effort, _), (effort, _) = one_step_both_ways(run, make, 0.1, 0.2)
+    assert c_effort.hex() == effort.hex() == command.hex()
+
+
+def law_row(kind: float) -> list[float]:
+    row = [0.0] * step_law.ROW_SIZE
+    row[step_law.KIND] = kind
+    return row
 
 
 @pytest.mark.parametrize(('laws', 'error'), [
     ([(0, 0, [0.0] * 5)], ValueError),  # a short row
-    ([(0, 3, [0.0] * step_law.POSITION_PID_SIZE)], ValueError),  # no such joint
-    ([(0, 0, [0.0] * 11 + ['x'])], TypeError),
-    ([[0, 0, [0.0] * step_law.POSITION_PID_SIZE]], TypeError),  # not a tuple
+    ([(0, 3, law_row(step_law.POSITION_PID))], ValueError),  # no such joint
+    ([(0, 0, law_row(3.0))], ValueError),  # no such law
+    ([(0, 0, law_row(0.5))], ValueError),
+    ([(0, 0, law_row(math.nan))], ValueError),
+    ([(0, 0, [0.0] * (step_law.ROW_SIZE - 1) + ['x'])], TypeError),
+    ([[0, 0, law_row(step_law.EFFORT)]], TypeError),  # not a tuple
 ])
 def test_a_malformed_law_is_refused_before_anything_is_sent(one_joint_runner, laws, error):
     physics, run = one_joint_runner
