@@ -50,6 +50,9 @@ LOGGER_NAME = 'pan_tilt_sim'
 # A joint this close to PyBullet's speed cap is riding it.
 AT_CAP = 0.99
 WARNING_THROTTLE_S = 1.0  # wall seconds between two warnings about one joint
+# The fewest steps handed to the compiled laws at once: below it, collecting
+# the laws and taking their state back costs more than the steps save.
+MIN_COMPILED_STEPS = 4
 INFO, WARNING = 'info', 'warning'
 
 
@@ -208,16 +211,36 @@ class Simulation:
 
         Where every controller updated each step has a compiled law
         (:mod:`pan_tilt_sim.controllers.step_law`) and the physics can run it
-        (:meth:`Physics.law_runner`), the steps between two
-        broadcaster samples run in C; a step at which a scheduled controller
-        is due runs in Python.  Either way the results are the same to the
-        last bit.
+        (:meth:`Physics.law_runner`), the steps between two broadcaster
+        samples run in C, at least :data:`MIN_COMPILED_STEPS` at a time; a
+        step at which a scheduled controller is due runs in Python.  Either
+        way the results are the same to the last bit.
         """
-        laws = self._compiled_laws() if self._run_laws is not None else None
-        if laws is None:
+        scheduled = self.manager.scheduled_updates
+        dt = self._time_step
+        shortest = min((schedule.period for schedule, _ in scheduled), default=math.inf)
+        if self._run_laws is None or shortest < MIN_COMPILED_STEPS * dt:
+            # A broadcaster due (nearly) every step leaves no stretch worth the hand-over.
             self._advance_python(steps)
-        elif steps > 0:
-            self._advance_compiled(steps, laws)
+            return
+        count, end = self._steps, self._steps + steps
+        while count < end:
+            stop = min([end] + [_first_due(schedule.next_due, count, dt)
+                                for schedule, _ in scheduled])
+            if stop - count >= MIN_COMPILED_STEPS:
+                laws = self._compiled_laws()
+                if laws is None:  # a controller without a law: Python, as ever
+                    self._advance_python(end - count)
+                    return
+                self._run_compiled(stop - count, laws)
+                count = stop
+                if count == end:
+                    self._check_health(self._states)
+                    return
+            # The due step (and a stretch too short to hand over), as the Python loop takes it.
+            python_steps = min(end, stop + 1) - count
+            self._advance_python(python_steps)
+            count += python_steps
 
     def _compiled_laws(self) -> list[tuple[int, int, list[float]]] | None:
         """Return each step member's law with its slots, or None if one has none."""
@@ -231,38 +254,23 @@ class Simulation:
             laws.append((effort_slot[handle.name], state_slot[handle.name], row))
         return laws
 
-    def _advance_compiled(self, steps: int, laws: list[tuple[int, int, list[float]]]) -> None:
-        """Run ``steps`` steps with the laws in C, a step with a scheduled update due in Python."""
-        members = self.manager.step_members
-        run = self._run_laws
-        scheduled = self.manager.scheduled_updates
+    def _run_compiled(self, steps: int, laws: list[tuple[int, int, list[float]]]) -> None:
+        """Run ``steps`` steps in C, none with a scheduled update due; hand the state back."""
         handles, effort_handles, efforts = self._handle_list, self._effort_handles, self._efforts
-        dt = self._time_step
-        count, end = self._steps, self._steps + steps
-        while True:
-            stop = min([end] + [_first_due(schedule.next_due, count, dt) for schedule, _ in
-                                scheduled])
-            if stop > count:
-                for index, handle in enumerate(effort_handles):
-                    efforts[index] = handle.effort
-                before, states = run(stop - count, dt, efforts, laws, self._states)
-                for handle, state in zip(handles, before, strict=False):
-                    handle.position = state[STATE_POSITION]
-                    handle.velocity = state[STATE_VELOCITY]
-                for handle, effort in zip(effort_handles, efforts, strict=False):
-                    handle.effort = effort
-                self.compiled_steps += stop - count
-                self._states, self._steps, count = states, stop, stop
-            for member, (_, _, row) in zip(members, laws, strict=True):
-                member.absorb_step_law(row)
-            if count >= end:
-                break
-            self._advance_python(1)  # the due step, as the Python loop takes it
-            count += 1
-            if count >= end:
-                break
-            laws = self._compiled_laws()
-        self._check_health(self._states)
+        for index, handle in enumerate(effort_handles):
+            efforts[index] = handle.effort
+        before, states = self._run_laws(steps, self._time_step, efforts, laws, self._states)
+        # As the Python loop leaves them: the handles hold the last step's starting state.
+        for handle, state in zip(handles, before, strict=False):
+            handle.position = state[STATE_POSITION]
+            handle.velocity = state[STATE_VELOCITY]
+        for handle, effort in zip(effort_handles, efforts, strict=False):
+            handle.effort = effort
+        for member, (_, _, row) in zip(self.manager.step_members, laws, strict=True):
+            member.absorb_step_law(row)
+        self.compiled_steps += steps
+        self._states = states
+        self._steps += steps
 
     def _advance_python(self, steps: int) -> None:
         """Run ``steps`` steps, every controller updated in Python."""
