@@ -117,24 +117,34 @@ def test_the_seed_steps_its_position_pids_in_c(monkeypatch):
         assert simulation.compiled_steps == 950
 
 
+def steps_in_c(folder, joints, controllers: str, check=None, steps: int = 300) -> int:
+    """Run a star robot with ``controllers`` (``check(simulation)`` first); return C's steps."""
+    urdf = write_star_robot(folder, joints)
+    path = write_text(folder, 'controllers.yaml', controllers)
+    with make_simulation(str(urdf), str(path), TIME_STEP) as simulation:
+        if check is not None:
+            check(simulation)
+        simulation.advance(steps)
+        return simulation.compiled_steps
+
+
 def test_a_controller_without_a_law_keeps_every_step_in_python(tmp_path):
     # Without gains a position controller is the ideal actuator: a velocity motor.
-    urdf = write_star_robot(tmp_path, JOINTS[:1])
-    controllers = write_text(tmp_path, 'controllers.yaml', """
+    def check(simulation):
+        assert simulation.controller('ideal').step_law() is None
+    assert steps_in_c(tmp_path, JOINTS[:1], """
         ideal:
           type: position_controllers/JointPositionController
           joint: a
-        """)
-    with make_simulation(str(urdf), str(controllers), TIME_STEP) as simulation:
-        assert simulation.controller('ideal').step_law() is None
-        simulation.advance(200)
-        assert simulation.compiled_steps == 0
+        """, check) == 0
 
 
 def test_a_law_beside_a_controller_without_one_keeps_every_step_in_python(tmp_path):
     # An effort-driven trajectory controller: the steps could be compiled, its update not.
-    urdf = write_star_robot(tmp_path, JOINTS[:2])
-    controllers = write_text(tmp_path, 'controllers.yaml', """
+    def check(simulation):
+        assert simulation.physics.law_runner() is not None
+        assert simulation.controller('trajectory').step_law() is None
+    assert steps_in_c(tmp_path, JOINTS[:2], """
         pid:
           type: effort_controllers/JointPositionController
           joint: a
@@ -145,29 +155,21 @@ def test_a_law_beside_a_controller_without_one_keeps_every_step_in_python(tmp_pa
           state_interfaces: [position, velocity]
           gains:
             b: {p: 100.0, d: 5.0}
-        """)
-    with make_simulation(str(urdf), str(controllers), TIME_STEP) as simulation:
-        assert simulation.physics.law_runner() is not None
-        assert simulation.controller('trajectory').step_law() is None
-        simulation.advance(200)
-        assert simulation.compiled_steps == 0
+        """, check) == 0
 
 
-@pytest.mark.parametrize('rate', [1000, 300])
-def test_a_broadcaster_due_every_few_steps_leaves_them_in_python(tmp_path, rate):
-    # ros2_control's update_rate 1000 samples every step; 300 Hz every 3 or 4 steps.
-    urdf = write_star_robot(tmp_path, JOINTS[:1])
-    controllers = write_text(tmp_path, 'controllers.yaml', f"""
+@pytest.mark.parametrize(('rate', 'in_c'), [(1000, 0), (300, 0), (100, 270)])
+def test_a_broadcaster_due_every_few_steps_leaves_them_in_python(tmp_path, rate, in_c):
+    # ros2_control's update_rate 1000 samples every step, 300 Hz every 3 or 4 steps: too
+    # short a stretch to hand over; 100 Hz leaves 9 of every 10 steps to C.
+    assert steps_in_c(tmp_path, JOINTS[:1], f"""
         jsb:
           type: joint_state_broadcaster/JointStateBroadcaster
           publish_rate: {rate}
         pid:
           type: effort_controllers/JointPositionController
           joint: a
-        """)
-    with make_simulation(str(urdf), str(controllers), TIME_STEP) as simulation:
-        simulation.advance(300)
-        assert simulation.compiled_steps == 0
+        """) == in_c
 
 
 # --- one law step in C against the controller's update -------------------------------------
