@@ -55,6 +55,14 @@ class PeriodicSchedule:
         """Return the first step after ``step`` at or past the next due time."""
         return max(self.due_step(time_step), step + 1)
 
+    def first_due_step(self, step: int, time_step: float) -> int:
+        """Return the first step >= ``step`` at whose sim time (``step * time_step``) one is due.
+
+        The step at which a loop testing :meth:`is_due` every step finds it
+        due (:data:`DUE_EPSILON` is far above the rounding of either side).
+        """
+        return max(step, self.due_step(time_step))
+
     def reset(self) -> None:
         """Start again: the next call is due at once (as at sim time 0)."""
         self.next_due = 0.0

@@ -1,6 +1,6 @@
 """PeriodicSchedule: what is due when, in sim time and in physics steps."""
 
-from pan_tilt_sim.schedule import PeriodicSchedule
+from pan_tilt_sim.schedule import DUE_EPSILON, PeriodicSchedule
 
 
 def test_something_is_due_at_once_then_once_per_period():
@@ -18,3 +18,15 @@ def test_the_next_step_is_the_first_one_after_the_given_step_at_or_past_the_due_
     assert schedule.next_step(19, 0.001) == 20
     assert schedule.next_step(20, 0.001) == 21  # never the step already reached
     assert schedule.next_step(35, 0.001) == 36  # overdue: the very next step
+
+
+def test_the_first_due_step_is_the_one_the_stepping_loop_finds_due():
+    for period, time_step in ((0.02, 0.001), (1 / 150, 0.001), (0.1, 0.003), (0.01, 0.01)):
+        schedule = PeriodicSchedule(period)
+        for now in (0.0, 0.0371, 0.5, 3.9):
+            schedule.advance(now)  # next due: the first grid point after ``now``
+            first = round(now / time_step)
+            expected = next(step for step in range(first, first + 10_000)
+                            if step * time_step + DUE_EPSILON >= schedule.next_due)
+            assert schedule.first_due_step(first, time_step) == expected
+            assert schedule.first_due_step(expected + 3, time_step) == expected + 3  # overdue

@@ -225,8 +225,7 @@ class Simulation:
             return
         count, end = self._steps, self._steps + steps
         while count < end:
-            stop = min([end] + [_first_due(schedule.next_due, count, dt)
-                                for schedule, _ in scheduled])
+            stop = min([end] + [schedule.first_due_step(count, dt) for schedule, _ in scheduled])
             if stop - count >= MIN_COMPILED_STEPS:
                 laws = self._compiled_laws()
                 if laws is None:  # a controller without a law: Python, as ever
@@ -370,18 +369,6 @@ class Simulation:
 
     def __exit__(self, *exc_info: object) -> None:
         self.close()
-
-
-def _first_due(next_due: float, first: int, dt: float) -> int:
-    """Return the first step count >= ``first`` whose time the stepping loop finds due.
-
-    The loop's own test (``count * dt + DUE_EPSILON >= next_due``), so that
-    both loops run a scheduled update at the same step.
-    """
-    count = max(first, math.ceil((next_due - DUE_EPSILON) / dt) - 1)
-    while count * dt + DUE_EPSILON < next_due:
-        count += 1
-    return count
 
 
 def make_simulation(description_file: str, controllers_file: str | None, time_step: float, *,
