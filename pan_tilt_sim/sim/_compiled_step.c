@@ -286,6 +286,12 @@ static PyObject *joint_states(ClientHandle client, StatusHandle status, const St
     return states;
 }
 
+static int float_item(PyObject *tuple, Py_ssize_t index, double *value)
+{
+    *value = PyFloat_AsDouble(PyTuple_GET_ITEM(tuple, index));
+    return !(*value == -1.0 && PyErr_Occurred());
+}
+
 /* Efforts for up to this many joints are converted on the stack. */
 #define LOCAL_TORQUES 64
 
@@ -331,29 +337,28 @@ static PyObject *stepper_call(Stepper *self, PyObject *args, PyObject *kwargs)
         PyErr_SetString(PyExc_RuntimeError, "the physics client is closed");
         return NULL;
     }
-    PyObject *fast = PySequence_Fast(efforts, "efforts: a sequence of floats");
-    if (fast == NULL) {
+    PyObject *values = PySequence_Tuple(efforts); /* a snapshot, whatever __float__ does */
+    if (values == NULL) {
         return NULL;
     }
-    if (PySequence_Fast_GET_SIZE(fast) != self->effort_count) {
+    if (PyTuple_GET_SIZE(values) != self->effort_count) {
         PyErr_Format(PyExc_ValueError, "%zd efforts for %zd effort-driven joints",
-                     PySequence_Fast_GET_SIZE(fast), self->effort_count);
-        Py_DECREF(fast);
+                     PyTuple_GET_SIZE(values), self->effort_count);
+        Py_DECREF(values);
         return NULL;
     }
     double local[LOCAL_TORQUES];
     double *torques = self->effort_count <= LOCAL_TORQUES
         ? local : PyMem_Malloc(sizeof(double) * (size_t)self->effort_count);
     if (torques == NULL) {
-        Py_DECREF(fast);
+        Py_DECREF(values);
         return PyErr_NoMemory();
     }
     int ok = 1;
     for (Py_ssize_t k = 0; ok && k < self->effort_count; k++) {
-        torques[k] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(fast, k));
-        ok = !(torques[k] == -1.0 && PyErr_Occurred());
+        ok = float_item(values, k, &torques[k]);
     }
-    Py_DECREF(fast);
+    Py_DECREF(values);
     /* Nothing is sent unless every effort is a number. */
     StatusHandle status = ok ? step_once(self, client, torques) : NULL;
     if (torques != local) {
@@ -382,7 +387,7 @@ typedef struct {
     int kind;
     Py_ssize_t effort_slot;
     Py_ssize_t state_slot;
-    PyObject *values; /* the row (a list), borrowed */
+    PyObject *values; /* the row (a list), kept alive by the call's copy of the laws */
     double p, i, d, i_min, i_max, max_velocity, effort_limit;
     int antiwindup;
     double setpoint, command, integral, output, last_measurement;
@@ -446,23 +451,71 @@ static double law_effort(Law *law, double dt)
     return law->command; /* JointEffortController */
 }
 
-static int float_item(PyObject *list, Py_ssize_t index, double *value)
-{
-    *value = PyFloat_AsDouble(PyList_GET_ITEM(list, index));
-    return !(*value == -1.0 && PyErr_Occurred());
-}
-
 static int store_float(PyObject *list, Py_ssize_t index, double value)
 {
     PyObject *number = PyFloat_FromDouble(value);
     if (number == NULL) {
         return 0;
     }
-    PyList_SetItem(list, index, number); /* steals the reference, drops the old item */
+    return PyList_SetItem(list, index, number) == 0; /* steals the reference */
+}
+
+/* Read a law's kind, gains, limits and state from a snapshot of its row. */
+static int read_row(PyObject *row, Law *law)
+{
+    double kind, antiwindup;
+    if (PyTuple_GET_SIZE(row) != LAW_SIZE) {
+        PyErr_Format(PyExc_ValueError, "a law row has %d values, not %zd", LAW_SIZE,
+                     PyTuple_GET_SIZE(row));
+        return 0;
+    }
+    if (!float_item(row, LAW_KIND, &kind)) {
+        return 0;
+    }
+    if (!(kind >= 0.0 && kind < LAW_KINDS) || (double)(int)kind != kind) {
+        PyErr_Format(PyExc_ValueError, "no law of kind %R", PyTuple_GET_ITEM(row, LAW_KIND));
+        return 0;
+    }
+    law->kind = (int)kind;
+    if (!float_item(row, LAW_P, &law->p) || !float_item(row, LAW_I, &law->i)
+        || !float_item(row, LAW_D, &law->d) || !float_item(row, LAW_I_MIN, &law->i_min)
+        || !float_item(row, LAW_I_MAX, &law->i_max)
+        || !float_item(row, LAW_ANTIWINDUP, &antiwindup)
+        || !float_item(row, LAW_MAX_VELOCITY, &law->max_velocity)
+        || !float_item(row, LAW_EFFORT_LIMIT, &law->effort_limit)
+        || !float_item(row, LAW_SETPOINT, &law->setpoint)
+        || !float_item(row, LAW_COMMAND, &law->command)
+        || !float_item(row, LAW_INTEGRAL, &law->integral)
+        || !float_item(row, LAW_OUTPUT, &law->output)
+        || !float_item(row, LAW_LAST_MEASUREMENT, &law->last_measurement)) {
+        return 0;
+    }
+    law->antiwindup = antiwindup != 0.0;
     return 1;
 }
 
-/* Read one law from (effort_slot, state_slot, row); 0 with an exception set if malformed. */
+/* Read the joint's position and velocity from a snapshot of its state. */
+static int read_state(PyObject *state, Law *law)
+{
+    PyObject *values = PySequence_Tuple(state);
+    if (values == NULL) {
+        return 0;
+    }
+    int ok = PyTuple_GET_SIZE(values) >= 2;
+    if (!ok) {
+        PyErr_SetString(PyExc_ValueError, "a joint state has a position and a velocity");
+    } else {
+        ok = float_item(values, 0, &law->position) && float_item(values, 1, &law->velocity);
+    }
+    Py_DECREF(values);
+    return ok;
+}
+
+/*
+ * Read one law, (effort_slot, state_slot, row); 0 with an exception set if
+ * it is malformed.  The rows are read from snapshots (tuples), so that what
+ * a number's __float__ might do to them cannot matter.
+ */
 static int read_law(PyObject *item, const Stepper *self, PyObject *states, Law *law)
 {
     PyObject *values;
@@ -479,53 +532,14 @@ static int read_law(PyObject *item, const Stepper *self, PyObject *states, Law *
                      law->state_slot);
         return 0;
     }
-    if (PyList_GET_SIZE(values) != LAW_SIZE) {
-        PyErr_Format(PyExc_ValueError, "a law row has %d values, not %zd", LAW_SIZE,
-                     PyList_GET_SIZE(values));
-        return 0;
-    }
-    law->values = values;
-    double antiwindup, kind;
-    if (!float_item(values, LAW_KIND, &kind)) {
-        return 0;
-    }
-    if (!(kind >= 0.0 && kind < LAW_KINDS) || (double)(int)kind != kind) {
-        PyErr_Format(PyExc_ValueError, "no law of kind %R", PyList_GET_ITEM(values, LAW_KIND));
-        return 0;
-    }
-    law->kind = (int)kind;
-    if (!float_item(values, LAW_P, &law->p) || !float_item(values, LAW_I, &law->i)
-        || !float_item(values, LAW_D, &law->d) || !float_item(values, LAW_I_MIN, &law->i_min)
-        || !float_item(values, LAW_I_MAX, &law->i_max)
-        || !float_item(values, LAW_ANTIWINDUP, &antiwindup)
-        || !float_item(values, LAW_MAX_VELOCITY, &law->max_velocity)
-        || !float_item(values, LAW_EFFORT_LIMIT, &law->effort_limit)
-        || !float_item(values, LAW_SETPOINT, &law->setpoint)
-        || !float_item(values, LAW_COMMAND, &law->command)
-        || !float_item(values, LAW_INTEGRAL, &law->integral)
-        || !float_item(values, LAW_OUTPUT, &law->output)
-        || !float_item(values, LAW_LAST_MEASUREMENT, &law->last_measurement)) {
-        return 0;
-    }
-    law->antiwindup = antiwindup != 0.0;
-    PyObject *row = PySequence_Fast(PySequence_Fast_GET_ITEM(states, law->state_slot),
-                                    "a joint state is a sequence");
+    law->values = values; /* alive as long as the call's snapshot of the laws */
+    PyObject *row = PyList_AsTuple(values);
     if (row == NULL) {
         return 0;
     }
-    int ok = PySequence_Fast_GET_SIZE(row) >= 2;
-    if (!ok) {
-        PyErr_SetString(PyExc_ValueError, "a joint state has a position and a velocity");
-    } else {
-        law->position = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(row, 0));
-        ok = !(law->position == -1.0 && PyErr_Occurred());
-        if (ok) {
-            law->velocity = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(row, 1));
-            ok = !(law->velocity == -1.0 && PyErr_Occurred());
-        }
-    }
+    int ok = read_row(row, law);
     Py_DECREF(row);
-    return ok;
+    return ok && read_state(PyTuple_GET_ITEM(states, law->state_slot), law);
 }
 
 /*
@@ -556,33 +570,37 @@ static PyObject *stepper_run_laws(Stepper *self, PyObject *args)
         PyErr_SetString(PyExc_ValueError, "steps must be >= 1 and dt > 0");
         return NULL;
     }
-    PyObject *states = PySequence_Fast(given_states, "states: a sequence of joint states");
-    if (states == NULL) {
-        return NULL;
-    }
-    if (PyList_GET_SIZE(efforts) != self->effort_count
-        || PySequence_Fast_GET_SIZE(states) != self->joint_count) {
-        PyErr_Format(PyExc_ValueError, "%zd efforts and %zd states for %zd and %zd joints",
-                     PyList_GET_SIZE(efforts), PySequence_Fast_GET_SIZE(states),
-                     self->effort_count, self->joint_count);
-        Py_DECREF(states);
-        return NULL;
-    }
-    Py_ssize_t law_count = PyList_GET_SIZE(laws);
-    Law *table = PyMem_Malloc(sizeof(Law) * (size_t)(law_count > 0 ? law_count : 1));
-    double *torques = PyMem_Malloc(sizeof(double) * (size_t)(self->effort_count + 1));
+    /* Snapshots: what a number's __float__ might do to the arguments cannot matter. */
+    PyObject *states = PySequence_Tuple(given_states);
+    PyObject *effort_values = PyList_AsTuple(efforts);
+    PyObject *law_items = PyList_AsTuple(laws);
+    Law *table = NULL;
+    double *torques = NULL;
     PyObject *before = NULL, *after = NULL, *result = NULL;
+    if (states == NULL || effort_values == NULL || law_items == NULL) {
+        goto done;
+    }
+    if (PyTuple_GET_SIZE(effort_values) != self->effort_count
+        || PyTuple_GET_SIZE(states) != self->joint_count) {
+        PyErr_Format(PyExc_ValueError, "%zd efforts and %zd states for %zd and %zd joints",
+                     PyTuple_GET_SIZE(effort_values), PyTuple_GET_SIZE(states),
+                     self->effort_count, self->joint_count);
+        goto done;
+    }
+    Py_ssize_t law_count = PyTuple_GET_SIZE(law_items);
+    table = PyMem_Malloc(sizeof(Law) * (size_t)(law_count > 0 ? law_count : 1));
+    torques = PyMem_Malloc(sizeof(double) * (size_t)(self->effort_count + 1));
     if (table == NULL || torques == NULL) {
         PyErr_NoMemory();
         goto done;
     }
     for (Py_ssize_t k = 0; k < self->effort_count; k++) {
-        if (!float_item(efforts, k, &torques[k])) {
+        if (!float_item(effort_values, k, &torques[k])) {
             goto done;
         }
     }
     for (Py_ssize_t k = 0; k < law_count; k++) {
-        if (!read_law(PyList_GET_ITEM(laws, k), self, states, &table[k])) {
+        if (!read_law(PyTuple_GET_ITEM(law_items, k), self, states, &table[k])) {
             goto done;
         }
     }
@@ -639,7 +657,9 @@ static PyObject *stepper_run_laws(Stepper *self, PyObject *args)
     }
     result = PyTuple_Pack(2, before, after);
 done:
-    Py_DECREF(states);
+    Py_XDECREF(states);
+    Py_XDECREF(effort_values);
+    Py_XDECREF(law_items);
     Py_XDECREF(before);
     Py_XDECREF(after);
     PyMem_Free(table);

@@ -285,3 +285,24 @@ def test_a_malformed_law_is_refused_before_anything_is_sent(one_joint_runner, la
     with pytest.raises(error):
         run(5, TIME_STEP, [30.0], laws, before)
     assert physics.read_states() == before  # no torque, no step
+
+
+@pytest.mark.parametrize(('empty_the_row', 'error'), [(False, IndexError), (True, ValueError)])
+def test_a_number_that_empties_the_lists_it_is_read_from_is_an_error_not_a_crash(
+        one_joint_runner, empty_the_row, error):
+    physics, run = one_joint_runner
+    row = law_row(step_law.EFFORT)
+    laws = [(0, 0, row)]
+
+    class Emptying:
+        def __float__(self):
+            laws.clear()
+            efforts.clear()
+            if empty_the_row:
+                row.clear()
+            return 2.0
+    efforts = [Emptying()]
+    # The C side reads snapshots of the efforts and the laws: an emptied row is refused,
+    # and otherwise only the efforts it hands back find no place to go.
+    with pytest.raises(error):
+        run(3, TIME_STEP, efforts, laws, physics.read_states())

@@ -103,3 +103,14 @@ def test_efforts_it_cannot_apply_are_refused_before_anything_is_sent(description
         with pytest.raises(error):
             step(efforts)
         assert physics.read_states() == before  # no step was taken
+
+
+def test_a_number_that_empties_the_efforts_it_is_read_from_is_no_crash(description):
+    class Emptying:
+        def __float__(self):
+            efforts.clear()
+            return 5.0
+    efforts = [Emptying(), 1.0]
+    with Physics(description, 0.001) as physics:
+        states = effort_stepper(physics)(efforts)  # the C side reads a snapshot
+    assert efforts == [] and len(states) == 2
