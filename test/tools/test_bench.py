@@ -89,13 +89,20 @@ def test_node_cpu_is_the_busiest_thread_over_the_window_not_the_busiest_so_far()
 
 @pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
 def test_quick_measures_the_physics_thread_at_factor_0(quick_run):
-    # At least the bare step's CPU per step, whoever listens: the physics thread was measured.
+    # The thread measured is the one stepping: at factor 0 it is busy nearly all the time, so
+    # its CPU per step is most of the wall time per step (an idle thread's would be ~0).  (The
+    # seed's node now costs ~1.5 us a step more than a bare step, and a quick run's bare step
+    # can read 50 % high on a busy machine: that is no floor to hold it to.)
     figures = json.loads(quick_run[0])
+    measured = {**figures['factor_0'],
+                **{f'chain of {joints}': values for joints, values in figures['scaling'].items()}}
+    for case, values in measured.items():
+        wall_us_per_step = 1e6 / values['steps_per_s']
+        assert values['node_cpu_us_per_step'] > 0.5 * wall_us_per_step, case
+    # The chains cost more per step the more joints they step: ~5, 11 and 50 us for 2, 8, 32.
     raw = figures['raw']['step_us_cpu']
-    for case, values in figures['factor_0'].items():
-        assert values['node_cpu_us_per_step'] > raw, case
-    for joints, values in figures['scaling'].items():
-        assert values['node_cpu_us_per_step'] > raw, joints
+    chains = [figures['scaling'][joints]['node_cpu_us_per_step'] for joints in ('2', '8', '32')]
+    assert chains[1] > 1.5 * chains[0] and chains[2] > 2 * chains[1] > raw, chains
 
 
 def test_children_run_the_installed_package_not_one_in_the_working_directory(tmp_path):
