@@ -252,6 +252,27 @@ static void stepper_dealloc(Stepper *self)
     PyObject_Free(self);
 }
 
+/* The client a stepper steps; NULL with an exception set once the simulation is gone. */
+static ClientHandle open_client(const Stepper *self)
+{
+    ClientHandle client = self->connection->client;
+    if (client == NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "the physics client is closed");
+    }
+    return client;
+}
+
+/* One joint's state in ``status``; 0 with an exception set if PyBullet has none. */
+static int read_joint(ClientHandle client, StatusHandle status, int joint,
+                      struct JointSensorState *state)
+{
+    if (api.joint_state(client, status, joint, state)) {
+        return 1;
+    }
+    PyErr_Format(PyExc_RuntimeError, "PyBullet gave no state for joint %d", joint);
+    return 0;
+}
+
 static PyObject *joint_states(ClientHandle client, StatusHandle status, const Stepper *self)
 {
     PyObject *states = PyTuple_New(self->joint_count);
@@ -260,10 +281,8 @@ static PyObject *joint_states(ClientHandle client, StatusHandle status, const St
     }
     struct JointSensorState state;
     for (Py_ssize_t k = 0; k < self->joint_count; k++) {
-        if (!api.joint_state(client, status, self->joints[k], &state)) {
+        if (!read_joint(client, status, self->joints[k], &state)) {
             Py_DECREF(states);
-            PyErr_Format(PyExc_RuntimeError, "PyBullet gave no state for joint %d",
-                         self->joints[k]);
             return NULL;
         }
         PyObject *reaction = PyTuple_New(6);
@@ -290,6 +309,29 @@ static int float_item(PyObject *tuple, Py_ssize_t index, double *value)
 {
     *value = PyFloat_AsDouble(PyTuple_GET_ITEM(tuple, index));
     return !(*value == -1.0 && PyErr_Occurred());
+}
+
+/*
+ * ``efforts``, one per effort-driven joint, into ``torques``, read from a
+ * snapshot (whatever a number's __float__ does to the sequence); 0 with an
+ * exception set if they are not that.
+ */
+static int read_torques(const Stepper *self, PyObject *efforts, double *torques)
+{
+    PyObject *values = PySequence_Tuple(efforts);
+    if (values == NULL) {
+        return 0;
+    }
+    int ok = PyTuple_GET_SIZE(values) == self->effort_count;
+    if (!ok) {
+        PyErr_Format(PyExc_ValueError, "%zd efforts for %zd effort-driven joints",
+                     PyTuple_GET_SIZE(values), self->effort_count);
+    }
+    for (Py_ssize_t k = 0; ok && k < self->effort_count; k++) {
+        ok = float_item(values, k, &torques[k]);
+    }
+    Py_DECREF(values);
+    return ok;
 }
 
 /* Efforts for up to this many joints are converted on the stack. */
@@ -332,35 +374,19 @@ static PyObject *stepper_call(Stepper *self, PyObject *args, PyObject *kwargs)
     if (!PyArg_UnpackTuple(args, "stepper", 1, 1, &efforts)) {
         return NULL;
     }
-    ClientHandle client = self->connection->client;
-    if (client == NULL) {
-        PyErr_SetString(PyExc_RuntimeError, "the physics client is closed");
-        return NULL;
-    }
-    PyObject *values = PySequence_Tuple(efforts); /* a snapshot, whatever __float__ does */
-    if (values == NULL) {
-        return NULL;
-    }
-    if (PyTuple_GET_SIZE(values) != self->effort_count) {
-        PyErr_Format(PyExc_ValueError, "%zd efforts for %zd effort-driven joints",
-                     PyTuple_GET_SIZE(values), self->effort_count);
-        Py_DECREF(values);
-        return NULL;
-    }
     double local[LOCAL_TORQUES];
     double *torques = self->effort_count <= LOCAL_TORQUES
         ? local : PyMem_Malloc(sizeof(double) * (size_t)self->effort_count);
     if (torques == NULL) {
-        Py_DECREF(values);
         return PyErr_NoMemory();
     }
-    int ok = 1;
-    for (Py_ssize_t k = 0; ok && k < self->effort_count; k++) {
-        ok = float_item(values, k, &torques[k]);
+    /* Nothing is sent unless every effort is a number.  The client is looked up after
+       the efforts are read: a number's __float__ may have closed the simulation. */
+    ClientHandle client = NULL;
+    if (read_torques(self, efforts, torques)) {
+        client = open_client(self);
     }
-    Py_DECREF(values);
-    /* Nothing is sent unless every effort is a number. */
-    StatusHandle status = ok ? step_once(self, client, torques) : NULL;
+    StatusHandle status = client != NULL ? step_once(self, client, torques) : NULL;
     if (torques != local) {
         PyMem_Free(torques);
     }
@@ -561,30 +587,22 @@ static PyObject *stepper_run_laws(Stepper *self, PyObject *args)
                           &laws, &given_states)) {
         return NULL;
     }
-    ClientHandle client = self->connection->client;
-    if (client == NULL) {
-        PyErr_SetString(PyExc_RuntimeError, "the physics client is closed");
-        return NULL;
-    }
     if (steps < 1 || !(dt > 0.0)) {
         PyErr_SetString(PyExc_ValueError, "steps must be >= 1 and dt > 0");
         return NULL;
     }
     /* Snapshots: what a number's __float__ might do to the arguments cannot matter. */
     PyObject *states = PySequence_Tuple(given_states);
-    PyObject *effort_values = PyList_AsTuple(efforts);
     PyObject *law_items = PyList_AsTuple(laws);
     Law *table = NULL;
     double *torques = NULL;
     PyObject *before = NULL, *after = NULL, *result = NULL;
-    if (states == NULL || effort_values == NULL || law_items == NULL) {
+    if (states == NULL || law_items == NULL) {
         goto done;
     }
-    if (PyTuple_GET_SIZE(effort_values) != self->effort_count
-        || PyTuple_GET_SIZE(states) != self->joint_count) {
-        PyErr_Format(PyExc_ValueError, "%zd efforts and %zd states for %zd and %zd joints",
-                     PyTuple_GET_SIZE(effort_values), PyTuple_GET_SIZE(states),
-                     self->effort_count, self->joint_count);
+    if (PyTuple_GET_SIZE(states) != self->joint_count) {
+        PyErr_Format(PyExc_ValueError, "%zd states for %zd joints", PyTuple_GET_SIZE(states),
+                     self->joint_count);
         goto done;
     }
     Py_ssize_t law_count = PyTuple_GET_SIZE(law_items);
@@ -594,17 +612,20 @@ static PyObject *stepper_run_laws(Stepper *self, PyObject *args)
         PyErr_NoMemory();
         goto done;
     }
-    for (Py_ssize_t k = 0; k < self->effort_count; k++) {
-        if (!float_item(effort_values, k, &torques[k])) {
-            goto done;
-        }
+    if (!read_torques(self, efforts, torques)) {
+        goto done;
     }
     for (Py_ssize_t k = 0; k < law_count; k++) {
         if (!read_law(PyTuple_GET_ITEM(law_items, k), self, states, &table[k])) {
             goto done;
         }
     }
-    /* Checked, nothing sent yet: from here on only PyBullet can fail. */
+    /* Checked, nothing sent yet (the client looked up last: a number's __float__ may
+       have closed the simulation); from here on only PyBullet can fail. */
+    ClientHandle client = open_client(self);
+    if (client == NULL) {
+        goto done;
+    }
     Py_INCREF(given_states);
     before = given_states;
     struct JointSensorState state;
@@ -632,9 +653,7 @@ static PyObject *stepper_run_laws(Stepper *self, PyObject *args)
         }
         for (Py_ssize_t k = 0; k < law_count; k++) {
             Law *law = &table[k];
-            if (!api.joint_state(client, status, self->joints[law->state_slot], &state)) {
-                PyErr_Format(PyExc_RuntimeError, "PyBullet gave no state for joint %d",
-                             self->joints[law->state_slot]);
+            if (!read_joint(client, status, self->joints[law->state_slot], &state)) {
                 goto done;
             }
             law->position = state.position;
@@ -658,7 +677,6 @@ static PyObject *stepper_run_laws(Stepper *self, PyObject *args)
     result = PyTuple_Pack(2, before, after);
 done:
     Py_XDECREF(states);
-    Py_XDECREF(effort_values);
     Py_XDECREF(law_items);
     Py_XDECREF(before);
     Py_XDECREF(after);

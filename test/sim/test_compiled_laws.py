@@ -306,3 +306,16 @@ def test_a_number_that_empties_the_lists_it_is_read_from_is_an_error_not_a_crash
     # and otherwise only the efforts it hands back find no place to go.
     with pytest.raises(error):
         run(3, TIME_STEP, efforts, laws, physics.read_states())
+
+
+def test_a_number_that_closes_the_simulation_is_an_error_not_a_crash(tmp_path):
+    physics = Physics(load_description(write_star_robot(tmp_path, JOINTS[:1])), TIME_STEP)
+    physics.set_drives([False])
+    run, states = physics.law_runner(), physics.read_states()
+
+    class Closing:
+        def __float__(self):
+            physics.close()
+            return 1.0
+    with pytest.raises(RuntimeError, match='closed'):  # the client is looked up last
+        run(3, TIME_STEP, [Closing()], [(0, 0, law_row(step_law.EFFORT))], states)

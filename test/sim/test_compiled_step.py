@@ -114,3 +114,15 @@ def test_a_number_that_empties_the_efforts_it_is_read_from_is_no_crash(descripti
     with Physics(description, 0.001) as physics:
         states = effort_stepper(physics)(efforts)  # the C side reads a snapshot
     assert efforts == [] and len(states) == 2
+
+
+def test_a_number_that_closes_the_simulation_is_an_error_not_a_crash(description):
+    physics = Physics(description, 0.001)
+    step = effort_stepper(physics)
+
+    class Closing:
+        def __float__(self):
+            physics.close()
+            return 1.0
+    with pytest.raises(RuntimeError, match='closed'):
+        step([Closing(), 1.0])  # the client is looked up after the efforts are read
