@@ -87,6 +87,39 @@ def test_node_cpu_is_the_busiest_thread_over_the_window_not_the_busiest_so_far()
     assert bench.busiest_thread_delta(before, after) == pytest.approx(1.0)
 
 
+# Burns CPU in threads that then end, reports its own CPU time, waits for a line; three times.
+BURN_AND_REPORT = """
+import sys, threading, time
+def burn(seconds):
+    start = time.process_time()
+    while time.process_time() - start < seconds:
+        pass
+for seconds in (0.013, 0.027, 0.041):
+    worker = threading.Thread(target=burn, args=(seconds,))
+    worker.start()
+    worker.join()
+    print(time.process_time(), flush=True)
+    sys.stdin.readline()
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith('linux'), reason="Linux's CPU-time clocks")
+def test_a_process_cpu_time_is_read_to_well_under_a_clock_tick_ended_threads_included():
+    # The factor-1 share is ~0.4 s of CPU in a 10 s window: /proc's 10 ms ticks would make
+    # it +-0.1 % of a core, a quarter of the distance to its target.
+    child = subprocess.Popen([sys.executable, '-c', BURN_AND_REPORT], stdin=subprocess.PIPE,
+                             stdout=subprocess.PIPE, text=True)
+    try:
+        for _ in range(3):
+            own = float(child.stdout.readline())
+            assert own <= bench.cpu_seconds(child.pid) < own + 0.002
+            child.stdin.write('\n')
+            child.stdin.flush()
+    finally:
+        child.kill()
+        child.wait()
+
+
 @pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
 def test_quick_measures_the_physics_thread_at_factor_0(quick_run):
     # The thread measured is the one stepping: at factor 0 it is busy nearly all the time, so
