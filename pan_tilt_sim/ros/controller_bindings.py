@@ -9,6 +9,10 @@ active), as a ros2_control controller's do:
   ``<ns>/<controller>/follow_joint_trajectory`` (:mod:`.trajectory_action`);
 * its PID gains as sim_node parameters (:mod:`.gain_parameters`).
 
+Given a :class:`~pan_tilt_sim.ros.command_reader.CommandReader` (the sim_node
+program), the command subscriptions are read by it rather than by the
+executor.
+
 :class:`ControllerBindings` creates them for the controllers configured at
 start-up, and :meth:`~ControllerBindings.load`,
 :meth:`~ControllerBindings.configure`, :meth:`~ControllerBindings.cleanup`,
@@ -30,6 +34,7 @@ from pan_tilt_sim.controllers import CommandController, CommandResult, Controlle
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
 from pan_tilt_sim.controllers.joint_trajectory_controller import JointTrajectoryController
 from pan_tilt_sim.errors import ConfigurationError
+from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.gain_parameters import GainParameters
 from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES, joint_state_message
 from pan_tilt_sim.ros.trajectory_action import ACTION, TrajectoryActionServer
@@ -44,8 +49,9 @@ class ControllerBindings:
 
     def __init__(self, node: Node, simulation: Simulation, topic: Callable[..., str],
                  gain_parameters: GainParameters, *, actions: bool,
-                 command_topics: bool = True) -> None:
+                 command_topics: bool = True, reader: CommandReader | None = None) -> None:
         self._node = node
+        self._reader = reader
         # False: command controllers take no topic (topic-based hardware feeds them).
         self._command_topics = command_topics
         self._simulation = simulation
@@ -156,9 +162,13 @@ class ControllerBindings:
             entities.append(publisher)
         elif isinstance(controller, CommandController) and self._command_topics:
             message_type, extract = COMMAND_MESSAGES[controller.command_kind]
-            entities.append(node.create_subscription(
+            subscription = node.create_subscription(
                 message_type, self._topic(name, controller.command_topic),
-                self._command_callback(controller, extract), QUEUE_DEPTH))
+                self._command_callback(controller, extract), QUEUE_DEPTH,
+                callback_group=self._reader.group if self._reader is not None else None)
+            entities.append(subscription)
+            if self._reader is not None:
+                self._reader.add(subscription)
         if isinstance(controller, JointTrajectoryController):
             self._trajectory_controllers.append(controller)
         if isinstance(controller, JointTrajectoryController) and self._actions_wanted:
@@ -176,6 +186,8 @@ class ControllerBindings:
             if hasattr(entity, 'publish'):
                 self._node.destroy_publisher(entity)
             else:
+                if self._reader is not None:
+                    self._reader.remove(entity)
                 self._node.destroy_subscription(entity)
         self._joint_state_sinks = [item for item in self._joint_state_sinks
                                    if item[0].name != name]

@@ -36,6 +36,7 @@ from pan_tilt_sim.ros import (
     simulation_services,
     topic_hardware,
 )
+from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.controller_bindings import ControllerBindings
 from pan_tilt_sim.ros.features import NodeFeatures
 from pan_tilt_sim.ros.gain_parameters import GainParameters
@@ -95,6 +96,7 @@ class SimNode(Node):
         # Nodes of this process spun on sim_node's executor and destroyed with it.
         self.companion_nodes: list[Node] = []
         self._physics_thread: PhysicsThread | None = None
+        self._command_reader: CommandReader | None = None
         self._timer = None
         super().__init__(NODE_NAME, **kwargs)
         try:
@@ -139,13 +141,18 @@ class SimNode(Node):
         self._clock_throttle = Throttle(CLOCK_MIN_WALL_PERIOD_S, CLOCK_BURST)
         self.gain_parameters = GainParameters(self)
         topic_mode = self._topic_settings is not None
+        # With a physics thread, callbacks take turns with it; commands have a reader of
+        # their own.
+        self.turns: Turns | None = Turns() if physics_thread else None
+        if self.turns is not None:
+            self._command_reader = CommandReader(self.context, self.turns)
         self.controllers = ControllerBindings(
             self, self.simulation,
             topic_hardware.topics(self._topic_settings, self.topic) if topic_mode
             else self.topic,
             self.gain_parameters,
             actions=not topic_mode and optional_interfaces.available('control_msgs'),
-            command_topics=not topic_mode)
+            command_topics=not topic_mode, reader=self._command_reader)
         self.topic_hardware = topic_hardware.TopicHardware(
             self, self._topic_settings, description,
             self.simulation.controllers) if topic_mode else None
@@ -160,9 +167,7 @@ class SimNode(Node):
         self._start_controller_manager(controllers)
         self._publish_clock()
         self.features.after_steps()  # their first samples at t = 0, as /clock's
-        self.turns: Turns | None = None
-        if physics_thread:
-            self.turns = Turns()
+        if self.turns is not None:
             self._physics_thread = PhysicsThread(self._on_tick, self._thread_period, self.turns)
         else:
             self._timer = self.create_timer(self._tick_period(), self._on_tick)
@@ -190,6 +195,7 @@ class SimNode(Node):
             f"'{self.robot_namespace or '/'}', time_step {self.settings.time_step} s, "
             f'real_time_factor {self._pacer.real_time_factor}')
         if self._physics_thread is not None:
+            self._command_reader.start()
             self._physics_thread.start()  # last: nothing may fail after it runs
 
     def create_publisher(self, *args, **kwargs):
@@ -341,6 +347,8 @@ class SimNode(Node):
         """Stop ticking, destroy the controller_manager node and release PyBullet."""
         if self._physics_thread is not None:
             self._physics_thread.stop()
+        if self._command_reader is not None:
+            self._command_reader.stop()  # before the subscriptions it holds go
         if self._timer is not None:
             self._timer.cancel()
         if self.controllers is not None:

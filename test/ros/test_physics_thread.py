@@ -10,6 +10,7 @@ import rclpy
 from rclpy.parameter import Parameter
 from std_msgs.msg import Float64
 
+from pan_tilt_sim.ros.command_reader import ReaderGroup
 from pan_tilt_sim.ros.physics_thread import PhysicsThread, Turns, TurnTakingExecutor, Wakeup
 from pan_tilt_sim.ros.runner import StopRequested, StopSignals
 from pan_tilt_sim.ros.sim_node import SimNode
@@ -233,3 +234,24 @@ def test_with_its_thread_a_paused_node_holds_and_destroying_it_stops_the_thread(
     thread = node._physics_thread
     node.destroy_node()
     assert not thread.alive
+
+
+def test_with_its_thread_commands_come_by_their_own_reader_also_after_a_reconfigure(threaded):
+    node, probe = threaded
+    name = 'joint1_position_controller'
+    publisher = probe.create_publisher(Float64, f'/ex_urdf_pan_tilt/{name}/command', 10)
+    assert wait_for(lambda: publisher.get_subscription_count() > 0)
+    commands = [s for s in node.subscriptions if s.topic_name.endswith('/command')]
+    assert commands and all(isinstance(s.callback_group, ReaderGroup) for s in commands)
+    with node.turns.callback():  # as controller_manager's services do it
+        node.controllers.switch([], [name], strict=True)
+        node.controllers.cleanup(name)
+    assert wait_for(lambda: publisher.get_subscription_count() == 0)
+    with node.turns.callback():
+        node.controllers.configure(name)
+        node.controllers.switch([name], [], strict=True)
+    assert wait_for(lambda: publisher.get_subscription_count() > 0)
+    controller = node.simulation.controller(name)
+    publisher.publish(Float64(data=0.4))
+    assert wait_for(lambda: controller.setpoints()['pan_joint'] > 0.0)
+    assert node.commands_received[name] == 1
