@@ -6,7 +6,8 @@ subscription, service and timer), more than half of sim_node's CPU at
 real_time_factor 1, and more with every service added.  So the sim_node
 program steps the physics from a :class:`PhysicsThread`, which sleeps
 between ticks, and the executor wakes only for messages, services and
-parameters.
+parameters (the command topics have a reader of their own:
+:mod:`pan_tilt_sim.ros.command_reader`).
 
 Both still take turns, as when a timer drove the physics: every callback
 runs between two batches of steps, never during one.  :class:`Turns` is
