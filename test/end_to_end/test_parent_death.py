@@ -19,12 +19,12 @@ import time
 
 import pytest
 import sim_process
+from waiting import wait_for
 
 from pan_tilt_sim.ros.runner import PARENT_PID_VARIABLE
 
 BUDGET_S = 30.0
 GONE_BUDGET_S = 5.0
-POLL_S = 0.05
 STARTED_LINE = b'simulating'
 
 # argv: log file, whether to set the variable, then sim_node's command line.
@@ -64,15 +64,6 @@ def start_under_parent(tmp_path: pathlib.Path,
         env=sim_process.environment(), stdin=subprocess.PIPE, stdout=subprocess.PIPE)
     child = int(parent.stdout.readline())
     return parent, child, log
-
-
-def wait_for(condition, budget_s: float) -> bool:
-    deadline = time.monotonic() + budget_s
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(POLL_S)
-    return True
 
 
 @pytest.fixture

@@ -7,21 +7,12 @@ import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from std_msgs.msg import Float64
+from waiting import BUDGET_S, wait_for
 
 from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.physics_thread import PhysicsThread, Turns, TurnTakingExecutor
 
-BUDGET_S = 10.0
 TOPIC = '/reader_test/command'
-
-
-def wait_for(condition, budget_s=BUDGET_S, step_s=0.005):
-    deadline = time.monotonic() + budget_s
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(step_s)
-    return True
 
 
 @pytest.fixture

@@ -9,23 +9,12 @@ import pytest
 import rclpy
 from rclpy.parameter import Parameter
 from std_msgs.msg import Float64
+from waiting import BUDGET_S, wait_for
 
 from pan_tilt_sim.ros.command_reader import ReaderGroup
 from pan_tilt_sim.ros.physics_thread import PhysicsThread, Turns, TurnTakingExecutor, Wakeup
 from pan_tilt_sim.ros.runner import StopRequested, StopSignals
 from pan_tilt_sim.ros.sim_node import SimNode
-
-BUDGET_S = 10.0
-
-
-def wait_for(condition, budget_s=BUDGET_S, step_s=0.005):
-    deadline = time.monotonic() + budget_s
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(step_s)
-    return True
-
 
 # --- Turns and the thread, without ROS -------------------------------------------------
 
