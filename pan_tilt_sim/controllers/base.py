@@ -27,7 +27,13 @@ from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
+from pan_tilt_sim.controllers.parameter_spec import (
+    LoadedParameters,
+    ParameterSpec,
+    load_parameters,
+)
 from pan_tilt_sim.controllers.pid import Pid, PidGains
+from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.model.robot import JointKind, JointSpec
 from pan_tilt_sim.schedule import PeriodicSchedule
@@ -182,19 +188,34 @@ class CommandResult(enum.Enum):
 
 
 class Controller(abc.ABC):
-    """Base of every controller type; subclasses list their YAML ``type`` strings."""
+    """Base of every controller type; subclasses list their YAML ``type`` strings.
+
+    ``parameters`` is the type's :class:`ParameterSpec`: the constructor
+    checks ``params`` against it and keeps the checked values, defaults
+    filled in, as :attr:`params`; keys the spec does not know are named in
+    :attr:`config_warnings`.  Parameters already checked (a
+    :class:`LoadedParameters`, as a group controller gives its members) are
+    taken as they are.
+    """
 
     type_names: ClassVar[tuple[str, ...]] = ()
+    parameters: ClassVar[ParameterSpec] = ParameterSpec()
     # The YAML type this controller was created from (the registry sets it).
     type_name: str = ''
     # The YAML section the PID gains come from: 'pid' (ROS 1, one joint) or
     # 'gains' (ros2_controllers, per joint); the gain parameters follow it.
     gains_field: ClassVar[str] = 'gains'
 
-    def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
+    def __init__(self, name: str, params: Mapping[str, Any] | LoadedParameters,
+                 source: str = '') -> None:
         self.name = name
-        self.params = params
         self._source = source
+        if not isinstance(params, LoadedParameters):
+            params = load_parameters(type(self).parameters, params, name, source)
+        self.params: dict[str, Any] = params.values
+        self.config_warnings: list[str] = params.warnings
+        # Events worth a warning while the controller runs (the node logs and clears them).
+        self.notices: list[str] = []
 
     @property
     def joint_names(self) -> tuple[str, ...]:
@@ -208,6 +229,10 @@ class Controller(abc.ABC):
     @abc.abstractmethod
     def update(self, time: float, period: float) -> None:
         """Run one control step at sim ``time`` (s), ``period`` s after the previous one."""
+
+    def ros_surface(self) -> tuple[Endpoint, ...]:
+        """Return the topics and actions this controller has while configured (none here)."""
+        return ()
 
     def step_members(self) -> list[Controller]:
         """Return the controllers whose ``update`` the stepping loop calls every step, in order.
@@ -291,36 +316,17 @@ class Controller(abc.ABC):
                 'and cannot be commanded')
         return handle
 
-    def required_joint(self) -> str:
-        """Return the ``joint`` parameter, which must be a non-empty string."""
-        joint = self.params.get('joint')
-        if joint is None or joint == '':
-            raise self.error('joint', 'missing: name the joint this controller drives')
-        if not isinstance(joint, str):
-            raise self.error('joint', f'{joint!r} is not a joint name (expected one string)')
-        return joint
-
-    def joint_list(self, field: str = 'joints', *, required: bool = True) -> tuple[str, ...]:
-        """Return the ``joints`` parameter: distinct joint names (may be empty if not required)."""
-        joints = self.params.get(field)
-        if joints is None and not required:
-            return ()
-        if not isinstance(joints, list | tuple) or not all(
-                isinstance(joint, str) and joint for joint in joints):
-            raise self.error(field, f'{joints!r} must be a list of joint names')
-        if required and not joints:
-            raise self.error(field, 'empty: name the joints this controller drives')
-        repeated = sorted({joint for joint in joints if joints.count(joint) > 1})
-        if repeated:
-            raise self.error(field, f"joint '{repeated[0]}' is named more than once")
-        return tuple(joints)
-
 
 class CommandController(Controller):
     """A controller that takes commands from a topic ``<controller>/<command_topic>``."""
 
     command_topic: ClassVar[str] = 'command'
     command_kind: ClassVar[CommandKind] = CommandKind.FLOAT64
+
+    def ros_surface(self) -> tuple[Endpoint, ...]:
+        """Return the command topic ``~/<command_topic>``."""
+        return (CommandTopic(f'~/{self.command_topic}', self.command_kind.value,
+                             self.set_command, self.command_problem),)
 
     @abc.abstractmethod
     def set_command(self, value: Any) -> CommandResult:

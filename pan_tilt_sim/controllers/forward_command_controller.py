@@ -42,7 +42,15 @@ from pan_tilt_sim.controllers.joint_effort_controller import JointEffortControll
 from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
 from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
 from pan_tilt_sim.controllers.multi_joint import JOINTS_FIELD, MultiJointController
+from pan_tilt_sim.controllers.parameter_spec import (
+    REQUIRED,
+    STRING,
+    LoadedParameters,
+    Param,
+    not_empty,
+)
 from pan_tilt_sim.controllers.pid import Pid
+from pan_tilt_sim.controllers.shared_parameters import joint_gains
 from pan_tilt_sim.controllers.single_joint import PidJointController
 
 INTERFACE_FIELD = 'interface_name'
@@ -55,9 +63,13 @@ INTERFACE_CONTROLLERS: dict[str, type[CommandController]] = {
 
 
 class ForwardCommandController(MultiJointController):
-    """A group of joints, commanded together through one interface."""
+    """One command per joint through ``interface_name``; a bad element rejects the whole command."""
 
     type_names = ('forward_command_controller/ForwardCommandController',)
+    parameters = MultiJointController.parameters.extend(
+        Param(INTERFACE_FIELD, STRING, REQUIRED, 'The command interface of every joint.',
+              (not_empty(),), read_only=True, example='position'),
+        *joint_gains())
     command_topic = 'commands'
     command_kind = CommandKind.FLOAT64_ARRAY
     # Set by the JointGroup*Controller types; otherwise ``interface_name`` says.
@@ -73,7 +85,8 @@ class ForwardCommandController(MultiJointController):
         gains = joint_gains_from_params(self, self._joint_names)
         member_type = INTERFACE_CONTROLLERS[interface]
         self._members = tuple(
-            member_type(name, {'joint': joint, PID_FIELD: gains.get(joint)}, source)
+            member_type(name, LoadedParameters({'joint': joint, PID_FIELD: gains.get(joint)}, []),
+                        source)
             for joint in self._joint_names)
         for joint, member in zip(self._joint_names, self._members, strict=True):
             if isinstance(member, PidJointController):

@@ -15,7 +15,7 @@ from pan_tilt_sim.controllers.step_law import effort_row
 
 
 class JointEffortController(SingleJointController):
-    """Effort command -> effort."""
+    """Effort command, applied to the joint within its effort limit."""
 
     type_names = ('effort_controllers/JointEffortController',)
     default_interface = 'effort'

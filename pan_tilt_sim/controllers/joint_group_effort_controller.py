@@ -5,11 +5,15 @@ See :mod:`pan_tilt_sim.controllers.forward_command_controller`.
 
 from __future__ import annotations
 
-from pan_tilt_sim.controllers.forward_command_controller import ForwardCommandController
+from pan_tilt_sim.controllers.forward_command_controller import (
+    INTERFACE_FIELD,
+    ForwardCommandController,
+)
 
 
 class JointGroupEffortController(ForwardCommandController):
-    """Effort commands for a group of joints, on ``<controller>/commands``."""
+    """The forward command controller with ``interface_name`` fixed to effort."""
 
     type_names = ('effort_controllers/JointGroupEffortController',)
+    parameters = ForwardCommandController.parameters.without(INTERFACE_FIELD)
     fixed_interface = 'effort'

@@ -40,7 +40,7 @@ DEFAULT_POSITION_GAINS = PidGains(p=100.0, i=0.01, d=10.0)
 
 
 class JointPositionController(PidJointController):
-    """Position setpoint -> effort through a PID, or -> the ideal actuator."""
+    """Position command: a limited setpoint, tracked by the ideal actuator or, with gains, a PID."""
 
     type_names = ('position_controllers/JointPositionController',
                   'effort_controllers/JointPositionController')

@@ -16,11 +16,21 @@ every movable joint.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from pan_tilt_sim.controllers.base import Controller, JointHandle
+from pan_tilt_sim.controllers.parameter_spec import (
+    BOOL,
+    DOUBLE,
+    STRING,
+    STRING_ARRAY,
+    Param,
+    ParameterSpec,
+    gt,
+    unique,
+)
+from pan_tilt_sim.controllers.surface import Endpoint, StateTopic
 from pan_tilt_sim.schedule import DUE_EPSILON, PeriodicSchedule
 
 DEFAULT_PUBLISH_RATE = 50.0  # Hz, as in the seeds' YAML
@@ -31,20 +41,37 @@ JointStateSink = Callable[[float, Sequence[str], Sequence[float], Sequence[float
 
 
 class JointStateController(Controller):
-    """Periodic snapshots of all movable joints."""
+    """Publishes the joints' position, velocity and effort at its rate of sim time."""
 
     type_names = ('joint_state_controller/JointStateController',
                   'joint_state_broadcaster/JointStateBroadcaster')
+    parameters = ParameterSpec([
+        Param('publish_rate', DOUBLE, None, 'Samples per second of sim time (ROS 1).',
+              (gt(0.0),)),
+        Param('update_rate', DOUBLE, None, "The controller's update rate (Hz); the "
+              "controller_manager's by default.", (gt(0.0),)),
+        Param('joints', STRING_ARRAY, [], 'The joints to publish, in this order; empty: every '
+              'movable joint.', (unique(),), read_only=True),
+        Param('extra_joints', STRING_ARRAY, [], 'Names published with zero state beside the '
+              "robot's joints.", (unique(),), read_only=True),
+        Param('interfaces', STRING_ARRAY, [], 'The state interfaces to publish; empty: all.',
+              (unique(),), read_only=True),
+        Param('use_local_topics', BOOL, False, "Publish on ~/joint_states (the controller's "
+              'namespace) instead of joint_states.', read_only=True),
+        Param('map_interface_to_joint_state.position', STRING, 'position',
+              'The interface published as JointState.position.', read_only=True),
+        Param('map_interface_to_joint_state.velocity', STRING, 'velocity',
+              'The interface published as JointState.velocity.', read_only=True),
+        Param('map_interface_to_joint_state.effort', STRING, 'effort',
+              'The interface published as JointState.effort.', read_only=True),
+    ])
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
-        field = next((name for name in RATE_FIELDS if name in params), None)
-        rate = params[field] if field else DEFAULT_PUBLISH_RATE
-        if isinstance(rate, bool) or not isinstance(rate, int | float) or not (
-                math.isfinite(rate) and rate > 0.0):
-            raise self.error(field, f'{rate!r} must be a number of Hz > 0')
+        field = next((name for name in RATE_FIELDS if name in self.params), None)
+        rate = self.params[field] if field else DEFAULT_PUBLISH_RATE
         self._schedule = PeriodicSchedule(1.0 / float(rate))
-        self._joint_names = self.joint_list(required=False)
+        self._joint_names = tuple(self.params['joints'])
         self._sink: JointStateSink | None = None
         self._handles: list[JointHandle] = []
 
@@ -57,6 +84,11 @@ class JointStateController(Controller):
     def publish_rate(self) -> float:
         """Samples per second of sim time."""
         return 1.0 / self._schedule.period
+
+    def ros_surface(self) -> tuple[Endpoint, ...]:
+        """Return the ``sensor_msgs/msg/JointState`` publisher on ``joint_states``."""
+        return (StateTopic('joint_states', 'sensor_msgs/msg/JointState', self.set_sink,
+                           {'names': tuple(self.names)}),)
 
     def set_sink(self, sink: JointStateSink | None) -> None:
         """Where samples go: ``sink(time, names, positions, velocities, efforts)``."""

@@ -78,14 +78,29 @@ from pan_tilt_sim.controllers.gains import (
 from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
 from pan_tilt_sim.controllers.limits import PositionLimits, clamp_effort
 from pan_tilt_sim.controllers.multi_joint import JOINTS_FIELD, MultiJointController
+from pan_tilt_sim.controllers.parameter_spec import (
+    BOOL,
+    DOUBLE,
+    STRING,
+    STRING_ARRAY,
+    Param,
+    gt_eq,
+    one_of,
+    unique,
+)
 from pan_tilt_sim.controllers.pid import Pid
+from pan_tilt_sim.controllers.shared_parameters import joint_gains
+from pan_tilt_sim.controllers.surface import ActionServer, Endpoint
 from pan_tilt_sim.controllers.trajectory import (
     JointTrajectory,
     TrajectoryPlan,
     TrajectoryPoint,
 )
 from pan_tilt_sim.controllers.trajectory_goal import (
+    CONSTRAINTS_FIELD,
     DEACTIVATED_TEXT,
+    DEFAULT_GOAL_TIME,
+    DEFAULT_STOPPED_VELOCITY_TOLERANCE,
     FLOAT_EPSILON,
     GOAL_TIME_TEXT,
     GOAL_TOLERANCE_VIOLATED,
@@ -120,50 +135,70 @@ TIME_EPSILON = 1e-9
 
 
 class JointTrajectoryController(MultiJointController):
-    """Follows a joint trajectory with one PID per joint."""
+    """Follows trajectories and FollowJointTrajectory goals in sim time, as ros2_controllers."""
 
     type_names = ('joint_trajectory_controller/JointTrajectoryController',)
+    parameters = MultiJointController.parameters.extend(
+        Param(COMMAND_INTERFACES_FIELD, STRING_ARRAY, [], 'The command interfaces of every '
+              'joint; empty: position through the ideal actuator.',
+              (unique(), one_of(*COMMAND_INTERFACES)), read_only=True),
+        Param(STATE_INTERFACES_FIELD, STRING_ARRAY, list(DEFAULT_STATE_INTERFACES),
+              'The state interfaces read from every joint.',
+              (unique(), one_of(*STATE_INTERFACES)), read_only=True),
+        Param(PARTIAL_FIELD, BOOL, False, 'Accept goals that name only some of the joints.'),
+        Param(NONZERO_END_FIELD, BOOL, False,
+              'Accept trajectories whose last point has a non-zero velocity.'),
+        Param(MONITOR_RATE_FIELD, DOUBLE, DEFAULT_MONITOR_RATE,
+              'Rate (Hz) of FollowJointTrajectory feedback.', (gt_eq(0.1),)),
+        Param(f'{CONSTRAINTS_FIELD}.goal_time', DOUBLE, DEFAULT_GOAL_TIME,
+              'Time (s) after the end a goal may take to reach its tolerances; 0: forever.',
+              (gt_eq(0.0),)),
+        Param(f'{CONSTRAINTS_FIELD}.stopped_velocity_tolerance', DOUBLE,
+              DEFAULT_STOPPED_VELOCITY_TOLERANCE,
+              'Goal velocity tolerance of every joint (rad/s or m/s).', (gt_eq(0.0),)),
+        Param(f'{CONSTRAINTS_FIELD}.__map_joints.trajectory', DOUBLE, 0.0,
+              'Path position tolerance; 0: not checked.', (gt_eq(0.0),)),
+        Param(f'{CONSTRAINTS_FIELD}.__map_joints.goal', DOUBLE, 0.0,
+              'Goal position tolerance; 0: not checked.', (gt_eq(0.0),)),
+        *joint_gains(),
+        Param('command_joints', STRING_ARRAY, [], 'Joints commanded in place of joints '
+              '(chaining).', simulated=False),
+        Param('interpolation_method', STRING, 'splines', 'How points are interpolated.',
+              (one_of('splines', 'none'),), simulated=False),
+        Param('open_loop_control', BOOL, False, 'Plan from the last command, not the '
+              'measured state.', simulated=False),
+        Param('allow_integration_in_goal_trajectories', BOOL, False,
+              'Integrate missing positions from velocities.', simulated=False),
+        Param('cmd_timeout', DOUBLE, 0.0, 'Hold position if no new command comes within this '
+              'time (s); 0: never.', (gt_eq(0.0),), simulated=False),
+    )
     command_topic = 'joint_trajectory'
     command_kind = CommandKind.JOINT_TRAJECTORY
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
-        interfaces = params.get(COMMAND_INTERFACES_FIELD, [])
-        if not isinstance(interfaces, list | tuple) or any(
-                interface not in COMMAND_INTERFACES for interface in interfaces):
-            raise self.error(COMMAND_INTERFACES_FIELD, f'{interfaces!r} must be a list of '
-                             f"{', '.join(COMMAND_INTERFACES)}")
+        interfaces = self.params[COMMAND_INTERFACES_FIELD]
         self._effort_interface = EFFORT_INTERFACE in interfaces
         self._command_interfaces = tuple(interfaces)
-        states = params.get(STATE_INTERFACES_FIELD) or list(DEFAULT_STATE_INTERFACES)
-        if not isinstance(states, list | tuple) or any(
-                interface not in STATE_INTERFACES for interface in states):
-            raise self.error(STATE_INTERFACES_FIELD, f'{states!r} must be a list of '
-                             f"{', '.join(STATE_INTERFACES)}")
+        states = self.params[STATE_INTERFACES_FIELD] or list(DEFAULT_STATE_INTERFACES)
         self._state_interfaces = tuple(states)
         # ros2_controllers measures the velocity error only in this case.
         self._velocity_error = 'velocity' in states and bool(
             {'velocity', 'effort'} & set(self._command_interfaces))
-        self._flags = {field: self._flag(field) for field in (PARTIAL_FIELD, NONZERO_END_FIELD)}
-        rate = params.get(MONITOR_RATE_FIELD, DEFAULT_MONITOR_RATE)
-        if isinstance(rate, bool) or not isinstance(rate, int | float) or not (
-                math.isfinite(rate) and rate > 0.0):
-            raise self.error(MONITOR_RATE_FIELD, f'{rate!r} must be a number of Hz > 0')
-        self.monitor_period = 1.0 / float(rate)
-        self.default_tolerances = default_tolerances(self, params, self._joint_names)
+        self._flags = {field: self.params[field] for field in (PARTIAL_FIELD, NONZERO_END_FIELD)}
+        self.monitor_period = 1.0 / self.params[MONITOR_RATE_FIELD]
+        self.default_tolerances = default_tolerances(self, self.params, self._joint_names)
         gains = joint_gains_from_params(self, self._joint_names)
         self._gains = [gains.get(joint) for joint in self._joint_names]
         scales = feedforward_scales(self, self._joint_names)
         self._feedforward = [scales[joint] for joint in self._joint_names]
         self._goal: TrajectoryGoal | None = None
-        # Events worth a warning that no goal reports (the node logs and clears them).
-        self.notices: list[str] = []
 
-    def _flag(self, field: str) -> bool:
-        value = self.params.get(field, False)
-        if not isinstance(value, bool):
-            raise self.error(field, f'{value!r} must be true or false')
-        return value
+    def ros_surface(self) -> tuple[Endpoint, ...]:
+        """Return the ``~/joint_trajectory`` topic and the FollowJointTrajectory action."""
+        return (*super().ros_surface(),
+                ActionServer('~/follow_joint_trajectory',
+                             'control_msgs/action/FollowJointTrajectory'))
 
     def command_interfaces(self) -> dict[str, tuple[str, ...]]:
         """Return the ``command_interfaces`` listed, for every joint."""

@@ -34,7 +34,7 @@ DEFAULT_VELOCITY_GAINS = PidGains(p=10.0)
 
 
 class JointVelocityController(PidJointController):
-    """Velocity command -> effort through a PID, or -> the ideal actuator."""
+    """Velocity command within the limit: the ideal actuator turns the joint, or a PID."""
 
     type_names = ('velocity_controllers/JointVelocityController',
                   'effort_controllers/JointVelocityController')

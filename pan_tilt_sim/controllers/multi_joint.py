@@ -12,6 +12,8 @@ from collections.abc import Mapping
 from typing import Any
 
 from pan_tilt_sim.controllers.base import CommandController, CommandResult
+from pan_tilt_sim.controllers.parameter_spec import ParameterSpec
+from pan_tilt_sim.controllers.shared_parameters import JOINTS
 
 JOINTS_FIELD = 'joints'
 
@@ -19,9 +21,11 @@ JOINTS_FIELD = 'joints'
 class MultiJointController(CommandController):
     """A command controller over the joints its ``joints`` parameter lists."""
 
+    parameters = ParameterSpec([JOINTS])
+
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
-        self._joint_names = self.joint_list(JOINTS_FIELD)
+        self._joint_names: tuple[str, ...] = tuple(self.params[JOINTS_FIELD])
         self._problem = ''
 
     @property

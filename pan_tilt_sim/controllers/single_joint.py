@@ -24,7 +24,9 @@ from pan_tilt_sim.controllers.base import (
     JointHandle,
 )
 from pan_tilt_sim.controllers.gains import PID_FIELD, choose_gains, gains_from_params
+from pan_tilt_sim.controllers.parameter_spec import ParameterSpec
 from pan_tilt_sim.controllers.pid import Pid, PidGains
+from pan_tilt_sim.controllers.shared_parameters import JOINT, pid_gains
 
 EFFORT_INTERFACE = 'effort'
 
@@ -33,12 +35,13 @@ class SingleJointController(CommandController):
     """A command controller driving the one joint its ``joint`` parameter names."""
 
     gains_field = PID_FIELD
+    parameters = ParameterSpec([JOINT])
     # The interface claimed unless the type's package says (effort_controllers/...).
     default_interface: ClassVar[str] = 'position'
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
-        self._joint_name = self.required_joint()
+        self._joint_name: str = self.params['joint']
         self._handle: JointHandle | None = None
 
     @property
@@ -74,6 +77,7 @@ class SingleJointController(CommandController):
 class PidJointController(SingleJointController):
     """A one-joint controller: a PID on effort when it has gains, else the ideal actuator."""
 
+    parameters = SingleJointController.parameters.extend(*pid_gains(PID_FIELD))
     default_gains: ClassVar[PidGains]
     pid_kind: ClassVar[ActuatorKind]
     ideal_kind: ClassVar[ActuatorKind]

@@ -1,14 +1,20 @@
 """The loaded controllers' ROS side on sim_node, and the one way to change them at run time.
 
 A controller's ROS entities exist while it is configured (inactive or
-active), as a ros2_control controller's do:
+active), as a ros2_control controller's do.  Each controller declares them
+(:meth:`~pan_tilt_sim.controllers.base.Controller.ros_surface`, see
+:mod:`pan_tilt_sim.controllers.surface`); this module creates one entity per
+declared entry from tables keyed by message and action type, never by
+controller type:
 
-* a broadcaster: ``<ns>/joint_states`` (``sensor_msgs/msg/JointState``);
-* a command controller: ``<ns>/<controller>/<command topic>``;
-* a joint trajectory controller, where control_msgs is installed, also
-  ``<ns>/<controller>/follow_joint_trajectory`` (:mod:`.trajectory_action`);
-* its PID gains as sim_node parameters (:mod:`.gain_parameters`).
+* a :class:`~pan_tilt_sim.controllers.surface.CommandTopic`: a subscription
+  whose messages' values go to the controller (:data:`COMMAND_MESSAGES`);
+* a :class:`~pan_tilt_sim.controllers.surface.StateTopic`: a publisher and
+  the sink the controller hands its samples to (:data:`STATE_SINKS`);
+* an :class:`~pan_tilt_sim.controllers.surface.ActionServer`, where its
+  interface package is installed (:data:`ACTION_SERVERS`);
 
+plus its tunable PID gains as sim_node parameters (:mod:`.gain_parameters`).
 Given a :class:`~pan_tilt_sim.ros.command_reader.CommandReader` (the sim_node
 program), the command subscriptions are read by it rather than by the
 executor.
@@ -30,14 +36,13 @@ from typing import Any
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 
-from pan_tilt_sim.controllers import CommandController, CommandResult, Controller
-from pan_tilt_sim.controllers.joint_state_controller import JointStateController
-from pan_tilt_sim.controllers.joint_trajectory_controller import JointTrajectoryController
+from pan_tilt_sim.controllers import CommandResult, Controller
+from pan_tilt_sim.controllers.surface import PRIVATE, ActionServer, CommandTopic, StateTopic
 from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.gain_parameters import GainParameters
 from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES, joint_state_message
-from pan_tilt_sim.ros.trajectory_action import ACTION, TrajectoryActionServer
+from pan_tilt_sim.ros.trajectory_action import TrajectoryActionServer
 from pan_tilt_sim.sim.engine import Simulation
 
 QUEUE_DEPTH = 10
@@ -63,9 +68,11 @@ class ControllerBindings:
         # Commands taken per controller (ignored ones included): a cheap health figure.
         self.commands_received: dict[str, int] = {}
         self._entities: dict[str, list[Any]] = {}
-        self._joint_state_sinks: list[tuple[JointStateController, Any, JointStateSink]] = []
-        self._trajectory_controllers: list[JointTrajectoryController] = []
-        self.actions: dict[str, TrajectoryActionServer] = {}
+        # (controller, publisher, sink) of every declared state topic.
+        self._state_sinks: list[tuple[Controller, Any, Any]] = []
+        self._connections: list[tuple[str, StateTopic, Any, Any]] = []
+        self._noticing: list[Controller] = []
+        self.actions: dict[str, Any] = {}
         # Wakes the executor when a goal ended or feedback is due (see after_steps).
         self._attention = node.create_guard_condition(self.serve_actions)
         for controller in self._manager.configured:
@@ -115,7 +122,7 @@ class ControllerBindings:
         on the executor); the goals' rclpy side is served on the executor, by
         :meth:`serve_actions`, through a guard condition.
         """
-        for controller in self._trajectory_controllers:
+        for controller in self._noticing:
             notices = controller.notices
             while notices:
                 self._logger.warning(f'{controller.name}: {notices.pop(0)}')
@@ -126,7 +133,7 @@ class ControllerBindings:
 
     def flush_joint_states(self) -> None:
         """Publish the JointState samples the broadcasters took since the last flush."""
-        for _controller, _publisher, sink in self._joint_state_sinks:
+        for _controller, _publisher, sink in self._state_sinks:
             sink.flush()
 
     def serve_actions(self) -> None:
@@ -135,9 +142,9 @@ class ControllerBindings:
             action.poll()
 
     def refresh_readers(self) -> None:
-        """Sample joint states only for broadcasters someone listens to."""
-        for controller, publisher, sink in self._joint_state_sinks:
-            controller.set_sink(sink if publisher.get_subscription_count() > 0 else None)
+        """Let controllers take samples only for state topics someone listens to."""
+        for _name, endpoint, publisher, sink in self._connections:
+            endpoint.connect(sink if publisher.get_subscription_count() > 0 else None)
 
     def destroy(self) -> None:
         """Remove every action server (their goals end aborted)."""
@@ -149,34 +156,57 @@ class ControllerBindings:
     # --- entities ------------------------------------------------------------------------------
 
     def _bind(self, controller: Controller) -> None:
-        node, name = self._node, controller.name
+        name = controller.name
         entities: list[Any] = []
         self._entities[name] = entities
         self.commands_received.setdefault(name, 0)
-        if isinstance(controller, JointStateController):
-            publisher = node.create_publisher(JointState, self._topic('joint_states'),
-                                              QUEUE_DEPTH)
-            sink = JointStateSink(publisher, controller.names)
-            self._joint_state_sinks.append((controller, publisher, sink))
-            controller.set_sink(sink)
-            entities.append(publisher)
-        elif isinstance(controller, CommandController) and self._command_topics:
-            message_type, extract = COMMAND_MESSAGES[controller.command_kind]
-            subscription = node.create_subscription(
-                message_type, self._topic(name, controller.command_topic),
-                self._command_callback(controller, extract), QUEUE_DEPTH,
-                callback_group=self._reader.group if self._reader is not None else None)
-            entities.append(subscription)
-            if self._reader is not None:
-                self._reader.add(subscription)
-        if isinstance(controller, JointTrajectoryController):
-            self._trajectory_controllers.append(controller)
-        if isinstance(controller, JointTrajectoryController) and self._actions_wanted:
-            self.actions[name] = TrajectoryActionServer(
-                node, controller, self._topic(name, ACTION),
-                now=lambda: self._simulation.time,
-                is_active=lambda: self._manager.is_active(name))
+        for warning in controller.config_warnings:
+            self._logger.warning(warning)
+        for endpoint in controller.ros_surface():
+            if isinstance(endpoint, CommandTopic):
+                if self._command_topics:
+                    entities.append(self._subscribe(controller, endpoint))
+            elif isinstance(endpoint, StateTopic):
+                entities.append(self._publish(controller, endpoint))
+            elif isinstance(endpoint, ActionServer):
+                self._serve(controller, endpoint)
+        self._noticing.append(controller)
         self._gains.add(controller)
+
+    def _name(self, controller: Controller, topic: str) -> str:
+        """Resolve a declared name: ``~/x`` in the controller's namespace, else the robot's."""
+        if topic.startswith(PRIVATE):
+            return self._topic(controller.name, topic[len(PRIVATE):])
+        return self._topic(topic)
+
+    def _subscribe(self, controller: Controller, endpoint: CommandTopic) -> Any:
+        message_type, extract = COMMAND_MESSAGES[endpoint.message]
+        subscription = self._node.create_subscription(
+            message_type, self._name(controller, endpoint.name),
+            self._command_callback(controller.name, endpoint, extract), QUEUE_DEPTH,
+            callback_group=self._reader.group if self._reader is not None else None)
+        if self._reader is not None:
+            self._reader.add(subscription)
+        return subscription
+
+    def _publish(self, controller: Controller, endpoint: StateTopic) -> Any:
+        message_type, make_sink = STATE_SINKS[endpoint.message]
+        publisher = self._node.create_publisher(
+            message_type, self._name(controller, endpoint.name), QUEUE_DEPTH)
+        sink = make_sink(publisher, endpoint.fields)
+        self._state_sinks.append((controller, publisher, sink))
+        self._connections.append((controller.name, endpoint, publisher, sink))
+        endpoint.connect(sink)
+        return publisher
+
+    def _serve(self, controller: Controller, endpoint: ActionServer) -> None:
+        if not self._actions_wanted or endpoint.action not in ACTION_SERVERS:
+            return
+        name = controller.name
+        self.actions[name] = ACTION_SERVERS[endpoint.action](
+            self._node, controller, self._name(controller, endpoint.name),
+            now=lambda: self._simulation.time,
+            is_active=lambda: self._manager.is_active(name))
 
     def _unbind(self, name: str) -> None:
         entities = self._entities.pop(name, None)
@@ -189,31 +219,32 @@ class ControllerBindings:
                 if self._reader is not None:
                     self._reader.remove(entity)
                 self._node.destroy_subscription(entity)
-        self._joint_state_sinks = [item for item in self._joint_state_sinks
-                                   if item[0].name != name]
-        self._trajectory_controllers = [controller for controller in self._trajectory_controllers
-                                        if controller.name != name]
+        self._state_sinks = [item for item in self._state_sinks if item[0].name != name]
+        self._connections = [item for item in self._connections if item[0] != name]
+        self._noticing = [controller for controller in self._noticing
+                          if controller.name != name]
         action = self.actions.pop(name, None)
         if action is not None:
             action.destroy()
         self._gains.remove(name)
 
-    def _command_callback(self, controller: CommandController, extract):
+    def _command_callback(self, name: str, endpoint: CommandTopic,
+                          extract: Callable[[Any], Any]) -> Callable[[Any], None]:
         logger = self._logger
-        name = controller.name
         counts = self.commands_received
         is_active = self._manager.is_active
+        accept, problem = endpoint.accept, endpoint.problem
 
-        def store(message) -> None:
+        def store(message: Any) -> None:
             counts[name] += 1
             if not is_active(name):
                 logger.warning(f'{name}: ignored a command: the controller is inactive',
                                throttle_duration_sec=WARNING_THROTTLE_S)
                 return
             value = extract(message)
-            result = controller.set_command(value)
+            result = accept(value)
             if result is not CommandResult.ACCEPTED:
-                logger.warning(f'{name}: {controller.command_problem(value, result)}',
+                logger.warning(f'{name}: {problem(value, result)}',
                                throttle_duration_sec=WARNING_THROTTLE_S)
         return store
 
@@ -231,7 +262,8 @@ class JointStateSink:
     costs ~150-250 us of CPU on these VMs and the next ~10-35 us.
     """
 
-    def __init__(self, publisher: Any, names: Iterable[str]) -> None:
+    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
+        names: Iterable[str] = fields['names']
         self._publisher = publisher
         self._message = JointState()
         self._message.name = list(names)  # once: the names never change
@@ -250,3 +282,14 @@ class JointStateSink:
         if self._pending:
             self._pending = False
             self._publisher.publish(self._message)
+
+
+# Each state message type (by its ROS name): its class, and the sink that
+# turns a controller's samples into messages on a publisher.
+STATE_SINKS: dict[str, tuple[type, Callable[[Any, Mapping[str, Any]], Any]]] = {
+    'sensor_msgs/msg/JointState': (JointState, JointStateSink),
+}
+# Each action type: the server that runs a controller's goals.
+ACTION_SERVERS: dict[str, Callable[..., Any]] = {
+    'control_msgs/action/FollowJointTrajectory': TrajectoryActionServer,
+}

@@ -1,9 +1,10 @@
 """Live PID tuning: every PID gain is a node parameter, as control_toolbox's PidROS makes it.
 
-For each PID, the same six parameters are declared, from the gains in
-effect (the YAML's, or the controller's defaults): ``<prefix>.p``, ``.i``,
-``.d``, ``.i_clamp_max``, ``.i_clamp_min`` (doubles) and ``.antiwindup``
-(bool), whatever the YAML wrote (its ``i_clamp: x`` is
+For each PID, the tunable entries of its controller's parameter spec
+(:meth:`~pan_tilt_sim.controllers.parameter_spec.ParameterSpec.tunable`) are
+declared, from the gains in effect (the YAML's, or the controller's
+defaults): ``<prefix>.p``, ``.i``, ``.d``, ``.i_clamp_max``, ``.i_clamp_min``
+(doubles) and ``.antiwindup`` (bool), whatever the YAML wrote (its ``i_clamp: x`` is
 ``i_clamp_min = -x``, ``i_clamp_max = x``).  The prefix follows the YAML the
 gains come from (:attr:`Controller.gains_field`):
 
@@ -31,28 +32,33 @@ from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
+from pan_tilt_sim.controllers import parameter_spec
 from pan_tilt_sim.controllers.base import Controller
 from pan_tilt_sim.controllers.gains import PID_FIELD
-from pan_tilt_sim.controllers.pid import ANTIWINDUP, GainsError, Pid, PidGains
+from pan_tilt_sim.controllers.parameter_spec import Param
+from pan_tilt_sim.controllers.pid import GainsError, Pid, PidGains
+from pan_tilt_sim.controllers.shared_parameters import pid_gains
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.ros.parameters import BOOL, DOUBLE, coerce, declare
 
-FIELDS = ('p', 'i', 'd', 'i_clamp_max', 'i_clamp_min', ANTIWINDUP)
-FIELD_TYPES = {field: DOUBLE for field in FIELDS} | {ANTIWINDUP: BOOL}
-DESCRIPTIONS = {
-    'p': 'Proportional gain.',
-    'i': 'Integral gain.',
-    'd': 'Derivative gain (on the measured rate).',
-    'i_clamp_max': 'Upper bound of the integral term (same unit as the effort).',
-    'i_clamp_min': 'Lower bound of the integral term.',
-    ANTIWINDUP: 'Hold the integrator itself within the clamp (else only its contribution).',
-}
+# The node parameter type of each spec type a gain may have.
+NODE_TYPES = {parameter_spec.DOUBLE: DOUBLE, parameter_spec.BOOL: BOOL}
 
 
-def field_values(gains: PidGains) -> dict[str, Any]:
+def tunable_fields(controller: Controller) -> dict[str, Param]:
+    """Return the live-tunable gain entries of ``controller``'s spec, by their last name."""
+    return {param.name.rpartition('.')[2]: param
+            for param in type(controller).parameters.tunable()}
+
+
+# Every PID's tunable gains, as the shared spec declares them (p, i, d, the clamp, antiwindup).
+FIELDS = tuple(param.name.rpartition('.')[2] for param in pid_gains(PID_FIELD) if param.tunable)
+
+
+def field_values(gains: PidGains, fields: Iterable[str] = FIELDS) -> dict[str, Any]:
     """Return the value of each gain parameter field for ``gains``."""
     values = dataclasses.asdict(gains)
-    return {field: values[field] for field in FIELDS}
+    return {field: values[field] for field in fields}
 
 
 def apply_fields(gains: PidGains, updates: dict[str, Any]) -> PidGains:
@@ -79,6 +85,7 @@ class GainParameters:
     def __init__(self, node: Node, controllers: Iterable[Controller] = ()) -> None:
         self._node = node
         self._pids: dict[str, Pid] = {}
+        self._fields: dict[str, dict[str, Param]] = {}
         self._by_controller: dict[str, list[str]] = {}
         # Declare before listening; values given at start-up (-p ...) pass the same check.
         for controller in controllers:
@@ -90,12 +97,14 @@ class GainParameters:
         """Declare the gain parameters of ``controller`` (values given with -p must pass)."""
         self.remove(controller.name)
         prefixes = parameter_prefixes(controller)
+        fields = tunable_fields(controller)
         self._by_controller[controller.name] = list(prefixes)
         for prefix, pid in prefixes.items():
             # Known to the on-set check only once declared: a bad start-up value (-p) then
             # ends here with the one-line ParameterError, not rclpy's exception.
-            declared = {field: self._declare(self._node, prefix, field, value)
-                        for field, value in field_values(pid.gains).items()}
+            declared = {field: self._declare(self._node, prefix, fields[field], value)
+                        for field, value in field_values(pid.gains, fields).items()}
+            self._fields[prefix] = fields
             self._pids[prefix] = pid
             pid.gains = self._checked(prefix, declared)
 
@@ -103,14 +112,14 @@ class GainParameters:
         """Undeclare the gain parameters of controller ``name`` (if any)."""
         for prefix in self._by_controller.pop(name, ()):
             self._pids.pop(prefix, None)
-            for field in FIELDS:
+            for field in self._fields.pop(prefix, {}):
                 full = f'{prefix}.{field}'
                 if self._node.has_parameter(full):
                     self._node.undeclare_parameter(full)
 
     def parameter_names(self) -> list[str]:
         """Return the names of every gain parameter."""
-        return [f'{prefix}.{field}' for prefix in self._pids for field in FIELDS]
+        return [f'{prefix}.{field}' for prefix in self._pids for field in self._fields[prefix]]
 
     def on_set_parameters(self, changed: Sequence[Parameter]) -> SetParametersResult:
         """Check the gain parameters among ``changed`` (the rest are not ours); apply nothing."""
@@ -129,10 +138,10 @@ class GainParameters:
         updates: dict[str, dict[str, Any]] = {}
         for parameter in changed:
             prefix, _, field = parameter.name.rpartition('.')
-            if prefix not in self._pids or field not in FIELD_TYPES:
+            if prefix not in self._pids or field not in self._fields[prefix]:
                 continue
             updates.setdefault(prefix, {})[field] = coerce(
-                parameter.name, FIELD_TYPES[field], parameter.value)
+                parameter.name, NODE_TYPES[self._fields[prefix][field].type], parameter.value)
         return {prefix: self._checked(prefix, fields) for prefix, fields in updates.items()}
 
     def _checked(self, prefix: str, fields: dict[str, Any]) -> PidGains:
@@ -140,11 +149,12 @@ class GainParameters:
             return apply_fields(self._pids[prefix].gains, fields)
         except GainsError as err:
             field, _, problem = str(err).partition(': ')
-            if field in FIELDS:
+            if field in self._fields[prefix]:
                 raise ParameterError(f"parameter '{prefix}.{field}': {problem}") from None
             raise ParameterError(f"parameters '{prefix}.*': {err}") from None
 
     @staticmethod
-    def _declare(node: Node, prefix: str, field: str, value: Any) -> Any:
-        return declare(node, f'{prefix}.{field}', FIELD_TYPES[field], value,
-                       f'{prefix}: {DESCRIPTIONS[field]}', read_only=False)
+    def _declare(node: Node, prefix: str, param: Param, value: Any) -> Any:
+        field = param.name.rpartition('.')[2]
+        return declare(node, f'{prefix}.{field}', NODE_TYPES[param.type], value,
+                       f'{prefix}: {param.description}', read_only=False)

@@ -35,11 +35,11 @@ def joint_trajectory(message: JointTrajectoryMessage) -> JointTrajectory:
         start_time=seconds(stamp_) if stamp_.sec or stamp_.nanosec else None)
 
 
-# Message type of each command kind, and how to get the command value out of it.
-COMMAND_MESSAGES: dict[CommandKind, tuple[type, Callable[[Any], Any]]] = {
-    CommandKind.FLOAT64: (Float64, lambda msg: msg.data),
-    CommandKind.FLOAT64_ARRAY: (Float64MultiArray, lambda msg: list(msg.data)),
-    CommandKind.JOINT_TRAJECTORY: (JointTrajectoryMessage, joint_trajectory),
+# Each command message type (by its ROS name), and how to get the command value out of it.
+COMMAND_MESSAGES: dict[str, tuple[type, Callable[[Any], Any]]] = {
+    CommandKind.FLOAT64.value: (Float64, lambda msg: msg.data),
+    CommandKind.FLOAT64_ARRAY.value: (Float64MultiArray, lambda msg: list(msg.data)),
+    CommandKind.JOINT_TRAJECTORY.value: (JointTrajectoryMessage, joint_trajectory),
 }
 
 

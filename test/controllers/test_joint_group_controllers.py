@@ -253,14 +253,14 @@ def test_ros2_controllers_gain_options_are_accepted():
 
 
 @pytest.mark.parametrize(('params', 'field', 'problem'), [
-    ({'joints': None}, 'grp.joints', 'must be a list of joint names'),
+    ({'joints': None}, 'grp.joints', 'missing'),
+    ({'joints': 'shoulder'}, 'grp.joints', 'must be a list of strings'),
     ({'joints': []}, 'grp.joints', 'empty'),
     ({'joints': ['shoulder', 'shoulder']}, 'grp.joints', "'shoulder' is named more than once"),
     ({'joints': ['shoulder', 'elbow']}, 'grp.joints', "joint 'elbow' is not a movable joint"),
     ({'joints': ['follower']}, 'grp.joints', "'follower' mimics 'shoulder'"),
     ({'gains': {'elbow': {'p': 1.0}}}, 'grp.gains.elbow', "not one of this controller's joints"),
-    ({'gains': {'slide': {'p': -1.0}}}, 'grp.gains.slide', 'p: -1.0 must be'),
-    ({'gains': {'slide': {'q': 1.0}}}, 'grp.gains.slide', "unknown field 'q'"),
+    ({'gains': {'slide': {'p': -1.0}}}, 'grp.gains.slide.p', '-1.0 must be'),
     ({'gains': [1, 2]}, 'grp.gains', 'expected a mapping'),
 ])
 def test_configuration_errors_name_the_field(params, field, problem):
@@ -270,12 +270,25 @@ def test_configuration_errors_name_the_field(params, field, problem):
     assert problem in str(err.value)
 
 
-@pytest.mark.parametrize('interface', [None, 'torque', 'Position'])
+def test_forward_command_controller_needs_an_interface():
+    with pytest.raises(ControllerConfigError, match=r'grp\.interface_name: missing'):
+        group(FORWARD)
+
+
+@pytest.mark.parametrize('interface', ['torque', 'Position'])
 def test_forward_command_controller_needs_a_known_interface(interface):
-    params = {} if interface is None else {'interface_name': interface}
     with pytest.raises(ControllerConfigError,
                        match=r'grp\.interface_name: .* must be one of position, velocity, effort'):
-        group(FORWARD, **params)
+        group(FORWARD, interface_name=interface)
+
+
+def test_an_unknown_gain_is_named_in_a_warning_with_the_closest_known_one():
+    controller = group(GROUP_TYPES['position'], gains={'slide': {'q': 1.0, 'pp': 2.0}})
+    assert controller.members[1].pid is None
+    assert any('grp.gains.slide.q: unknown parameter' in line
+               for line in controller.config_warnings)
+    assert any("grp.gains.slide.pp: unknown parameter, ignored (did you mean 'gains.slide.p'?)"
+               in line for line in controller.config_warnings)
 
 
 def test_joint_group_types_fix_their_interface():

@@ -263,7 +263,7 @@ def test_without_gains_the_ideal_actuator_tracks_the_desired_state(interfaces):
 @pytest.mark.parametrize(('params', 'field'), [
     ({'joints': []}, 'arm.joints'),
     ({'command_interfaces': ['torque']}, 'arm.command_interfaces'),
-    ({'gains': {'a': {'p': 'high'}}}, 'arm.gains.a'),
+    ({'gains': {'a': {'p': 'high'}}}, 'arm.gains.a.p'),
     ({'gains': {'a': {'ff_velocity_scale': 'x'}}}, 'arm.gains.a.ff_velocity_scale'),
 ])
 def test_configuration_errors_name_the_field(params, field):

@@ -20,7 +20,7 @@ def sample(sink: JointStateSink, time: float, position: float) -> None:
 
 def test_a_sample_leaves_only_when_flushed_and_only_once():
     publisher = RecordingPublisher()
-    sink = JointStateSink(publisher, ['a'])
+    sink = JointStateSink(publisher, {'names': ['a']})
     sample(sink, 0.02, 1.5)
     assert publisher.sent == []
     sink.flush()
@@ -30,7 +30,7 @@ def test_a_sample_leaves_only_when_flushed_and_only_once():
 
 def test_a_sample_taken_before_the_flush_pushes_out_the_one_held():
     publisher = RecordingPublisher()
-    sink = JointStateSink(publisher, ['a'])
+    sink = JointStateSink(publisher, {'names': ['a']})
     sample(sink, 0.02, 1.0)
     sample(sink, 0.04, 2.0)
     sample(sink, 0.06, 3.0)

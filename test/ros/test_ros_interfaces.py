@@ -13,21 +13,21 @@ from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES, joint_trajectory, 
 
 
 def test_every_command_kind_has_a_message_type():
-    assert set(COMMAND_MESSAGES) == set(CommandKind)
-    for kind, (message_type, _extract) in COMMAND_MESSAGES.items():
-        package, _, name = kind.value.partition('/msg/')
+    assert set(COMMAND_MESSAGES) == {kind.value for kind in CommandKind}
+    for type_name, (message_type, _extract) in COMMAND_MESSAGES.items():
+        package, _, name = type_name.partition('/msg/')
         assert (message_type.__module__.split('.')[0], message_type.__name__) == (package, name)
 
 
 def test_float64_arrays_become_lists_of_floats():
-    _type, extract = COMMAND_MESSAGES[CommandKind.FLOAT64_ARRAY]
+    _type, extract = COMMAND_MESSAGES[CommandKind.FLOAT64_ARRAY.value]
     value = extract(Float64MultiArray(data=[1.0, -2.5, math.nan]))
     assert isinstance(value, list)
     assert value[:2] == [1.0, -2.5] and math.isnan(value[2])
 
 
 def test_float64_is_its_data():
-    _type, extract = COMMAND_MESSAGES[CommandKind.FLOAT64]
+    _type, extract = COMMAND_MESSAGES[CommandKind.FLOAT64.value]
     assert extract(Float64(data=1.57)) == 1.57
 
 

@@ -280,7 +280,7 @@ def record_publications(node) -> list[tuple[str, float]]:
             return getattr(self._publisher, name)
 
     node._clock_publisher = Recording('clock', clock)
-    for _controller, _publisher, sink in node.controllers._joint_state_sinks:
+    for _controller, _publisher, sink in node.controllers._state_sinks:
         sink._publisher = Recording('joint_states', sink._publisher)
     return sent
 

@@ -1,0 +1,66 @@
+"""A controller's ROS surface, declared as data: its topics and actions.
+
+A controller returns its surface from
+:meth:`~pan_tilt_sim.controllers.base.Controller.ros_surface`; the ROS
+adapter (:mod:`pan_tilt_sim.ros.controller_bindings`) creates one entity per
+entry while the controller is configured and removes them at cleanup.  The
+adapter knows message and action types, never controller types: an entry
+names its interface type (``std_msgs/msg/Float64MultiArray``) and carries
+the controller's callable that takes or gives the data.
+
+Topic names follow ros2_controllers: ``~/name`` is in the controller's own
+namespace (``<robot namespace>/<controller>/name``), any other relative name
+in the robot's namespace (``joint_states``), and ``/name`` is absolute.
+Pure Python: no rclpy.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from typing import Any
+
+PRIVATE = '~/'
+
+
+@dataclasses.dataclass(frozen=True)
+class CommandTopic:
+    """A subscription whose messages become commands.
+
+    ``accept(value)`` stores the value the adapter extracted from a message
+    (see the adapter's table for each message type) and says what became of
+    it; ``problem(value, result)`` describes a refused or clamped value for
+    the node's throttled warning.  Commands reach an inactive controller
+    only as a warning.
+    """
+
+    name: str
+    message: str
+    accept: Callable[[Any], Any]  # returns a base.CommandResult
+    problem: Callable[[Any, Any], str]
+
+
+@dataclasses.dataclass(frozen=True)
+class StateTopic:
+    """A publisher fed by the controller's samples.
+
+    ``connect(sink)`` hands the controller the adapter's sink for the
+    message type (None: nobody listens, take no samples); ``fields`` are
+    what the sink needs to build the message once (the joint names, say).
+    """
+
+    name: str
+    message: str
+    connect: Callable[[Any], None]
+    fields: dict[str, Any] = dataclasses.field(default_factory=dict)
+
+
+@dataclasses.dataclass(frozen=True)
+class ActionServer:
+    """An action server run by the controller (the adapter has one server per action type)."""
+
+    name: str
+    action: str
+
+
+Endpoint = CommandTopic | StateTopic | ActionServer
