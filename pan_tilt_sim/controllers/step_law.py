@@ -24,15 +24,26 @@ The laws (``KIND``):
 
 A row has every field; a law reads the ones it needs (the gains are a
 Pid's, the antiwindup flag as 0.0 / 1.0).
+
+The compiled loop has its own copy of this layout; :data:`FIELDS` and
+:data:`KINDS` name it for :mod:`pan_tilt_sim.sim.compiled_step`, which
+compares the two before it runs a step in C.  A change here is a change to
+``_compiled_step.c`` too.
 """
 
 from __future__ import annotations
 
+# The fields' names in row order: FIELDS[index] names the constant equal to index.
+FIELDS = ('KIND', 'P_GAIN', 'I_GAIN', 'D_GAIN', 'I_CLAMP_MIN', 'I_CLAMP_MAX', 'ANTIWINDUP',
+          'MAX_VELOCITY', 'EFFORT_LIMIT', 'SETPOINT', 'COMMAND', 'INTEGRAL', 'OUTPUT',
+          'LAST_MEASUREMENT')
+ROW_SIZE = len(FIELDS)
 (KIND, P_GAIN, I_GAIN, D_GAIN, I_CLAMP_MIN, I_CLAMP_MAX, ANTIWINDUP, MAX_VELOCITY, EFFORT_LIMIT,
- SETPOINT, COMMAND, INTEGRAL, OUTPUT, LAST_MEASUREMENT) = range(14)
-ROW_SIZE = 14
+ SETPOINT, COMMAND, INTEGRAL, OUTPUT, LAST_MEASUREMENT) = range(ROW_SIZE)
 
 POSITION_PID, VELOCITY_PID, EFFORT = 0.0, 1.0, 2.0
+# Each law kind's name and its code in a row's KIND field.
+KINDS = {'POSITION_PID': POSITION_PID, 'VELOCITY_PID': VELOCITY_PID, 'EFFORT': EFFORT}
 _UNUSED = 0.0
 
 

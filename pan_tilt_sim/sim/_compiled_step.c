@@ -400,14 +400,26 @@ static PyObject *stepper_call(Stepper *self, PyObject *args, PyObject *kwargs)
 
 /*
  * A law row, as pan_tilt_sim.controllers.step_law lays it out (a list of
- * floats); the loop reads the gains and writes the state back.
+ * floats); the loop reads the gains and writes the state back.  Each field
+ * and each law kind is named once, in row (code) order, in the lists below:
+ * they make the indices (LAW_<field>, <kind>) and the module's LAW_FIELDS,
+ * LAW_ROW_SIZE and LAW_KINDS, which pan_tilt_sim.sim.compiled_step compares
+ * with step_law's before it uses this file, so that the two cannot part
+ * silently.  The names are step_law's.
  */
-enum {
-    LAW_KIND, LAW_P, LAW_I, LAW_D, LAW_I_MIN, LAW_I_MAX, LAW_ANTIWINDUP, LAW_MAX_VELOCITY,
-    LAW_EFFORT_LIMIT, LAW_SETPOINT, LAW_COMMAND, LAW_INTEGRAL, LAW_OUTPUT, LAW_LAST_MEASUREMENT,
-    LAW_SIZE,
-};
-enum { POSITION_PID, VELOCITY_PID, EFFORT, LAW_KINDS };
+#define LAW_FIELD_LIST(FIELD)                                                               \
+    FIELD(KIND) FIELD(P_GAIN) FIELD(I_GAIN) FIELD(D_GAIN) FIELD(I_CLAMP_MIN) FIELD(I_CLAMP_MAX) \
+    FIELD(ANTIWINDUP) FIELD(MAX_VELOCITY) FIELD(EFFORT_LIMIT) FIELD(SETPOINT) FIELD(COMMAND)    \
+    FIELD(INTEGRAL) FIELD(OUTPUT) FIELD(LAST_MEASUREMENT)
+#define LAW_KIND_LIST(KIND) KIND(POSITION_PID) KIND(VELOCITY_PID) KIND(EFFORT)
+
+#define LAW_FIELD_INDEX(name) LAW_##name,
+#define LAW_KIND_CODE(name) name,
+#define LAW_NAME(name) #name,
+enum { LAW_FIELD_LIST(LAW_FIELD_INDEX) LAW_SIZE };
+enum { LAW_KIND_LIST(LAW_KIND_CODE) LAW_KINDS };
+static const char *const law_field_names[LAW_SIZE] = {LAW_FIELD_LIST(LAW_NAME)};
+static const char *const law_kind_names[LAW_KINDS] = {LAW_KIND_LIST(LAW_NAME)};
 
 typedef struct {
     int kind;
@@ -503,9 +515,10 @@ static int read_row(PyObject *row, Law *law)
         return 0;
     }
     law->kind = (int)kind;
-    if (!float_item(row, LAW_P, &law->p) || !float_item(row, LAW_I, &law->i)
-        || !float_item(row, LAW_D, &law->d) || !float_item(row, LAW_I_MIN, &law->i_min)
-        || !float_item(row, LAW_I_MAX, &law->i_max)
+    if (!float_item(row, LAW_P_GAIN, &law->p) || !float_item(row, LAW_I_GAIN, &law->i)
+        || !float_item(row, LAW_D_GAIN, &law->d)
+        || !float_item(row, LAW_I_CLAMP_MIN, &law->i_min)
+        || !float_item(row, LAW_I_CLAMP_MAX, &law->i_max)
         || !float_item(row, LAW_ANTIWINDUP, &antiwindup)
         || !float_item(row, LAW_MAX_VELOCITY, &law->max_velocity)
         || !float_item(row, LAW_EFFORT_LIMIT, &law->effort_limit)
@@ -741,6 +754,39 @@ static struct PyModuleDef module_definition = {
     module_methods,
 };
 
+/* {name: index} for count names; NULL with an exception set on failure. */
+static PyObject *name_indices(const char *const *names, int count)
+{
+    PyObject *indices = PyDict_New();
+    for (int k = 0; indices != NULL && k < count; k++) {
+        PyObject *index = PyLong_FromLong(k);
+        int stored = index != NULL ? PyDict_SetItemString(indices, names[k], index) : -1;
+        Py_XDECREF(index);
+        if (stored < 0) {
+            Py_CLEAR(indices);
+        }
+    }
+    return indices;
+}
+
+/*
+ * The law layout, for pan_tilt_sim.sim.compiled_step to check against
+ * step_law's: LAW_FIELDS {field: row index}, LAW_ROW_SIZE, LAW_KINDS
+ * {kind: code}.  0 with an exception set on failure.
+ */
+static int add_law_layout(PyObject *module)
+{
+    PyObject *fields = name_indices(law_field_names, LAW_SIZE);
+    PyObject *kinds = name_indices(law_kind_names, LAW_KINDS);
+    int ok = fields != NULL && kinds != NULL
+             && PyModule_AddObjectRef(module, "LAW_FIELDS", fields) == 0
+             && PyModule_AddIntConstant(module, "LAW_ROW_SIZE", LAW_SIZE) == 0
+             && PyModule_AddObjectRef(module, "LAW_KINDS", kinds) == 0;
+    Py_XDECREF(fields);
+    Py_XDECREF(kinds);
+    return ok;
+}
+
 PyMODINIT_FUNC PyInit__compiled_step(void)
 {
     if (PyType_Ready(&ConnectionType) < 0 || PyType_Ready(&StepperType) < 0) {
@@ -751,7 +797,8 @@ PyMODINIT_FUNC PyInit__compiled_step(void)
         return NULL;
     }
     if (PyModule_AddIntConstant(module, "API_VERSION", API_VERSION) < 0
-        || PyModule_AddStringConstant(module, "PLUGIN_POSTFIX", POSTFIX) < 0) {
+        || PyModule_AddStringConstant(module, "PLUGIN_POSTFIX", POSTFIX) < 0
+        || !add_law_layout(module)) {
         Py_DECREF(module);
         return NULL;
     }

@@ -22,17 +22,21 @@ ideal actuators) run only in Python.
 The C side gets its PyBullet client the documented way, as a PyBullet
 plugin (:func:`pybullet.loadPlugin` on the extension's own file).  It is
 used only with the PyBullet C API version it was written against
-(:data:`API_VERSION`); otherwise, without the extension, or with
-``PAN_TILT_SIM_COMPILED_STEP=0`` in the environment, the physics steps
-through PyBullet's Python module as before.
+(:data:`API_VERSION`) and only when the law row layout it was built with is
+step_law's (:func:`layout_mismatch`, checked at import); otherwise, without
+the extension, or with ``PAN_TILT_SIM_COMPILED_STEP=0`` in the environment,
+the physics steps through PyBullet's Python module as before.
 """
 
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Callable, Sequence
+from types import ModuleType
 from typing import Protocol
 
+from pan_tilt_sim.controllers import step_law
 from pan_tilt_sim.sim.bullet import pybullet, quiet_native_output
 
 ENVIRONMENT_SWITCH = 'PAN_TILT_SIM_COMPILED_STEP'
@@ -44,6 +48,58 @@ except ImportError:  # built without a compiler: the Python calls serve
 
 API_VERSION: int | None = _compiled_step.API_VERSION if _compiled_step else None
 _bound = False
+
+
+def layout_mismatch(compiled: ModuleType) -> str:
+    """Say how ``compiled``'s law layout differs from step_law's ('' where it is the same).
+
+    ``compiled`` is ``_compiled_step`` or anything with its attributes
+    ``LAW_FIELDS`` ({field name: row index}), ``LAW_ROW_SIZE`` and
+    ``LAW_KINDS`` ({kind name: code}); every field, the row size and every
+    kind that differs is named, in row order, then kind order.
+    """
+    try:
+        fields, row_size, kinds = compiled.LAW_FIELDS, compiled.LAW_ROW_SIZE, compiled.LAW_KINDS
+    except AttributeError:
+        return 'it exports no law layout (LAW_FIELDS, LAW_ROW_SIZE, LAW_KINDS)'
+    ours = {name: getattr(step_law, name) for name in step_law.FIELDS}
+    differences = [
+        f'field {name} at {_where(ours.get(name))} in step_law, {_where(fields.get(name))} in C'
+        for name in [*step_law.FIELDS, *sorted(set(fields) - set(ours), key=fields.get)]
+        if ours.get(name) != fields.get(name)]
+    if row_size != step_law.ROW_SIZE:
+        differences.append(f'ROW_SIZE {step_law.ROW_SIZE} in step_law, {row_size} in C')
+    differences += [
+        f'law kind {name} {_code(step_law.KINDS.get(name))} in step_law, '
+        f'{_code(kinds.get(name))} in C'
+        for name in [*step_law.KINDS, *sorted(set(kinds) - set(step_law.KINDS), key=kinds.get)]
+        if step_law.KINDS.get(name) != kinds.get(name)]
+    return '; '.join(differences)
+
+
+def _where(index: int | None) -> str:
+    return 'no index' if index is None else f'index {index}'
+
+
+def _code(code: float | None) -> str:
+    return 'missing' if code is None else f'is {code:g}'
+
+
+# A compiled step whose row layout is not step_law's would read gains as
+# states and write states over gains: the physics would be wrong without an
+# error.  Such a build (the installed extension compiled from another
+# _compiled_step.c than this package's step_law.py) is not used at all, not
+# even for the plain per-step calls: its parts come from two sources, and the
+# Python loop, the reference, gives the right results.  A warning rather
+# than an error: the simulation stays correct and runs, only slower, while
+# the warning names every field that differs, so the stale build is seen and
+# rebuilt; the test install additionally asserts that nothing refuses it.
+_LAYOUT_MISMATCH = layout_mismatch(_compiled_step) if _compiled_step else ''
+if _LAYOUT_MISMATCH:
+    warnings.warn(f'{_compiled_step.__file__} was built with another law row layout than '
+                  f'pan_tilt_sim.controllers.step_law ({_LAYOUT_MISMATCH}); the physics steps '
+                  'through Python: reinstall pan_tilt_sim to rebuild it', RuntimeWarning,
+                  stacklevel=1)  # the importer's frame would be importlib's
 
 
 class Connection(Protocol):
@@ -65,6 +121,8 @@ def unavailable_reason() -> str:
         return f'{ENVIRONMENT_SWITCH}=0'
     if _compiled_step is None:
         return 'pan_tilt_sim was installed without its compiled step (no C compiler?)'
+    if _LAYOUT_MISMATCH:
+        return f'the compiled step was built with another law row layout: {_LAYOUT_MISMATCH}'
     if pybullet.getAPIVersion() != API_VERSION:
         return (f'PyBullet C API version {pybullet.getAPIVersion()}, the compiled step '
                 f'knows {API_VERSION}')

@@ -2,17 +2,21 @@
 
 That both ways give the same JointStates to the last bit is
 test_engine_bit_identity's business (it runs every scenario both ways);
-here: the test install has it, the switch turns it off, each simulation's
-steps go to its own client, and a step after the simulation is gone is an
-error, not a crash.
+here: the test install has it, the switch turns it off, it was built with
+step_law's row layout and one built with another is refused, each
+simulation's steps go to its own client, and a step after the simulation is
+gone is an error, not a crash.
 """
 
 import gc
+import importlib
+from types import SimpleNamespace
 
 import pytest
 
+from pan_tilt_sim.controllers import step_law
 from pan_tilt_sim.model.description import load_description
-from pan_tilt_sim.sim import compiled_step
+from pan_tilt_sim.sim import _compiled_step, compiled_step
 from pan_tilt_sim.sim.physics import Physics, pybullet
 
 EFFORTS = ([40.0, -10.0], [-25.0, 30.0])
@@ -42,6 +46,74 @@ def test_the_environment_switch_makes_the_physics_step_through_python(descriptio
     with Physics(description, 0.001) as physics:
         assert not physics.compiled_step
         assert callable(effort_stepper(physics))  # Python's three calls serve
+
+
+def step_law_layout() -> dict:
+    """Return step_law's layout as the compiled step exports it."""
+    return {'LAW_FIELDS': {name: getattr(step_law, name) for name in step_law.FIELDS},
+            'LAW_ROW_SIZE': step_law.ROW_SIZE, 'LAW_KINDS': dict(step_law.KINDS)}
+
+
+def test_the_compiled_step_exports_step_laws_row_layout_and_law_kinds():
+    assert {name: getattr(_compiled_step, name) for name in step_law_layout()} == \
+        step_law_layout()
+    assert compiled_step.layout_mismatch(_compiled_step) == ''
+
+
+def swapped(fields: dict, first: str, second: str) -> dict:
+    return {**fields, first: fields[second], second: fields[first]}
+
+
+def without(mapping: dict, name: str) -> dict:
+    return {key: value for key, value in mapping.items() if key != name}
+
+
+@pytest.mark.parametrize(('change', 'named'), [
+    (lambda layout: {'LAW_FIELDS': swapped(layout['LAW_FIELDS'], 'P_GAIN', 'I_GAIN')},
+     ['field P_GAIN at index 1 in step_law, index 2 in C',
+      'field I_GAIN at index 2 in step_law, index 1 in C']),
+    (lambda layout: {'LAW_FIELDS': {**layout['LAW_FIELDS'], 'JERK_LIMIT': 14},
+                     'LAW_ROW_SIZE': 15},
+     ['field JERK_LIMIT at no index in step_law, index 14 in C',
+      'ROW_SIZE 14 in step_law, 15 in C']),
+    (lambda layout: {'LAW_FIELDS': without(layout['LAW_FIELDS'], 'LAST_MEASUREMENT'),
+                     'LAW_ROW_SIZE': 13},
+     ['field LAST_MEASUREMENT at index 13 in step_law, no index in C',
+      'ROW_SIZE 14 in step_law, 13 in C']),
+    (lambda layout: {'LAW_KINDS': {**layout['LAW_KINDS'], 'EFFORT': 3}},
+     ['law kind EFFORT is 2 in step_law, is 3 in C']),
+    (lambda layout: {'LAW_KINDS': without(layout['LAW_KINDS'], 'VELOCITY_PID')},
+     ['law kind VELOCITY_PID is 1 in step_law, missing in C']),
+], ids=['swapped fields', 'a field only in C', 'a field only in step_law', 'a kind code',
+        'a kind only in step_law'])
+def test_a_law_layout_other_than_step_laws_is_found_and_every_difference_named(change, named):
+    layout = step_law_layout()
+    mismatch = compiled_step.layout_mismatch(SimpleNamespace(**{**layout, **change(layout)}))
+    assert mismatch.split('; ') == named
+
+
+def test_a_build_without_a_law_layout_is_a_mismatch():
+    assert 'exports no law layout' in compiled_step.layout_mismatch(SimpleNamespace())
+
+
+def test_a_compiled_step_built_with_another_law_layout_is_refused_at_import(description,
+                                                                             monkeypatch):
+    monkeypatch.delenv(compiled_step.ENVIRONMENT_SWITCH, raising=False)
+    fields = swapped(_compiled_step.LAW_FIELDS, 'SETPOINT', 'COMMAND')
+    try:
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(_compiled_step, 'LAW_FIELDS', fields)
+            with pytest.warns(RuntimeWarning, match='another law row layout') as warned:
+                importlib.reload(compiled_step)
+            assert 'field SETPOINT at index 9 in step_law, index 10 in C' in \
+                str(warned[0].message)
+            assert 'field COMMAND' in compiled_step.unavailable_reason()
+            with Physics(description, 0.001) as physics:
+                assert not physics.compiled_step
+                assert physics.law_runner() is None  # the engine's Python loop serves
+    finally:
+        importlib.reload(compiled_step)  # the installed extension's layout again
+    assert compiled_step.unavailable_reason() == ''
 
 
 def python_reference(description, efforts, steps: int) -> list:
