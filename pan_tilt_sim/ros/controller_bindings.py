@@ -4,7 +4,9 @@ A controller's ROS entities exist while it is configured (inactive or
 active), as a ros2_control controller's do:
 
 * a broadcaster: ``<ns>/joint_states`` (``sensor_msgs/msg/JointState``);
-* a command controller: ``<ns>/<controller>/<command topic>``;
+* a command controller: ``<ns>/<controller>/<command topic>`` (whose commands
+  are ignored while the controller is inactive, or in chained mode: then the
+  controller before it in the chain writes its references);
 * a joint trajectory controller, where control_msgs is installed, also
   ``<ns>/<controller>/follow_joint_trajectory`` (:mod:`.trajectory_action`);
 * its PID gains as sim_node parameters (:mod:`.gain_parameters`).
@@ -208,6 +210,11 @@ class ControllerBindings:
             counts[name] += 1
             if not is_active(name):
                 logger.warning(f'{name}: ignored a command: the controller is inactive',
+                               throttle_duration_sec=WARNING_THROTTLE_S)
+                return
+            if controller.is_chained:
+                logger.warning(f'{name}: ignored a command: the controller is in chained mode, '
+                               'its references come from the controller before it',
                                throttle_duration_sec=WARNING_THROTTLE_S)
                 return
             value = extract(message)
