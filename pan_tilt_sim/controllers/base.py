@@ -14,6 +14,14 @@ each of its joints' handles which :class:`Actuator` drives it:
   joint at ``handle.velocity_target`` with at most the joint's effort limit,
   and the simulation writes the effort it applied back into ``handle.effort``.
 
+Controllers can be chained, as ros2_control's chainable controllers are: a
+*chainable* controller exports reference interfaces (:class:`Reference`),
+named ``<controller>/<reference>``, which a *preceding* controller claims
+and writes as it would a joint's command interface; the following
+controller reads them in the same step (the manager updates preceding
+controllers first).  While an active controller uses its references the
+chainable controller is in chained mode (:attr:`Controller.is_chained`).
+
 Controllers never touch PyBullet or rclpy.
 """
 
@@ -24,6 +32,7 @@ import dataclasses
 import enum
 import math
 from collections.abc import Mapping, Sequence
+from types import MappingProxyType
 from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
@@ -171,6 +180,23 @@ class JointHandle:
         self.velocity_target = 0.0
 
 
+class Reference:
+    """One reference interface a chainable controller exports: ``<controller>/<reference>``.
+
+    The preceding controller that claims it writes ``value`` in its update;
+    the chainable controller reads it in its own, later in the same step.
+    ``value`` is in the unit of the interface it stands for (rad for a
+    ``.../position`` reference, say); NaN means nothing was written since
+    the chainable controller last reset it.
+    """
+
+    __slots__ = ('name', 'value')
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.value = math.nan
+
+
 class CommandKind(enum.Enum):
     """What a command controller's topic carries (the node maps kinds to message types)."""
 
@@ -205,6 +231,11 @@ class Controller(abc.ABC):
     # The YAML section the PID gains come from: 'pid' (ROS 1, one joint) or
     # 'gains' (ros2_controllers, per joint); the gain parameters follow it.
     gains_field: ClassVar[str] = 'gains'
+    # Whether the type exports reference interfaces (ros2_control's ChainableControllerInterface).
+    chainable: ClassVar[bool] = False
+    # Chained mode, and the references offered before configure (see the methods below).
+    _chained: bool = False
+    _available_references: Mapping[str, Reference] = MappingProxyType({})
 
     def __init__(self, name: str, params: Mapping[str, Any] | LoadedParameters,
                  source: str = '') -> None:
@@ -276,6 +307,68 @@ class Controller(abc.ABC):
     def state_interfaces(self) -> dict[str, tuple[str, ...]]:
         """Return the state interfaces this controller reads, by joint (none here)."""
         return {}
+
+    # --- chaining: the following (chainable) side ------------------------------------------
+
+    def reference_interfaces(self) -> Mapping[str, Reference]:
+        """Return the reference interfaces this controller exports, by ``<name>/<reference>``.
+
+        Only a :attr:`chainable` type exports any.  It creates them when it is
+        built and keeps them as long as it lives (preceding controllers hold
+        them from their configure on); it reads them in its update and
+        resets their values when it is reset.
+        """
+        return MappingProxyType({})
+
+    @property
+    def is_chained(self) -> bool:
+        """Whether an active controller writes this controller's references (chained mode).
+
+        In chained mode the references come from the preceding controller,
+        not from this controller's own command topic.
+        """
+        return self._chained
+
+    def set_chained_mode(self, chained: bool) -> None:
+        """Enter or leave chained mode (the manager calls it while the controller is stopped)."""
+        self._chained = chained
+
+    # --- chaining: the preceding side ---------------------------------------------------------
+
+    def set_available_references(self, references: Mapping[str, Reference]) -> None:
+        """Take the reference interfaces the loaded controllers export, by full name.
+
+        The manager calls it before every :meth:`configure`; a controller that
+        claims references finds them with :meth:`command_target`.
+        """
+        self._available_references = references
+
+    def command_target(self, joints: Mapping[str, JointHandle], entry: str, interface: str,
+                       field: str) -> JointHandle | Reference:
+        """Return what ``entry`` of ``field`` commands through ``interface``.
+
+        A joint of the robot: its handle (see :meth:`handle`).  Otherwise the
+        reference interface ``<entry>/<interface>`` of a loaded chainable
+        controller (``entry`` is ``<controller>/<dof>``, as ros2_control's
+        chained controllers name it).  Neither: an error naming it and what
+        exists.
+        """
+        if entry in joints or '/' not in entry:
+            return self.handle(joints, entry, field)
+        name = f'{entry}/{interface}'
+        reference = self._available_references.get(name)
+        if reference is not None:
+            return reference
+        owner = entry.partition('/')[0]
+        theirs = [other for other in self._available_references if other.startswith(f'{owner}/')]
+        if theirs:
+            raise self.error(field, f"'{name}' is not a reference interface of controller "
+                                    f"'{owner}' (its reference interfaces: {', '.join(theirs)})")
+        raise self.error(
+            field, f"'{entry}' is not a movable joint of the robot and '{name}' is not a "
+            'reference interface of a loaded chainable controller (movable joints: '
+            f"{', '.join(sorted(joints)) or 'none'}; reference interfaces: "
+            f"{', '.join(self._available_references) or 'none'})")
 
     def reset(self) -> None:  # noqa: B027 -- stateless controllers need no reset
         """Forget commands and internal state, as after a fresh start."""

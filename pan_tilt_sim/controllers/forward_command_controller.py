@@ -17,6 +17,14 @@ it is built from, with gains from ``gains: {<joint>: {p, i, d, i_clamp}}``:
   warns at start-up about any joint that is too light for its gains.
 * effort: the command is the effort.
 
+An entry of ``joints`` may instead name a chainable controller's degree of
+freedom, ``<controller>/<dof>``, as ros2_control's chained controllers do: the
+controller then claims that controller's reference interface
+``<controller>/<dof>/<interface_name>`` and writes its command there every
+step, unchanged -- no limits, ramp, PID or actuator, since a reference is
+not a joint: the following controller decides what it means.  Before the
+first command nothing is written.
+
 A command of the wrong length, or with a NaN or infinite element, is
 rejected whole and nothing changes.  The ``JointGroup*Controller`` types
 are this controller with the interface fixed.
@@ -35,6 +43,7 @@ from pan_tilt_sim.controllers.base import (
     CommandResult,
     Controller,
     JointHandle,
+    Reference,
     is_sane_number,
 )
 from pan_tilt_sim.controllers.gains import GAINS_FIELD, PID_FIELD, joint_gains_from_params
@@ -94,7 +103,11 @@ class ForwardCommandController(MultiJointController):
 
     @property
     def members(self) -> tuple[CommandController, ...]:
-        """The one-joint controller of each joint (their PIDs may be tuned live)."""
+        """Per entry of ``joints``: its one-joint controller (PIDs may be tuned live).
+
+        Once configured, an entry naming a reference interface has a
+        :class:`ReferenceForwarder` instead.
+        """
         return self._members
 
     def command_interfaces(self) -> dict[str, tuple[str, ...]]:
@@ -116,10 +129,15 @@ class ForwardCommandController(MultiJointController):
                 for joint, value in member.setpoints().items()}
 
     def configure(self, joints: Mapping[str, JointHandle]) -> None:
-        """Bind every joint (named in errors as an entry of ``joints``)."""
-        for joint in self._joint_names:
-            self.handle(joints, joint, JOINTS_FIELD)
-        for member in self._members:
+        """Bind every entry to its joint or reference (named in errors as one of ``joints``)."""
+        members: list[CommandController] = []
+        for entry, member in zip(self._joint_names, self._members, strict=True):
+            own = member.replaced if isinstance(member, ReferenceForwarder) else member
+            target = self.command_target(joints, entry, self.interface_name, JOINTS_FIELD)
+            members.append(own if isinstance(target, JointHandle) else ReferenceForwarder(
+                self.name, entry, self.interface_name, target, own, self._source))
+        self._members = tuple(members)
+        for member in members:
             member.configure(joints)
 
     def reset(self) -> None:
@@ -162,3 +180,56 @@ class ForwardCommandController(MultiJointController):
         """Update every joint's controller."""
         for member in self._members:
             member.update(time, period)
+
+
+class ReferenceForwarder(CommandController):
+    """The member of a group entry that names a reference interface: writes the command there.
+
+    The command is any finite number within +-MAX_COMMAND_MAGNITUDE; every
+    update writes the latest one to the reference.  Before the first command
+    (after a reset) it writes nothing.  It has no step law, so a stepping
+    loop runs it in Python, before the chainable controller that reads it.
+    """
+
+    def __init__(self, name: str, entry: str, interface: str, reference: Reference,
+                 replaced: CommandController, source: str = '') -> None:
+        super().__init__(name, {}, source)
+        self.reference = reference
+        # The joint member it stands in for, should the entry name a joint when configured again.
+        self.replaced = replaced
+        self._entry = entry
+        self._interface = interface
+        self._command: float | None = None
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """The entry of ``joints`` (``<controller>/<dof>``); it claims no joint."""
+        return (self._entry,)
+
+    def command_interfaces(self) -> dict[str, tuple[str, ...]]:
+        """Return the claimed reference as ros2_control names it: ``<entry>/<interface>``."""
+        return {self._entry: (self._interface,)}
+
+    def configure(self, joints: Mapping[str, JointHandle]) -> None:
+        """Nothing to bind: the reference was found when the group was configured."""
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the command: write nothing until the next one."""
+        self._command = None
+
+    def set_command(self, value: float) -> CommandResult:
+        """Store the command (NaN, Inf and huge values rejected; nothing to clamp to)."""
+        if not is_sane_number(value):
+            return CommandResult.REJECTED
+        self._command = float(value)
+        return CommandResult.ACCEPTED
+
+    def setpoints(self) -> dict[str, float]:
+        """Return the reference's present value (NaN until anything was written)."""
+        return {self._entry: self.reference.value}
+
+    def update(self, time: float, period: float) -> None:
+        """Write the latest command to the reference."""
+        if self._command is not None:
+            self.reference.value = self._command

@@ -30,6 +30,21 @@ deactivated one holds nothing: its joints keep the last command applied to
 them (the last effort), as a ros2_control command interface keeps its last
 value when its controller stops writing it.
 
+Controllers chain as controller_manager chains them.  A claimed command
+interface whose first name part is a loaded controller's name
+(``pid/joint1/position``) is one of that controller's reference interfaces:
+the claiming controller *precedes* it, which *follows*.  A controller can be
+configured only against references a loaded controller exports; it can be
+activated only if every controller it precedes is chainable and active or
+activated in the same switch (and not being deactivated); a following
+controller cannot be deactivated while an active preceding controller stays
+active.  A chainable controller is in chained mode while an active
+controller claims its references; an active one whose chained mode changes
+is restarted (deactivated and activated again), as upstream.  Activation
+runs following controllers first, deactivation preceding ones first, and
+every step updates preceding controllers before those they feed, so a
+reference written in a step is used in that step.
+
 Each loaded controller has ros2_control's lifecycle state
 (:data:`UNCONFIGURED`, :data:`INACTIVE`, :data:`ACTIVE`): :meth:`load`,
 :meth:`configure`, :meth:`cleanup`, :meth:`unload` and :meth:`switch`
@@ -46,7 +61,7 @@ import dataclasses
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
-from pan_tilt_sim.controllers.base import CommandController, Controller, JointHandle
+from pan_tilt_sim.controllers.base import CommandController, Controller, JointHandle, Reference
 from pan_tilt_sim.controllers.registry import (
     create_controller,
     is_command_type,
@@ -93,6 +108,8 @@ class ControllerManager:
         self._controllers: list[Controller] = []
         self._by_name: dict[str, Controller] = {}
         self._states: dict[str, str] = {}
+        # Per configured controller, the references it was configured against, by full name.
+        self._bound: dict[str, dict[str, Reference]] = {}
         self._switch_listeners: list[Callable[[], None]] = []
         self._set_active(set())
         self.skipped: tuple[SkippedController, ...] = ()
@@ -122,23 +139,38 @@ class ControllerManager:
                     f"{self._source}: {drivers[0].name}.type: unknown controller type "
                     f"'{drivers[0].type}', and no other controller in the file commands a "
                     f"joint (supported: {', '.join(supported_types())})")
-        skipped = [SkippedController(spec.name, str(spec.type),
-                                     'a controller type this simulator does not have')
-                   for spec in unknown]
+        failures: dict[str, str] = {}
+
+        def fail(spec: ControllerSpec, err: ControllerConfigError) -> None:
+            if wanted is None or spec.name in wanted:
+                raise err
+            failures[spec.name] = f'cannot be loaded: {err}'
+
+        # All loaded before any is configured: a preceding controller needs the
+        # references of the ones it feeds, wherever the file declares them.
+        loaded: list[tuple[ControllerSpec, Controller]] = []
         for spec in specs:
             if spec in unknown:
                 continue
             try:
                 controller = self._create(spec.name, spec.type, spec.params, self._source)
-                controller.configure(self._handles)
             except ControllerConfigError as err:
-                if wanted is None or spec.name in wanted:
-                    raise
-                skipped.append(SkippedController(spec.name, str(spec.type),
-                                                 f'cannot be loaded: {err}'))
+                fail(spec, err)
                 continue
-            self._add(controller, INACTIVE)
-        self.skipped = tuple(skipped)
+            self._add(controller, UNCONFIGURED)
+            loaded.append((spec, controller))
+        for spec, controller in loaded:
+            try:
+                self._configure(controller)
+            except ControllerConfigError as err:
+                self.unload(controller.name)
+                fail(spec, err)
+        self.skipped = tuple(
+            [SkippedController(spec.name, str(spec.type),
+                               'a controller type this simulator does not have')
+             for spec in unknown]
+            + [SkippedController(spec.name, str(spec.type), failures[spec.name])
+               for spec in specs if spec.name in failures])
         active_names = set(self._by_name) if wanted is None else set(wanted)
         problem = self._problem(active_names)
         if problem is not None:
@@ -153,7 +185,16 @@ class ControllerManager:
             raise ControllerConfigError(
                 f"{active_name}: '{first}' and '{second}' both claim joint '{joint}'; "
                 'only one active controller can command a joint')
-        self._set_active(active_names)
+        for name in active_names:
+            following = self._following_problem(name, active_names, set())
+            if following is not None:
+                raise ControllerConfigError(
+                    f"{active_name}: could not activate controller with name '{name}': "
+                    f'{following}')
+        chain = self._chain_problem(active_names)
+        if chain is not None:
+            raise ControllerConfigError(f'{active_name}: {chain}')
+        self._change_active(active_names, set())
 
     @property
     def controllers(self) -> list[Controller]:
@@ -205,6 +246,30 @@ class ControllerManager:
         """Return the lifecycle state of the loaded controller ``name``; KeyError if none."""
         return self._states[name]
 
+    def chain_connections(self, name: str) -> dict[str, tuple[str, ...]]:
+        """Return the controllers the loaded controller ``name`` precedes, with what it claims.
+
+        By following controller (in claim order): the full names of the
+        reference interfaces ``name`` claims of it.  As controller_manager, a
+        claimed interface is a reference interface when its first name part
+        (before the first '/') is a loaded controller's name -- unless it is
+        a joint of the robot.
+        """
+        connections: dict[str, list[str]] = {}
+        for entry, interfaces in self._by_name[name].command_interfaces().items():
+            if entry in self._handles:
+                continue
+            owner = entry.partition('/')[0]
+            if owner != name and owner in self._by_name:
+                connections.setdefault(owner, []).extend(
+                    f'{entry}/{interface}' for interface in interfaces)
+        return {owner: tuple(claimed) for owner, claimed in connections.items()}
+
+    def references(self) -> dict[str, Reference]:
+        """Return every reference interface the loaded controllers export, by full name."""
+        return {name: reference for controller in self._controllers
+                for name, reference in controller.reference_interfaces().items()}
+
     # --- lifecycle, as controller_manager's services -------------------------------------
 
     def load(self, name: str, type_name: Any, params: Mapping[str, Any],
@@ -231,10 +296,22 @@ class ControllerManager:
         if self._states[name] == ACTIVE:
             raise ControllerConfigError(
                 f"controller '{name}' can not be configured from '{ACTIVE}' state")
-        self._states[name] = UNCONFIGURED
-        controller.configure(self._handles)
-        self._states[name] = INACTIVE
+        self._configure(controller)
         return controller
+
+    def _configure(self, controller: Controller) -> None:
+        """Configure ``controller`` against the joints and the loaded controllers' references."""
+        name = controller.name
+        self._states[name] = UNCONFIGURED
+        self._bound.pop(name, None)
+        references = self.references()
+        controller.set_available_references(references)
+        controller.configure(self._handles)
+        self._bound[name] = {claimed: references[claimed] for entry, interfaces
+                             in controller.command_interfaces().items()
+                             if entry not in self._handles for interface in interfaces
+                             if (claimed := f'{entry}/{interface}') in references}
+        self._states[name] = INACTIVE
 
     def cleanup(self, name: str) -> Controller:
         """Return an inactive controller to unconfigured (an unconfigured one stays so)."""
@@ -243,6 +320,7 @@ class ControllerManager:
             raise ControllerConfigError(
                 f"controller '{name}' can not be cleaned-up from '{ACTIVE}' state")
         self._states[name] = UNCONFIGURED
+        self._bound.pop(name, None)
         return controller
 
     def unload(self, name: str) -> Controller:
@@ -253,6 +331,7 @@ class ControllerManager:
                 f"could not unload controller with name '{name}' because it is still active")
         self._controllers.remove(controller)
         del self._by_name[name], self._states[name]
+        self._bound.pop(name, None)
         return controller
 
     def switch(self, activate: Iterable[str] = (), deactivate: Iterable[str] = (), *,
@@ -262,15 +341,18 @@ class ControllerManager:
         As controller_manager's switch_controller: every name must be a loaded
         controller, every one to activate inactive (or active and being
         deactivated in the same call), every one to deactivate active.
+        So must the chains (see the module's description): a controller whose
+        following controllers would not all be active, or a following
+        controller whose active preceding controller stays active.
         ``strict`` (STRICT): any of these problems refuses the whole switch;
         otherwise (BEST_EFFORT) the controllers concerned are left out -- one
         line each in the returned list -- and only a list naming no loaded
         controller at all is refused.  Either way the switch is refused when
         afterwards a joint would be claimed by two active controllers or lack
-        an interface one claims.  Refusals raise :class:`ControllerSwitchError`
-        and change nothing.  Activated controllers start from the joints'
-        present state; deactivated ones leave their joints with the last
-        command applied.
+        an interface one claims, or a claimed reference interface would be
+        missing.  Refusals raise :class:`ControllerSwitchError` and change
+        nothing.  Activated controllers start from the joints' present state;
+        deactivated ones leave their joints with the last command applied.
         """
         activate, deactivate = list(dict.fromkeys(activate)), list(dict.fromkeys(deactivate))
         dropped: list[str] = []
@@ -303,6 +385,23 @@ class ControllerManager:
                 activate.remove(name)
                 refuse(f"could not activate controller '{name}': it is unconfigured and must "
                        "be configured (to 'inactive') first")
+        # The chains, as controller_manager's check_following_controllers_for_activate and
+        # check_preceding_controllers_for_deactivate; leaving one out may fail another.
+        changed = True
+        while changed:
+            changed = False
+            for name in list(activate):
+                problem = self._following_problem(name, set(activate), set(deactivate))
+                if problem is not None:
+                    activate.remove(name)
+                    changed = True
+                    refuse(f"could not activate controller with name '{name}': {problem}")
+            for name in list(deactivate):
+                problem = self._preceding_problem(name, set(deactivate))
+                if problem is not None:
+                    deactivate.remove(name)
+                    changed = True
+                    refuse(problem)
         names = (self._active_names - set(deactivate)) | set(activate)
         problem = self._problem(names)
         if problem is not None:
@@ -312,14 +411,10 @@ class ControllerManager:
             raise ControllerSwitchError(
                 f"'{first}' and '{second}' would both claim joint '{joint}'; "
                 'only one active controller can command a joint')
-        stopped = [self._by_name[name] for name in deactivate]
-        started = set(activate)
-        self._set_active(names)
-        for controller in stopped:
-            controller.deactivate()
-        for controller in self._active:
-            if controller.name in started:
-                controller.reset()
+        chain = self._chain_problem(names)
+        if chain is not None:
+            raise ControllerSwitchError(chain)
+        self._change_active(names, set(activate))
         for listener in self._switch_listeners:
             listener()
         return dropped
@@ -328,6 +423,28 @@ class ControllerManager:
         """Call ``listener()`` after every switch (the simulation re-drives the joints)."""
         self._switch_listeners.append(listener)
 
+    def _change_active(self, names: set[str], started: set[str]) -> None:
+        """Make ``names`` the active set; ``started`` are (re)activated even if active already.
+
+        Deactivation runs preceding controllers first; chained modes change
+        while the controllers concerned are stopped (an active one whose mode
+        changes is restarted); activation runs following controllers first.
+        """
+        chained = {following for name in names for following in self.chain_connections(name)}
+        # In the old update order: preceding controllers first.
+        stopped = [c for c in self._active if c.name not in names or c.name in started
+                   or c.is_chained != (c.name in chained)]
+        self._set_active(names)
+        for controller in stopped:
+            controller.deactivate()
+        for controller in self._controllers:
+            if controller.is_chained != (controller.name in chained):
+                controller.set_chained_mode(controller.name in chained)
+        restarted = {c.name for c in stopped} | started
+        for controller in reversed(self._active):
+            if controller.name in restarted:
+                controller.reset()
+
     def _set_active(self, names: set[str]) -> None:
         self._active_names = frozenset(names)
         for name, state in self._states.items():
@@ -335,7 +452,9 @@ class ControllerManager:
                 self._states[name] = ACTIVE
             elif state == ACTIVE:
                 self._states[name] = INACTIVE
-        self._active = [c for c in self._controllers if c.name in self._active_names]
+        active = [c for c in self._controllers if c.name in self._active_names]
+        ordered = self._chain_order(active)  # None only for loops, which switch() refuses
+        self._active = active if ordered is None else ordered
         self._step_members = [member for controller in self._active
                               for member in controller.step_members()]
         self._updates = [member.update for member in self._step_members]
@@ -373,19 +492,130 @@ class ControllerManager:
 
         (joint, controller, other controller, None) for a joint claimed twice,
         (joint, controller, None, interface) for an interface the joint lacks.
+        Only joints of the robot: claimed reference interfaces are
+        :meth:`_chain_problem`'s.
         """
         owners: dict[str, str] = {}
         for controller in self._controllers:
             if controller.name not in names:
                 continue
             for joint in controller.joint_names:
+                if joint not in self._handles:
+                    continue
                 if joint in owners:
                     return joint, owners[joint], controller.name, None
                 owners[joint] = controller.name
             for joint, interfaces in controller.command_interfaces().items():
+                if joint not in self._handles:
+                    continue
                 for interface in interfaces:
                     if interface not in self._interfaces_of(joint, interface):
                         return joint, controller.name, None, interface
+        return None
+
+    def _chain_order(self, controllers: list[Controller]) -> list[Controller] | None:
+        """Return ``controllers`` with every preceding controller before those it feeds.
+
+        Otherwise in the given order; None when the chains among them loop.
+        """
+        names = {controller.name for controller in controllers}
+        preceding: dict[str, list[Controller]] = {name: [] for name in names}
+        for controller in controllers:
+            for following in self.chain_connections(controller.name):
+                if following in names:
+                    preceding[following].append(controller)
+        ordered: list[Controller] = []
+        placed: set[str] = set()
+        placing: set[str] = set()
+
+        def place(controller: Controller) -> bool:
+            if controller.name in placed:
+                return True
+            if controller.name in placing:
+                return False
+            placing.add(controller.name)
+            if not all(place(before) for before in preceding[controller.name]):
+                return False
+            placed.add(controller.name)
+            ordered.append(controller)
+            return True
+
+        return ordered if all(place(controller) for controller in controllers) else None
+
+    def _following_problem(self, name: str, activate: set[str], deactivate: set[str],
+                           seen: frozenset[str] = frozenset()) -> str | None:
+        """Return why ``name`` cannot be activated as things stand in its chain, or None.
+
+        Every controller it precedes must be chainable, and active (and not
+        being deactivated) or being activated; and so on down the chain.
+        The texts are controller_manager's.
+        """
+        for following, claimed in self.chain_connections(name).items():
+            if following in seen:
+                continue
+            if not self._by_name[following].chainable:
+                return (f"No state/reference interface from controller : '{claimed[0]}' exist, "
+                        f"since the following controller with name '{following}' is not "
+                        'chainable.')
+            if self.is_active(following):
+                if following in deactivate:
+                    return (f"The following controller with name '{following}' is currently "
+                            'active but it is requested to be deactivated.')
+            elif following not in activate:
+                return (f"The following controller with name '{following}' is currently "
+                        'inactive and it is not requested to be activated.')
+            problem = self._following_problem(following, activate, deactivate, seen | {name})
+            if problem is not None:
+                return problem
+        return None
+
+    def _preceding_problem(self, name: str, deactivate: set[str]) -> str | None:
+        """Return why ``name`` cannot be deactivated while its preceding controllers run, or None.
+
+        (A preceding controller being activated is refused by its own check.)
+        The text is controller_manager's.
+        """
+        for other in self._controllers:
+            if other.name == name or name not in self.chain_connections(other.name):
+                continue
+            if self.is_active(other.name) and other.name not in deactivate:
+                return (f"Unable to deactivate controller with name '{name}' because preceding "
+                        f"controller with name '{other.name}' is currently active and will not "
+                        'be deactivated.')
+        return None
+
+    def _chain_problem(self, names: set[str]) -> str | None:
+        """Return what is wrong with the chains if ``names`` were the active set, or None.
+
+        Every reference interface a controller of ``names`` claims must be
+        exported by a loaded controller -- the very one it was configured
+        against -- and claimed by no other; the chains must not loop.
+        """
+        exported = self.references()
+        claimers: dict[str, str] = {}
+        for controller in self._controllers:
+            if controller.name not in names:
+                continue
+            bound = self._bound.get(controller.name, {})
+            for entry, interfaces in controller.command_interfaces().items():
+                if entry in self._handles:
+                    continue
+                for interface in interfaces:
+                    claimed = f'{entry}/{interface}'
+                    reference = exported.get(claimed)
+                    if reference is None or reference is not bound.get(claimed):
+                        return (f"Unable to activate controller '{controller.name}' since the "
+                                f"command interface '{claimed}' is not available.")
+                    if claimed in claimers:
+                        return (f"'{claimers[claimed]}' and '{controller.name}' would both "
+                                f"claim the reference interface '{claimed}'; only one active "
+                                'controller can command it')
+                    claimers[claimed] = controller.name
+        active = [controller for controller in self._controllers if controller.name in names]
+        if self._chain_order(active) is None:
+            looping = sorted(name for name in names if self.chain_connections(name))
+            return (f"the chains of {', '.join(repr(name) for name in looping)} loop: a "
+                    'controller cannot feed, through others, the ones that feed it')
         return None
 
     def _interfaces_of(self, joint: str, interface: str) -> tuple[str, ...]:

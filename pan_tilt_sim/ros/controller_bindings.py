@@ -15,7 +15,9 @@ controller type:
   interface package is installed (:data:`ACTION_SERVERS`);
 
 plus its tunable PID gains as sim_node parameters (:mod:`.gain_parameters`).
-Given a :class:`~pan_tilt_sim.ros.command_reader.CommandReader` (the sim_node
+A command controller's commands are ignored while it is inactive, or in
+chained mode (then the controller before it in the chain writes its
+references).  Given a :class:`~pan_tilt_sim.ros.command_reader.CommandReader` (the sim_node
 program), the command subscriptions are read by it rather than by the
 executor.
 
@@ -183,7 +185,7 @@ class ControllerBindings:
         message_type, extract = COMMAND_MESSAGES[endpoint.message]
         subscription = self._node.create_subscription(
             message_type, self._name(controller, endpoint.name),
-            self._command_callback(controller.name, endpoint, extract), QUEUE_DEPTH,
+            self._command_callback(controller, endpoint, extract), QUEUE_DEPTH,
             callback_group=self._reader.group if self._reader is not None else None)
         if self._reader is not None:
             self._reader.add(subscription)
@@ -228,8 +230,9 @@ class ControllerBindings:
             action.destroy()
         self._gains.remove(name)
 
-    def _command_callback(self, name: str, endpoint: CommandTopic,
+    def _command_callback(self, controller: Controller, endpoint: CommandTopic,
                           extract: Callable[[Any], Any]) -> Callable[[Any], None]:
+        name = controller.name
         logger = self._logger
         counts = self.commands_received
         is_active = self._manager.is_active
@@ -239,6 +242,11 @@ class ControllerBindings:
             counts[name] += 1
             if not is_active(name):
                 logger.warning(f'{name}: ignored a command: the controller is inactive',
+                               throttle_duration_sec=WARNING_THROTTLE_S)
+                return
+            if controller.is_chained:
+                logger.warning(f'{name}: ignored a command: the controller is in chained mode, '
+                               'its references come from the controller before it',
                                throttle_duration_sec=WARNING_THROTTLE_S)
                 return
             value = extract(message)

@@ -29,8 +29,13 @@ that node) and answers them with ros2_control's rules:
   and times out while a simulator is paused) -- so ``activate_asap`` and
   ``timeout`` change nothing.
 * the lists: controllers with their lifecycle state, type, claimed and
-  required interfaces; the types this simulator has; one hardware component
-  per ``<ros2_control>`` block, always active; the joints' interfaces.
+  required interfaces, and their chains (``is_chainable``, ``is_chained``,
+  the ``reference_interfaces`` a chainable controller exports, and for a
+  preceding controller one ``chain_connections`` entry per controller it
+  feeds, with the reference interfaces it claims of it -- what
+  ``ros2 control list_controllers`` and ``view_controller_chains`` show);
+  the types this simulator has; one hardware component per
+  ``<ros2_control>`` block, always active; the joints' interfaces.
 
 All its callbacks run on sim_node's executor; changes to the simulation go
 through :class:`~pan_tilt_sim.ros.controller_bindings.ControllerBindings`.
@@ -51,7 +56,7 @@ from rclpy.parameter import Parameter
 from pan_tilt_sim.controllers import CommandController
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
 from pan_tilt_sim.controllers.manager import ACTIVE, INACTIVE, ControllerManager
-from pan_tilt_sim.controllers.registry import supported_types
+from pan_tilt_sim.controllers.registry import CONTROLLER_TYPES, supported_types
 from pan_tilt_sim.errors import ConfigurationError, ControllerSwitchError
 from pan_tilt_sim.model.controller_config import (
     DEFAULT_UPDATE_RATE,
@@ -68,6 +73,7 @@ FALLBACK = 'fallback_controllers'
 STRICTNESS_PARAMETER = 'defaults.switch_controller.strictness'
 BEST_EFFORT, STRICT = 1, 2  # controller_manager_msgs/srv/SwitchController
 BASE_CLASS = 'controller_interface::ControllerInterface'
+CHAINABLE_BASE_CLASS = 'controller_interface::ChainableControllerInterface'
 DATA_TYPE = 'double'
 ALL_INTERFACES = ('position', 'velocity', 'effort')
 ACTIVE_STATE = State(id=State.PRIMARY_STATE_ACTIVE, label='active')
@@ -124,11 +130,13 @@ class ControllerManagerNode(Node):
                                 '~/set_hardware_component_state', self._set_component_state),
         ]
         from controller_manager_msgs.msg import (
+            ChainConnection,
             ControllerState,
             HardwareComponentState,
             HardwareInterface,
         )
 
+        self._chain_connection = ChainConnection
         self._controller_state = ControllerState
         self._component_state = HardwareComponentState
         self._interface = HardwareInterface
@@ -263,6 +271,15 @@ class ControllerManagerNode(Node):
             configured = state in (INACTIVE, ACTIVE)
             commands = _flatten(controller.command_interfaces())
             rate = controller.params.get(UPDATE_RATE_FIELD, self.update_rate)
+            # As upstream: the chain of a controller that is inactive or active, the
+            # interfaces named without their controller's prefix.
+            references = [_without_prefix(name) for name in controller.reference_interfaces()]
+            connections = [
+                self._chain_connection(name=following,
+                                       reference_interfaces=[_without_prefix(name)
+                                                             for name in claimed])
+                for following, claimed in sorted(manager.chain_connections(
+                    controller.name).items())]
             states.append(self._controller_state(
                 name=controller.name, state=state, type=controller.type_name, is_async=False,
                 update_rate=int(round(rate)) if isinstance(rate, int | float) else
@@ -270,13 +287,17 @@ class ControllerManagerNode(Node):
                 claimed_interfaces=commands if state == ACTIVE else [],
                 required_command_interfaces=commands if configured else [],
                 required_state_interfaces=self._state_interfaces_of(controller)
-                if configured else []))
+                if configured else [],
+                is_chainable=controller.chainable, is_chained=controller.is_chained,
+                reference_interfaces=references if configured else [],
+                chain_connections=connections if configured else []))
         response.controller = states
         return response
 
     def _list_types(self, request, response):
         response.types = supported_types()
-        response.base_classes = [BASE_CLASS] * len(response.types)
+        response.base_classes = [CHAINABLE_BASE_CLASS if CONTROLLER_TYPES[name].chainable
+                                 else BASE_CLASS for name in response.types]
         return response
 
     def _list_interfaces(self, request, response):
@@ -391,6 +412,11 @@ class ControllerManagerNode(Node):
 
 def _flatten(interfaces: Mapping[str, Sequence[str]]) -> list[str]:
     return [f'{joint}/{interface}' for joint, names in interfaces.items() for interface in names]
+
+
+def _without_prefix(interface: str) -> str:
+    """``pid/joint1/position`` -> ``joint1/position``: a reference interface, as listed."""
+    return interface.partition('/')[2]
 
 
 def _is_strings(value: Any) -> bool:

@@ -6,7 +6,8 @@ services, built the way the spawner builds them; load_controller;
 configure_controller; switch_controller STRICT) against sim_node started as
 a ros2_control launch file starts gz_ros2_control: ``autostart_controllers``
 false, nothing loaded.  Then a UR-style file's controllers are switched back
-and forth, and a conflicting STRICT switch is refused.
+and forth, and a conflicting STRICT switch is refused.  A chain (a forward
+group feeding a chainable controller) is spawned, listed and commanded.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import importlib.util
 
 import pytest
 from builtin_interfaces.msg import Duration
+from chaining_fixtures import CHAINABLE_TYPE, register_chainable
 from node_harness import sim_node
 from rclpy.parameter import Parameter
 from ros2_control_fixtures import write, write_arm
@@ -328,3 +330,71 @@ def test_a_late_joint_state_subscriber_gets_states_from_a_spawned_broadcaster(sp
     assert sim.spin_until(lambda: late), 'the spawned broadcaster publishes nothing'
 
 
+
+
+# --- a chain of controllers --------------------------------------------------------------
+
+CHAIN_FILE = """\
+    pid:
+      ros__parameters:
+        type: test_controllers/ChainableTestController
+        joints: [shoulder_joint]
+    forward:
+      ros__parameters:
+        type: position_controllers/JointGroupPositionController
+        joints: [pid/shoulder_joint]
+    """
+
+
+def shoulder(sim) -> float:
+    return sim.simulation.joint_positions()['shoulder_joint']
+
+
+@pytest.fixture
+def chain(spawner_mode, tmp_path, monkeypatch):
+    """``pid`` (the test's chainable type) and ``forward`` feeding it, spawned in that order."""
+    sim, spawner = spawner_mode
+    register_chainable(monkeypatch)
+    params = write(tmp_path, 'chain.yaml', CHAIN_FILE)
+    assert spawner.spawn('pid', [params]) == 0
+    assert spawner.spawn('forward', [params]) == 0  # the following one first, as spawners do
+    return sim, spawner
+
+
+def test_a_spawned_chain_is_listed_with_its_references_and_connections(chain):
+    sim, spawner = chain
+    listed = spawner.controllers()
+    pid, forward = listed['pid'], listed['forward']
+    assert (pid.is_chainable, pid.is_chained) == (True, True)
+    assert list(pid.reference_interfaces) == ['shoulder_joint/position']
+    assert list(pid.chain_connections) == []
+    assert (forward.is_chainable, forward.is_chained) == (False, False)
+    assert list(forward.claimed_interfaces) == ['pid/shoulder_joint/position']
+    assert [(c.name, list(c.reference_interfaces)) for c in forward.chain_connections] == [
+        ('pid', ['shoulder_joint/position'])]
+    types = spawner.call('list_controller_types')
+    assert dict(zip(types.types, types.base_classes, strict=True))[CHAINABLE_TYPE] == (
+        'controller_interface::ChainableControllerInterface')
+    # pid cannot stop under the group; without the group it leaves chained mode.
+    response = spawner.switch(deactivate=['pid'])
+    assert not response.ok and response.message == (
+        "Unable to deactivate controller with name 'pid' because preceding controller with "
+        "name 'forward' is currently active and will not be deactivated.")
+    assert spawner.switch(deactivate=['forward']).ok
+    pid = spawner.controllers()['pid']
+    assert (pid.state, pid.is_chained) == ('active', False)
+
+
+def test_a_chained_controller_takes_its_reference_from_the_preceding_one_not_its_topic(chain):
+    sim, spawner = chain
+    sim.command('pid', Float64MultiArray(data=[-0.5]))
+    sim.run_for(1.0)
+    assert shoulder(sim) == pytest.approx(0.0, abs=0.01)
+    sim.command('forward', Float64MultiArray(data=[0.5]))
+    sim.run_for(2.0)
+    assert shoulder(sim) == pytest.approx(0.5, abs=0.01)
+    # Out of chained mode its own topic drives it again.
+    assert spawner.switch(deactivate=['forward']).ok
+    sim.command('pid', Float64MultiArray(data=[-0.3]))
+    sim.run_for(2.0)
+    assert shoulder(sim) == pytest.approx(-0.3, abs=0.01)
