@@ -1,4 +1,8 @@
-"""controller_bindings: a broadcaster's samples leave as JointStates, held until flushed."""
+"""controller_bindings: the declared surface on the node; JointStates held until flushed."""
+
+from node_harness import sim_node
+from rcl_interfaces.msg import Log
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile
 
 from pan_tilt_sim.ros.controller_bindings import JointStateSink
 
@@ -36,3 +40,32 @@ def test_a_sample_taken_before_the_flush_pushes_out_the_one_held():
     sample(sink, 0.06, 3.0)
     sink.flush()
     assert publisher.sent == [(0.02, [1.0]), (0.04, [2.0]), (0.06, [3.0])]
+
+
+MISSPELT_YAML = '''controller_manager:
+  ros__parameters:
+    update_rate: 100
+    joint_state_broadcaster: {type: joint_state_broadcaster/JointStateBroadcaster}
+    arm: {type: joint_trajectory_controller/JointTrajectoryController}
+arm:
+  ros__parameters:
+    joints: [pan_joint, tilt_joint]
+    alow_partial_joints_goal: true
+'''
+
+
+def test_a_misspelt_controller_parameter_is_logged_with_the_closest_known_one(tmp_path):
+    config = tmp_path / 'misspelt.yaml'
+    config.write_text(MISSPELT_YAML)
+    # /rosout keeps its history for late joiners (transient local), so start-up lines arrive.
+    history = QoSProfile(depth=1000, history=HistoryPolicy.KEEP_LAST,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    with sim_node(controllers_file=str(config)) as sim:
+        log = sim.collect(Log, '/rosout', history)
+        wanted = (f"{config}: arm.alow_partial_joints_goal: unknown parameter, ignored "
+                  "(did you mean 'allow_partial_joints_goal'?)")
+        assert sim.harness.spin_until(
+            lambda: any(entry.level == Log.WARN and entry.msg == wanted for entry in log)), \
+            [entry.msg for entry in log]
+        assert not sim.node.simulation.manager.controller('arm')._flags[
+            'allow_partial_joints_goal']
