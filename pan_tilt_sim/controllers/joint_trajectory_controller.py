@@ -19,6 +19,12 @@ the node serves them as ``<controller>/follow_joint_trajectory``).
   driven by effort from a PID on the position error whose derivative acts
   on the velocity error (desired minus measured velocity), plus
   ``ff_velocity_scale`` times the desired velocity, as in ros2_controllers.
+* ``command_interfaces`` are those ros2_controllers allows: ``position``,
+  ``velocity`` or ``effort`` alone, or ``position`` with ``velocity`` (and
+  ``acceleration``) or with ``effort``.  Each joint follows the desired
+  position whatever the list; an ``acceleration`` interface is claimed (the
+  hardware may refuse it beside the others, see
+  :mod:`pan_tilt_sim.model.command_modes`) but adds nothing.
 * A joint without gains is driven by the ideal actuator (see
   :mod:`~pan_tilt_sim.controllers.actuator`): a velocity motor capped at the
   effort limit tracks the desired position, with the desired velocity as
@@ -57,7 +63,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from pan_tilt_sim.controllers.base import (
@@ -106,7 +112,7 @@ from pan_tilt_sim.controllers.trajectory_goal import (
 from pan_tilt_sim.model.robot import JointKind
 
 COMMAND_INTERFACES_FIELD = 'command_interfaces'
-COMMAND_INTERFACES = ('position', 'velocity', 'effort')
+COMMAND_INTERFACES = ('position', 'velocity', 'acceleration', 'effort')
 EFFORT_INTERFACE = 'effort'
 STATE_INTERFACES_FIELD = 'state_interfaces'
 STATE_INTERFACES = ('position', 'velocity', 'acceleration')
@@ -117,6 +123,24 @@ PARTIAL_FIELD = 'allow_partial_joints_goal'
 NONZERO_END_FIELD = 'allow_nonzero_velocity_at_trajectory_end'
 # A knot this close after the start is taken as at the start (float stamps).
 TIME_EPSILON = 1e-9
+
+
+def command_interfaces_problem(interfaces: Sequence[str]) -> str | None:
+    """Return what is wrong with a combination of command interfaces, as upstream says; or None.
+
+    ros2_controllers (jazzy) takes ``effort`` or ``velocity`` alone, or
+    ``position`` with ``velocity``, ``acceleration`` or ``effort``.
+    """
+    if 'velocity' in interfaces and len(interfaces) > 1 and 'position' not in interfaces:
+        return ("'velocity' command interface can be used either alone or 'position' "
+                'command interface has to be present')
+    if 'acceleration' in interfaces and not {'velocity', 'position'} & set(interfaces):
+        return ("'acceleration' command interface can only be used if 'velocity' and "
+                "'position' command interfaces are present")
+    if 'effort' in interfaces and not (len(interfaces) == 1 or (
+            len(interfaces) == 2 and 'position' in interfaces)):
+        return "'effort' command interface has to be used alone or with a 'position' interface"
+    return None
 
 
 class JointTrajectoryController(MultiJointController):
@@ -133,6 +157,9 @@ class JointTrajectoryController(MultiJointController):
                 interface not in COMMAND_INTERFACES for interface in interfaces):
             raise self.error(COMMAND_INTERFACES_FIELD, f'{interfaces!r} must be a list of '
                              f"{', '.join(COMMAND_INTERFACES)}")
+        problem = command_interfaces_problem(interfaces)
+        if problem is not None:
+            raise self.error(COMMAND_INTERFACES_FIELD, f'{list(interfaces)!r}: {problem}')
         self._effort_interface = EFFORT_INTERFACE in interfaces
         self._command_interfaces = tuple(interfaces)
         states = params.get(STATE_INTERFACES_FIELD) or list(DEFAULT_STATE_INTERFACES)
