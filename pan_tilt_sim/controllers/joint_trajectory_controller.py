@@ -20,8 +20,8 @@ the node serves them as ``<controller>/follow_joint_trajectory``).
   on the velocity error (desired minus measured velocity), plus
   ``ff_velocity_scale`` times the desired velocity, as in ros2_controllers.
 * ``command_interfaces`` are those ros2_controllers allows: ``position``,
-  ``velocity`` or ``effort`` alone, or ``position`` with ``velocity`` (and
-  ``acceleration``) or with ``effort``.  Each joint follows the desired
+  ``velocity`` or ``effort`` alone, or ``position`` with ``velocity``,
+  ``acceleration`` or both, or with ``effort``.  Each joint follows the desired
   position whatever the list; an ``acceleration`` interface is claimed (the
   hardware may refuse it beside the others, see
   :mod:`pan_tilt_sim.model.command_modes`) but adds nothing.
@@ -128,8 +128,9 @@ TIME_EPSILON = 1e-9
 def command_interfaces_problem(interfaces: Sequence[str]) -> str | None:
     """Return what is wrong with a combination of command interfaces, as upstream says; or None.
 
-    ros2_controllers (jazzy) takes ``effort`` or ``velocity`` alone, or
-    ``position`` with ``velocity``, ``acceleration`` or ``effort``.
+    ros2_controllers (jazzy) takes ``position``, ``velocity`` or ``effort``
+    alone, or ``position`` with ``velocity``, ``acceleration`` or both, or
+    with ``effort``; its texts for the others are returned.
     """
     if 'velocity' in interfaces and len(interfaces) > 1 and 'position' not in interfaces:
         return ("'velocity' command interface can be used either alone or 'position' "

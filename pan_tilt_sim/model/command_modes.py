@@ -27,16 +27,19 @@ hardware would decide:
   does not stop.  So a controller on one of its two joints
   (``forward_illegal1_controller``), one command mode on one joint and
   another on the other, or deactivating its controller without starting
-  another in the same switch, are refused.
+  another in the same switch, are refused -- while that controller and
+  its twin on the other joint, activated in one switch, are accepted, as
+  that hardware accepts them.
 * Any other plugin, and joints outside every block (the simulator's own
   system), accept any combination, including ``position`` and ``velocity``
   active on one joint at once.  gz_ros2_control's ``GazeboSimSystem`` does
   not override ``prepare_command_mode_switch`` (ros2_control's default
   accepts everything) and its ``perform_command_mode_switch`` sets one flag
   per started interface on the joint; the simulator stands in for it, so a
-  controllers file that runs in Gazebo runs here.  A real robot's driver
-  may refuse more, but its rules are not known here: ros2_control's
-  default stands for it.
+  controllers file that runs in Gazebo runs here.  (How such a joint
+  moves is the controller's business: a trajectory controller follows its
+  desired position.)  A real robot's driver may refuse more, but its rules
+  are not known here: ros2_control's default stands for it.
 
 Mixing two interfaces on a joint is refused only by the hardware above;
 two active controllers on one joint are refused whatever the hardware (see
