@@ -20,8 +20,9 @@ class ControllerConfigError(ConfigurationError):
 class ControllerSwitchError(ControllerConfigError):
     """Activating or deactivating controllers would leave the robot in a state ros2_control refuses.
 
-    Two active controllers claiming one joint, a controller that is not loaded, or a
-    command interface the joint does not have; nothing was switched.
+    Two active controllers claiming one joint, a controller that is not loaded, a
+    command interface the joint does not have, or a combination of command interfaces
+    the robot's hardware refuses; nothing was switched.
     """
 
 

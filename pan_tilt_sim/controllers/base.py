@@ -12,7 +12,8 @@ each of its joints' handles which :class:`Actuator` drives it:
   an effort command, or a PID's output;
 * :attr:`Drive.VELOCITY` -- the ideal actuator: a velocity motor moves the
   joint at ``handle.velocity_target`` with at most the joint's effort limit,
-  and the simulation writes the effort it applied back into ``handle.effort``.
+  and the simulation writes the effort it applied back into ``handle.effort``
+  (an acceleration command is integrated into that target).
 
 Controllers can be chained, as ros2_control's chainable controllers are: a
 *chainable* controller exports reference interfaces (:class:`Reference`),
@@ -73,6 +74,8 @@ class ActuatorKind(enum.Enum):
     VELOCITY_PID = ('velocity PID on effort', Drive.EFFORT)
     IDEAL_POSITION = ('ideal position actuator', Drive.VELOCITY)
     IDEAL_VELOCITY = ('ideal velocity actuator', Drive.VELOCITY)
+    IDEAL_ACCELERATION = ('acceleration command integrated into the ideal velocity actuator',
+                          Drive.VELOCITY)
 
     @property
     def label(self) -> str:
@@ -116,6 +119,8 @@ class Actuator:
             if self.kind is ActuatorKind.HOLD:
                 return (f'{self.kind.label}: a zero-velocity motor with {limit} '
                         "(gz_ros2_control's hold_joints)")
+            if self.kind is ActuatorKind.IDEAL_ACCELERATION:
+                return f'{self.kind.label}{owner}, a velocity motor with {limit}'
             return (f'{self.kind.label}{owner}, a velocity motor with {limit}: no PID gains '
                     'for it in the YAML')
         return f'{self.kind.label}{owner}'
@@ -299,8 +304,10 @@ class Controller(abc.ABC):
     def command_interfaces(self) -> dict[str, tuple[str, ...]]:
         """Return the command interfaces this controller claims, by joint (ros2_control's claim).
 
-        ``position``, ``velocity`` or ``effort``: a joint whose ``<ros2_control>``
-        block lacks one of them cannot be driven by this controller.
+        ``position``, ``velocity``, ``effort``, ``acceleration``: a joint whose
+        ``<ros2_control>`` block lacks one of them cannot be driven by this
+        controller, and the block's hardware may refuse some combinations
+        (:mod:`pan_tilt_sim.model.command_modes`).
         """
         return {}
 

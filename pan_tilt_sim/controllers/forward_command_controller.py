@@ -1,11 +1,11 @@
 """``forward_command_controller/ForwardCommandController``: one command per joint, as a group.
 
 The controller drives the ``joints`` it names through one command
-interface, ``interface_name`` (position, velocity or effort), and takes
-``std_msgs/msg/Float64MultiArray`` commands on ``<controller>/commands``:
-element k is the command of the k-th joint.  Each joint behaves exactly
-like the one-joint controller of its interface (limits, ramp, actuator), which
-it is built from, with gains from ``gains: {<joint>: {p, i, d, i_clamp}}``:
+interface, ``interface_name``, and takes ``std_msgs/msg/Float64MultiArray``
+commands on ``<controller>/commands``: element k is the command of the k-th
+joint.  Each joint behaves exactly like the one-joint controller of its
+interface (limits, ramp, actuator), which it is built from, with gains from
+``gains: {<joint>: {p, i, d, i_clamp}}``:
 
 * position and velocity: a joint with gains (there, or in
   ``gazebo_ros_control/pid_gains``) is driven by a PID on effort; one
@@ -15,7 +15,18 @@ it is built from, with gains from ``gains: {<joint>: {p, i, d, i_clamp}}``:
   effective inertia -- at the default 1 ms step and the seed's p 100, d 10,
   inertias above 0.005 kg m^2 (or 5 g on a prismatic joint); the simulation
   warns at start-up about any joint that is too light for its gains.
-* effort: the command is the effort.
+* effort: the command is the effort;
+* acceleration: the command is integrated into the velocity target of the
+  ideal velocity actuator, as ros2_control's mock hardware integrates it
+  (:mod:`~pan_tilt_sim.controllers.joint_acceleration_controller`).
+
+ros2_control lets a ``<ros2_control>`` block name any command interface, so
+any ``interface_name`` is taken when the file is read; configuring the
+controller refuses, naming the joint, one the simulator cannot drive
+(``pid_gain``, say).  Whether the joint's block gives it the interface, and
+whether the block's hardware accepts it beside the others, is the
+:mod:`~pan_tilt_sim.controllers.manager`'s question when the controller is
+activated.
 
 An entry of ``joints`` may instead name a chainable controller's degree of
 freedom, ``<controller>/<dof>``, as ros2_control's chained controllers do: the
@@ -47,6 +58,7 @@ from pan_tilt_sim.controllers.base import (
     is_sane_number,
 )
 from pan_tilt_sim.controllers.gains import GAINS_FIELD, PID_FIELD, joint_gains_from_params
+from pan_tilt_sim.controllers.joint_acceleration_controller import JointAccelerationController
 from pan_tilt_sim.controllers.joint_effort_controller import JointEffortController
 from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
 from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
@@ -68,7 +80,9 @@ INTERFACE_CONTROLLERS: dict[str, type[CommandController]] = {
     'position': JointPositionController,
     'velocity': JointVelocityController,
     'effort': JointEffortController,
+    'acceleration': JointAccelerationController,
 }
+DRIVABLE = 'position, velocity, effort and acceleration'
 
 
 class ForwardCommandController(MultiJointController):
@@ -86,18 +100,17 @@ class ForwardCommandController(MultiJointController):
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
-        interface = self.fixed_interface or params.get(INTERFACE_FIELD)
-        if interface not in INTERFACE_CONTROLLERS:
-            raise self.error(INTERFACE_FIELD, f"{interface!r} must be one of "
-                             f"{', '.join(INTERFACE_CONTROLLERS)}")
+        interface: str = self.fixed_interface or self.params[INTERFACE_FIELD]
         self.interface_name = interface
         gains = joint_gains_from_params(self, self._joint_names)
-        member_type = INTERFACE_CONTROLLERS[interface]
-        self._members = tuple(
+        # No members for an interface the simulator cannot drive: configure() refuses it on a
+        # joint (a chained reference may carry any interface its controller exports).
+        member_type = INTERFACE_CONTROLLERS.get(interface)
+        self._members = () if member_type is None else tuple(
             member_type(name, LoadedParameters({'joint': joint, PID_FIELD: gains.get(joint)}, []),
                         source)
             for joint in self._joint_names)
-        for joint, member in zip(self._joint_names, self._members, strict=True):
+        for joint, member in zip(self._joint_names, self._members, strict=False):  # or none
             if isinstance(member, PidJointController):
                 member.gains_origin = f'{name}.{GAINS_FIELD}.{joint}'
 
@@ -129,13 +142,24 @@ class ForwardCommandController(MultiJointController):
                 for joint, value in member.setpoints().items()}
 
     def configure(self, joints: Mapping[str, JointHandle]) -> None:
-        """Bind every entry to its joint or reference (named in errors as one of ``joints``)."""
+        """Bind every entry to its joint or reference (named in errors as one of ``joints``).
+
+        Refuses an ``interface_name`` the simulator cannot drive on a joint,
+        naming the joint and the interface.
+        """
         members: list[CommandController] = []
-        for entry, member in zip(self._joint_names, self._members, strict=True):
+        for index, entry in enumerate(self._joint_names):
+            member = self._members[index] if self._members else None
             own = member.replaced if isinstance(member, ReferenceForwarder) else member
             target = self.command_target(joints, entry, self.interface_name, JOINTS_FIELD)
-            members.append(own if isinstance(target, JointHandle) else ReferenceForwarder(
-                self.name, entry, self.interface_name, target, own, self._source))
+            if not isinstance(target, JointHandle):
+                members.append(ReferenceForwarder(self.name, entry, self.interface_name, target,
+                                                  own, self._source))
+            elif own is None:
+                raise self.error(INTERFACE_FIELD, f"joint '{entry}' interface "
+                                 f"'{self.interface_name}': the simulator can drive {DRIVABLE}")
+            else:
+                members.append(own)
         self._members = tuple(members)
         for member in members:
             member.configure(joints)
@@ -192,7 +216,7 @@ class ReferenceForwarder(CommandController):
     """
 
     def __init__(self, name: str, entry: str, interface: str, reference: Reference,
-                 replaced: CommandController, source: str = '') -> None:
+                 replaced: CommandController | None, source: str = '') -> None:
         super().__init__(name, {}, source)
         self.reference = reference
         # The joint member it stands in for, should the entry name a joint when configured again.

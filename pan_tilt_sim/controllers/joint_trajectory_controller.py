@@ -19,6 +19,12 @@ the node serves them as ``<controller>/follow_joint_trajectory``).
   driven by effort from a PID on the position error whose derivative acts
   on the velocity error (desired minus measured velocity), plus
   ``ff_velocity_scale`` times the desired velocity, as in ros2_controllers.
+* ``command_interfaces`` are those ros2_controllers allows: ``position``,
+  ``velocity`` or ``effort`` alone, or ``position`` with ``velocity``,
+  ``acceleration`` or both, or with ``effort``.  Each joint follows the desired
+  position whatever the list; an ``acceleration`` interface is claimed (the
+  hardware may refuse it beside the others, see
+  :mod:`pan_tilt_sim.model.command_modes`) but adds nothing.
 * A joint without gains is driven by the ideal actuator (see
   :mod:`~pan_tilt_sim.controllers.actuator`): a velocity motor capped at the
   effort limit tracks the desired position, with the desired velocity as
@@ -57,7 +63,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from pan_tilt_sim.controllers.base import (
@@ -84,6 +90,7 @@ from pan_tilt_sim.controllers.parameter_spec import (
     STRING,
     STRING_ARRAY,
     Param,
+    Validator,
     gt_eq,
     one_of,
     unique,
@@ -121,7 +128,7 @@ from pan_tilt_sim.controllers.trajectory_goal import (
 from pan_tilt_sim.model.robot import JointKind
 
 COMMAND_INTERFACES_FIELD = 'command_interfaces'
-COMMAND_INTERFACES = ('position', 'velocity', 'effort')
+COMMAND_INTERFACES = ('position', 'velocity', 'acceleration', 'effort')
 EFFORT_INTERFACE = 'effort'
 STATE_INTERFACES_FIELD = 'state_interfaces'
 STATE_INTERFACES = ('position', 'velocity', 'acceleration')
@@ -134,6 +141,31 @@ NONZERO_END_FIELD = 'allow_nonzero_velocity_at_trajectory_end'
 TIME_EPSILON = 1e-9
 
 
+def command_interfaces_problem(interfaces: Sequence[str]) -> str | None:
+    """Return what is wrong with a combination of command interfaces, as upstream says; or None.
+
+    ros2_controllers (jazzy) takes ``position``, ``velocity`` or ``effort``
+    alone, or ``position`` with ``velocity``, ``acceleration`` or both, or
+    with ``effort``; its texts for the others are returned.
+    """
+    if 'velocity' in interfaces and len(interfaces) > 1 and 'position' not in interfaces:
+        return ("'velocity' command interface can be used either alone or 'position' "
+                'command interface has to be present')
+    if 'acceleration' in interfaces and not {'velocity', 'position'} & set(interfaces):
+        return ("'acceleration' command interface can only be used if 'velocity' and "
+                "'position' command interfaces are present")
+    if 'effort' in interfaces and not (len(interfaces) == 1 or (
+            len(interfaces) == 2 and 'position' in interfaces)):
+        return "'effort' command interface has to be used alone or with a 'position' interface"
+    return None
+
+
+# The spec's check of command_interfaces: a combination jazzy's controller accepts.
+COMBINATIONS = Validator('a combination ros2_controllers accepts', lambda interfaces: (
+    None if (problem := command_interfaces_problem(interfaces)) is None
+    else f'{list(interfaces)!r}: {problem}'))
+
+
 class JointTrajectoryController(MultiJointController):
     """Follows trajectories and FollowJointTrajectory goals in sim time, as ros2_controllers."""
 
@@ -141,7 +173,7 @@ class JointTrajectoryController(MultiJointController):
     parameters = MultiJointController.parameters.extend(
         Param(COMMAND_INTERFACES_FIELD, STRING_ARRAY, [], 'The command interfaces of every '
               'joint; empty: position through the ideal actuator.',
-              (unique(), one_of(*COMMAND_INTERFACES)), read_only=True),
+              (unique(), one_of(*COMMAND_INTERFACES), COMBINATIONS), read_only=True),
         Param(STATE_INTERFACES_FIELD, STRING_ARRAY, list(DEFAULT_STATE_INTERFACES),
               'The state interfaces read from every joint.',
               (unique(), one_of(*STATE_INTERFACES)), read_only=True),

@@ -22,6 +22,12 @@ same with the controllers of one :class:`ControllersConfig`:
 * A controller may claim only command interfaces that the URDF's
   ``<ros2_control>`` block gives its joints (joints outside every block are
   not checked).
+* The block's hardware may refuse a combination of command interfaces --
+  two on one joint, different command modes on its joints -- as its
+  ``prepare_command_mode_switch`` does; which hardware refuses what, and
+  why the simulator follows it, is in :mod:`pan_tilt_sim.model.command_modes`.
+  The start-up active set is asked as one switch that starts all of them
+  (as one spawner activating them as a group).
 
 :meth:`ControllerManager.switch` activates and deactivates controllers at run
 time, atomically, under the same rules.  An activated controller starts from
@@ -69,6 +75,12 @@ from pan_tilt_sim.controllers.registry import (
     supported_types,
 )
 from pan_tilt_sim.errors import ControllerConfigError, ControllerSwitchError
+from pan_tilt_sim.model.command_modes import (
+    SWITCH_REJECTED,
+    Claim,
+    mode_switch_refusal,
+    system_claims,
+)
 from pan_tilt_sim.model.controller_config import ControllersConfig, ControllerSpec
 from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.schedule import PeriodicSchedule
@@ -194,6 +206,11 @@ class ControllerManager:
         chain = self._chain_problem(active_names)
         if chain is not None:
             raise ControllerConfigError(f'{active_name}: {chain}')
+        refusal = self._hardware_refusal([name for name in self._by_name if name in active_names],
+                                         [])
+        if refusal is not None:
+            where = self._source if wanted is None else active_name
+            raise ControllerConfigError(f'{where}: {refusal}')
         self._change_active(active_names, set())
 
     @property
@@ -349,9 +366,11 @@ class ControllerManager:
         line each in the returned list -- and only a list naming no loaded
         controller at all is refused.  Either way the switch is refused when
         afterwards a joint would be claimed by two active controllers or lack
-        an interface one claims, or a claimed reference interface would be
-        missing.  Refusals raise :class:`ControllerSwitchError` and change
-        nothing.  Activated controllers start from the joints' present state;
+        an interface one claims, a claimed reference interface would be
+        missing, or a ``<ros2_control>`` block's hardware refuses the
+        interfaces it starts and stops (:mod:`~pan_tilt_sim.model.command_modes`).
+        Refusals raise :class:`ControllerSwitchError` and change nothing.
+        Activated controllers start from the joints' present state;
         deactivated ones leave their joints with the last command applied.
         """
         activate, deactivate = list(dict.fromkeys(activate)), list(dict.fromkeys(deactivate))
@@ -414,6 +433,9 @@ class ControllerManager:
         chain = self._chain_problem(names)
         if chain is not None:
             raise ControllerSwitchError(chain)
+        refusal = self._hardware_refusal(activate, deactivate)
+        if refusal is not None:
+            raise ControllerSwitchError(refusal)
         self._change_active(names, set(activate))
         for listener in self._switch_listeners:
             listener()
@@ -617,6 +639,32 @@ class ControllerManager:
             return (f"the chains of {', '.join(repr(name) for name in looping)} loop: a "
                     'controller cannot feed, through others, the ones that feed it')
         return None
+
+    def _hardware_refusal(self, activate: Sequence[str], deactivate: Sequence[str]) -> str | None:
+        """Return why a ``<ros2_control>`` block's hardware refuses this switch, or None.
+
+        As controller_manager, the interfaces of the controllers to activate
+        are started and those of the controllers to deactivate stopped (both
+        for a controller restarted), and every block is asked about its own.
+        """
+        if self._model is None:
+            return None
+        start, stop = self._claims(activate), self._claims(deactivate)
+        in_use = self._claims(self._active_names)
+        for system in self._model.ros2_control:
+            own = system_claims(system)
+            refusal = mode_switch_refusal(
+                system, [claim for claim in start if claim in own],
+                [claim for claim in stop if claim in own], own.intersection(in_use))
+            if refusal is not None:
+                return f'{SWITCH_REJECTED}: {refusal}'
+        return None
+
+    def _claims(self, names: Iterable[str]) -> list[Claim]:
+        """Return the command interfaces the controllers ``names`` claim, in their order."""
+        return [(joint, interface) for name in names
+                for joint, interfaces in self._by_name[name].command_interfaces().items()
+                for interface in interfaces]
 
     def _interfaces_of(self, joint: str, interface: str) -> tuple[str, ...]:
         """Return the joint's command interfaces in the URDF (outside every block: any)."""

@@ -208,7 +208,11 @@ class ControlJoint:
 
     @property
     def command_interface_names(self) -> tuple[str, ...]:
-        """Names of the command interfaces (position, velocity, effort...), in file order."""
+        """Names of the command interfaces, in file order.
+
+        Any name ros2_control allows (``acceleration``, ``pid_gain``...): what
+        the simulator can drive is decided when a controller claims one.
+        """
         return tuple(interface.name for interface in self.command_interfaces)
 
     @property

@@ -57,6 +57,7 @@ def all_kinds():
     for interface, type_name in GROUP_TYPES.items():
         yield interface, type_name, {}
         yield interface, FORWARD, {'interface_name': interface}
+    yield 'acceleration', FORWARD, {'interface_name': 'acceleration'}
 
 
 KINDS = list(all_kinds())
@@ -209,6 +210,45 @@ def test_effort_group_applies_the_efforts_clamped_to_the_limits():
     assert (handles['shoulder'].effort, handles['slide'].effort) == (5.0, -30.0)
 
 
+def test_acceleration_group_integrates_the_command_into_the_velocity_target():
+    handles = make_handles()
+    controller = group(FORWARD, handles, interface_name='acceleration')
+    assert [actuator.kind for actuator in controller.actuators().values()] == [
+        ActuatorKind.IDEAL_ACCELERATION] * 2
+    assert controller.actuators()['slide'].drive is Drive.VELOCITY
+    assert controller.set_command([3.0, -0.25]) is CommandResult.ACCEPTED
+    for step in range(100):  # joints frozen: the target is the integral, not the measurement
+        controller.update(step * DT, DT)
+    assert handles['shoulder'].velocity_target == pytest.approx(3.0 * 100 * DT)
+    assert handles['slide'].velocity_target == pytest.approx(-0.25 * 100 * DT)
+    controller.set_command([0.0, 0.0])  # no acceleration: the velocity stays
+    controller.update(0.1, DT)
+    assert handles['shoulder'].velocity_target == pytest.approx(0.3)
+
+
+def test_acceleration_group_keeps_the_velocity_within_the_limit_without_winding_up():
+    handles = make_handles()
+    controller = group(FORWARD, handles, interface_name='acceleration')
+    controller.set_command([100.0, 100.0])
+    for step in range(100):
+        controller.update(step * DT, DT)
+    assert (handles['shoulder'].velocity_target, handles['slide'].velocity_target) == (2.0, 0.5)
+    controller.set_command([-100.0, -100.0])
+    controller.update(0.1, DT)
+    assert handles['shoulder'].velocity_target == pytest.approx(2.0 - 0.1)
+    assert handles['slide'].velocity_target == pytest.approx(0.5 - 0.1)
+
+
+def test_acceleration_group_starts_from_the_joints_present_velocity():
+    handles = make_handles()
+    controller = group(FORWARD, handles, interface_name='acceleration')
+    controller.set_command([1.0, 1.0])
+    handles['shoulder'].velocity, handles['slide'].velocity = 0.7, 9.0
+    controller.reset()  # as when activated: zero command, from the present state
+    controller.update(0.0, DT)
+    assert (handles['shoulder'].velocity_target, handles['slide'].velocity_target) == (0.7, 0.5)
+
+
 def test_reset_forgets_the_commands():
     handles = make_handles()
     controller = group(GROUP_TYPES['effort'], handles)
@@ -270,16 +310,25 @@ def test_configuration_errors_name_the_field(params, field, problem):
     assert problem in str(err.value)
 
 
-def test_forward_command_controller_needs_an_interface():
-    with pytest.raises(ControllerConfigError, match=r'grp\.interface_name: missing'):
-        group(FORWARD)
+@pytest.mark.parametrize(('interface', 'problem'), [
+    (None, 'missing'), ('', 'must not be empty'), (5, '5 must be a string')])
+def test_forward_command_controller_needs_an_interface_name(interface, problem):
+    params = {} if interface is None else {'interface_name': interface}
+    with pytest.raises(ControllerConfigError) as caught:
+        create_controller('grp', FORWARD, {'joints': ['shoulder'], **params}, 'test.yaml')
+    assert str(caught.value).startswith(f'test.yaml: grp.interface_name: {problem}')
 
 
-@pytest.mark.parametrize('interface', ['torque', 'Position'])
-def test_forward_command_controller_needs_a_known_interface(interface):
-    with pytest.raises(ControllerConfigError,
-                       match=r'grp\.interface_name: .* must be one of position, velocity, effort'):
-        group(FORWARD, interface_name=interface)
+@pytest.mark.parametrize('interface', ['pid_gain', 'torque', 'Position'])
+def test_an_interface_the_simulator_cannot_drive_is_read_then_refused_at_configure(interface):
+    controller = create_controller('grp', FORWARD, {'joints': ['shoulder', 'slide'],
+                                                    'interface_name': interface}, 'test.yaml')
+    assert controller.command_interfaces() == {'shoulder': (interface,), 'slide': (interface,)}
+    with pytest.raises(ControllerConfigError) as caught:
+        controller.configure(make_handles())
+    assert str(caught.value) == (
+        f"test.yaml: grp.interface_name: joint 'shoulder' interface '{interface}': the "
+        'simulator can drive position, velocity, effort and acceleration')
 
 
 def test_an_unknown_gain_is_named_in_a_warning_with_the_closest_known_one():
@@ -370,6 +419,19 @@ def test_velocity_group_with_gains_lags_like_a_first_order_loop(tmp_path, type_n
     for (joint, inertia), command in zip(STAR_INERTIAS.items(), commands, strict=True):
         expected = first_order_speed(gain * command, gain + damping, inertia, seconds)
         assert velocities[joint] == pytest.approx(expected, rel=0.03)
+
+
+def test_acceleration_group_speeds_its_joints_up_at_the_command(tmp_path):
+    accelerations, steps = [1.0, -0.2], 500
+    with star_simulation(tmp_path, FORWARD, interface_name='acceleration') as sim:
+        sim.controller('group').set_command(accelerations)
+        sim.advance(steps)
+        velocities, positions = sim.joint_velocities(), sim.joint_positions()
+    # As ros2_control's mock hardware: v += a * dt, then x += v * dt, every step.
+    for joint, acceleration in zip(('pan', 'slide'), accelerations, strict=True):
+        assert velocities[joint] == pytest.approx(acceleration * steps * DT, abs=1e-6)
+        assert positions[joint] == pytest.approx(
+            acceleration * DT * DT * steps * (steps + 1) / 2, abs=1e-5)
 
 
 @pytest.mark.parametrize('type_name', [GROUP_TYPES['effort'], FORWARD])

@@ -271,6 +271,31 @@ def test_configuration_errors_name_the_field(params, field):
         controller_for(**params)
 
 
+@pytest.mark.parametrize('interfaces', [
+    ['position', 'acceleration'], ['position', 'velocity', 'acceleration'],
+    ['position', 'effort'], ['velocity'],
+])
+def test_command_interfaces_take_the_combinations_upstream_takes(interfaces):
+    controller = controller_for(command_interfaces=interfaces)
+    assert controller.command_interfaces()['a'] == tuple(interfaces)
+
+
+@pytest.mark.parametrize(('interfaces', 'problem'), [
+    (['acceleration'], "'acceleration' command interface can only be used if 'velocity' and "
+                       "'position' command interfaces are present"),
+    (['velocity', 'acceleration'], "'velocity' command interface can be used either alone or "
+                                   "'position' command interface has to be present"),
+    (['velocity', 'effort'], "'velocity' command interface can be used either alone"),
+    (['position', 'velocity', 'effort'], "'effort' command interface has to be used alone or "
+                                         "with a 'position' interface"),
+])
+def test_command_interfaces_refuse_the_combinations_upstream_refuses(interfaces, problem):
+    with pytest.raises(ControllerConfigError) as caught:
+        controller_for(command_interfaces=interfaces)
+    assert str(caught.value).startswith(f'test.yaml: arm.command_interfaces: {interfaces!r}: ')
+    assert problem in str(caught.value)
+
+
 def test_reset_forgets_the_trajectory():
     controller = controller_for()
     clock = Clock(controller)

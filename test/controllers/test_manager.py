@@ -8,6 +8,7 @@ what ros2_control would refuse, and switches controllers atomically.
 from __future__ import annotations
 
 import pytest
+from robot_fixtures import JointDef, star_robot_urdf
 from ros2_control_fixtures import UR_STYLE_YAML, write, write_arm
 
 from pan_tilt_sim.controllers import JointHandle
@@ -328,3 +329,152 @@ def test_a_deactivated_trajectory_controller_ends_its_goal(arm):
         TrajectoryPoint(1.0, (0.5, 0.5)),)), jtc.default_tolerances)
     manager.switch(activate=[FORWARD_POSITION], deactivate=[JTC])
     assert goal.status is GoalStatus.ABORTED
+
+
+# --- what the <ros2_control> block's hardware accepts (example 3's shape) -------------------
+
+DEMO_PLUGIN = 'ros2_control_demo_example_3/RRBotSystemMultiInterfaceHardware'
+MOCK_PLUGIN = 'mock_components/GenericSystem'
+GAZEBO_PLUGIN = 'gz_ros2_control/GazeboSimSystem'
+MODES = ('position', 'velocity', 'acceleration')
+
+
+def forward(joints, interface):
+    names = ', '.join(joints)
+    return ('    type: forward_command_controller/ForwardCommandController\n'
+            f'    joints: [{names}]\n    interface_name: {interface}\n')
+
+
+# Controllers on both joints in each mode, one on each joint alone, and a trajectory
+# controller commanding position and velocity.
+MULTI_INTERFACE_YAML = (
+    'controller_manager:\n  ros__parameters:\n    joint_state_broadcaster:\n'
+    '      type: joint_state_broadcaster/JointStateBroadcaster\n'
+    + ''.join(f'forward_{mode}_controller:\n  ros__parameters:\n'
+              + forward(('joint1', 'joint2'), mode) for mode in MODES)
+    + 'position_joint1:\n  ros__parameters:\n' + forward(('joint1',), 'position')
+    + 'position_joint2:\n  ros__parameters:\n' + forward(('joint2',), 'position')
+    + 'velocity_joint2:\n  ros__parameters:\n' + forward(('joint2',), 'velocity')
+    + 'pid_gain_controller:\n  ros__parameters:\n' + forward(('joint1', 'joint2'), 'pid_gain')
+    + 'trajectory_controller:\n  ros__parameters:\n'
+    '    type: joint_trajectory_controller/JointTrajectoryController\n'
+    '    joints: [joint1, joint2]\n    command_interfaces: [position, velocity]\n')
+
+
+@pytest.fixture
+def rrbot(tmp_path):
+    """Return a function building a manager for a two-joint robot under ``plugin``."""
+    def build(plugin, active, params=''):
+        entries = ''.join(
+            f'<joint name="{joint}">'
+            + ''.join(f'<command_interface name="{interface}"/>'
+                      for interface in (*MODES, 'pid_gain'))
+            + '<state_interface name="position"/><state_interface name="velocity"/></joint>'
+            for joint in ('joint1', 'joint2'))
+        block = (f'<ros2_control name="MultiInterfaceBot" type="system"><hardware>'
+                 f'<plugin>{plugin}</plugin>{params}</hardware>{entries}</ros2_control>')
+        urdf = star_robot_urdf([JointDef('joint1'), JointDef('joint2')], 'rrbot').replace(
+            '</robot>', f'{block}</robot>')
+        description = load_description(write(tmp_path, 'rrbot.urdf', urdf))
+        handles = {joint.name: JointHandle(joint) for joint in description.actuated_joints}
+        config = load_controllers_config(write(tmp_path, 'rrbot.yaml', MULTI_INTERFACE_YAML))
+        return ControllerManager(config, handles, description.model, active=active)
+    return build
+
+
+REJECTED = 'Could not switch controllers since prepare command mode switch was rejected: '
+DEMO_COMPONENT = f"component 'MultiInterfaceBot' ({DEMO_PLUGIN}) did not accept command "
+
+
+def test_the_demo_hardware_refuses_at_start_up_a_mode_on_one_of_its_joints(rrbot):
+    with pytest.raises(ControllerConfigError) as caught:
+        rrbot(DEMO_PLUGIN, active=[JSB, 'position_joint1'])
+    assert str(caught.value) == (
+        f"the parameter 'active_controllers': {REJECTED}{DEMO_COMPONENT}interfaces combination "
+        '(start: joint1/position; stop: none): all joints (joint1, joint2) must be given new '
+        'command mode at the same time')
+
+
+def test_the_demo_hardware_refuses_a_switch_to_a_mode_on_one_of_its_joints(rrbot):
+    manager = rrbot(DEMO_PLUGIN, active=[JSB, 'forward_velocity_controller'])
+    with pytest.raises(ControllerSwitchError) as caught:
+        manager.switch(activate=['position_joint1'], deactivate=['forward_velocity_controller'])
+    assert str(caught.value) == (
+        f'{REJECTED}{DEMO_COMPONENT}interfaces combination (start: joint1/position; stop: '
+        'joint1/velocity, joint2/velocity): all joints (joint1, joint2) must be given new '
+        'command mode at the same time')
+    assert manager.is_active('forward_velocity_controller')
+    assert not manager.is_active('position_joint1')
+
+
+def test_the_demo_hardware_refuses_position_on_one_joint_with_velocity_on_the_other(rrbot):
+    manager = rrbot(DEMO_PLUGIN, active=[JSB])
+    with pytest.raises(ControllerSwitchError, match=r'all joints must have the same command '
+                                                    r'mode \(joint1/position, joint2/velocity\)'):
+        manager.switch(activate=['position_joint1', 'velocity_joint2'])
+    assert [c.name for c in manager.active] == [JSB]
+
+
+def test_the_demo_hardware_refuses_to_stop_its_mode_without_starting_another(rrbot):
+    manager = rrbot(DEMO_PLUGIN, active=[JSB, 'forward_velocity_controller'])
+    with pytest.raises(ControllerSwitchError, match=r'\(start: none; stop: joint1/velocity, '
+                                                    r'joint2/velocity\): all joints'):
+        manager.switch(deactivate=['forward_velocity_controller'])
+    assert manager.is_active('forward_velocity_controller')
+
+
+def test_the_demo_hardware_takes_one_mode_on_both_joints_and_hands_it_over(rrbot):
+    manager = rrbot(DEMO_PLUGIN, active=[JSB, 'forward_velocity_controller'])
+    manager.switch(activate=['forward_position_controller'],
+                   deactivate=['forward_velocity_controller'])
+    manager.switch(activate=['forward_acceleration_controller'],
+                   deactivate=['forward_position_controller'])
+    manager.switch(activate=['position_joint1', 'position_joint2'],
+                   deactivate=['forward_acceleration_controller'])
+    assert {c.name for c in manager.active} == {JSB, 'position_joint1', 'position_joint2'}
+    assert rrbot(DEMO_PLUGIN, active=[JSB, 'position_joint1', 'position_joint2']).is_active(
+        'position_joint2')
+
+
+def test_the_demo_hardware_refuses_two_modes_on_a_joint(rrbot):
+    with pytest.raises(ControllerConfigError, match='must be given new command mode'):
+        rrbot(DEMO_PLUGIN, active=['trajectory_controller'])
+
+
+def test_mock_hardware_with_dynamics_refuses_two_command_interfaces_on_one_joint(rrbot):
+    dynamics = '<param name="calculate_dynamics">true</param>'
+    with pytest.raises(ControllerConfigError) as caught:
+        rrbot(MOCK_PLUGIN, active=['trajectory_controller'], params=dynamics)
+    assert str(caught.value).endswith(
+        "(start: joint1/position, joint1/velocity, joint2/position, joint2/velocity; stop: "
+        "none): Got multiple (2) starting interfaces for joint 'joint1' - this is not "
+        'supported!')
+    manager = rrbot(MOCK_PLUGIN, active=[JSB], params=dynamics)
+    with pytest.raises(ControllerSwitchError, match=f'^{REJECTED}.*Got multiple'):
+        manager.switch(activate=['trajectory_controller'])
+    manager.switch(activate=['position_joint1', 'velocity_joint2'])  # one mode per joint
+
+
+@pytest.mark.parametrize(('plugin', 'params'), [
+    (GAZEBO_PLUGIN, ''),
+    (MOCK_PLUGIN, ''),
+])
+def test_gazebo_and_mock_hardware_take_position_and_velocity_on_one_joint(rrbot, plugin, params):
+    manager = rrbot(plugin, active=[JSB, 'trajectory_controller'], params=params)
+    assert manager.is_active('trajectory_controller')
+    manager.switch(activate=['position_joint1', 'velocity_joint2'],
+                   deactivate=['trajectory_controller'])
+    manager.switch(deactivate=['position_joint1'])
+    assert [c.name for c in manager.active] == ['velocity_joint2', JSB]
+
+
+def test_an_interface_the_simulator_cannot_drive_is_refused_naming_joint_and_interface(rrbot):
+    with pytest.raises(ControllerConfigError) as caught:
+        rrbot(GAZEBO_PLUGIN, active=[JSB, 'pid_gain_controller'])
+    assert str(caught.value).endswith(
+        ": pid_gain_controller.interface_name: joint 'joint1' interface 'pid_gain': the "
+        'simulator can drive position, velocity, effort and acceleration')
+    manager = rrbot(GAZEBO_PLUGIN, active=[JSB, 'forward_acceleration_controller'])
+    (skipped,) = manager.skipped
+    assert skipped.name == 'pid_gain_controller'
+    assert "joint 'joint1' interface 'pid_gain'" in skipped.reason

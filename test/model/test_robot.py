@@ -120,6 +120,16 @@ def test_the_ros2_control_block_gives_interfaces_initial_values_and_hardware_par
     assert model.control_joint('nothing') is None
 
 
+def test_the_ros2_control_block_keeps_command_interfaces_beyond_the_usual_three():
+    # ros2_control allows any name: what the simulator can drive is decided later.
+    text = CONTROLLED.replace('<command_interface name="velocity"/>',
+                              '<command_interface name="velocity"/>'
+                              '<command_interface name="acceleration"/>'
+                              '<command_interface name="pid_gain"/>')
+    joint = parse_urdf(text, pathlib.Path('c.urdf')).control_joint('j')
+    assert joint.command_interface_names == ('position', 'velocity', 'acceleration', 'pid_gain')
+
+
 def test_the_control_plugin_names_its_controllers_file_and_namespace():
     (plugin,) = parse_urdf(CONTROLLED, pathlib.Path('c.urdf')).control_plugins
     assert plugin.filename == 'gz_ros2_control-system'
