@@ -1,12 +1,37 @@
-"""Group controllers: ForwardCommandController and the three JointGroup*Controllers.
+"""ForwardCommandController: one command per joint, the behaviour every JointGroup type shares.
 
-Pure-Python tests drive real JointHandles made from JointSpecs (no
-simulator); the engine tests run the controllers on a PyBullet robot.
+The JointGroup{Position,Velocity,Effort}Controller types are this
+controller with ``interface_name`` fixed (their own files say only that);
+every shared test here runs on both ways to get an interface.  Pure-Python
+tests drive real JointHandles made from JointSpecs (no simulator); the engine
+tests run the controllers on a PyBullet robot.
+
+The limits a group enforces are its joints' one-joint controllers' (see
+test_joint_position_controller, test_joint_velocity_controller,
+test_joint_effort_controller), each joint held to its own: position commands
+clamped to the joint's range and ramped within its velocity limit (and, on
+the ideal actuator, SETPOINT_ACCELERATION, with the velocity target within
+the velocity limit); velocity commands clamped to the velocity limit;
+effort commands and PID outputs clamped to the effort limit.  An element
+that is NaN, infinite or beyond MAX_COMMAND_MAGNITUDE rejects the whole
+command.
 """
 
 import math
 
 import pytest
+from controller_fixtures import loaded, raises_naming, step
+from group_fixtures import (
+    DT,
+    FORWARD,
+    GROUP_TYPES,
+    KIND_IDS,
+    KINDS,
+    group,
+    make_handles,
+    way_ids,
+    ways,
+)
 from robot_fixtures import (
     LINK_LENGTH,
     LINK_MASS,
@@ -16,52 +41,12 @@ from robot_fixtures import (
     write_text,
 )
 
-from pan_tilt_sim.controllers import CommandKind, CommandResult, JointHandle, create_controller
+from pan_tilt_sim.controllers import CommandKind, CommandResult
 from pan_tilt_sim.controllers.actuator import SETPOINT_ACCELERATION, TRACKING_GAIN
-from pan_tilt_sim.controllers.base import ActuatorKind, Drive
+from pan_tilt_sim.controllers.base import MAX_COMMAND_MAGNITUDE, ActuatorKind, Drive
+from pan_tilt_sim.controllers.manager import ACTIVE, INACTIVE, UNCONFIGURED
 from pan_tilt_sim.controllers.pid import PidGains
-from pan_tilt_sim.errors import ControllerConfigError
-from pan_tilt_sim.model.robot import JointKind, JointSpec, Mimic
 from pan_tilt_sim.sim.engine import make_simulation
-
-DT = 0.001
-GROUP_TYPES = {
-    'position': 'position_controllers/JointGroupPositionController',
-    'velocity': 'velocity_controllers/JointGroupVelocityController',
-    'effort': 'effort_controllers/JointGroupEffortController',
-}
-FORWARD = 'forward_command_controller/ForwardCommandController'
-
-
-def make_handles():
-    specs = [
-        JointSpec('shoulder', JointKind.REVOLUTE, lower=-1.0, upper=1.0, effort_limit=20.0,
-                  velocity_limit=2.0),
-        JointSpec('slide', JointKind.PRISMATIC, lower=0.0, upper=0.5, effort_limit=30.0,
-                  velocity_limit=0.5),
-        JointSpec('follower', JointKind.REVOLUTE, lower=-1.0, upper=1.0,
-                  mimic=Mimic('shoulder', -1.0, 0.0)),
-    ]
-    return {spec.name: JointHandle(spec) for spec in specs}
-
-
-def group(type_name, handles=None, **params):
-    params.setdefault('joints', ['shoulder', 'slide'])
-    controller = create_controller('grp', type_name, params, 'test.yaml')
-    controller.configure(handles if handles is not None else make_handles())
-    return controller
-
-
-def all_kinds():
-    """(type string, params) of every way to build a group on each interface."""
-    for interface, type_name in GROUP_TYPES.items():
-        yield interface, type_name, {}
-        yield interface, FORWARD, {'interface_name': interface}
-
-
-KINDS = list(all_kinds())
-KIND_IDS = [f'{type_name.split("/")[1]}-{interface}' for interface, type_name, _ in KINDS]
-
 
 # --- the interface every group shares -----------------------------------------------------
 
@@ -77,8 +62,8 @@ def test_group_takes_float64_arrays_on_commands(interface, type_name, extra):
 def efforts_over_steps(controller, handles, steps, start=0):
     """Update ``steps`` times (state frozen); return every step's efforts and velocity targets."""
     efforts = []
-    for step in range(start, start + steps):
-        controller.update(step * DT, DT)
+    for step_number in range(start, start + steps):
+        controller.update(step_number * DT, DT)
         efforts.append([(handle.effort, handle.velocity_target) for handle in handles.values()])
     return efforts
 
@@ -115,11 +100,76 @@ def test_a_non_finite_element_rejects_the_whole_command(interface, type_name, ex
 
 
 SEED_GAINS = {'p': 100.0, 'i': 0.01, 'd': 10.0}
+POSITION, VELOCITY, EFFORT = (pytest.mark.parametrize(
+    ('type_name', 'extra'), ways(interface), ids=way_ids(interface))
+    for interface in ('position', 'velocity', 'effort'))
 
 
-def test_position_group_with_gains_ramps_each_setpoint_and_pushes_toward_it():
+# --- parameters ----------------------------------------------------------------------------
+
+@pytest.mark.parametrize(('params', 'field'), [
+    ({'joints': None}, 'grp.joints'),
+    ({'joints': []}, 'grp.joints'),
+    ({'joints': 'shoulder'}, 'grp.joints'),
+    ({'joints': ['shoulder', 'shoulder']}, 'grp.joints'),
+    ({'joints': ['shoulder', 'elbow']}, 'grp.joints'),
+    ({'joints': ['follower']}, 'grp.joints'),
+    ({'gains': {'elbow': {'p': 1.0}}}, 'grp.gains.elbow'),
+    ({'gains': {'slide': {'p': -1.0}}}, 'grp.gains.slide'),
+    ({'gains': {'slide': {'q': 1.0}}}, 'grp.gains.slide'),
+    ({'gains': [1, 2]}, 'grp.gains'),
+])
+@POSITION
+def test_configuration_errors_name_the_field(type_name, extra, params, field):
+    with raises_naming(field):
+        group(type_name, **extra, **params)
+
+
+@pytest.mark.parametrize('interface', [None, 'torque', 'Position'])
+def test_forward_command_controller_needs_a_known_interface(interface):
+    params = {} if interface is None else {'interface_name': interface}
+    with raises_naming('grp.interface_name'):
+        group(FORWARD, **params)
+
+
+@pytest.mark.parametrize('interface', ['position', 'velocity', 'effort'])
+def test_forward_command_controller_claims_interface_name_for_every_joint(interface):
+    controller = group(FORWARD, interface_name=interface)
+    assert controller.interface_name == interface
+    assert controller.command_interfaces() == {'shoulder': (interface,), 'slide': (interface,)}
+
+
+# --- lifecycle -----------------------------------------------------------------------------
+
+def test_the_manager_configures_activates_and_cleans_it_up_and_it_holds_where_activated():
     handles = make_handles()
-    controller = group(GROUP_TYPES['position'], handles,
+    manager = loaded('grp', FORWARD, {'joints': ['shoulder', 'slide'],
+                                      'interface_name': 'position'}, handles)
+    assert manager.state('grp') == UNCONFIGURED
+    controller = manager.configure('grp')
+    assert manager.state('grp') == INACTIVE
+    handles['shoulder'].position, handles['slide'].position = 0.4, 0.1
+    manager.switch(activate=['grp'])
+    assert manager.state('grp') == ACTIVE
+    assert controller.setpoints() == {'shoulder': 0.4, 'slide': 0.1}
+    assert controller.set_command([-0.2, 0.3]) is CommandResult.ACCEPTED
+    step(manager, 2000)
+    assert controller.setpoints() == {'shoulder': -0.2, 'slide': 0.3}
+    manager.switch(deactivate=['grp'])
+    last = [handle.velocity_target for handle in handles.values()]
+    controller.set_command([0.9, 0.0])
+    step(manager, 100, start=2000)
+    assert [handle.velocity_target for handle in handles.values()] == last
+    manager.cleanup('grp')
+    assert manager.state('grp') == UNCONFIGURED
+
+
+# --- position ------------------------------------------------------------------------------
+
+@POSITION
+def test_position_group_with_gains_ramps_each_setpoint_and_pushes_toward_it(type_name, extra):
+    handles = make_handles()
+    controller = group(type_name, handles, **extra,
                        gains={'shoulder': SEED_GAINS, 'slide': SEED_GAINS})
     assert controller.set_command([0.5, 0.25]) is CommandResult.ACCEPTED
     controller.update(0.0, DT)
@@ -132,16 +182,18 @@ def test_position_group_with_gains_ramps_each_setpoint_and_pushes_toward_it():
     assert {actuator.drive for actuator in controller.actuators().values()} == {Drive.EFFORT}
 
 
-def test_position_group_without_gains_drives_the_ideal_actuator_within_the_limits():
+@POSITION
+def test_position_group_without_gains_drives_the_ideal_actuator_within_the_limits(type_name,
+                                                                                  extra):
     handles = make_handles()
-    controller = group(GROUP_TYPES['position'], handles)
+    controller = group(type_name, handles, **extra)
     assert [actuator.drive for actuator in controller.actuators().values()] == [
         Drive.VELOCITY] * 2
     assert controller.pids() == {}
     assert controller.set_command([0.5, 0.25]) is CommandResult.ACCEPTED
     targets, setpoints = [], [0.0]
-    for step in range(3000):  # joints frozen at 0: the setpoints still travel to the command
-        controller.update(step * DT, DT)
+    for step_number in range(3000):  # joints frozen at 0: the setpoints still travel
+        controller.update(step_number * DT, DT)
         targets.append(handles['shoulder'].velocity_target)
         setpoints.append(controller.members[0].setpoint)
     shoulder, slide = controller.members
@@ -158,9 +210,11 @@ def test_position_group_without_gains_drives_the_ideal_actuator_within_the_limit
     assert handles['shoulder'].effort == 0.0 and handles['follower'].velocity_target == 0.0
 
 
-def test_ideal_position_target_is_the_setpoint_rate_plus_a_tenth_of_the_error_per_step():
+@POSITION
+def test_ideal_position_target_is_the_setpoint_rate_plus_a_tenth_of_the_error_per_step(
+        type_name, extra):
     handles = make_handles()
-    controller = group(GROUP_TYPES['position'], handles)
+    controller = group(type_name, handles, **extra)
     controller.set_command([0.0, 0.01])
     handles['slide'].position = 0.0013  # past the setpoint while it moves
     controller.update(0.0, DT)
@@ -171,20 +225,24 @@ def test_ideal_position_target_is_the_setpoint_rate_plus_a_tenth_of_the_error_pe
         rate + TRACKING_GAIN / DT * (rate * DT - 0.0013))
 
 
-def test_position_group_clamps_to_limits_and_says_which_joint():
-    controller = group(GROUP_TYPES['position'])
+@POSITION
+def test_position_group_clamps_to_limits_and_says_which_joint(type_name, extra):
+    controller = group(type_name, **extra)
     assert controller.set_command([0.5, 0.9]) is CommandResult.CLAMPED
     assert 'outside the limits of slide; clamped' in controller.command_problem(
         None, CommandResult.CLAMPED)
-    for step in range(2000):
-        controller.update(step * DT, DT)
+    for step_number in range(2000):
+        controller.update(step_number * DT, DT)
     assert [member.setpoint for member in controller.members] == pytest.approx([0.5, 0.5])
 
 
-def test_velocity_group_with_gains_pushes_by_the_velocity_error():
+# --- velocity ------------------------------------------------------------------------------
+
+@VELOCITY
+def test_velocity_group_with_gains_pushes_by_the_velocity_error(type_name, extra):
     handles = make_handles()
     handles['slide'].velocity = 0.1
-    controller = group(GROUP_TYPES['velocity'], handles,
+    controller = group(type_name, handles, **extra,
                        gains={'shoulder': {'p': 10.0}, 'slide': {'p': 10.0}})
     controller.set_command([1.0, -0.2])
     controller.update(0.0, DT)
@@ -192,37 +250,97 @@ def test_velocity_group_with_gains_pushes_by_the_velocity_error():
     assert handles['slide'].effort == pytest.approx(10.0 * (-0.2 - 0.1))
 
 
-def test_velocity_group_without_gains_targets_the_clamped_command():
+@VELOCITY
+def test_velocity_group_without_gains_targets_the_clamped_command(type_name, extra):
     handles = make_handles()
-    controller = group(GROUP_TYPES['velocity'], handles)
+    controller = group(type_name, handles, **extra)
     assert controller.set_command([1.0, -0.9]) is CommandResult.CLAMPED  # slide: 0.5 m/s
     controller.update(0.0, DT)
     assert (handles['shoulder'].velocity_target, handles['slide'].velocity_target) == (1.0, -0.5)
     assert controller.actuators()['shoulder'].drive is Drive.VELOCITY
 
 
-def test_effort_group_applies_the_efforts_clamped_to_the_limits():
+# --- effort --------------------------------------------------------------------------------
+
+@EFFORT
+def test_effort_group_applies_the_efforts_clamped_to_the_limits(type_name, extra):
     handles = make_handles()
-    controller = group(GROUP_TYPES['effort'], handles)
+    controller = group(type_name, handles, **extra)
     assert controller.set_command([5.0, -100.0]) is CommandResult.CLAMPED
     controller.update(0.0, DT)
     assert (handles['shoulder'].effort, handles['slide'].effort) == (5.0, -30.0)
 
 
-def test_reset_forgets_the_commands():
+@EFFORT
+def test_reset_forgets_the_commands(type_name, extra):
     handles = make_handles()
-    controller = group(GROUP_TYPES['effort'], handles)
+    controller = group(type_name, handles, **extra)
     controller.set_command([5.0, 5.0])
     controller.reset()
     controller.update(0.0, DT)
     assert (handles['shoulder'].effort, handles['slide'].effort) == (0.0, 0.0)
 
 
-# --- gains and configuration errors --------------------------------------------------------
+# --- limits, each joint held to its own ----------------------------------------------------
 
-def test_gains_section_sets_each_joint_pid_and_the_ideal_actuator_drives_the_rest():
+def _applied(handles, interface):
+    """What the group drives each joint with: setpoint-tracking target, or effort."""
+    if interface == 'effort':
+        return [handles['shoulder'].effort, handles['slide'].effort]
+    return [handles['shoulder'].velocity_target, handles['slide'].velocity_target]
+
+
+@pytest.mark.parametrize(('interface', 'type_name', 'extra'), KINDS, ids=KIND_IDS)
+def test_every_element_beyond_its_joints_limit_is_clamped_to_that_joints_limit(
+        interface, type_name, extra):
     handles = make_handles()
-    controller = group(GROUP_TYPES['position'], handles,
+    controller = group(type_name, handles, **extra)
+    assert controller.set_command([50.0, -50.0]) is CommandResult.CLAMPED
+    assert 'outside the limits of shoulder, slide; clamped' in controller.command_problem(
+        None, CommandResult.CLAMPED)
+    for step_number in range(2000):
+        controller.update(step_number * DT, DT)
+    if interface == 'position':  # range: shoulder +-1 rad, slide 0..0.5 m
+        assert list(controller.setpoints().values()) == [1.0, 0.0]
+    else:  # velocity: +-2 rad/s and +-0.5 m/s; effort: +-20 N*m and +-30 N
+        assert _applied(handles, interface) == (
+            [2.0, -0.5] if interface == 'velocity' else [20.0, -30.0])
+
+
+@pytest.mark.parametrize(('interface', 'commands'), [('position', [-1.0, 0.5]),
+                                                     ('velocity', [-2.0, 0.5])])
+@pytest.mark.parametrize('forward', [False, True], ids=['JointGroup', 'Forward'])
+def test_with_gains_each_joints_pid_effort_is_clamped_to_its_own_effort_limit(
+        interface, commands, forward):
+    type_name, extra = ways(interface)[1 if forward else 0]
+    handles = make_handles()
+    controller = group(type_name, handles, **extra,
+                       gains={'shoulder': {'p': 1e6}, 'slide': {'p': 1e6}})
+    controller.set_command(commands)
+    for step_number in range(100):
+        controller.update(step_number * DT, DT)
+    assert _applied(handles, 'effort') == [-20.0, 30.0]
+
+
+@pytest.mark.parametrize(('interface', 'type_name', 'extra'), KINDS, ids=KIND_IDS)
+def test_an_element_beyond_the_command_magnitude_bound_rejects_the_whole_command(
+        interface, type_name, extra):
+    handles = make_handles()
+    controller = group(type_name, handles, **extra)
+    controller.update(0.0, DT)
+    idle = _applied(handles, interface)
+    assert controller.set_command([0.3, 10 * MAX_COMMAND_MAGNITUDE]) is CommandResult.REJECTED
+    controller.update(DT, DT)
+    assert _applied(handles, interface) == idle
+
+
+# --- gains ---------------------------------------------------------------------------------
+
+@POSITION
+def test_gains_section_sets_each_joint_pid_and_the_ideal_actuator_drives_the_rest(type_name,
+                                                                                  extra):
+    handles = make_handles()
+    controller = group(type_name, handles, **extra,
                        gains={'slide': {'p': 500.0, 'i': 2.0, 'd': 20.0, 'i_clamp': 3.0}})
     shoulder, slide = controller.members
     assert shoulder.pid is None
@@ -234,52 +352,24 @@ def test_gains_section_sets_each_joint_pid_and_the_ideal_actuator_drives_the_res
     assert actuators['slide'].gains_from == 'grp.gains.slide'
 
 
-def test_gazebo_ros_control_pid_gains_drive_a_joint_without_gains_of_its_own():
+@POSITION
+def test_gazebo_ros_control_pid_gains_drive_a_joint_without_gains_of_its_own(type_name, extra):
     handles = make_handles()
     handles['shoulder'].plugin_gains = PidGains(p=7.0)
     handles['slide'].plugin_gains = PidGains(p=8.0)
-    controller = group(GROUP_TYPES['position'], handles, gains={'slide': {'p': 500.0}})
+    controller = group(type_name, handles, **extra, gains={'slide': {'p': 500.0}})
     shoulder, slide = controller.members
     assert (shoulder.pid.gains.p, slide.pid.gains.p) == (7.0, 500.0)
     assert controller.actuators()['shoulder'].gains_from == (
         'gazebo_ros_control.pid_gains.shoulder')
 
 
-def test_ros2_controllers_gain_options_are_accepted():
-    controller = group(GROUP_TYPES['velocity'], gains={
+@VELOCITY
+def test_ros2_controllers_gain_options_are_accepted(type_name, extra):
+    controller = group(type_name, **extra, gains={
         'shoulder': {'p': 5.0, 'ff_velocity_scale': 1.0, 'angle_wraparound': False}})
     assert controller.members[1].pid is None
     assert controller.members[0].pid.gains.p == 5.0
-
-
-@pytest.mark.parametrize(('params', 'field', 'problem'), [
-    ({'joints': None}, 'grp.joints', 'must be a list of joint names'),
-    ({'joints': []}, 'grp.joints', 'empty'),
-    ({'joints': ['shoulder', 'shoulder']}, 'grp.joints', "'shoulder' is named more than once"),
-    ({'joints': ['shoulder', 'elbow']}, 'grp.joints', "joint 'elbow' is not a movable joint"),
-    ({'joints': ['follower']}, 'grp.joints', "'follower' mimics 'shoulder'"),
-    ({'gains': {'elbow': {'p': 1.0}}}, 'grp.gains.elbow', "not one of this controller's joints"),
-    ({'gains': {'slide': {'p': -1.0}}}, 'grp.gains.slide', 'p: -1.0 must be'),
-    ({'gains': {'slide': {'q': 1.0}}}, 'grp.gains.slide', "unknown field 'q'"),
-    ({'gains': [1, 2]}, 'grp.gains', 'expected a mapping'),
-])
-def test_configuration_errors_name_the_field(params, field, problem):
-    with pytest.raises(ControllerConfigError) as err:
-        group(GROUP_TYPES['position'], **params)
-    assert str(err.value).startswith(f'test.yaml: {field}: ')
-    assert problem in str(err.value)
-
-
-@pytest.mark.parametrize('interface', [None, 'torque', 'Position'])
-def test_forward_command_controller_needs_a_known_interface(interface):
-    params = {} if interface is None else {'interface_name': interface}
-    with pytest.raises(ControllerConfigError,
-                       match=r'grp\.interface_name: .* must be one of position, velocity, effort'):
-        group(FORWARD, **params)
-
-
-def test_joint_group_types_fix_their_interface():
-    assert group(GROUP_TYPES['effort'], interface_name='position').interface_name == 'effort'
 
 
 # --- on a PyBullet robot -------------------------------------------------------------------
@@ -368,5 +458,3 @@ def test_effort_group_drives_its_joints_with_the_efforts(tmp_path, type_name):
     for (joint, inertia), effort in zip(STAR_INERTIAS.items(), efforts, strict=True):
         expected = first_order_speed(effort, damping, inertia, seconds)
         assert velocities[joint] == pytest.approx(expected, rel=0.03)
-
-
