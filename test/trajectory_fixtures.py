@@ -20,6 +20,19 @@ def make_handles() -> dict[str, JointHandle]:
     return {spec.name: JointHandle(spec) for spec in specs}
 
 
+def limited_handles() -> dict[str, JointHandle]:
+    """As :func:`make_handles`, with velocity and effort limits on 'a' and 'b'.
+
+    'a': 1 rad/s and 30 N*m; 'b': 0.2 m/s and 50 N.
+    """
+    specs = [JointSpec('a', JointKind.REVOLUTE, -2.0, 2.0, effort_limit=30.0,
+                       velocity_limit=1.0),
+             JointSpec('b', JointKind.PRISMATIC, -0.5, 0.5, effort_limit=50.0,
+                       velocity_limit=0.2),
+             JointSpec('c', JointKind.CONTINUOUS)]
+    return {spec.name: JointHandle(spec) for spec in specs}
+
+
 def controller_for(handles: dict[str, JointHandle] | None = None, **params: Any):
     """A configured JTC named 'arm' over JOINTS (unless ``joints`` is given)."""
     params.setdefault('joints', list(JOINTS))

@@ -106,6 +106,13 @@ class JointPositionController(PidJointController):
             if rate != 0.0 or not -ARRIVED < delta < ARRIVED:
                 setpoint, rate = ramp(setpoint, rate, command, period, max_velocity,
                                       SETPOINT_ACCELERATION)
+                # Braking for a command that reversed can carry the setpoint a little
+                # past the one it was heading for: it stops at a limit it would cross.
+                limits = self._limits
+                if setpoint > limits.upper >= self._setpoint:
+                    setpoint, rate = limits.upper, 0.0
+                elif setpoint < limits.lower <= self._setpoint:
+                    setpoint, rate = limits.lower, 0.0
                 self._setpoint, self._rate = setpoint, rate
             target = rate + self._tracking_gain / period * (setpoint - handle.position)
             handle.velocity_target = (max_velocity if target > max_velocity else

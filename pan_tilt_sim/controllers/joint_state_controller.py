@@ -28,6 +28,7 @@ from pan_tilt_sim.controllers.parameter_spec import (
     Param,
     ParameterSpec,
     gt,
+    names,
     unique,
 )
 from pan_tilt_sim.controllers.surface import Endpoint, StateTopic
@@ -51,9 +52,9 @@ class JointStateController(Controller):
         Param('update_rate', DOUBLE, None, "The controller's update rate (Hz); the "
               "controller_manager's by default.", (gt(0.0),)),
         Param('joints', STRING_ARRAY, [], 'The joints to publish, in this order; empty: every '
-              'movable joint.', (unique(),), read_only=True),
+              'movable joint.', (names(), unique()), read_only=True),
         Param('extra_joints', STRING_ARRAY, [], 'Names published with zero state beside the '
-              "robot's joints.", (unique(),), read_only=True),
+              "robot's joints.", (names(), unique()), read_only=True),
         Param('interfaces', STRING_ARRAY, [], 'The state interfaces to publish; empty: all.',
               (unique(),), read_only=True),
         Param('use_local_topics', BOOL, False, "Publish on ~/joint_states (the controller's "

@@ -95,6 +95,11 @@ def not_empty() -> Validator:
     return Validator('not empty', lambda value: None if len(value) else 'must not be empty')
 
 
+def names() -> Validator:
+    """Require every element of a string array to be a non-empty name."""
+    return _each('a non-empty name', lambda value: bool(value))
+
+
 def unique() -> Validator:
     """Require an array without repeated elements."""
     def check(value: Sequence[Any]) -> str | None:

@@ -15,6 +15,7 @@ from pan_tilt_sim.controllers.parameter_spec import (
     STRING_ARRAY,
     Param,
     gt_eq,
+    names,
     not_empty,
     unique,
 )
@@ -22,7 +23,7 @@ from pan_tilt_sim.controllers.parameter_spec import (
 JOINT = Param('joint', STRING, REQUIRED, 'The joint this controller drives.',
               (not_empty(),), read_only=True, example='joint1')
 JOINTS = Param('joints', STRING_ARRAY, REQUIRED, 'The joints this controller drives, in '
-               'the order of every command.', (not_empty(), unique()), read_only=True,
+               'the order of every command.', (not_empty(), names(), unique()), read_only=True,
                example=['joint1'])
 
 

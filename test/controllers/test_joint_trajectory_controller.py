@@ -2,19 +2,40 @@
 
 The pure-Python part drives real JointHandles made from JointSpecs and
 reads the controller's desired positions; the engine part follows
-trajectories with the shipped three-joint arm in PyBullet.
+trajectories with the shipped three-joint arm in PyBullet.  Goals and
+tolerances are test_trajectory_goal's.
+
+The limits it enforces:
+
+* every point's positions are clamped to each joint's [lower, upper] (not on
+  a continuous joint); a point with a NaN, infinite or absurd (beyond
+  MAX_COMMAND_MAGNITUDE) position or velocity rejects the trajectory;
+* without gains (the ideal actuator) the velocity target is clamped to
+  +-velocity limit, however fast the trajectory;
+* with a PID the effort is clamped to +-effort limit, and the integral term
+  is bounded by the effort limit unless the YAML gives a clamp.
 """
 
 import math
 
 import pytest
-from trajectory_fixtures import JOINTS, controller_for, make_handles, trajectory
+from controller_fixtures import loaded, raises_naming, step
+from trajectory_fixtures import (
+    JOINTS,
+    JTC,
+    controller_for,
+    limited_handles,
+    make_handles,
+    trajectory,
+)
 
 from pan_tilt_sim.controllers import CommandKind, CommandResult
 from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
-from pan_tilt_sim.controllers.base import Drive
+from pan_tilt_sim.controllers.base import MAX_COMMAND_MAGNITUDE, Drive
 from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
+from pan_tilt_sim.controllers.manager import ACTIVE, INACTIVE, UNCONFIGURED
 from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPlan, TrajectoryPoint
+from pan_tilt_sim.controllers.trajectory_goal import GoalStatus
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.sim.engine import make_simulation
 
@@ -252,8 +273,8 @@ def test_without_gains_the_ideal_actuator_tracks_the_desired_state(interfaces):
     assert actuators['b'].drive is Drive.VELOCITY and actuators['a'].drive is Drive.EFFORT
     controller.set_command(trajectory((1.0, (0.0, 0.4))))
     handles['b'].position = 0.01
-    for step in range(101):
-        controller.update(step * DT, DT)
+    for step_number in range(101):
+        controller.update(step_number * DT, DT)
     # Desired 0.04 m moving at 0.4 m/s; measured 0.01 m: the target is the desired
     # velocity plus a tenth of the position error per step.
     assert handles['b'].velocity_target == pytest.approx(0.4 + TRACKING_GAIN / DT * 0.03)
@@ -262,12 +283,23 @@ def test_without_gains_the_ideal_actuator_tracks_the_desired_state(interfaces):
 
 @pytest.mark.parametrize(('params', 'field'), [
     ({'joints': []}, 'arm.joints'),
+    ({'joints': None}, 'arm.joints'),
+    ({'joints': ['a', 'a']}, 'arm.joints'),
     ({'command_interfaces': ['torque']}, 'arm.command_interfaces'),
-    ({'gains': {'a': {'p': 'high'}}}, 'arm.gains.a.p'),
+    ({'command_interfaces': 'position'}, 'arm.command_interfaces'),
+    ({'state_interfaces': ['effort']}, 'arm.state_interfaces'),
+    ({'action_monitor_rate': 0.0}, 'arm.action_monitor_rate'),
+    ({'action_monitor_rate': 'often'}, 'arm.action_monitor_rate'),
+    ({'allow_partial_joints_goal': 'yes'}, 'arm.allow_partial_joints_goal'),
+    ({'allow_nonzero_velocity_at_trajectory_end': 1},
+     'arm.allow_nonzero_velocity_at_trajectory_end'),
+    ({'constraints': {'goal_time': 'soon'}}, 'arm.constraints.goal_time'),
+    ({'gains': {'a': {'p': 'high'}}}, 'arm.gains.a'),
+    ({'gains': {'z': {'p': 1.0}}}, 'arm.gains.z'),
     ({'gains': {'a': {'ff_velocity_scale': 'x'}}}, 'arm.gains.a.ff_velocity_scale'),
 ])
 def test_configuration_errors_name_the_field(params, field):
-    with pytest.raises(ControllerConfigError, match=rf'^test.yaml: {field}: '):
+    with raises_naming(field):
         controller_for(**params)
 
 
@@ -296,6 +328,39 @@ def test_command_interfaces_refuse_the_combinations_upstream_refuses(interfaces,
     assert problem in str(caught.value)
 
 
+def test_a_joint_the_robot_lacks_fails_at_configure_naming_the_joints_field():
+    with raises_naming('arm.joints'):
+        controller_for(joints=['a', 'elbow'])
+
+
+def test_it_claims_its_command_and_state_interfaces_for_every_joint():
+    controller = controller_for(command_interfaces=['position', 'velocity'])
+    assert controller.command_interfaces() == {'a': ('position', 'velocity'),
+                                               'b': ('position', 'velocity')}
+    assert controller.state_interfaces() == {'a': ('position', 'velocity'),
+                                             'b': ('position', 'velocity')}
+
+
+def test_the_manager_configures_activates_and_cleans_it_up_and_it_holds_where_activated():
+    handles = limited_handles()
+    manager = loaded('arm', JTC, {'joints': list(JOINTS)}, handles)
+    assert manager.state('arm') == UNCONFIGURED
+    controller = manager.configure('arm')
+    assert manager.state('arm') == INACTIVE
+    handles['a'].position = 0.3
+    manager.switch(activate=['arm'])
+    assert manager.state('arm') == ACTIVE
+    assert controller.desired_positions == [0.3, 0.0]  # holds where the joints are
+    assert controller.set_command(trajectory((1.0, (1.0, 0.2)))) is CommandResult.ACCEPTED
+    step(manager, 1500)
+    assert controller.desired_positions == pytest.approx([1.0, 0.2])
+    goal = controller.start_goal(trajectory((1.0, (0.0, 0.0))), controller.default_tolerances)
+    manager.switch(deactivate=['arm'])
+    assert goal.status is GoalStatus.ABORTED
+    manager.cleanup('arm')
+    assert manager.state('arm') == UNCONFIGURED
+
+
 def test_reset_forgets_the_trajectory():
     controller = controller_for()
     clock = Clock(controller)
@@ -304,6 +369,91 @@ def test_reset_forgets_the_trajectory():
     controller.reset()
     assert Clock(controller).run_to(2.0) == [0.0, 0.0]
 
+
+
+# --- limits --------------------------------------------------------------------------------
+
+@pytest.mark.parametrize('goal', [False, True], ids=['topic', 'goal'])
+def test_every_point_is_clamped_to_each_joints_position_limits(goal):
+    controller = controller_for(limited_handles())
+    clock = Clock(controller)
+    beyond = trajectory((1.0, (-3.0, 0.9)), (2.0, (3.0, -0.9)))
+    if goal:
+        assert controller.start_goal(beyond, controller.default_tolerances).status is (
+            GoalStatus.EXECUTING)
+    else:
+        assert controller.set_command(beyond) is CommandResult.CLAMPED
+        assert 'trajectory positions of a, b' in controller.command_problem(
+            None, CommandResult.CLAMPED)
+    desired = [clock.run_to(step_number * 0.01) for step_number in range(300)]
+    assert desired[100] == pytest.approx([-2.0, 0.5])
+    assert desired[-1] == pytest.approx([2.0, -0.5])
+    assert max(abs(a) for a, _b in desired) == 2.0
+    assert max(abs(b) for _a, b in desired) == 0.5
+
+
+@pytest.mark.parametrize('value', [10 * MAX_COMMAND_MAGNITUDE, -10 * MAX_COMMAND_MAGNITUDE])
+def test_a_point_beyond_the_command_magnitude_bound_rejects_the_trajectory(value):
+    controller = controller_for(joints=['c'])
+    assert controller.set_command(trajectory((1.0, (value,)), names=('c',))) is (
+        CommandResult.REJECTED)
+    assert Clock(controller).run_to(2.0) == [0.0]
+
+
+@pytest.mark.parametrize('sign', [1.0, -1.0])
+def test_without_gains_the_velocity_target_never_exceeds_the_joints_velocity_limit(sign):
+    handles = limited_handles()
+    controller = controller_for(handles)
+    # 1.5 rad in 0.3 s is 5 rad/s of a 1 rad/s joint; 0.3 m in 0.3 s is 1 m/s of a 0.2 m/s one.
+    controller.set_command(trajectory((0.3, (1.5 * sign, 0.3 * sign))))
+    fastest = {'a': 0.0, 'b': 0.0}
+    for step_number in range(3000):
+        controller.update(step_number * DT, DT)
+        for name in fastest:
+            handle = handles[name]
+            fastest[name] = max(fastest[name], abs(handle.velocity_target))
+            handle.position += handle.velocity_target * DT  # a motor that keeps to its target
+    assert fastest == {'a': 1.0, 'b': 0.2}
+    # Held to its limit, each joint arrives late, but arrives.
+    assert [handles['a'].position, handles['b'].position] == pytest.approx(
+        [1.5 * sign, 0.3 * sign], abs=1e-3)
+
+
+@pytest.mark.parametrize('sign', [1.0, -1.0])
+def test_with_gains_the_effort_is_clamped_to_the_joints_effort_limit(sign):
+    handles = limited_handles()
+    controller = controller_for(handles, command_interfaces=['effort'],
+                                gains={'a': {'p': 1e4}, 'b': {'p': 1e4}})
+    controller.set_command(trajectory((0.5, (1.0 * sign, 0.4 * sign))))
+    efforts = []
+    for step_number in range(300):  # the joints stay where they are
+        controller.update(step_number * DT, DT)
+        efforts.append((handles['a'].effort, handles['b'].effort))
+    assert efforts[-1] == (30.0 * sign, 50.0 * sign)
+    assert max(abs(effort) for effort, _ in efforts) == 30.0
+    assert max(abs(effort) for _, effort in efforts) == 50.0
+
+
+def _windup_then_overshoot(controller, handle):
+    """Hold the joint 0.2 short of a desired position of 0 for a second, then 0.5 past it."""
+    handle.position = -0.2
+    for step_number in range(1000):
+        controller.update(step_number * DT, DT)
+    handle.position = 0.5
+    controller.update(1.0, DT)
+    return handle.effort
+
+
+def test_the_integral_term_is_bounded_by_the_effort_limit_unless_the_yaml_clamps_it():
+    # i 1e4 integrates 2 N*m per step: without a bound the term would reach 2000 N*m,
+    # and still outweigh the proportional -20 N*m once the joint overshoots.
+    handles = limited_handles()
+    controller = controller_for(handles, gains={'a': {'p': 40.0, 'i': 1e4}})
+    assert _windup_then_overshoot(controller, handles['a']) == pytest.approx(-20.0 + 30.0)
+    assert controller.pids()['a'].integral_term == 30.0
+    handles = limited_handles()
+    controller = controller_for(handles, gains={'a': {'p': 40.0, 'i': 1e4, 'i_clamp': 5.0}})
+    assert _windup_then_overshoot(controller, handles['a']) == pytest.approx(-20.0 + 5.0)
 
 
 # --- on the three-joint arm in PyBullet ----------------------------------------------------

@@ -148,6 +148,22 @@ def test_a_trajectory_controller_without_gains_follows_the_trajectory_under_grav
     assert max(map(abs, errors)) < 0.01
 
 
+def test_a_trajectory_faster_than_the_velocity_limit_is_followed_at_the_limit(tmp_path):
+    # 1.2 rad in 0.3 s asks 4 rad/s of joints whose URDF limit is 2 rad/s: without gains the
+    # trajectory controller's ideal actuator holds them to 2 rad/s, and they arrive late.
+    yaml = ros2_control_yaml({'arm': (
+        'joint_trajectory_controller/JointTrajectoryController',
+        {'joints': ARM_JOINTS, 'command_interfaces': '[position]'})})
+    points = (TrajectoryPoint(0.3, (1.2, -1.2)),)
+    with simulation(tmp_path, two_link_arm_urdf(velocity=2.0), yaml) as sim:
+        sim.controller('arm').set_command(JointTrajectory(tuple(ARM_JOINTS), points))
+        fastest = track(sim, ARM_JOINTS, 1.5)
+        positions = sim.joint_positions()
+    assert max(fastest.values()) <= 2.0 * 1.001
+    assert min(fastest.values()) >= 2.0 * 0.99  # they did move at the limit
+    assert [positions[joint] for joint in ARM_JOINTS] == pytest.approx([1.2, -1.2], abs=0.005)
+
+
 def test_gazebo_ros_control_pid_gains_put_a_pid_on_a_position_controller(tmp_path):
     yaml = """
         arm:
