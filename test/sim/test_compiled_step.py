@@ -27,6 +27,12 @@ def description(repo_root):
     return load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
 
 
+# What a malformed number may do to the C reader; PyBullet's own module (the fallback) crashes.
+needs_the_compiled_step = pytest.mark.skipif(
+    compiled_step.unavailable_reason() != '',
+    reason='the compiled step is not in use, and PyBullet itself does not survive such numbers')
+
+
 def effort_stepper(physics: Physics):
     return physics.effort_stepper([physics.joint_index(joint.name) for joint in physics.joints])
 
@@ -177,6 +183,7 @@ def test_efforts_it_cannot_apply_are_refused_before_anything_is_sent(description
         assert physics.read_states() == before  # no step was taken
 
 
+@needs_the_compiled_step
 def test_a_number_that_empties_the_efforts_it_is_read_from_is_no_crash(description):
     class Emptying:
         def __float__(self):
@@ -188,6 +195,7 @@ def test_a_number_that_empties_the_efforts_it_is_read_from_is_no_crash(descripti
     assert efforts == [] and len(states) == 2
 
 
+@needs_the_compiled_step
 def test_a_number_that_closes_the_simulation_is_an_error_not_a_crash(description):
     physics = Physics(description, 0.001)
     step = effort_stepper(physics)
