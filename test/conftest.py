@@ -27,16 +27,13 @@ if sys.prefix not in _prefixes:
     os.environ['AMENT_PREFIX_PATH'] = os.pathsep.join([sys.prefix, *_prefixes])
 
 REPO_ROOT = pathlib.Path(__file__).resolve().parents[1]
-SEEDS_RESTORED = REPO_ROOT.parent / 'shared' / 'seeds' / 'restored'
+ORIGINAL_EXAMPLES = REPO_ROOT / 'test' / 'data' / 'original_examples'
 
 
 @pytest.fixture
-def seeds_dir() -> pathlib.Path:
-    """Return the seeds' restored files, or skip where the folder is absent."""
-    if not SEEDS_RESTORED.is_dir():
-        pytest.skip(f'seed files not found: {SEEDS_RESTORED} is absent '
-                    '(a user clone has no ../shared)')
-    return SEEDS_RESTORED
+def original_examples() -> pathlib.Path:
+    """Return the folder of the examples' original files (see its README.md)."""
+    return ORIGINAL_EXAMPLES
 
 
 @pytest.fixture
@@ -80,10 +77,10 @@ def cache_dir(tmp_path):
 
 
 @pytest.fixture
-def seed2(tmp_path, monkeypatch, seeds_dir):
+def seed2(tmp_path, monkeypatch, original_examples):
     """Install the seed-2 package into a temporary prefix; return its share folder."""
     import mesh_fixtures as mf
 
-    prefix = mf.make_seed2_package(tmp_path, seeds_dir / 'my_robot.urdf')
+    prefix = mf.make_seed2_package(tmp_path, original_examples / 'my_robot.urdf')
     monkeypatch.setenv('AMENT_PREFIX_PATH', str(prefix))
     return prefix / 'share' / mf.SEED2_PACKAGE

@@ -49,15 +49,15 @@ def test_our_config_wraps_the_seeds_controllers_in_the_robot_namespace(repo_root
         assert by_name[name].params['pid'] == {'p': 100.0, 'i': 0.01, 'd': 10.0}
 
 
-def test_the_seeds_own_yaml_loads_unchanged_and_matches_ours(seeds_dir, repo_root):
-    seed = load_controllers_config(seeds_dir / 'pan_tilt_control.yaml')
+def test_the_seeds_own_yaml_loads_unchanged_and_matches_ours(original_examples, repo_root):
+    seed = load_controllers_config(original_examples / 'pan_tilt_control.yaml')
     ours = load_controllers_config(repo_root / 'config' / 'pan_tilt_control.yaml')
     assert seed.namespace == ours.namespace
     assert seed.controllers == ours.controllers
 
 
-def test_controllers_at_the_top_level_have_no_namespace(seeds_dir):
-    config = load_controllers_config(seeds_dir / 'joint_controllers.yaml')
+def test_controllers_at_the_top_level_have_no_namespace(original_examples):
+    config = load_controllers_config(original_examples / 'joint_controllers.yaml')
     assert config.namespace is None
     assert [spec.name for spec in config.controllers] == ['joint_state_controller',
                                                           'arm_controller']
@@ -82,9 +82,9 @@ def test_a_missing_file_names_the_file(tmp_path):
     with pytest.raises(ControllerConfigError, match='missing.yaml: no such file'):
         load_controllers_config(tmp_path / 'missing.yaml')
 
-def test_ros1_files_get_no_update_rate(seeds_dir):
+def test_ros1_files_get_no_update_rate(original_examples):
     # publish_rate stays the only rate of a ROS 1 file's joint_state_controller.
-    config = load_controllers_config(seeds_dir / 'joint_controllers.yaml')
+    config = load_controllers_config(original_examples / 'joint_controllers.yaml')
     assert all('update_rate' not in spec.params for spec in config.controllers)
 
 
@@ -560,8 +560,8 @@ def test_a_plugin_file_that_does_not_exist_says_where_it_was_named(tmp_path):
         f"'missing.yaml' (resolved to {tmp_path / 'missing.yaml'}): no such file")
 
 
-def test_the_default_model_gets_the_default_controllers(repo_root, seeds_dir):
-    for model in (repo_root / 'urdf' / 'pan_tilt.xacro', seeds_dir / 'pan_tilt.xacro'):
+def test_the_default_model_gets_the_default_controllers(repo_root, original_examples):
+    for model in (repo_root / 'urdf' / 'pan_tilt.xacro', original_examples / 'pan_tilt.xacro'):
         assert controllers_files_for('', load_description(model)) == (
             package_share() / 'config' / 'pan_tilt_control.yaml',)
 

@@ -26,14 +26,14 @@ def test_our_pan_tilt_xacro_has_the_seeds_joints_limits_and_dynamics(repo_root):
         assert (joint.damping, joint.friction) == (50.0, 1.0)
 
 
-def test_the_seeds_own_xacro_loads_unchanged_and_matches_ours(seeds_dir, repo_root):
-    seed = load_description(seeds_dir / 'pan_tilt.xacro')
+def test_the_seeds_own_xacro_loads_unchanged_and_matches_ours(original_examples, repo_root):
+    seed = load_description(original_examples / 'pan_tilt.xacro')
     ours = load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
     assert _facts(seed) == _facts(ours)
     assert seed.plugin_namespace == ours.plugin_namespace == '/ex_urdf_pan_tilt'
 
 
-def test_our_xacro_keeps_the_seeds_links_geometry_and_inertia(seeds_dir, repo_root):
+def test_our_xacro_keeps_the_seeds_links_geometry_and_inertia(original_examples, repo_root):
     import xml.etree.ElementTree as ElementTree
 
     def links(path):
@@ -54,7 +54,8 @@ def test_our_xacro_keeps_the_seeds_links_geometry_and_inertia(seeds_dir, repo_ro
         return ([{k: float(v) for k, v in c.items()} for c in cylinders], colours, origins,
                 float(mass['value']), inertia)
 
-    seed, ours = links(seeds_dir / 'pan_tilt.xacro'), links(repo_root / 'urdf' / 'pan_tilt.xacro')
+    seed = links(original_examples / 'pan_tilt.xacro')
+    ours = links(repo_root / 'urdf' / 'pan_tilt.xacro')
     assert seed.keys() == ours.keys() == {'base_link', 'pan_link', 'tilt_link'}
     for name in seed:
         assert numeric(seed[name]) == numeric(ours[name]), name

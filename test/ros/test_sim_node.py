@@ -152,9 +152,9 @@ def test_an_effort_controller_meets_damping_and_friction(tmp_path):
         assert pan_tilt.states[-1].effort[0] == pytest.approx(50.0)
 
 
-def test_the_seeds_own_files_drive_the_same_topics(seeds_dir):
-    with sim_node(robot_description_file=str(seeds_dir / 'pan_tilt.xacro'),
-                  controllers_file=str(seeds_dir / 'pan_tilt_control.yaml')) as pan_tilt:
+def test_the_seeds_own_files_drive_the_same_topics(original_examples):
+    with sim_node(robot_description_file=str(original_examples / 'pan_tilt.xacro'),
+                  controllers_file=str(original_examples / 'pan_tilt_control.yaml')) as pan_tilt:
         topics = pan_tilt.topics_once_seen(PAN_COMMAND, f'{NS}/joint_states')
         assert topics[PAN_COMMAND] == ['std_msgs/msg/Float64']
         assert topics[f'{NS}/joint_states'] == ['sensor_msgs/msg/JointState']

@@ -35,11 +35,11 @@ def start_node():
 # --- seed 2: my_robot_pkg from an ament prefix, with generated meshes ----------------------
 
 @pytest.fixture
-def seed2_package(tmp_path, monkeypatch, seeds_dir):
+def seed2_package(tmp_path, monkeypatch, original_examples):
     """Install my_robot_pkg (URDF, meshes, the seed's YAML) into a temporary ament prefix."""
-    prefix = mf.make_seed2_package(tmp_path, seeds_dir / 'my_robot.urdf')
+    prefix = mf.make_seed2_package(tmp_path, original_examples / 'my_robot.urdf')
     mf.write_file(prefix / 'share' / mf.SEED2_PACKAGE / 'config' / 'joint_controllers.yaml',
-                  (seeds_dir / 'joint_controllers.yaml').read_bytes())
+                  (original_examples / 'joint_controllers.yaml').read_bytes())
     monkeypatch.setenv('AMENT_PREFIX_PATH', os.pathsep.join(
         [str(prefix), os.environ.get('AMENT_PREFIX_PATH', '')]))
     monkeypatch.setenv('XDG_CACHE_HOME', str(tmp_path / 'cache'))
