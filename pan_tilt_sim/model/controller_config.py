@@ -66,13 +66,11 @@ import math
 import os
 import pathlib
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-import yaml
-
 from pan_tilt_sim.errors import ConfigurationError, ControllerConfigError
-from pan_tilt_sim.model import naming
+from pan_tilt_sim.model import naming, yaml_input
 from pan_tilt_sim.model.resources import resolve_resource
 from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_ROBOT_NAME, package_share
 
@@ -124,6 +122,8 @@ class ControllersConfig:
     update_rate: float | None = None
     # gazebo_ros_control/pid_gains/<joint>: {p, i, d, ...} as written (ROS 1 layout).
     pid_gains: Mapping[str, Any] = dataclasses.field(default_factory=dict)
+    # One line each (naming the file): what the file holds that the reader's rules drop.
+    warnings: tuple[str, ...] = ()
 
     @property
     def label(self) -> str:
@@ -259,28 +259,27 @@ def _plugin_file(text: str, plugin: str, description_file: pathlib.Path) -> path
 
 
 def read_text(path: pathlib.Path) -> str:
-    """Return a controllers file's text; errors name the file."""
-    if path.is_dir():
-        raise ControllerConfigError(f'controllers file {path}: is a directory, not a file')
-    if not path.is_file():
-        raise ControllerConfigError(f'controllers file {path}: no such file')
+    """Return a controllers file's text; errors name the file.
+
+    Within :mod:`~pan_tilt_sim.model.yaml_input`'s limits: a regular file
+    (not a device or FIFO) of at most ``MAX_FILE_BYTES``.
+    """
     try:
-        return path.read_text(encoding='utf-8')
-    except (OSError, UnicodeDecodeError) as err:
-        raise ControllerConfigError(f'controllers file {path}: cannot read: {err}') from None
+        return yaml_input.read_text(path)
+    except yaml_input.YamlInputError as err:
+        raise ControllerConfigError(f'controllers file {path}: {err}') from None
 
 
 def parse_yaml(text: str, path: pathlib.Path) -> Any:
-    """Parse YAML text; errors name the file and, for syntax errors, the line."""
+    """Parse YAML text within the limits; errors name the file and, where known, the line.
+
+    Aliases are expanded with a bound on the expanded size and depth, and an
+    alias holding itself is refused (:mod:`~pan_tilt_sim.model.yaml_input`).
+    """
     try:
-        return yaml.safe_load(text)
-    except yaml.MarkedYAMLError as err:
-        mark = err.problem_mark or err.context_mark
-        line = f':{mark.line + 1}' if mark is not None else ''
-        problem = err.problem or err.context or 'invalid YAML'
-        raise ControllerConfigError(f'{path}{line}: YAML syntax error: {problem}') from None
-    except yaml.YAMLError as err:
-        raise ControllerConfigError(f'{path}: YAML error: {err}') from None
+        return yaml_input.load(text)
+    except yaml_input.YamlInputError as err:
+        raise ControllerConfigError(f'{path}{err.where}: {err}') from None
 
 
 def read_yaml(path: pathlib.Path) -> Any:
@@ -305,7 +304,10 @@ def load_controllers_config(paths: pathlib.Path | str | Sequence[pathlib.Path | 
     ros2 = [(path, _ros2_nodes(document, path)) for path, document in documents]
     if all(nodes for _path, nodes in ros2):
         config = _ros2_control_config([node for _path, nodes in ros2 for node in nodes], label)
-        return dataclasses.replace(config, source=paths[0], sources=tuple(paths))
+        warnings = [warning for path, document in documents
+                    for warning in _ros2_dropped_blocks(document, path)]
+        return dataclasses.replace(config, source=paths[0], sources=tuple(paths),
+                                   warnings=tuple(warnings))
     if len(documents) > 1:
         mixed = ', '.join(str(path) for path, nodes in ros2 if not nodes)
         raise ControllerConfigError(
@@ -325,12 +327,65 @@ def load_controllers_config(paths: pathlib.Path | str | Sequence[pathlib.Path | 
             controllers = _controllers_in(inner)
             namespace = str(key) if controllers else None
             holder = inner
+    blocks = _controller_blocks(document, {spec.name for spec in controllers})
+    if not controllers and len(blocks) > 1:
+        raise ControllerConfigError(
+            f"{path}: several top-level keys hold controllers ({_quoted(blocks)}): one key "
+            "may wrap a robot's controllers (its namespace), or put them all at the top level")
     if not controllers:
         raise ControllerConfigError(
             f"{path}: no controllers in it (a controller is a mapping with a '{TYPE_FIELD}')")
     _check_names(path, controllers, namespace)
+    top_level = _quoted(spec.name for spec in controllers)
+    warnings = [] if namespace is not None else [
+        f"{path}: top-level key '{key}' holds controllers ({_quoted(names)}) that are not "
+        f'loaded: beside controllers at the top level ({top_level}) a block of controllers '
+        "is ignored; put every controller at the top level, or all under one key (the robot's "
+        'namespace)'
+        for key, names in blocks.items()]
     return ControllersConfig(controllers=tuple(controllers), source=path, namespace=namespace,
-                             sources=(path,), pid_gains=_plugin_pid_gains(holder, path))
+                             sources=(path,), pid_gains=_plugin_pid_gains(holder, path),
+                             warnings=tuple(warnings))
+
+
+def _quoted(names: Iterable[Any]) -> str:
+    return ', '.join(f"'{name}'" for name in names)
+
+
+def _controller_blocks(document: Mapping[Any, Any], controllers: set[str]) -> dict[str, list[str]]:
+    """Return the top-level keys, other than controllers, whose mapping holds controllers."""
+    blocks = {}
+    for key, value in document.items():
+        if str(key) in controllers or key == GAZEBO_ROS_CONTROL or not isinstance(value, Mapping):
+            continue
+        held = _controllers_in(value)
+        if held:
+            blocks[str(key)] = [spec.name for spec in held]
+    return blocks
+
+
+def _ros2_dropped_blocks(document: Mapping[Any, Any], path: pathlib.Path) -> list[str]:
+    """Name the top-level blocks of a ros2_control file that hold a controller but are ignored.
+
+    Only ``ros__parameters`` sections are read; a block with none under it
+    (an anchor's holder, a ROS 1 style block) is dropped, whatever it holds.
+    """
+    return [
+        f"{path}: top-level key '{key}' holds a controller (a mapping with a '{TYPE_FIELD}') "
+        f"but is ignored: it has no '{ROS2_PARAMETERS}' (in a ros2_control style file only "
+        f"'<node>: {ROS2_PARAMETERS}:' sections are read)"
+        for key, value in document.items()
+        if isinstance(value, Mapping) and not _has_parameters(value) and _holds_controller(value)]
+
+
+def _has_parameters(mapping: Mapping[Any, Any]) -> bool:
+    return ROS2_PARAMETERS in mapping or any(
+        _has_parameters(value) for value in mapping.values() if isinstance(value, Mapping))
+
+
+def _holds_controller(mapping: Mapping[Any, Any]) -> bool:
+    return isinstance(mapping.get(TYPE_FIELD), str) or any(
+        _holds_controller(value) for value in mapping.values() if isinstance(value, Mapping))
 
 
 def _plugin_pid_gains(holder: Mapping[Any, Any], path: pathlib.Path) -> dict[str, Any]:

@@ -30,6 +30,7 @@ from typing import Any
 import yaml
 
 from pan_tilt_sim.errors import ControllerConfigError
+from pan_tilt_sim.model import yaml_input
 from pan_tilt_sim.model.controller_config import ROS2_PARAMETERS, TYPE_FIELD, WILDCARD_CHARACTERS
 
 PID_FIELD = 'pid'
@@ -133,9 +134,9 @@ class _Definition:
 
 def _compose(text: str, source: str) -> yaml.Node:
     try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.YAMLError as err:
-        raise ControllerConfigError(f'{source}: YAML error: {err}') from None
+        root = yaml_input.compose(text)
+    except yaml_input.YamlInputError as err:
+        raise ControllerConfigError(f'{source}{err.where}: {err}') from None
     if not isinstance(root, yaml.MappingNode):
         raise ControllerConfigError(f'{source}: not a YAML mapping of controllers')
     return root

@@ -31,9 +31,8 @@ import pathlib
 from collections.abc import Mapping
 from typing import Any
 
-import yaml
-
 from pan_tilt_sim.errors import ConfigurationError, ParameterError
+from pan_tilt_sim.model import yaml_input
 from pan_tilt_sim.model.resources import resolve_resource
 from pan_tilt_sim.model.transforms import (
     IDENTITY_ROTATION,
@@ -96,7 +95,7 @@ def world_from_parameter(value: str) -> World:
         path = resolve_resource(value, pathlib.Path.cwd())
     except ConfigurationError as err:
         raise ParameterError(f"parameter 'world': {err}") from None
-    if not path.is_file():
+    if not path.exists():  # a folder, device or FIFO: read_world_file says what it is
         raise ParameterError(
             f"parameter 'world': '{value}' is none of {', '.join(SCENERIES)}, and no world "
             f'file ({path}: no such file)')
@@ -106,14 +105,9 @@ def world_from_parameter(value: str) -> World:
 def read_world_file(path: pathlib.Path) -> World:
     """Read and check a YAML world file."""
     try:
-        document = yaml.safe_load(path.read_text(encoding='utf-8'))
-    except yaml.MarkedYAMLError as err:
-        mark = err.problem_mark or err.context_mark
-        line = f':{mark.line + 1}' if mark is not None else ''
-        raise WorldFileError(
-            f'{path}{line}: YAML syntax error: {err.problem or err.context}') from None
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as err:
-        raise WorldFileError(f'{path}: cannot read: {err}') from None
+        document = yaml_input.load_file(path)
+    except yaml_input.YamlInputError as err:
+        raise WorldFileError(f'{path}{err.where}: {err}') from None
     if document is None:
         document = {}
     _check_mapping(document, WORLD_KEYS, path, 'the file')
@@ -160,7 +154,7 @@ def _pose(pose: Any, path: pathlib.Path, where: str) -> tuple[Vector, Quaternion
     else:
         x, y, z, w = _numbers(pose.get('orientation', list(IDENTITY_ROTATION)), 4, path,
                               f'{where}.orientation')
-        norm = math.sqrt(x * x + y * y + z * z + w * w)
+        norm = math.hypot(x, y, z, w)  # no overflow for huge components
         if norm < NORM_TOLERANCE:
             raise WorldFileError(f'{path}: {where}.orientation: a quaternion of length 0 is '
                                  'no rotation')

@@ -30,6 +30,13 @@ MAX_BATCH_GROWTH = 2
 MAX_CATCH_UP_S = 0.1
 # Wall clocks are floats: a step due "exactly now" must not round down.
 STEP_EPSILON = 1e-6
+# Sim seconds per wall second at most.  With time steps of 1 us or more, every figure
+# below (steps due, the debt dropped) stays a finite number well inside a float's range.
+MAX_REAL_TIME_FACTOR = 1000.0
+# Steps of one paced tick at most, whatever the factor asks: a factor the machine cannot
+# follow then costs ticks of bounded length (commands and services still get their turn)
+# instead of one long catch-up batch.
+MAX_PACED_BATCH_STEPS = 10_000
 
 
 class Throttle:
@@ -68,10 +75,17 @@ class Throttle:
 
 
 class Pacer:
-    """Tells each tick how many physics steps are due."""
+    """Tells each tick how many physics steps are due.
+
+    ``real_time_factor`` lies in [0, MAX_REAL_TIME_FACTOR] and ``time_step``
+    (seconds) is finite and > 0; anything else is a ValueError (the node's
+    parameter checks refuse it first, with the parameter's name).
+    """
 
     def __init__(self, real_time_factor: float, time_step: float,
                  clock: Callable[[], float] = time.monotonic) -> None:
+        if not (math.isfinite(time_step) and time_step > 0.0):
+            raise ValueError(f'time_step must be a finite number > 0, got {time_step}')
         self._time_step = time_step
         self._clock = clock
         self.real_time_factor = real_time_factor
@@ -83,6 +97,12 @@ class Pacer:
 
     @real_time_factor.setter
     def real_time_factor(self, factor: float) -> None:
+        if not 0.0 <= factor <= MAX_REAL_TIME_FACTOR:  # NaN fails too
+            raise ValueError(
+                f'real_time_factor must lie in [0, {MAX_REAL_TIME_FACTOR:g}], got {factor}')
+        if not math.isfinite(MAX_CATCH_UP_S * factor / self._time_step):
+            raise ValueError(f'real_time_factor {factor} at time_step {self._time_step} s '
+                             'asks for more steps per second than a float holds')
         self._factor = factor
         self.restart()
 
@@ -106,7 +126,8 @@ class Pacer:
             self._start = now
         target = math.floor((now - self._start) * self._factor / self._time_step + STEP_EPSILON)
         due = target - self._done
-        max_due = max(1, math.ceil(MAX_CATCH_UP_S * self._factor / self._time_step))
+        max_due = min(MAX_PACED_BATCH_STEPS,
+                      max(1, math.ceil(MAX_CATCH_UP_S * self._factor / self._time_step)))
         if due > max_due:
             # Behind by more than we should catch up: run the cap, drop the rest.
             self._start = now - (self._done + max_due) * self._time_step / self._factor

@@ -21,6 +21,7 @@ from rclpy.parameter import Parameter
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model.initial_positions import parse_initial_positions
 from pan_tilt_sim.model.naming import check_namespace
+from pan_tilt_sim.ros.pacing import MAX_REAL_TIME_FACTOR
 from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
 
 BOOL = ParameterType.PARAMETER_BOOL
@@ -31,6 +32,9 @@ STRING_ARRAY = ParameterType.PARAMETER_STRING_ARRAY
 
 DEFAULT_TIME_STEP = 0.001  # s, PyBullet's recommended range is 1/1000 .. 1/240
 MAX_TIME_STEP = 0.1  # s; beyond this the PID loop is meaningless
+# s; below it a second of sim time is over a million steps, and pacing's steps per
+# wall second (real_time_factor / time_step) would leave the range of floats.
+MIN_TIME_STEP = 1e-6
 DEFAULT_REAL_TIME_FACTOR = 1.0
 
 
@@ -75,9 +79,11 @@ def _specs() -> tuple[_Spec, ...]:
               'spawner loads, configures and activates it through /<ns>/controller_manager, '
               'as with gz_ros2_control.'),
         _Spec('time_step', ParameterType.PARAMETER_DOUBLE, DEFAULT_TIME_STEP,
-              'Physics step in seconds of sim time (0 < time_step <= 0.1).'),
+              f'Physics step in seconds of sim time ({MIN_TIME_STEP:g} <= time_step <= '
+              f'{MAX_TIME_STEP:g}).'),
         _Spec('real_time_factor', ParameterType.PARAMETER_DOUBLE, DEFAULT_REAL_TIME_FACTOR,
-              'Sim seconds per wall second; 0 runs as fast as the machine allows.',
+              'Sim seconds per wall second (0 <= real_time_factor <= '
+              f'{MAX_REAL_TIME_FACTOR:g}); 0 runs as fast as the machine allows.',
               read_only=False),
         _Spec('paused', ParameterType.PARAMETER_BOOL, False,
               'Hold the physics (topics stay alive).', read_only=False),
@@ -171,17 +177,25 @@ def coerce(name: str, wanted: int, value: Any) -> Any:
 
 
 def check_time_step(value: float) -> None:
-    """``time_step`` must lie in (0, MAX_TIME_STEP]."""
+    """``time_step`` must lie in [MIN_TIME_STEP, MAX_TIME_STEP] seconds."""
     if not (math.isfinite(value) and 0.0 < value <= MAX_TIME_STEP):
         raise ParameterError(
             f"parameter 'time_step' must be > 0 and <= {MAX_TIME_STEP} s, got {value}")
+    if value < MIN_TIME_STEP:
+        raise ParameterError(
+            f"parameter 'time_step' must be >= {MIN_TIME_STEP:g} s (a million steps per sim "
+            f'second), got {value}')
 
 
 def check_real_time_factor(value: float) -> None:
-    """``real_time_factor`` must be finite and >= 0."""
+    """``real_time_factor`` must lie in [0, MAX_REAL_TIME_FACTOR] (0: as fast as possible)."""
     if not (math.isfinite(value) and value >= 0.0):
         raise ParameterError(
             f"parameter 'real_time_factor' must be a finite number >= 0, got {value}")
+    if value > MAX_REAL_TIME_FACTOR:
+        raise ParameterError(
+            f"parameter 'real_time_factor' must be <= {MAX_REAL_TIME_FACTOR:g} (use 0 to run "
+            f'as fast as the machine allows), got {value}')
 
 
 def runtime_value(parameter: Parameter) -> Any:

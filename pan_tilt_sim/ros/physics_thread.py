@@ -14,7 +14,9 @@ runs between two batches of steps, never during one.  :class:`Turns` is
 that lock; a callback waiting for its turn goes before the next batch, so
 at real_time_factor 0 a command waits at most for the batch in progress
 (~5 ms).  :class:`TurnTakingExecutor` is rclpy's SingleThreadedExecutor
-with each callback run inside its turn.  If the physics thread fails, it
+with each callback run inside its turn; the callbacks ready at once share one
+turn (up to :data:`CALLBACK_TURN_S`), so that a queue of requests is not
+served one per batch of steps.  If the physics thread fails, it
 wakes the executor, which raises its exception, so the program ends with
 the traceback -- the executor never has to poll for it.
 """
@@ -33,8 +35,13 @@ from rclpy.executors import (
     SingleThreadedExecutor,
     TimeoutException,
 )
+from rclpy.task import Task
 
 JOIN_TIMEOUT_S = 5.0
+# Wall seconds of callbacks one turn may run when more are ready, before the physics
+# gets its batch: about one batch at real_time_factor 0 (pacing.FAST_TICK_S), so under
+# a flood of requests the two share the time, and a request waits for at most one batch.
+CALLBACK_TURN_S = 0.005
 
 
 class Turns:
@@ -107,21 +114,36 @@ class TurnTakingExecutor(SingleThreadedExecutor):
             self.wake()
 
     def spin_once(self, timeout_sec: float | None = None) -> None:
-        """Wait for one ready callback (without holding the turn), then run it in its turn."""
+        """Wait for a ready callback (without holding the turn), then run it in its turn.
+
+        Callbacks that are ready by then run in the same turn, up to
+        :data:`CALLBACK_TURN_S` of wall time: a queue of requests is served
+        between two batches of steps, not one request per batch.
+        """
+        handler = self._next_ready(timeout_sec)
+        if handler is None:
+            return
+        with self._turns.callback():
+            deadline = time.perf_counter() + CALLBACK_TURN_S
+            while handler is not None:
+                handler()
+                if handler.exception() is not None:
+                    raise handler.exception()
+                handler.result()
+                handler = self._next_ready(0.0) if time.perf_counter() < deadline else None
+
+    def _next_ready(self, timeout_sec: float | None) -> Task | None:
+        """Return the next ready callback, waiting up to ``timeout_sec`` (None: not in time)."""
         if self._turns.failure is not None:
             raise self._turns.failure
         try:
             handler, _entity, _node = self.wait_for_ready_callbacks(
                 timeout_sec, condition=self._physics_failed)
         except (ShutdownException, TimeoutException):
-            return
+            return None
         except ConditionReachedException:  # the physics failed and woke the wait
             raise self._turns.failure from None
-        with self._turns.callback():
-            handler()
-        if handler.exception() is not None:
-            raise handler.exception()
-        handler.result()
+        return handler
 
 
 class Wakeup:

@@ -6,6 +6,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from builtin_interfaces.msg import Duration, Time
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64, Float64MultiArray
@@ -15,6 +16,13 @@ from pan_tilt_sim.controllers import CommandKind
 from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
 
 NANOSECONDS_PER_SECOND = 1_000_000_000
+# Requests a service of the node holds while it is busy (a batch of physics steps, other
+# callbacks).  rclpy's default keeps the last 10 and silently drops older ones, so 20
+# callers at once lost requests for good; parameter services keep 1000 for that reason.
+SERVICE_QUEUE_DEPTH = 1000
+SERVICE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=SERVICE_QUEUE_DEPTH,
+                         reliability=ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.VOLATILE)
 
 
 def seconds(time: Time | Duration) -> float:

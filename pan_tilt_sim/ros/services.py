@@ -25,6 +25,8 @@ from rclpy.node import Node
 from rclpy.service import Service
 from std_srvs.srv import Empty
 
+from pan_tilt_sim.ros.ros_interfaces import SERVICE_QOS
+
 RESET_SIMULATION = 'reset_simulation'
 RESET_WORLD = 'reset_world'
 PAUSE_PHYSICS = 'pause_physics'
@@ -52,8 +54,11 @@ def create_world_services(node: Node, *, reset: Callable[..., None],
         return serve
 
     return [
-        node.create_service(Empty, RESET_SIMULATION, resetting(reset_time=True)),
-        node.create_service(Empty, RESET_WORLD, resetting(reset_time=False)),
-        node.create_service(Empty, PAUSE_PHYSICS, pausing(paused=True)),
-        node.create_service(Empty, UNPAUSE_PHYSICS, pausing(paused=False)),
+        node.create_service(Empty, RESET_SIMULATION, resetting(reset_time=True),
+                            qos_profile=SERVICE_QOS),
+        node.create_service(Empty, RESET_WORLD, resetting(reset_time=False),
+                            qos_profile=SERVICE_QOS),
+        node.create_service(Empty, PAUSE_PHYSICS, pausing(paused=True), qos_profile=SERVICE_QOS),
+        node.create_service(Empty, UNPAUSE_PHYSICS, pausing(paused=False),
+                            qos_profile=SERVICE_QOS),
     ]

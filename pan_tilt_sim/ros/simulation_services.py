@@ -29,10 +29,14 @@ exits 0).  NO_WORLD and LOADING_WORLD: FEATURE_UNSUPPORTED (no worlds to load).
 
 **Stepping.**  StepSimulation and the SimulateSteps action run their steps
 only while paused (else OPERATION_FAILED, as the srv says), one request at a
-time, through the node's own stepping (controllers, /clock, JointState), as
-fast as the machine allows, in slices that leave the executor free between
-them (:mod:`pan_tilt_sim.ros.stepping`).  SimulateSteps sends feedback after
-each slice (~5 ms of wall time) and stops after the slice in progress when
+time.  A StepSimulation request runs at most :data:`MAX_STEP_SIMULATION_STEPS`
+steps (more: OPERATION_FAILED, saying so), so that it answers in bounded time
+and a caller that dies mid-call leaves no endless stepping behind; longer runs
+are SimulateSteps goals, which can be cancelled.  Steps run through the
+node's own stepping (controllers, /clock, JointState), as fast as the machine
+allows, in slices that leave the executor free between them
+(:mod:`pan_tilt_sim.ros.stepping`).  SimulateSteps sends feedback after each
+slice (~5 ms of wall time) and stops after the slice in progress when
 cancelled, still paused (result OK, status canceled).
 
 **Reset.**  ResetSimulation's scope is a bit field: TIME (sim time to 0 and
@@ -69,7 +73,7 @@ from pan_tilt_sim.model.resources import PACKAGE_SCHEME, resolve_resource
 from pan_tilt_sim.model.transforms import Transform, rotate
 from pan_tilt_sim.ros import parameters as params
 from pan_tilt_sim.ros import services as world_services
-from pan_tilt_sim.ros.ros_interfaces import stamp
+from pan_tilt_sim.ros.ros_interfaces import SERVICE_QOS, stamp
 from pan_tilt_sim.ros.stepping import JobEnd, StepJob, StepRunner
 from pan_tilt_sim.share import PACKAGE_NAME
 from pan_tilt_sim.sim.entities import (
@@ -80,6 +84,8 @@ from pan_tilt_sim.sim.entities import (
     NotDeletableError,
     SpawnError,
     SpawnProblem,
+    check_twist,
+    checked_pose,
 )
 
 PACKAGE = 'simulation_interfaces'
@@ -93,6 +99,10 @@ QUIT_GRACE_S = 0.1  # wall time between QUITTING's answer and the shutdown (DDS 
 SPAWNABLES_FOLDER = pathlib.PurePosixPath('urdf', 'objects')
 SPAWNABLE_SUFFIXES = ('.urdf', '.xacro')
 SCOPE_BITS = 0b111  # TIME | STATE | SPAWNED
+# StepSimulation steps at most: a service call must answer within seconds (a few at
+# most, whatever the robot costs per step), and a caller that dies mid-call cannot
+# cancel it.  Longer runs are SimulateSteps goals, which report progress and cancel.
+MAX_STEP_SIMULATION_STEPS = 100_000
 
 SERVICES = ('get_simulator_features', 'get_simulation_state', 'set_simulation_state',
             'step_simulation', 'reset_simulation', 'get_entities', 'get_entities_states',
@@ -195,7 +205,7 @@ class SimulationServices:
         }
         self.services = {
             leaf: node.create_service(
-                kind, service_name(namespace, leaf), handler,
+                kind, service_name(namespace, leaf), handler, qos_profile=SERVICE_QOS,
                 callback_group=waiting if leaf == 'step_simulation' else None)
             for leaf, (kind, handler) in handlers.items()}
         self.action_server = ActionServer(
@@ -310,6 +320,12 @@ class SimulationServices:
         self._node.context.try_shutdown()
 
     async def _step_simulation(self, request, response):
+        if request.steps > MAX_STEP_SIMULATION_STEPS:
+            return self._fail(
+                response, self._msg.Result.RESULT_OPERATION_FAILED,
+                f'steps {request.steps}: a step_simulation request runs at most '
+                f'{MAX_STEP_SIMULATION_STEPS} steps (it cannot be cancelled); run more with '
+                'the simulate_steps action, which reports progress and can be cancelled')
         problem = self._cannot_step()
         if problem:
             return self._fail(response, self._msg.Result.RESULT_OPERATION_FAILED, problem)
@@ -438,11 +454,17 @@ class SimulationServices:
             return self._fail(response, invalid, f"unknown frame '{message.header.frame_id}' "
                               "(use '' or world, an entity's name, or a link of the robot)")
         twist = message.twist
-        state = EntityState(
-            reference.then(_transform(message.pose)),
-            rotate(reference.rotation, (twist.linear.x, twist.linear.y, twist.linear.z)),
-            rotate(reference.rotation, (twist.angular.x, twist.angular.y, twist.angular.z)))
+        linear = (twist.linear.x, twist.linear.y, twist.linear.z)
+        angular = (twist.angular.x, twist.angular.y, twist.angular.z)
         try:
+            # Bounded and normalised in the request's own frame first, so that composing
+            # with the reference frame cannot overflow (set_state checks the result).
+            pose = checked_pose(_transform(message.pose),
+                                lambda text: EntityStateError(text, invalid_pose=True))
+            check_twist(linear, angular, lambda text: EntityStateError(
+                f"'{request.entity}': {text}"))
+            state = EntityState(reference.then(pose), rotate(reference.rotation, linear),
+                                rotate(reference.rotation, angular))
             self._entities.set_state(request.entity, state)
         except EntityStateError as err:
             return self._fail(response, invalid if err.invalid_pose

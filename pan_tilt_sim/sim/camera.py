@@ -48,6 +48,13 @@ OPTICAL_SUFFIX = '_optical'
 RGBA_CHANNELS = 4
 RGB_CHANNELS = 3
 BACKGROUND_DEPTH = 1.0  # OpenGL depth where nothing was drawn (the far plane)
+# TinyRenderer writes the far plane's depth where nothing was drawn as 1.0 give or take
+# a couple of float32 steps (2**-24 each), which way depending on its rounding of near
+# and far.  Buffer values within this many steps of 1.0 are taken as nothing drawn: a
+# surface that close to the far plane (a few steps of the buffer's own resolution
+# there) reads as beyond it.
+BACKGROUND_STEPS = 8
+BACKGROUND_THRESHOLD = BACKGROUND_DEPTH - BACKGROUND_STEPS * 2.0 ** -24
 # Link axes that may serve as the camera's "up" (perpendicular to its +z view axis).
 UP_CANDIDATES: tuple[Vector, ...] = ((1.0, 0.0, 0.0), (-1.0, 0.0, 0.0),
                                      (0.0, 1.0, 0.0), (0.0, -1.0, 0.0))
@@ -208,7 +215,7 @@ class Renderer:
     def _paint_ground(self, pixels: numpy.ndarray, depth, eye: Vector, forward: Vector,
                       up: Vector) -> None:
         # Where nothing was drawn and the viewing ray meets z = 0, the ground shows.
-        background = numpy.asarray(depth).reshape(pixels.shape[:2]) >= BACKGROUND_DEPTH
+        background = nothing_drawn(numpy.asarray(depth).reshape(pixels.shape[:2]))
         right_z = forward[0] * up[1] - forward[1] * up[0]  # z of forward x up
         ray_z = (forward[2] + self._ray_x[numpy.newaxis, :] * right_z
                  - self._ray_y[:, numpy.newaxis] * up[2])
@@ -225,6 +232,15 @@ class Renderer:
                                           physicsClientId=self._client)
             position, orientation = state[4], state[5]  # the URDF link frame
         return Transform(tuple(position), tuple(orientation))
+
+
+def nothing_drawn(buffer: numpy.ndarray) -> numpy.ndarray:
+    """Return where a TinyRenderer depth buffer (values in [0, 1]) holds nothing drawn.
+
+    Robust to the renderer's rounding of the far plane (:data:`BACKGROUND_THRESHOLD`),
+    whatever the image size and clip planes.
+    """
+    return numpy.asarray(buffer, dtype=numpy.float64) >= BACKGROUND_THRESHOLD
 
 
 def _dot(a: Sequence[float], b: Sequence[float]) -> float:

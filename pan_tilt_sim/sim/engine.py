@@ -88,7 +88,7 @@ class Simulation:
         starts = start_positions(description.model, initial_positions)
         movable = [joint.name for joint in description.actuated_joints]
         gains = plugin_gains(controllers.pid_gains, movable, controllers.label)
-        load_messages: list[str] = []
+        load_messages: list[str] = list(controllers.warnings)  # the file's dropped blocks
         self.physics = Physics(
             description, time_step, gui=gui,
             initial_positions=[starts[joint].position for joint in movable],

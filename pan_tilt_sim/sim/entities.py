@@ -38,7 +38,7 @@ import math
 import pathlib
 import re
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.description import RobotDescription
@@ -61,6 +61,13 @@ DEFAULT_NAME = 'entity'  # base of a generated name when neither request nor URD
 # typed on command lines).
 _NAME = re.compile(r'[^\s]+')
 NORM_TOLERANCE = 1e-6  # a quaternion this close to length 0 is no rotation
+# What an entity's state may be (set_entity_state, spawn, world files).  Beyond these
+# PyBullet's integration leaves the range of floats within a few steps, and the pose
+# would turn NaN for good.  They are far beyond any robot scene: 1,000 km from the
+# world origin, 10 km/s, 10,000 rad/s.
+MAX_POSITION_M = 1e6  # each coordinate of a position, in the world
+MAX_LINEAR_SPEED = 1e4  # m/s, length of the linear velocity
+MAX_ANGULAR_SPEED = 1e4  # rad/s, length of the angular velocity
 DYNAMICS_MASS = 0  # index of the mass in pybullet.getDynamicsInfo
 DYNAMICS_INERTIAL_POSITION = 3
 DYNAMICS_INERTIAL_ORIENTATION = 4
@@ -277,17 +284,21 @@ class Entities:
     # --- changing -------------------------------------------------------------------------
 
     def set_state(self, name: str, state: EntityState) -> None:
-        """Put the entity at ``state`` at once (pose and twist; a static one only moves)."""
+        """Put the entity at ``state`` at once (pose and twist; a static one only moves).
+
+        The pose is bounded and its quaternion normalised (:func:`checked_pose`),
+        the twist bounded (:func:`check_twist`); else :class:`EntityStateError`
+        and nothing changes.
+        """
         entity = self._entities[name]
-        check_pose(state.pose, lambda text: EntityStateError(text, invalid_pose=True))
+        pose = checked_pose(state.pose, lambda text: EntityStateError(text, invalid_pose=True))
+        check_twist(state.linear, state.angular,
+                    lambda text: EntityStateError(f"'{name}': {text}"))
         velocities = (*state.linear, *state.angular)
-        if not all(math.isfinite(v) for v in velocities):
-            raise EntityStateError(f"'{name}': the twist must be finite numbers")
         if entity.static and any(velocities):
             raise EntityStateError(
                 f"'{name}' is static ({entity.origin.value}): it can be moved, but not given "
                 'a velocity')
-        pose = _normalized(state.pose)
         com = pose.then(entity.inertial)
         client = self._client
         pybullet.resetBasePositionAndOrientation(entity.body, com.translation, com.rotation,
@@ -319,7 +330,7 @@ class Entities:
             raise SpawnError(SpawnProblem.NAMESPACE_INVALID,
                              f"'{namespace}' is not a valid ROS namespace "
                              f'({naming.NAMESPACE_RULE})')
-        check_pose(pose, lambda text: SpawnError(SpawnProblem.INVALID_POSE, text))
+        pose = checked_pose(pose, lambda text: SpawnError(SpawnProblem.INVALID_POSE, text))
         try:
             reference = self.frame_pose(frame)
         except KeyError:
@@ -331,7 +342,9 @@ class Entities:
         except EntityResourceError as err:
             raise SpawnError(_RESOURCE_PROBLEMS[err.problem], str(err)) from None
         name = self._free_name(name or resource.name, allow_renaming)
-        entity = self._load(resource, name, reference.then(_normalized(pose)), origin)
+        placed = checked_pose(reference.then(pose),
+                              lambda text: SpawnError(SpawnProblem.INVALID_POSE, text))
+        entity = self._load(resource, name, placed, origin)
         entity.namespace = namespace
         entity.info.description = description or (
             f"'{resource.model.name}' from {uri}" if uri else
@@ -510,19 +523,41 @@ def spawn_world_objects(entities: Entities, world: World) -> list[str]:
     return names
 
 
-def check_pose(pose: Transform, error) -> None:
-    """Raise ``error(text)`` unless the pose is finite and its quaternion not of length 0."""
+def checked_pose(pose: Transform, error: Callable[[str], Exception]) -> Transform:
+    """Return ``pose`` with its quaternion normalised, or raise ``error(text)`` saying why not.
+
+    A pose must be finite numbers, each coordinate within ±:data:`MAX_POSITION_M`,
+    and its quaternion of length >= :data:`NORM_TOLERANCE` (any finite length
+    above it is normalised, 1e300 included: the length is computed without
+    overflow).
+    """
     values = (*pose.translation, *pose.rotation)
     if not all(math.isfinite(v) for v in values):
         raise error('the pose must be finite numbers')
-    if math.sqrt(sum(q * q for q in pose.rotation)) < NORM_TOLERANCE:
+    if any(abs(v) > MAX_POSITION_M for v in pose.translation):
+        raise error(f'the position must lie within ±{MAX_POSITION_M:g} m of the world origin '
+                    f'on each axis, got {tuple(pose.translation)}')
+    norm = math.hypot(*pose.rotation)
+    if norm < NORM_TOLERANCE:
         raise error('the orientation is a quaternion of length 0')
-
-
-def _normalized(pose: Transform) -> Transform:
-    norm = math.sqrt(sum(q * q for q in pose.rotation))
-    return Transform(tuple(pose.translation),
+    return Transform(tuple(pose.translation),  # type: ignore[arg-type]
                      tuple(q / norm for q in pose.rotation))  # type: ignore[arg-type]
+
+
+def check_twist(linear: Sequence[float], angular: Sequence[float],
+                error: Callable[[str], Exception]) -> None:
+    """Raise ``error(text)`` unless both velocities are finite and within their bounds.
+
+    Linear: length <= :data:`MAX_LINEAR_SPEED` m/s; angular: length <=
+    :data:`MAX_ANGULAR_SPEED` rad/s.
+    """
+    if not all(math.isfinite(v) for v in (*linear, *angular)):
+        raise error('the twist must be finite numbers')
+    for what, vector, bound, unit in (('linear', linear, MAX_LINEAR_SPEED, 'm/s'),
+                                      ('angular', angular, MAX_ANGULAR_SPEED, 'rad/s')):
+        if math.hypot(*vector) > bound:
+            raise error(f'the {what} velocity must be at most {bound:g} {unit} long, got '
+                        f'{tuple(vector)}')
 
 
 def _inverse(pose: Transform) -> Transform:

@@ -40,6 +40,13 @@ than wall time):
 * ``scaling``: serial chains of 2, 8 and 32 revolute joints, each with a
   position controller, at real_time_factor 0 with no subscriber:
   ``steps_per_s`` and ``node_cpu_us_per_step`` (keys are the joint counts).
+* ``service_round_trip``: sim_node at real_time_factor 1 (the default) answering
+  ``SERVICE_CALLERS`` callers of its simulation_interfaces services
+  (``get_entity_state`` and ``get_simulation_state``, half each) from one process
+  (this one, on loopback), each with one call in flight, for ``Plan.services_s``
+  wall seconds and at most ``SERVICE_MAX_CALLS`` calls: ``p50_ms`` / ``p99_ms``
+  of the round trips, ``answers_per_s`` and ``unanswered`` (calls with no answer
+  within ``SERVICE_CALL_TIMEOUT_S``); absent without simulation_interfaces.
 * ``sensor_us_per_message``: wall microseconds sim_node spends per message
   of each sensor of ``urdf/pan_tilt_sensors.xacro`` with every topic watched
   (:mod:`pan_tilt_sim.tools.sensor_cost`, in this process).
@@ -129,6 +136,10 @@ RAW_AGREEMENT = 0.25
 # 150..229 keeps DDS ports valid and away from the low ids people use by hand.
 PID_DOMAIN_BASE = 150
 PID_DOMAIN_COUNT = 80
+SERVICE_CALLERS = 20  # concurrent service callers, one call in flight each
+SERVICE_MAX_CALLS = 20_000  # calls at most in the service window, whatever its length
+SERVICE_CALL_TIMEOUT_S = 5.0  # a call unanswered this long counts as unanswered
+SIM_NODE_NAME = 'sim_node'
 
 
 @dataclasses.dataclass(frozen=True)
@@ -143,12 +154,13 @@ class Plan:
     startup_runs: int
     chain_s: float
     sensor_sim_s: float = 2.0  # sim seconds with every sensor watched
+    services_s: float = 5.0  # wall seconds of service calls
 
 
 FULL_PLAN = Plan(raw_s=3.0, raw_sim_s=RAW_SIM_S, warmup_s=1.0, fast_s=5.0, paced_s=10.0,
                  startup_runs=STARTUP_RUNS, chain_s=3.0)
 QUICK_PLAN = Plan(raw_s=0.3, raw_sim_s=QUICK_RAW_SIM_S, warmup_s=0.2, fast_s=0.6, paced_s=0.6,
-                  startup_runs=1, chain_s=0.4, sensor_sim_s=0.3)
+                  startup_runs=1, chain_s=0.4, sensor_sim_s=0.3, services_s=0.5)
 
 
 class BenchError(RuntimeError):
@@ -164,6 +176,7 @@ class Model:
     joint_states_topic: str
     # Command topic -> the two position targets it alternates between.
     commands: dict[str, tuple[float, float]]
+    robot: str = ''  # the robot's entity name (its URDF name)
 
 
 def load_model(description_file: pathlib.Path, controllers_file: pathlib.Path) -> Model:
@@ -181,7 +194,7 @@ def load_model(description_file: pathlib.Path, controllers_file: pathlib.Path) -
             commands[topic] = position_targets(joint.lower, joint.upper,
                                                joint.has_position_limits)
     return Model(description_file, controllers_file,
-                 naming.join(namespace, 'joint_states'), commands)
+                 naming.join(namespace, 'joint_states'), commands, description.name)
 
 
 def position_targets(lower: float, upper: float, limited: bool) -> tuple[float, float]:
@@ -667,6 +680,71 @@ class Bench:
             clock_cpu = (clock.cpu_seconds() - clock_start) / wall
         return cpu, clock_cpu
 
+    def service_round_trips(self, model: Model) -> dict[str, float] | None:
+        """Round trips of SERVICE_CALLERS concurrent service callers (see the module).
+
+        None where simulation_interfaces is not installed.
+        """
+        try:
+            from simulation_interfaces.srv import GetEntityState, GetSimulationState
+        except ImportError:
+            return None
+        node_probe = self.probe.node
+        calls = [(GetEntityState, 'get_entity_state', GetEntityState.Request(entity=model.robot)),
+                 (GetSimulationState, 'get_simulation_state', GetSimulationState.Request())]
+        clients = [(node_probe.create_client(kind, f'/{SIM_NODE_NAME}/{leaf}'), request)
+                   for kind, leaf, request in (calls[index % 2]
+                                               for index in range(SERVICE_CALLERS))]
+        try:
+            with self.node(model, 1.0) as node:
+                self.spin_until(node, lambda: all(c.service_is_ready() for c, _ in clients),
+                                FIRST_MESSAGE_TIMEOUT_S, 'simulation_interfaces services')
+                return self._call_in_a_loop(node, clients)
+        finally:
+            for client, _request in clients:
+                node_probe.destroy_client(client)
+
+    def _call_in_a_loop(self, node: NodeProcess, clients: list) -> dict[str, float]:
+        round_trips: list[float] = []
+        unanswered = 0
+        in_flight: dict[int, tuple[object, float]] = {}
+        started = time.monotonic()
+        stop_calling = started + self.plan.services_s
+        sent = 0
+
+        def call(index: int) -> None:
+            nonlocal sent
+            client, request = clients[index]
+            in_flight[index] = (client.call_async(request), time.monotonic())
+            sent += 1
+
+        for index in range(len(clients)):
+            call(index)
+        while in_flight:
+            node.check_alive()
+            self.probe.spin_once(SPIN_TIMEOUT_S)
+            now = time.monotonic()
+            for index, (future, sent_at) in list(in_flight.items()):
+                if future.done():
+                    round_trips.append(now - sent_at)
+                elif now - sent_at > SERVICE_CALL_TIMEOUT_S:
+                    unanswered += 1
+                    clients[index][0].remove_pending_request(future)
+                else:
+                    continue
+                del in_flight[index]
+                if now < stop_calling and sent < SERVICE_MAX_CALLS:
+                    call(index)
+        wall = time.monotonic() - started
+        if not round_trips:
+            raise BenchError('no service call was answered')
+        return {
+            'p50_ms': statistics.median(round_trips) * MILLISECONDS_PER_SECOND,
+            'p99_ms': percentile_99(round_trips) * MILLISECONDS_PER_SECOND,
+            'answers_per_s': len(round_trips) / wall,
+            'unanswered': float(unanswered),
+        }
+
     def startup_times(self, model: Model) -> tuple[float, float]:
         """Median wall times from a process start to its first JointState here.
 
@@ -743,6 +821,8 @@ def run_once(bench: Bench, model: Model) -> dict:
         factor_0[case] = {**figures, 'ratio_to_raw': figures['steps_per_s'] / raw['steps_per_s']}
     bench.log('sim_node at real_time_factor 1 with a /clock subscriber')
     paced = bench.paced(model)
+    bench.log(f'{SERVICE_CALLERS} service callers at real_time_factor 1')
+    service_round_trip = bench.service_round_trips(model)
     bench.log('start-up')
     startup, startup_floor = bench.startup_times(model)
     scaling = {}
@@ -753,7 +833,7 @@ def run_once(bench: Bench, model: Model) -> dict:
     bench.log('sensors, every topic watched')
     sensors = {name: figures['us_per_message'] for name, figures in sensor_costs(
         sim_seconds=plan.sensor_sim_s, domain_id=bench.domain_id).items()}
-    return {
+    figures = {
         'raw': raw,
         'factor_0': factor_0,
         'factor_1': paced,
@@ -762,6 +842,9 @@ def run_once(bench: Bench, model: Model) -> dict:
         'scaling': scaling,
         'sensor_us_per_message': sensors,
     }
+    if service_round_trip is not None:
+        figures['service_round_trip'] = service_round_trip
+    return figures
 
 
 def median_of(results: Sequence[dict]) -> dict:

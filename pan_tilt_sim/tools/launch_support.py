@@ -21,9 +21,7 @@ import os
 from collections.abc import Sequence
 from typing import Any
 
-import yaml
-
-from pan_tilt_sim.model import naming
+from pan_tilt_sim.model import naming, yaml_input
 from pan_tilt_sim.model.controller_config import (
     controllers_files_for,
     load_controllers_config,
@@ -62,8 +60,8 @@ def list_argument(text: str) -> list[str]:
     text = text.strip()
     if text.startswith('['):
         try:
-            items = yaml.safe_load(text)
-        except yaml.YAMLError:
+            items = yaml_input.load(text)
+        except yaml_input.YamlInputError:
             items = None
         if isinstance(items, list):
             return [str(item) for item in items]

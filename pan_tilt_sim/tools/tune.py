@@ -51,7 +51,11 @@ from collections.abc import Callable, Mapping, Sequence
 
 from pan_tilt_sim.controllers.pid import PidGains
 from pan_tilt_sim.errors import ConfigurationError, ControllerConfigError
-from pan_tilt_sim.model.controller_config import load_controllers_config, parse_controllers_args
+from pan_tilt_sim.model.controller_config import (
+    load_controllers_config,
+    parse_controllers_args,
+    read_text,
+)
 from pan_tilt_sim.model.gains_yaml import (
     GainsUpdate,
     clamp_values,
@@ -503,7 +507,7 @@ def write_yaml(scenario: Scenario, result: TuneResult, out: pathlib.Path) -> Non
     """
     config = scenario.controllers
     files = list(config.sources or (config.source,))
-    texts = [path.read_text(encoding='utf-8') for path in files]
+    texts = [read_text(path) for path in files]
     updates: dict[int, list[GainsUpdate]] = {}
     for tuning in result.tunings:
         path = ('pid',) if tuning.gains_field == 'pid' else ('gains', tuning.joint)

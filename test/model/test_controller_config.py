@@ -2,6 +2,7 @@
 
 import dataclasses
 import math
+import os
 import textwrap
 
 import pytest
@@ -628,3 +629,131 @@ def test_node_parameters_expand_substitutions_and_name_the_file(write_yaml):
     assert node_parameters([path], 'arm', {'prefix': 'left_'}) == {'joints': ['left_j']}
     with pytest.raises(ControllerConfigError, match=r'subst.yaml:3: \$\(var prefix\) is not set'):
         node_parameters([path], 'arm')
+
+
+# --- hostile or surprising files ------------------------------------------------------------
+
+LAUGHS = 'a0: &a0 [lol, lol, lol, lol, lol, lol, lol, lol, lol]\n' + ''.join(
+    f"a{level}: &a{level} [{', '.join([f'*a{level - 1}'] * 9)}]\n" for level in range(1, 10))
+
+
+@pytest.mark.parametrize(('text', 'problem'), [
+    ('a: &a [*a]\n', ':1: an alias refers to the node that holds it'),
+    ('a: &a {type: x, joint: *a}\n', ':1: an alias refers to the node that holds it'),
+    ('[' * 500 + ']' * 500 + '\n', ':1: nested deeper than 64 levels'),
+    (''.join(f"{'  ' * level}k{level}:\n" for level in range(500)), ': nested deeper than'),
+    (LAUGHS, 'its aliases expand it to more than 1,000,000 values'),
+], ids=['alias in itself', 'alias in a controller', '500 flow levels', '500 block levels',
+        'billion laughs'])
+def test_a_hostile_file_is_one_line_naming_it(write_yaml, text, problem):
+    path = write_yaml(text)
+    with pytest.raises(ControllerConfigError) as raised:
+        load_controllers_config(path)
+    message = str(raised.value)
+    assert message.startswith(f'{path}:')
+    assert problem in message
+    assert '\n' not in message
+    with pytest.raises(ControllerConfigError, match='nested deeper|alias|expand it'):
+        node_parameters([path], 'arm_controller')
+
+
+@pytest.mark.parametrize('device', ['/dev/null', '/dev/zero'])
+def test_a_device_is_not_a_regular_file_not_a_missing_one(device):
+    with pytest.raises(ControllerConfigError,
+                       match=f'controllers file {device}: not a regular file'):
+        load_controllers_config(device)
+
+
+def test_a_fifo_is_refused_without_waiting_for_a_writer(tmp_path):
+    fifo = tmp_path / 'controllers.yaml'
+    os.mkfifo(fifo)
+    with pytest.raises(ControllerConfigError, match=r'not a regular file \(a FIFO\)'):
+        load_controllers_config(fifo)
+
+
+def test_a_16_mb_file_is_refused_by_its_size(write_yaml):
+    line = 'c{}: {{type: position_controllers/JointPositionController, joint: pan_joint}}\n'
+    path = write_yaml(''.join(line.format(index) for index in range(16 * 1024 * 1024 // 72)))
+    with pytest.raises(ControllerConfigError, match=f'{path}: larger than 1048576 bytes'):
+        load_controllers_config(path)
+
+
+ANCHOR_BESIDE_THE_ROBOT = """
+    base: &base
+      type: position_controllers/JointPositionController
+      joint: pan_joint
+      pid: {p: 100.0, i: 0.01, d: 10.0}
+    my_robot:
+      pan_controller: *base
+      tilt_controller: {<<: *base, joint: tilt_joint}
+    """
+
+
+def test_a_block_of_controllers_beside_top_level_ones_is_named_in_a_warning(write_yaml):
+    path = write_yaml(ANCHOR_BESIDE_THE_ROBOT)
+    config = load_controllers_config(path)
+    assert [spec.name for spec in config.controllers] == ['base']
+    warning, = config.warnings
+    assert warning.startswith(f"{path}: top-level key 'my_robot' holds controllers "
+                              "('pan_controller', 'tilt_controller') that are not loaded")
+    assert "('base')" in warning
+
+
+def test_the_warning_reaches_the_simulations_start_up_report(write_yaml):
+    path = write_yaml(ANCHOR_BESIDE_THE_ROBOT)
+    messages = []
+    with make_simulation(str(package_share() / 'urdf' / 'pan_tilt.xacro'), str(path), 0.001,
+                         logger=_ListLogger(messages)):
+        pass
+    assert any("top-level key 'my_robot' holds controllers" in line for line in messages)
+
+
+class _ListLogger:
+    """A logger keeping warning lines."""
+
+    def __init__(self, lines):
+        self.lines = lines
+
+    def warning(self, message):
+        self.lines.append(message)
+
+    def info(self, message):
+        pass
+
+
+def test_one_namespace_key_or_top_level_controllers_alone_warn_of_nothing(repo_root, seeds_dir):
+    assert load_controllers_config(repo_root / 'config' / 'pan_tilt_control.yaml').warnings == ()
+    assert load_controllers_config(seeds_dir / 'joint_controllers.yaml').warnings == ()
+
+
+def test_several_blocks_of_controllers_and_none_at_the_top_are_an_error(write_yaml):
+    path = write_yaml("""
+        defaults: &defaults
+          pan_controller: {type: position_controllers/JointPositionController, joint: pan_joint}
+        my_robot:
+          <<: *defaults
+          tilt_controller: {type: position_controllers/JointPositionController,
+                            joint: tilt_joint}
+        """)
+    with pytest.raises(ControllerConfigError,
+                       match=f"{path}: several top-level keys hold controllers "
+                             r"\('defaults', 'my_robot'\)"):
+        load_controllers_config(path)
+
+
+def test_a_ros2_file_names_a_block_of_controllers_it_ignores(write_yaml):
+    path = write_yaml("""
+        common: &common
+          type: position_controllers/JointGroupPositionController
+        controller_manager:
+          ros__parameters:
+            arm_controller: *common
+        arm_controller:
+          ros__parameters:
+            joints: [pan_joint]
+        """)
+    config = load_controllers_config(path)
+    assert [spec.name for spec in config.controllers] == ['arm_controller']
+    warning, = config.warnings
+    assert warning.startswith(f"{path}: top-level key 'common' holds a controller")
+    assert "no 'ros__parameters'" in warning

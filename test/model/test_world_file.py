@@ -80,7 +80,12 @@ def test_a_world_file_by_file_uri_and_its_default_scenery(tmp_path):
     ('entities: [{uri: a, name: x}, {uri: b, name: x}]\n', "the name 'x' is used twice"),
     ('entities: [\n', r'world.yaml:\d+: YAML syntax error'),
     ('other: 1\n', "the file: unknown key 'other'"),
-])
+    ('a: &a [*a]\n', 'world.yaml:1: an alias refers to the node that holds it'),
+    ('[' * 500 + ']' * 500 + '\n', 'world.yaml:1: nested deeper than 64 levels'),
+    ('a0: &a0 [x, x, x, x, x, x, x, x, x]\n' + ''.join(
+        f"a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 9)}]\n" for i in range(1, 10)),
+     'its aliases expand it to more than'),
+], ids=lambda value: value[:40] if isinstance(value, str) else None)
 def test_every_problem_names_the_file_and_the_field(tmp_path, text, message):
     path = _world(tmp_path, text)
     with pytest.raises(WorldFileError, match=message) as error:
@@ -97,6 +102,18 @@ def test_neither_a_scenery_nor_a_file_lists_the_choices(tmp_path):
         world_from_parameter('package://no_such_package/world.yaml')
     with pytest.raises(ParameterError, match="parameter 'world' must be one of"):
         world_from_parameter('')
+
+
+def test_a_huge_quaternion_is_normalised_not_zeroed(tmp_path):
+    world = read_world_file(_world(
+        tmp_path, 'entities: [{uri: a, pose: {orientation: [0, 0, 1.0e+300, 1.0e+300]}}]\n'))
+    assert world.entities[0].orientation == pytest.approx((0.0, 0.0, 0.5 ** 0.5, 0.5 ** 0.5))
+
+
+@pytest.mark.parametrize('device', ['/dev/null', '/dev/zero'])
+def test_a_device_given_as_the_world_is_not_a_regular_file(device):
+    with pytest.raises(WorldFileError, match=f'{device}: not a regular file'):
+        world_from_parameter(device)
 
 
 def test_the_shipped_world_file_reads(repo_root):

@@ -1,6 +1,18 @@
 """Pacing: steps per tick follow wall time times the real-time factor."""
 
-from pan_tilt_sim.ros.pacing import FAST_BATCH_STEPS, FAST_TICK_S, MAX_CATCH_UP_S, Pacer, Throttle
+import math
+
+import pytest
+
+from pan_tilt_sim.ros.pacing import (
+    FAST_BATCH_STEPS,
+    FAST_TICK_S,
+    MAX_CATCH_UP_S,
+    MAX_PACED_BATCH_STEPS,
+    MAX_REAL_TIME_FACTOR,
+    Pacer,
+    Throttle,
+)
 
 
 class FakeClock:
@@ -87,6 +99,30 @@ def test_restart_forgets_time_spent_paused():
     assert pacer.steps_due() == 0
     clock.now += 0.02
     assert pacer.steps_due() == 20
+
+
+@pytest.mark.parametrize('factor', [1e308, MAX_REAL_TIME_FACTOR * 1.001, math.inf, math.nan,
+                                    -1.0])
+def test_a_factor_outside_the_bound_is_a_value_error_not_an_overflow_later(factor):
+    pacer = Pacer(1.0, 0.001)
+    with pytest.raises(ValueError, match='real_time_factor'):
+        pacer.real_time_factor = factor
+    assert pacer.real_time_factor == 1.0
+
+
+def test_a_tick_at_the_highest_factor_and_smallest_step_runs_a_bounded_batch():
+    clock = FakeClock()
+    pacer = Pacer(MAX_REAL_TIME_FACTOR, 1e-6, clock)
+    pacer.steps_due()
+    clock.now += 1.0  # wants 1e9 steps
+    assert pacer.steps_due() == MAX_PACED_BATCH_STEPS
+    clock.now += 1e-6  # the debt was dropped: only this microsecond's steps are due
+    assert pacer.steps_due() in (999, 1000)  # float wall times: a step may fall either side
+
+
+def test_a_time_step_whose_rate_overflows_is_refused():
+    with pytest.raises(ValueError, match='more steps per second than a float holds'):
+        Pacer(1.0, 5e-324)
 
 
 # --- the /clock throttle: one per wall millisecond on average, in bursts ----------------

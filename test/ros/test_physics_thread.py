@@ -9,10 +9,12 @@ import pytest
 import rclpy
 from rclpy.parameter import Parameter
 from std_msgs.msg import Float64
+from std_srvs.srv import Empty
 from waiting import BUDGET_S, wait_for
 
 from pan_tilt_sim.ros.command_reader import ReaderGroup
 from pan_tilt_sim.ros.physics_thread import PhysicsThread, Turns, TurnTakingExecutor, Wakeup
+from pan_tilt_sim.ros.ros_interfaces import SERVICE_QOS
 from pan_tilt_sim.ros.runner import StopRequested, StopSignals
 from pan_tilt_sim.ros.sim_node import SimNode
 
@@ -164,6 +166,40 @@ def test_a_failing_tick_wakes_an_executor_that_waits_without_a_timeout(context):
     finally:
         thread.stop()
         executor.shutdown()
+
+
+def test_requests_ready_together_are_served_in_one_turn_not_one_per_batch(context):
+    # Each batch holds the turn for 20 ms; 30 requests queued at once must not wait
+    # for 30 batches.
+    turns, batches, served_in = Turns(), [], []
+
+    def tick():
+        batches.append(1)
+        time.sleep(0.02)  # a batch of steps in progress
+
+    server = rclpy.create_node('server', context=context)
+    caller = rclpy.create_node('caller', context=context)
+    server.create_service(Empty, 'ping', lambda request, response: (
+        served_in.append(len(batches)), response)[1], qos_profile=SERVICE_QOS)
+    clients = [caller.create_client(Empty, 'ping', qos_profile=SERVICE_QOS) for _ in range(30)]
+    executor = TurnTakingExecutor(turns, context=context)
+    executor.add_node(server)
+    thread = PhysicsThread(tick, lambda: 0.0, turns)
+    try:
+        assert wait_for(lambda: all(client.service_is_ready() for client in clients))
+        for client in clients:
+            client.call_async(Empty.Request())
+        thread.start()
+        deadline = time.monotonic() + BUDGET_S
+        while len(served_in) < len(clients) and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.05)
+    finally:
+        thread.stop()
+        executor.shutdown()
+        caller.destroy_node()
+        server.destroy_node()
+    assert len(served_in) == len(clients)
+    assert len(set(served_in)) <= 5, f'served between batches {sorted(set(served_in))}'
 
 
 # --- sim_node with its physics thread -------------------------------------------------

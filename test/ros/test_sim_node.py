@@ -302,3 +302,19 @@ def test_paced_a_batch_is_one_chunk_and_its_stamps_leave_after_it_before_its_joi
         # The broadcaster (50 Hz) samples the state at the batch's first step.
         assert sent == [('clock', round(t + 0.01, 9)), ('clock', round(t + 0.02, 9)),
                         ('joint_states', round(t, 9))]
+
+
+@pytest.mark.parametrize('factor', [1e308, 1001.0, math.inf, -1.0])
+def test_a_real_time_factor_pacing_cannot_follow_is_refused_and_the_node_runs_on(factor):
+    with sim_node(real_time_factor=0.0) as harness:
+        result, = harness.set_parameters(real_time_factor=factor)
+        assert not result.successful
+        assert "'real_time_factor'" in result.reason
+        assert harness.node.real_time_factor == 0.0
+        before = harness.simulation.time
+        assert harness.spin_until(lambda: harness.simulation.time > before + 0.05), \
+            'the node stopped stepping'
+        accepted, = harness.set_parameters(real_time_factor=1000.0)
+        assert accepted.successful, accepted.reason
+        paced = harness.simulation.time
+        assert harness.spin_until(lambda: harness.simulation.time > paced + 0.05)

@@ -262,6 +262,62 @@ def test_set_state_in_another_frame_and_of_a_static_object(sim):
     assert unknown_frame.result == srv.SetEntityState.Response.INVALID_POSE
 
 
+def _twist(linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0, 0.0)) -> Twist:
+    twist = Twist()
+    twist.linear.x, twist.linear.y, twist.linear.z = linear
+    twist.angular.x, twist.angular.y, twist.angular.z = angular
+    return twist
+
+
+@pytest.mark.parametrize(('at', 'twist', 'code', 'reason'), [
+    (pose(1e308, 0.0, 1.0), None, 'INVALID_POSE', 'the position must lie within'),
+    (pose(0.0, 0.0, 1.0), _twist(linear=(1e308, 0.0, 0.0)), 'OPERATION_FAILED',
+     'the linear velocity must be at most'),
+    (pose(0.0, 0.0, 1.0), _twist(angular=(0.0, 0.0, 1e300)), 'OPERATION_FAILED',
+     'the angular velocity must be at most'),
+    (pose(0.0, 0.0, 1.0), _twist(linear=(1e308, 1e308, 1e308)), 'OPERATION_FAILED',
+     'the linear velocity must be at most'),
+    (pose(orientation=(1e-300, 0.0, 0.0, 0.0)), None, 'INVALID_POSE', 'length 0'),
+], ids=['position 1e308', 'linear 1e308', 'angular 1e300', 'linear overflowing its length',
+        'quaternion 1e-300'])
+def test_a_state_physics_cannot_run_is_refused_and_the_entity_stays_sound(sim, at, twist, code,
+                                                                          reason):
+    _spawn_box(sim, 'box', z=HALF)
+    before = position(sim.entity_state('box'))
+    refused = sim.set_entity_state('box', at, twist)
+    expected = (srv.SetEntityState.Response.INVALID_POSE if code == 'INVALID_POSE'
+                else Result.RESULT_OPERATION_FAILED)
+    assert refused.result == expected, refused.error_message
+    assert reason in refused.error_message
+    assert sim.step(10).result == OK
+    assert position(sim.entity_state('box')) == pytest.approx(before, abs=1e-3)
+    # Requests relative to it still work.
+    assert sim.set_entity_state('box', pose(0.0, 0.0, 1.0, frame='box')).result == OK
+    assert all(math.isfinite(v) for v in position(sim.entity_state('box')))
+
+
+@pytest.mark.parametrize('scale', [1e300, 1e308, 1e-3])
+def test_a_huge_or_small_quaternion_is_normalised(sim, scale):
+    _spawn_box(sim, 'box', z=HALF)
+    quarter_turn = (0.0, 0.0, math.sin(math.pi / 4), math.cos(math.pi / 4))
+    at = pose(0.0, 2.0, 1.0, tuple(scale * q for q in quarter_turn))
+    assert sim.set_entity_state('box', at).result == OK
+    o = sim.entity_state('box').pose.orientation
+    assert (o.x, o.y, o.z, o.w) == pytest.approx(quarter_turn)
+    assert sim.step(10).result == OK
+    assert position(sim.entity_state('box')) == pytest.approx((0.0, 2.0, 1.0), abs=1e-2)
+    relative = sim.set_entity_state('box', pose(0.0, 0.0, 0.5, frame='box'))
+    assert relative.result == OK
+
+
+def test_a_pose_beyond_the_bound_once_in_the_world_frame_is_refused(sim):
+    _spawn_box(sim, 'box', z=HALF)
+    assert sim.set_entity_state('box', pose(9e5, 0.0, 1.0)).result == OK
+    refused = sim.set_entity_state('box', pose(9e5, 0.0, 0.0, frame='box'))
+    assert refused.result == srv.SetEntityState.Response.INVALID_POSE
+    assert 'the position must lie within' in refused.error_message
+
+
 def test_a_pose_is_that_of_the_urdf_root_frame_not_the_centre_of_mass(sim):
     _spawn_box(sim, 'offset', x=0.0, y=2.0, z=1.0, com=(0.05, 0.0, 0.0))
     assert position(sim.entity_state('offset')) == pytest.approx((0.0, 2.0, 1.0))

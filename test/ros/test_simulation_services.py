@@ -25,9 +25,11 @@ from std_srvs.srv import Empty
 
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.ros import simulation_services
+from pan_tilt_sim.ros.ros_interfaces import SERVICE_QOS
 
 Features = msg.SimulatorFeatures
 TIME_STEP = 0.002  # not the default, so that "steps x time_step" is checked
+MAX_STEPS = simulation_services.MAX_STEP_SIMULATION_STEPS
 
 
 @pytest.fixture
@@ -162,6 +164,21 @@ def test_quitting_answers_then_shuts_the_context_down(paused):
     assert not sim.node.context.ok()
 
 
+def test_forty_callers_at_once_are_all_answered(paused):
+    # rclpy's default service QoS keeps 10 requests: a burst beyond that lost the oldest.
+    sim = paused.sim
+    callers = 40
+    clients = [sim.probe.create_client(srv.GetSimulationState, paused.name('get_simulation_state'),
+                                       qos_profile=SERVICE_QOS) for _ in range(callers)]
+    assert sim.spin_until(lambda: all(client.service_is_ready() for client in clients))
+    futures = [client.call_async(srv.GetSimulationState.Request()) for client in clients]
+    assert sim.spin_until(lambda: all(future.done() for future in futures), budget_s=10.0), \
+        f'{sum(not future.done() for future in futures)} of {callers} requests unanswered'
+    assert {future.result().state.state for future in futures} == {State.STATE_STOPPED}
+    for client in clients:
+        sim.probe.destroy_client(client)
+
+
 # --- stepping ------------------------------------------------------------------------------
 
 def test_step_simulation_runs_exactly_the_steps_asked_for_and_publishes_for_them(paused):
@@ -191,11 +208,11 @@ def test_a_single_step_is_one_time_step(paused):
 
 def test_stepping_while_playing_is_refused(playing):
     before = playing.sim.simulation.steps
-    result = playing.step(1_000_000)
+    result = playing.step(MAX_STEPS)
     assert result.result == Result.RESULT_OPERATION_FAILED
     assert 'paused' in result.error_message
-    # Not a million steps: the answer came at once (the pace runs on, a little).
-    assert playing.sim.simulation.steps - before < 100_000
+    # Not the steps asked for: the answer came at once (the pace runs on, a little).
+    assert playing.sim.simulation.steps - before < MAX_STEPS
 
 
 def test_many_steps_leave_the_executor_free_between_slices(paused):
@@ -203,7 +220,7 @@ def test_many_steps_leave_the_executor_free_between_slices(paused):
     sim = paused.sim
     client = paused._client('step_simulation')
     paused._client('get_simulation_state')
-    future = client.call_async(srv.StepSimulation.Request(steps=300_000))
+    future = client.call_async(srv.StepSimulation.Request(steps=MAX_STEPS))
     assert sim.spin_until(lambda: sim.simulation.steps > 0)
     state = paused.call('get_simulation_state')  # answered between slices
     assert not future.done()
@@ -213,14 +230,26 @@ def test_many_steps_leave_the_executor_free_between_slices(paused):
     assert 'in progress' in second.error_message
     assert sim.spin_until(future.done, budget_s=60.0)
     assert future.result().result.result == OK
-    assert sim.simulation.steps == 300_000
+    assert sim.simulation.steps == MAX_STEPS
+
+
+@pytest.mark.parametrize('steps', [MAX_STEPS + 1, 2 ** 63, 2 ** 64 - 1])
+def test_step_simulation_beyond_its_bound_is_refused_at_once_pointing_to_the_action(paused,
+                                                                                   steps):
+    result = paused.step(steps)
+    assert result.result == Result.RESULT_OPERATION_FAILED
+    assert f'at most {MAX_STEPS} steps' in result.error_message
+    assert 'simulate_steps' in result.error_message
+    assert paused.sim.simulation.steps == 0
+    assert paused.step(3).result == OK  # nothing left running
+    assert paused.sim.simulation.steps == 3
 
 
 def test_setting_playing_while_stepping_fails_the_request(paused):
     sim = paused.sim
     client = paused._client('step_simulation')
     paused._client('set_simulation_state')
-    future = client.call_async(srv.StepSimulation.Request(steps=10_000_000))
+    future = client.call_async(srv.StepSimulation.Request(steps=MAX_STEPS))
     assert sim.spin_until(lambda: sim.simulation.steps > 0)
     assert paused.set_state(State.STATE_PLAYING).result == OK
     assert sim.spin_until(future.done)

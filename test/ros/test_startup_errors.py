@@ -93,6 +93,10 @@ FILES = {
                                 'JointPositionController, joint: pan_joint}\n',
     'plugin_gains.yaml': 'a: {type: position_controllers/JointPositionController, '
                          'joint: pan_joint}\ngazebo_ros_control: {pid_gains: {elbow: {p: 1}}}\n',
+    'self_alias.yaml': 'a: &a [*a]\n',
+    'deep.yaml': '[' * 500 + ']' * 500 + '\n',
+    'laughs.yaml': 'a0: &a0 [lol, lol, lol, lol, lol, lol, lol, lol, lol]\n' + ''.join(
+        f"a{level}: &a{level} [{', '.join([f'*a{level - 1}'] * 9)}]\n" for level in range(1, 10)),
 }
 
 
@@ -173,6 +177,16 @@ CASES = [
           'not a valid ROS namespace'),
     _case('controller name invalid', {'controllers_file': '{dir}/bad_controller_name.yaml'},
           ControllerConfigError, "'pan controller'", 'not a valid ROS name'),
+    _case('controllers alias inside its anchor', {'controllers_file': '{dir}/self_alias.yaml'},
+          ControllerConfigError, '{dir}/self_alias.yaml:1: an alias refers to the node'),
+    _case('controllers nested 500 levels', {'controllers_file': '{dir}/deep.yaml'},
+          ControllerConfigError, '{dir}/deep.yaml:1: nested deeper than 64 levels'),
+    _case('controllers billion laughs', {'controllers_file': '{dir}/laughs.yaml'},
+          ControllerConfigError, '{dir}/laughs.yaml:', 'aliases expand it to more than'),
+    _case('controllers /dev/null', {'controllers_file': '/dev/null'},
+          ControllerConfigError, 'controllers file /dev/null: not a regular file'),
+    _case('controllers /dev/zero', {'controllers_file': '/dev/zero'},
+          ControllerConfigError, 'controllers file /dev/zero: not a regular file'),
     # Parameters: values.
     _case('time_step zero', {'time_step': 0.0}, ParameterError, "'time_step'", '> 0', '0.0'),
     _case('time_step negative', {'time_step': -0.001}, ParameterError, "'time_step'", '-0.001'),
@@ -184,6 +198,10 @@ CASES = [
           ParameterError, "'real_time_factor'", 'finite', 'inf'),
     _case('real_time_factor NaN', {'real_time_factor': float('nan')},
           ParameterError, "'real_time_factor'", 'finite', 'nan'),
+    _case('real_time_factor 1e308', {'real_time_factor': 1e308},
+          ParameterError, "'real_time_factor' must be <= 1000", '1e+308'),
+    _case('time_step below a microsecond', {'time_step': 5e-324},
+          ParameterError, "'time_step' must be >= 1e-06 s", '5e-324'),
     _case('robot_namespace starts with a digit', {'robot_namespace': '1robot'},
           ParameterError, "'robot_namespace'", "'1robot'", 'not a valid ROS namespace'),
     _case('robot_namespace with a space', {'robot_namespace': 'my robot'},
@@ -258,6 +276,19 @@ def test_a_bad_start_up_input_raises_one_line_naming_it(context, files, override
         assert _fill(part, files) in message
 
 
+def test_a_fifo_or_a_16_mb_controllers_file_is_refused_at_once(context, tmp_path):
+    fifo = tmp_path / 'fifo.yaml'
+    os.mkfifo(fifo)
+    huge = tmp_path / 'huge.yaml'
+    huge.write_text('c: {type: position_controllers/JointPositionController, joint: pan_joint}\n'
+                    * (16 * 1024 * 1024 // 70))
+    for path, problem in ((fifo, 'not a regular file (a FIFO)'), (huge, 'larger than')):
+        with pytest.raises(ControllerConfigError) as raised:
+            SimNode(context=context, parameter_overrides=_overrides(
+                {'controllers_file': str(path)}))
+        assert str(raised.value).startswith(f'controllers file {path}: {problem}')
+
+
 @pytest.mark.parametrize('overrides', [
     {'time_step': -1.0},  # the first parameter read
     {'controllers_file': '/no/such/controllers.yaml'},  # after the description
@@ -311,6 +342,8 @@ def _assert_one_line_exit_2(result, *expected: str) -> str:
                  id='fixed joint (after PyBullet loaded the robot)'),
     pytest.param(['-p', 'controllers_file:={dir}/bad_controller_name.yaml'],
                  ["'pan controller'"], id='controller name not a ROS name'),
+    pytest.param(['-p', 'controllers_file:={dir}/laughs.yaml'],
+                 ['{dir}/laughs.yaml:', 'aliases expand it'], id='billion laughs'),
     pytest.param(['-p', "initial_positions:=['tilt_joint:=-2.0', 'roll:=1']"],
                  ["parameter 'initial_positions': 'roll' is not a movable joint"],
                  id='initial position of an unknown joint (after PyBullet loaded the robot)'),

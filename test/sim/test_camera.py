@@ -17,6 +17,7 @@ from pan_tilt_sim.sim.camera import (
     Renderer,
     camera_mount,
     intrinsics,
+    nothing_drawn,
     vertical_fov_deg,
 )
 from pan_tilt_sim.sim.physics import Physics
@@ -173,6 +174,24 @@ def test_the_image_is_upright_sky_above_ground_below(renderer):
     image = as_array(renderer.render([math.pi / 4, HORIZONTAL_TILT]), renderer.settings)
     assert image[0].min() == 255  # background above the horizon
     assert (image[-1] == GROUND_RGB).all()  # ground below
+
+
+@pytest.mark.parametrize(('near', 'far'), [(0.1, 100.0), (0.05, 10.0), (0.02, 10.0)])
+def test_the_ground_is_painted_whatever_the_clip_planes(renderer, seed_description, near, far):
+    settings = CameraSettings(near=near, far=far)
+    camera = Renderer(renderer.physics, seed_description.model, settings, 'targets')
+    renderer.physics.reset_joints([math.pi / 4, HORIZONTAL_TILT - 0.3])
+    image = as_array(camera.render(), settings)
+    below = int(intrinsics(settings).cy) + 5  # the horizon is above the centre row
+    assert (image[below:, 100] == GROUND_RGB).all()
+    assert image[0].min() == 255  # and the sky stays background
+
+
+def test_only_buffer_values_within_a_few_float32_steps_of_one_are_nothing_drawn():
+    step = 2.0 ** -24
+    buffer = numpy.array([1.0 + 2 * step, 1.0, 1.0 - step, 1.0 - 2 * step,
+                          1.0 - 8 * step, 1.0 - 9 * step, 0.999, 0.5], dtype=numpy.float32)
+    assert nothing_drawn(buffer).tolist() == [True] * 5 + [False] * 3
 
 
 @pytest.mark.parametrize('down', [0.0, 0.2, -0.3])

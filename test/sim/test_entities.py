@@ -198,6 +198,46 @@ def test_passive_joints_of_an_object_move_freely(seed):
         body, 0, physicsClientId=simulation.physics.client_id)[0] == 0.0
 
 
+@pytest.mark.parametrize(('state', 'problem'), [
+    (EntityState(Transform((0.0, 0.0, 1e308))), 'the position must lie within'),
+    (EntityState(Transform((0.0, 0.0, 1.0)), (1e308, 0.0, 0.0)), 'the linear velocity'),
+    (EntityState(Transform((0.0, 0.0, 1.0)), (0.0, 0.0, 0.0), (1e300, 1e300, 0.0)),
+     'the angular velocity'),
+    (EntityState(Transform((0.0, 0.0, 1.0), (0.0, 0.0, 0.0, 1e-9))), 'length 0'),
+], ids=['position', 'linear', 'angular', 'degenerate quaternion'])
+def test_a_state_beyond_the_physics_bounds_is_refused_and_changes_nothing(seed, state, problem):
+    simulation, entities = seed
+    entities.spawn('ball', resource_string=box_urdf(), pose=Transform((0.0, 3.0, 1.0)))
+    with pytest.raises(EntityStateError, match=problem):
+        entities.set_state('ball', state)
+    simulation.advance(100)
+    after = entities.state('ball')
+    assert all(math.isfinite(v) for v in (*after.pose.translation, *after.pose.rotation,
+                                          *after.linear, *after.angular))
+    assert after.pose.translation[:2] == pytest.approx((0.0, 3.0), abs=1e-3)
+
+
+@pytest.mark.parametrize('scale', [1e308, 1e300, 1e-5])
+def test_any_quaternion_of_finite_non_zero_length_is_normalised(seed, scale):
+    simulation, entities = seed
+    turned = (0.0, 0.0, math.sin(0.4), math.cos(0.4))
+    entities.spawn('ball', resource_string=box_urdf(),
+                   pose=Transform((0.0, 3.0, 1.0), tuple(scale * q for q in turned)))
+    assert entities.state('ball').pose.rotation == pytest.approx(turned)
+    entities.set_state('ball', EntityState(Transform((0.0, 2.0, 1.0),
+                                                     tuple(scale * q for q in turned))))
+    simulation.advance(10)
+    assert entities.state('ball').pose.rotation == pytest.approx(turned, abs=1e-6)
+
+
+def test_a_spawn_beyond_the_position_bound_is_refused(seed):
+    _simulation, entities = seed
+    with pytest.raises(SpawnError, match='the position must lie within') as refused:
+        entities.spawn('far', resource_string=box_urdf(), pose=Transform((2e6, 0.0, 0.0)))
+    assert refused.value.problem is SpawnProblem.INVALID_POSE
+    assert 'far' not in entities
+
+
 def test_names_renaming_and_refusals(seed):
     _simulation, entities = seed
     assert entities.spawn('', resource_string=box_urdf(name='crate')) == 'crate'

@@ -109,6 +109,71 @@ def test_a_ground_in_the_world_has_its_depth(rig):
     assert numpy.abs(centre - CAMERA_Z).max() <= ONE_PERCENT * CAMERA_Z
 
 
+# The clip ranges and sizes users declare: Gazebo's defaults (320x240, 0.1-100 m), and
+# 160x120 to 1280x720 with near 0.02-0.1 m and far 10-100 m.  TinyRenderer's "nothing
+# drawn" depth is 1.0 give or take a float32 step or two, depending on near and far.
+GROUND_CLIPS = [(0.1, 100.0), (0.02, 10.0), (0.05, 10.0), (0.1, 10.0), (0.02, 100.0),
+                (0.05, 30.0)]
+GROUND_PITCHES = [0.3, 0.8, math.pi / 2]  # rad below horizontal; pi/2: straight down
+GROUND_HEIGHT = 1.2  # m: the camera above the ground
+
+
+def _ground_view(rig, width, height, near, far, pitch):
+    """Render a depth camera GROUND_HEIGHT above the ground, facing away from the wall."""
+    from dataclasses import replace
+
+    from pan_tilt_sim.model.transforms import Transform, quaternion_from_rpy
+
+    spec = sensor(rig, 'depth_camera')
+    # Declared the gazebo_ros way: on the link, +x forward, pitched down by `pitch`,
+    # turned to look along -x (the wall is at +x).
+    pose = Transform((0.0, 0.0, GROUND_HEIGHT - CAMERA_Z), quaternion_from_rpy(0.0, pitch, math.pi))
+    declared = replace(spec, pose=pose, camera=replace(spec.camera, width=width, height=height,
+                                                       near=near, far=far))
+    return VisionSensor(rig.physics, declared, 'ground')
+
+
+def _expected_ground_depth(camera: VisionSensor, pitch: float) -> numpy.ndarray:
+    """Planar depth of the plane z = 0 for each pixel (inf where the ray misses it)."""
+    # Optical ray (x, y, 1) with y down: its world z is -sin(pitch) - y cos(pitch).
+    intrinsics = camera.intrinsics
+    rows = (numpy.arange(camera.camera.height) - intrinsics.cy) / intrinsics.fy
+    falling = math.sin(pitch) + rows * math.cos(pitch)
+    with numpy.errstate(divide='ignore'):
+        column = numpy.where(falling > 0.0, GROUND_HEIGHT / falling, math.inf)
+    return numpy.repeat(column[:, numpy.newaxis], camera.camera.width, axis=1)
+
+
+def _assert_the_ground_has_its_depth_and_colour(view, expected, far):
+    from pan_tilt_sim.sim.world import GROUND_RGB
+
+    seen = expected < 0.99 * far  # clear of the far plane's own margin
+    assert seen.any()
+    error = numpy.abs(view.depth[seen] - expected[seen]) / expected[seen]
+    assert error.max() <= ONE_PERCENT, (
+        f'{(error > ONE_PERCENT).sum()} of {seen.sum()} ground pixels off; '
+        f'worst reads {view.depth[seen][error.argmax()]:.3f} m for '
+        f'{expected[seen][error.argmax()]:.3f} m')
+    assert (view.rgb[seen] == GROUND_RGB).all()
+
+
+@pytest.mark.parametrize(('near', 'far'), GROUND_CLIPS)
+def test_the_ground_has_its_depth_whatever_the_clip_range_and_pitch(rig, near, far):
+    for pitch in GROUND_PITCHES:
+        camera = _ground_view(rig, 160, 120, near, far, pitch)
+        _assert_the_ground_has_its_depth_and_colour(
+            camera.render(), _expected_ground_depth(camera, pitch), far)
+
+
+@pytest.mark.parametrize(('width', 'height'), [(160, 120), (320, 240), (640, 480), (1280, 720)])
+def test_the_ground_has_its_depth_at_every_image_size(rig, width, height):
+    near, far = 0.05, 10.0
+    for pitch in (0.5, math.pi / 2):
+        camera = _ground_view(rig, width, height, near, far, pitch)
+        _assert_the_ground_has_its_depth_and_colour(
+            camera.render(), _expected_ground_depth(camera, pitch), far)
+
+
 # --- lidar --------------------------------------------------------------------------------------
 
 def test_lidar_centre_beam_meets_the_wall_within_the_declared_resolution(rig):

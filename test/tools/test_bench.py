@@ -23,6 +23,7 @@ FACTOR_0 = {
     'joint_state_subscriber': {'steps_per_s', 'node_cpu_us_per_step', 'ratio_to_raw',
                                'subscriber_cpu_percent'},
 }
+SERVICE_ROUND_TRIP = {'p50_ms', 'p99_ms', 'answers_per_s', 'unanswered'}
 FACTOR_1 = {'cpu_percent', 'cpu_percent_with_joint_states', 'clock_subscriber_cpu_percent',
             'joint_states_p50_ms', 'joint_states_p99_ms', 'rtf_error'}
 
@@ -52,7 +53,8 @@ def quick_run():
 def test_quick_prints_exactly_one_json_object_with_every_figure(quick_run):
     figures = json.loads(quick_run[0])
     assert set(figures) == {'raw', 'factor_0', 'factor_1', 'startup_s', 'startup_floor_s',
-                            'scaling', 'sensor_us_per_message'}
+                            'scaling', 'sensor_us_per_message', 'service_round_trip'}
+    assert set(figures['service_round_trip']) == SERVICE_ROUND_TRIP
     assert set(figures['raw']) == RAW
     assert {case: set(values) for case, values in figures['factor_0'].items()} == FACTOR_0
     assert set(figures['factor_1']) == FACTOR_1
@@ -65,6 +67,14 @@ def test_quick_prints_exactly_one_json_object_with_every_figure(quick_run):
         assert math.isfinite(value) and value >= 0, (key, value)
     assert figures['raw']['steps_per_s'] > 0
     assert all(case['steps_per_s'] > 0 for case in figures['factor_0'].values())
+
+
+@pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
+def test_quick_answers_every_service_call_of_its_concurrent_callers(quick_run):
+    figures = json.loads(quick_run[0])['service_round_trip']
+    assert figures['unanswered'] == 0.0
+    assert figures['answers_per_s'] > 0
+    assert 0 < figures['p50_ms'] <= figures['p99_ms']
 
 
 @pytest.mark.timeout(QUICK_TIMEOUT_S + 30)

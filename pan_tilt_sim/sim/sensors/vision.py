@@ -12,7 +12,8 @@ OpenGL's: a buffer value ``d`` in [0, 1] is ``z_ndc = 2 d - 1`` of a
 perspective division, so the distance along the optical axis is
 ``z = far * near / (far - (far - near) * d)`` -- planar depth, what
 sensor_msgs/Image depth images and point clouds carry (not the distance
-along the pixel's ray).  Where nothing was drawn (``d = 1``), a world with
+along the pixel's ray).  Where nothing was drawn (``d = 1``, give or take the
+renderer's rounding: :func:`~pan_tilt_sim.sim.camera.nothing_drawn`), a world with
 a ground gives the depth of the ground plane z = 0 along the pixel's ray,
 as the colour image paints it (see :mod:`pan_tilt_sim.sim.world`); else
 there is nothing: ``+inf``.
@@ -28,7 +29,7 @@ import numpy
 from pan_tilt_sim.model.sensors import CameraSpec, SensorSpec, data_frame
 from pan_tilt_sim.model.transforms import Transform, rotation_matrix
 from pan_tilt_sim.sim.bullet import pybullet
-from pan_tilt_sim.sim.camera import Intrinsics, centred_intrinsics
+from pan_tilt_sim.sim.camera import Intrinsics, centred_intrinsics, nothing_drawn
 from pan_tilt_sim.sim.physics import Physics
 from pan_tilt_sim.sim.sensors.mount import LinkReader
 from pan_tilt_sim.sim.sensors.noise import NoiseModel
@@ -36,7 +37,6 @@ from pan_tilt_sim.sim.world import GROUND_RGB, has_ground
 
 RGBA_CHANNELS = 4
 RGB_CHANNELS = 3
-BACKGROUND = 1.0  # OpenGL depth where nothing was drawn (the far plane)
 BYTE_MAX = 255.0
 
 
@@ -105,7 +105,7 @@ class VisionSensor:
             camera.height, camera.width, RGBA_CHANNELS)[:, :, :RGB_CHANNELS]
         buffer = numpy.asarray(buffer, dtype=numpy.float32).reshape(camera.height, camera.width)
         depth = linear_depth(buffer.astype(numpy.float64), self.near, self.far)
-        empty = buffer >= BACKGROUND
+        empty = nothing_drawn(buffer)
         depth[empty] = math.inf
         if self._ground and empty.any():
             # World z of each pixel's ray (optical (x, y, 1)), and where it meets z = 0:
