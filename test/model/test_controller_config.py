@@ -721,9 +721,9 @@ class _ListLogger:
         pass
 
 
-def test_one_namespace_key_or_top_level_controllers_alone_warn_of_nothing(repo_root, seeds_dir):
+def test_one_namespace_key_or_top_level_controllers_alone_warn_of_nothing(repo_root, original_examples):
     assert load_controllers_config(repo_root / 'config' / 'pan_tilt_control.yaml').warnings == ()
-    assert load_controllers_config(seeds_dir / 'joint_controllers.yaml').warnings == ()
+    assert load_controllers_config(original_examples / 'joint_controllers.yaml').warnings == ()
 
 
 def test_several_blocks_of_controllers_and_none_at_the_top_are_an_error(write_yaml):
