@@ -22,6 +22,11 @@ from std_msgs.msg import Float64MultiArray
 
 RRBOT = ['rrbot_joint1', 'rrbot_joint2']
 THREEDOFBOT = ['threedofbot_joint1', 'threedofbot_joint2', 'threedofbot_joint3']
+JSB_TYPE = 'joint_state_broadcaster/JointStateBroadcaster'
+# The global broadcaster's entry under controller_manager's ros__parameters.
+GLOBAL_ENTRY = f"""
+            joint_state_broadcaster:
+              type: {JSB_TYPE}"""
 RRBOT_JSB, THREEDOFBOT_JSB = 'rrbot_joint_state_broadcaster', 'threedofbot_joint_state_broadcaster'
 PID_GAIN_START = 0.25  # threedofbot_joint1's pid_gain initial_value; the others have none
 TARGET = [0.5, -0.25]  # rad, the rrbot's command
@@ -40,7 +45,7 @@ def _control_joint(name: str, *custom: str, initial: float | None = None) -> str
     return '\n'.join([*lines, '</joint>'])
 
 
-def write_three_robots(folder):
+def write_three_robots(folder, *, global_broadcaster: bool = True):
     """Write the fixture's URDF and controllers file; return both paths."""
     blocks = (
         '<ros2_control name="RRBotSystemPositionOnly" type="system">'
@@ -57,15 +62,13 @@ def write_three_robots(folder):
     controllers = write_text(folder, 'three_robots_controllers.yaml', f"""
         controller_manager:
           ros__parameters:
-            update_rate: 100
-            joint_state_broadcaster:
-              type: joint_state_broadcaster/JointStateBroadcaster
+            update_rate: 100{GLOBAL_ENTRY if global_broadcaster else ''}
             {RRBOT_JSB}:
-              type: joint_state_broadcaster/JointStateBroadcaster
+              type: {JSB_TYPE}
             rrbot_position_controller:
               type: forward_command_controller/ForwardCommandController
             {THREEDOFBOT_JSB}:
-              type: joint_state_broadcaster/JointStateBroadcaster
+              type: {JSB_TYPE}
         {RRBOT_JSB}:
           ros__parameters:
             use_local_topics: True
@@ -194,3 +197,13 @@ def test_list_controllers_shows_the_interfaces_each_broadcaster_reads(three_robo
     # Those the hardware lists: the <ros2_control> blocks declare position (and pid_gain).
     assert required == {'joint_state_broadcaster': rrbot + threedofbot, RRBOT_JSB: rrbot,
                         THREEDOFBOT_JSB: threedofbot}
+
+
+def test_with_only_local_broadcasters_start_up_warns_that_joint_states_stays_empty(
+        tmp_path, capfd):
+    urdf, controllers = write_three_robots(tmp_path, global_broadcaster=False)
+    with sim_node(robot_description_file=str(urdf), controllers_file=str(controllers)) as sim:
+        topic = sim.node.topic('joint_states')
+    assert (f'no joint_state_broadcaster in {controllers} publishes on {topic} '
+            f'(use_local_topics: {RRBOT_JSB}, {THREEDOFBOT_JSB}): nothing will be published on '
+            f'{topic}') in capfd.readouterr().err
