@@ -3,10 +3,11 @@
 The fixture is shaped like ros2_control_demos' example 13 (several robots
 under one controller_manager), written here from scratch: one URDF holding
 a two-joint ``rrbot`` and a three-joint ``threedofbot`` whose
-``<ros2_control>`` block also declares a ``pid_gain`` state interface; a
-controllers file with a global joint_state_broadcaster, one broadcaster per
-robot with ``use_local_topics`` and ``joints`` x ``interfaces``, and a
-forward position controller for the rrbot.
+``<ros2_control>`` block also declares ``velocity`` and a custom
+``pid_gain`` state interface; a controllers file with a global
+joint_state_broadcaster, one broadcaster per robot with ``use_local_topics``
+and ``joints`` x ``interfaces``, and a forward position controller for the
+rrbot.
 """
 
 from __future__ import annotations
@@ -36,10 +37,13 @@ needs_control_msgs = pytest.mark.skipif(importlib.util.find_spec('control_msgs')
                                         reason='control_msgs is not installed')
 
 
-def _control_joint(name: str, *custom: str, initial: float | None = None) -> str:
+def _control_joint(name: str, *custom: str, initial: float | None = None,
+                   velocity: bool = False) -> str:
     start = '' if initial is None else f'<param name="initial_value">{initial}</param>'
     lines = [f'<joint name="{name}">', '<command_interface name="position"/>',
              '<state_interface name="position"/>']
+    if velocity:
+        lines.append('<state_interface name="velocity"/>')
     lines += [f'<state_interface name="{interface}">{start}</state_interface>'
               for interface in custom]
     return '\n'.join([*lines, '</joint>'])
@@ -53,8 +57,8 @@ def write_three_robots(folder, *, global_broadcaster: bool = True):
         + ''.join(_control_joint(joint) for joint in RRBOT) + '</ros2_control>'
         '<ros2_control name="FakeThreeDofBot" type="system">'
         '<hardware><plugin>mock_components/GenericSystem</plugin></hardware>'
-        + _control_joint(THREEDOFBOT[0], 'pid_gain', initial=PID_GAIN_START)
-        + ''.join(_control_joint(joint, 'pid_gain') for joint in THREEDOFBOT[1:])
+        + _control_joint(THREEDOFBOT[0], 'pid_gain', initial=PID_GAIN_START, velocity=True)
+        + ''.join(_control_joint(joint, 'pid_gain', velocity=True) for joint in THREEDOFBOT[1:])
         + '</ros2_control>')
     urdf = star_robot_urdf([JointDef(name) for name in RRBOT + THREEDOFBOT], 'three_robots')
     urdf_path = folder / 'three_robots.urdf'
@@ -192,11 +196,13 @@ def test_list_controllers_shows_the_interfaces_each_broadcaster_reads(three_robo
     required = {name: list(listed[name].required_state_interfaces)
                 for name in ('joint_state_broadcaster', RRBOT_JSB, THREEDOFBOT_JSB)}
     rrbot = [f'{joint}/position' for joint in RRBOT]
-    threedofbot = [f'{joint}/{interface}' for joint in THREEDOFBOT
-                   for interface in ('position', 'pid_gain')]
-    # Those the hardware lists: the <ros2_control> blocks declare position (and pid_gain).
-    assert required == {'joint_state_broadcaster': rrbot + threedofbot, RRBOT_JSB: rrbot,
-                        THREEDOFBOT_JSB: threedofbot}
+    # What each reads that the hardware lists: the <ros2_control> blocks declare no effort.
+    assert required == {
+        'joint_state_broadcaster': rrbot + [f'{joint}/{interface}' for joint in THREEDOFBOT
+                                            for interface in ('position', 'velocity', 'pid_gain')],
+        RRBOT_JSB: rrbot,
+        THREEDOFBOT_JSB: [f'{joint}/{interface}' for joint in THREEDOFBOT
+                          for interface in ('position', 'pid_gain')]}
 
 
 def test_with_only_local_broadcasters_start_up_warns_that_joint_states_stays_empty(
