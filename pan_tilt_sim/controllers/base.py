@@ -45,12 +45,14 @@ from pan_tilt_sim.controllers.parameter_spec import (
 from pan_tilt_sim.controllers.pid import Pid, PidGains
 from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint
 from pan_tilt_sim.errors import ControllerConfigError
-from pan_tilt_sim.model.robot import JointKind, JointSpec
+from pan_tilt_sim.model.robot import ControlJoint, JointKind, JointSpec
 from pan_tilt_sim.schedule import PeriodicSchedule
 
 # The command interface a ros2_control controller package's controllers claim.
 PACKAGE_INTERFACES = {'position_controllers': 'position', 'velocity_controllers': 'velocity',
                       'effort_controllers': 'effort'}
+# The state interfaces the physics measures for every joint; each is a JointHandle attribute.
+MEASURED_STATES = ('position', 'velocity', 'effort')
 # Largest command magnitude taken on a side without a limit (rad, m, rad/s, N*m...):
 # far beyond any real joint, small enough that PID arithmetic on it stays finite.
 MAX_COMMAND_MAGNITUDE = 1e12
@@ -148,15 +150,32 @@ class JointHandle:
     step (gz_ros2_control's ``position_proportional_gain``).  ``actuator``
     is what drives the joint now: the simulation sets it from the active
     controllers (:meth:`Controller.actuators`).
+
+    ``control`` is the joint's entry in the URDF's ``<ros2_control>`` block,
+    if it has one.  The joint's state interfaces (:attr:`state_interface_names`)
+    are the :data:`MEASURED_STATES` -- the physics measures all three for
+    every joint -- then the other ``<state_interface>`` entries the block
+    declares for it (:attr:`other_states`).  The physics measures none of
+    those: each keeps the value it starts with (its ``initial_value``, else
+    NaN), as a state interface of ros2_control's mock hardware does when
+    nothing commands it.
     """
 
     __slots__ = ('spec', 'position', 'velocity', 'effort', 'velocity_target',
-                 'initial_position', 'plugin_gains', 'tracking_gain', 'actuator')
+                 'initial_position', 'plugin_gains', 'tracking_gain', 'actuator',
+                 'other_states')
 
     def __init__(self, spec: JointSpec, initial_position: float | None = None,
                  plugin_gains: PidGains | None = None,
-                 tracking_gain: float = TRACKING_GAIN) -> None:
+                 tracking_gain: float = TRACKING_GAIN,
+                 control: ControlJoint | None = None) -> None:
         self.spec = spec
+        # Unmeasured state interfaces, in the block's order, and the value each holds
+        # (read-only by contract; a plain dict so that handles can be copied).
+        self.other_states: Mapping[str, float] = {
+            interface.name: interface.initial_value
+            for interface in (control.state_interfaces if control is not None else ())
+            if interface.name not in MEASURED_STATES}
         self.initial_position = (spec.initial_position if initial_position is None
                                  else initial_position)
         self.plugin_gains = plugin_gains
@@ -176,6 +195,11 @@ class JointHandle:
     def drive(self) -> Drive:
         """How the physics moves the joint (see :class:`Drive`)."""
         return self.actuator.drive
+
+    @property
+    def state_interface_names(self) -> tuple[str, ...]:
+        """The joint's state interfaces: the measured ones, then :attr:`other_states`."""
+        return (*MEASURED_STATES, *self.other_states)
 
     def reset(self) -> None:
         """Return to the joint's initial state (at rest, no effort)."""

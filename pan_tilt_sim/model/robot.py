@@ -28,6 +28,7 @@ from pan_tilt_sim.model.transforms import (
 
 DEFAULT_AXIS: Vector = (1.0, 0.0, 0.0)  # URDF's default joint axis
 POSITION_PROPORTIONAL_GAIN = 'position_proportional_gain'
+INITIAL_VALUE = 'initial_value'  # the <param> of a ros2_control interface that sets its start
 
 
 class JointKind(enum.Enum):
@@ -194,6 +195,19 @@ class ControlInterface:
 
     name: str
     params: Mapping[str, str] = dataclasses.field(default_factory=dict)
+
+    @property
+    def initial_value(self) -> float:
+        """The value the interface holds until something writes it: ``initial_value``, else NaN.
+
+        A ros2_control interface starts so (hardware_interface's handles).  A
+        text that is not a number gives NaN too (an interface of another data
+        type, ``data_type="bool"``, holds no number).
+        """
+        try:
+            return float(self.params.get(INITIAL_VALUE, 'nan'))
+        except ValueError:
+            return math.nan
 
 
 @dataclasses.dataclass(frozen=True)

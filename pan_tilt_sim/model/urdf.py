@@ -17,6 +17,7 @@ from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.robot import (
     DEFAULT_AXIS,
+    INITIAL_VALUE,
     POSITION_PROPORTIONAL_GAIN,
     ControlInterface,
     ControlJoint,
@@ -60,7 +61,6 @@ URDF_ROOT_TAG = 'robot'
 GAZEBO_ROS_CONTROL_PLUGINS = ('libgazebo_ros_control.so', 'libgazebo_ros2_control.so',
                               'gz_ros2_control-system', 'libgz_ros2_control-system.so',
                               'ign_ros2_control-system', 'libign_ros2_control-system.so')
-INITIAL_VALUE = 'initial_value'
 POSITION = 'position'
 INERTIA_FIELDS = ('ixx', 'ixy', 'ixz', 'iyy', 'iyz', 'izz')
 SHAPE_ROLES = ('visual', 'collision')

@@ -10,7 +10,8 @@ controller type:
 * a :class:`~pan_tilt_sim.controllers.surface.CommandTopic`: a subscription
   whose messages' values go to the controller (:data:`COMMAND_MESSAGES`);
 * a :class:`~pan_tilt_sim.controllers.surface.StateTopic`: a publisher and
-  the sink the controller hands its samples to (:data:`STATE_SINKS`);
+  the sink the controller hands its samples to (:data:`STATE_SINKS`), where
+  the message's interface package is installed;
 * an :class:`~pan_tilt_sim.controllers.surface.ActionServer`, where its
   interface package is installed (:data:`ACTION_SERVERS`);
 
@@ -32,7 +33,7 @@ entities in step.  Each is one short call, made between physics steps.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
 from rclpy.node import Node
@@ -41,9 +42,10 @@ from sensor_msgs.msg import JointState
 from pan_tilt_sim.controllers import CommandResult, Controller
 from pan_tilt_sim.controllers.surface import PRIVATE, ActionServer, CommandTopic, StateTopic
 from pan_tilt_sim.errors import ConfigurationError
+from pan_tilt_sim.ros import optional_interfaces
 from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.gain_parameters import GainParameters
-from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES, joint_state_message
+from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES, joint_state_message, stamp
 from pan_tilt_sim.ros.trajectory_action import TrajectoryActionServer
 from pan_tilt_sim.sim.engine import Simulation
 
@@ -134,7 +136,7 @@ class ControllerBindings:
                 return
 
     def flush_joint_states(self) -> None:
-        """Publish the JointState samples the broadcasters took since the last flush."""
+        """Publish the samples the state topics took since the last flush."""
         for _controller, _publisher, sink in self._state_sinks:
             sink.flush()
 
@@ -169,7 +171,8 @@ class ControllerBindings:
                 if self._command_topics:
                     entities.append(self._subscribe(controller, endpoint))
             elif isinstance(endpoint, StateTopic):
-                entities.append(self._publish(controller, endpoint))
+                if endpoint.message in STATE_SINKS:
+                    entities.append(self._publish(controller, endpoint))
             elif isinstance(endpoint, ActionServer):
                 self._serve(controller, endpoint)
         self._noticing.append(controller)
@@ -214,6 +217,9 @@ class ControllerBindings:
         entities = self._entities.pop(name, None)
         if entities is None:
             return
+        for owner, endpoint, _publisher, _sink in self._connections:
+            if owner == name:
+                endpoint.connect(None)  # its publisher goes: no more samples for it
         for entity in entities:
             if hasattr(entity, 'publish'):
                 self._node.destroy_publisher(entity)
@@ -292,11 +298,61 @@ class JointStateSink:
             self._publisher.publish(self._message)
 
 
-# Each state message type (by its ROS name): its class, and the sink that
-# turns a controller's samples into messages on a publisher.
-STATE_SINKS: dict[str, tuple[type, Callable[[Any, Mapping[str, Any]], Any]]] = {
-    'sensor_msgs/msg/JointState': (JointState, JointStateSink),
-}
+class DynamicJointStateSink:
+    """A broadcaster's samples as DynamicJointState messages, held until :meth:`flush`.
+
+    The topic's fields name the joints (``joint_names``) and each joint's
+    interfaces (``interface_names``), once; a sample is a list of values per
+    joint, copied into one reused message.  Held and published as
+    :class:`JointStateSink` holds and publishes its samples.
+    """
+
+    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
+        from control_msgs.msg import DynamicJointState, InterfaceValue
+
+        self._publisher = publisher
+        self._message = DynamicJointState()
+        self._message.joint_names = list(fields['joint_names'])
+        self._message.interface_values = [InterfaceValue(interface_names=list(names))
+                                          for names in fields['interface_names']]
+        self._pending = False
+
+    def __call__(self, time: float, values: Sequence[Sequence[float]]) -> None:
+        """Take a sample: ``values[i]`` are joint i's interface values."""
+        if self._pending:
+            self._publisher.publish(self._message)
+        message = self._message
+        stamp(time, message.header.stamp)
+        for interface_value, joint_values in zip(message.interface_values, values, strict=True):
+            interface_value.values = joint_values
+        self._pending = True
+
+    def flush(self) -> None:
+        """Publish the sample taken since the last flush, if any."""
+        if self._pending:
+            self._pending = False
+            self._publisher.publish(self._message)
+
+
+def _state_sinks() -> dict[str, tuple[type, Callable[[Any, Mapping[str, Any]], Any]]]:
+    sinks: dict[str, tuple[type, Callable[[Any, Mapping[str, Any]], Any]]] = {
+        'sensor_msgs/msg/JointState': (JointState, JointStateSink),
+    }
+    if optional_interfaces.available('control_msgs'):
+        try:
+            from control_msgs.msg import DynamicJointState
+        except ImportError:  # a control_msgs without it (older than the stand-in's)
+            pass
+        else:
+            sinks['control_msgs/msg/DynamicJointState'] = (DynamicJointState,
+                                                            DynamicJointStateSink)
+    return sinks
+
+
+# Each state message type (by its ROS name) whose interface package is
+# installed: its class, and the sink that turns a controller's samples into
+# messages on a publisher.  A state topic of another type is not created.
+STATE_SINKS = _state_sinks()
 # Each action type: the server that runs a controller's goals.
 ACTION_SERVERS: dict[str, Callable[..., Any]] = {
     'control_msgs/action/FollowJointTrajectory': TrajectoryActionServer,

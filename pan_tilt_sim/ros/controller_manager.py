@@ -399,8 +399,10 @@ class ControllerManagerNode(Node):
 
     def _state_interfaces_of(self, controller) -> list[str]:
         if isinstance(controller, JointStateController):
-            return [f'{joint}/{interface}' for joint in controller.names
-                    for interface in self._interfaces_of(joint, False)]
+            # What it reads that the hardware lists (it reads every measured interface).
+            return [f'{joint}/{interface}'
+                    for joint, read in controller.state_interfaces().items()
+                    for interface in read if interface in self._interfaces_of(joint, False)]
         interfaces = _flatten(controller.state_interfaces())
         if not interfaces and isinstance(controller, CommandController) and (
                 controller.pids()):

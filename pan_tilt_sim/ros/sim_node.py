@@ -480,11 +480,15 @@ class SimNode(Node):
         if inactive:
             logger.info(f"loaded but inactive (not in 'active_controllers'): "
                         f"{', '.join(inactive)}")
-        broadcasters = [c for c in manager.controllers if isinstance(c, JointStateController)]
+        every = [c for c in manager.controllers if isinstance(c, JointStateController)]
+        broadcasters = [c for c in every if not c.params['use_local_topics']]
         topic = self.topic('joint_states')
         if not broadcasters:
+            local = [c.name for c in every]
+            where = (f' publishes on {topic} (use_local_topics: {", ".join(local)})' if local
+                     else '')
             logger.warning(
-                f'no joint_state_broadcaster in {controllers.label}: nothing will '
+                f'no joint_state_broadcaster in {controllers.label}{where}: nothing will '
                 f'be published on {topic}')
         elif not any(manager.is_active(c.name) for c in broadcasters):
             logger.warning(

@@ -94,9 +94,11 @@ class Simulation:
             initial_positions=[starts[joint].position for joint in movable],
             warn=load_messages.append)
         try:
-            gain = description.model.position_proportional_gain or TRACKING_GAIN
+            model = description.model
+            gain = model.position_proportional_gain or TRACKING_GAIN
             self.handles = {
-                joint.name: JointHandle(joint, position, gains.get(joint.name), gain)
+                joint.name: JointHandle(joint, position, gains.get(joint.name), gain,
+                                        control=model.control_joint(joint.name))
                 for joint, position in zip(self.physics.joints,
                                            self.physics.initial_positions, strict=True)}
             self.manager = ControllerManager(controllers, self.handles, description.model,

@@ -721,7 +721,8 @@ class _ListLogger:
         pass
 
 
-def test_one_namespace_key_or_top_level_controllers_alone_warn_of_nothing(repo_root, original_examples):
+def test_one_namespace_key_or_top_level_controllers_alone_warn_of_nothing(repo_root,
+                                                                          original_examples):
     assert load_controllers_config(repo_root / 'config' / 'pan_tilt_control.yaml').warnings == ()
     assert load_controllers_config(original_examples / 'joint_controllers.yaml').warnings == ()
 

@@ -1,10 +1,13 @@
-"""controller_bindings: the declared surface on the node; JointStates held until flushed."""
+"""controller_bindings: the declared surface on the node; samples held until flushed."""
 
+import importlib.util
+
+import pytest
 from node_harness import sim_node
 from rcl_interfaces.msg import Log
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile
 
-from pan_tilt_sim.ros.controller_bindings import JointStateSink
+from pan_tilt_sim.ros.controller_bindings import DynamicJointStateSink, JointStateSink
 
 
 class RecordingPublisher:
@@ -69,3 +72,34 @@ def test_a_misspelt_controller_parameter_is_logged_with_the_closest_known_one(tm
             [entry.msg for entry in log]
         assert not sim.node.simulation.manager.controller('arm')._flags[
             'allow_partial_joints_goal']
+
+
+class RecordingDynamicPublisher:
+    """Keeps each DynamicJointState sent, as it was at that moment."""
+
+    def __init__(self) -> None:
+        self.sent: list[tuple] = []
+
+    def publish(self, message) -> None:
+        stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+        self.sent.append((round(stamp, 9), list(message.joint_names),
+                          [(list(value.interface_names), list(value.values))
+                           for value in message.interface_values]))
+
+
+@pytest.mark.skipif(importlib.util.find_spec('control_msgs') is None,
+                    reason='control_msgs is not installed')
+def test_a_dynamic_sample_is_copied_and_held_until_flushed():
+    publisher = RecordingDynamicPublisher()
+    sink = DynamicJointStateSink(publisher, {'joint_names': ('a', 'b'), 'interface_names': (
+        ('position', 'temperature'), ('position',))})
+    values = [[0.5, 21.5], [-0.25]]
+    sink(0.02, values)
+    values[0][0] = 9.0  # the broadcaster reuses its lists
+    sink(0.04, values)
+    assert len(publisher.sent) == 1
+    sink.flush()
+    sink.flush()
+    assert publisher.sent == [
+        (0.02, ['a', 'b'], [(['position', 'temperature'], [0.5, 21.5]), (['position'], [-0.25])]),
+        (0.04, ['a', 'b'], [(['position', 'temperature'], [9.0, 21.5]), (['position'], [-0.25])])]
