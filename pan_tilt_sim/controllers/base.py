@@ -232,6 +232,7 @@ class CommandKind(enum.Enum):
     FLOAT64 = 'std_msgs/msg/Float64'
     FLOAT64_ARRAY = 'std_msgs/msg/Float64MultiArray'
     JOINT_TRAJECTORY = 'trajectory_msgs/msg/JointTrajectory'
+    MULTI_DOF_COMMAND = 'control_msgs/msg/MultiDOFCommand'
 
 
 class CommandResult(enum.Enum):

@@ -19,6 +19,7 @@ from pan_tilt_sim.controllers.joint_position_controller import JointPositionCont
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
 from pan_tilt_sim.controllers.joint_trajectory_controller import JointTrajectoryController
 from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
+from pan_tilt_sim.controllers.pid_controller import PidController
 from pan_tilt_sim.errors import ControllerConfigError
 
 CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
@@ -31,6 +32,7 @@ CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
     JointGroupVelocityController,
     JointGroupEffortController,
     JointTrajectoryController,
+    PidController,
 )
 
 CONTROLLER_TYPES: dict[str, type[Controller]] = {

@@ -1,12 +1,12 @@
-"""A controller's ROS surface, declared as data: its topics and actions.
+"""A controller's ROS surface, declared as data: its topics, services and actions.
 
 A controller returns its surface from
 :meth:`~pan_tilt_sim.controllers.base.Controller.ros_surface`; the ROS
 adapter (:mod:`pan_tilt_sim.ros.controller_bindings`) creates one entity per
 entry while the controller is configured and removes them at cleanup.  The
-adapter knows message and action types, never controller types: an entry
-names its interface type (``std_msgs/msg/Float64MultiArray``) and carries
-the controller's callable that takes or gives the data.
+adapter knows message, service and action types, never controller types: an
+entry names its interface type (``std_msgs/msg/Float64MultiArray``) and
+carries the controller's callable that takes or gives the data.
 
 Topic names follow ros2_controllers: ``~/name`` is in the controller's own
 namespace (``<robot namespace>/<controller>/name``), any other relative name
@@ -31,13 +31,16 @@ class CommandTopic:
     (see the adapter's table for each message type) and says what became of
     it; ``problem(value, result)`` describes a refused or clamped value for
     the node's throttled warning.  Commands reach an inactive controller
-    only as a warning.
+    only as a warning, and a controller in chained mode (whose references
+    come from the controller before it) likewise -- unless ``while_chained``:
+    the topic carries something else than references (measurements).
     """
 
     name: str
     message: str
     accept: Callable[[Any], Any]  # returns a base.CommandResult
     problem: Callable[[Any, Any], str]
+    while_chained: bool = False
 
 
 @dataclasses.dataclass(frozen=True)
@@ -56,6 +59,20 @@ class StateTopic:
 
 
 @dataclasses.dataclass(frozen=True)
+class Service:
+    """A service served while the controller is configured, active or not.
+
+    ``call(value)`` takes the value the adapter extracted from a request
+    (see the adapter's table for each service type) and returns
+    ``(success, message)`` for the response.
+    """
+
+    name: str
+    service: str
+    call: Callable[[Any], tuple[bool, str]]
+
+
+@dataclasses.dataclass(frozen=True)
 class ActionServer:
     """An action server run by the controller (the adapter has one server per action type)."""
 
@@ -63,4 +80,4 @@ class ActionServer:
     action: str
 
 
-Endpoint = CommandTopic | StateTopic | ActionServer
+Endpoint = CommandTopic | StateTopic | Service | ActionServer

@@ -12,13 +12,18 @@ controller type:
 * a :class:`~pan_tilt_sim.controllers.surface.StateTopic`: a publisher and
   the sink the controller hands its samples to (:data:`STATE_SINKS`), where
   the message's interface package is installed;
+* a :class:`~pan_tilt_sim.controllers.surface.Service`: a service whose
+  requests' values go to the controller (:data:`SERVICES`);
 * an :class:`~pan_tilt_sim.controllers.surface.ActionServer`, where its
   interface package is installed (:data:`ACTION_SERVERS`);
 
+
+each where its interface package is installed (an optional one may not be);
 plus its tunable PID gains as sim_node parameters (:mod:`.gain_parameters`).
 A command controller's commands are ignored while it is inactive, or in
 chained mode (then the controller before it in the chain writes its
-references).  Given a :class:`~pan_tilt_sim.ros.command_reader.CommandReader` (the sim_node
+references) unless the topic is taken ``while_chained``.  Given a
+:class:`~pan_tilt_sim.ros.command_reader.CommandReader` (the sim_node
 program), the command subscriptions are read by it rather than by the
 executor.
 
@@ -37,17 +42,34 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
 from rclpy.node import Node
+from rclpy.service import Service as ServiceEntity
 from sensor_msgs.msg import JointState
+from std_srvs.srv import SetBool
 
 from pan_tilt_sim.controllers import CommandResult, Controller
-from pan_tilt_sim.controllers.surface import PRIVATE, ActionServer, CommandTopic, StateTopic
+from pan_tilt_sim.controllers.surface import (
+    PRIVATE,
+    ActionServer,
+    CommandTopic,
+    Service,
+    StateTopic,
+)
 from pan_tilt_sim.errors import ConfigurationError
-from pan_tilt_sim.ros import optional_interfaces
 from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.gain_parameters import GainParameters
 from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES, joint_state_message, stamp
 from pan_tilt_sim.ros.trajectory_action import TrajectoryActionServer
 from pan_tilt_sim.sim.engine import Simulation
+
+try:
+    from control_msgs.msg import (
+        DynamicJointState,
+        InterfaceValue,
+        MultiDOFStateStamped,
+        SingleDOFState,
+    )
+except ImportError:  # an optional interface package (see optional_interfaces)
+    DynamicJointState = InterfaceValue = MultiDOFStateStamped = SingleDOFState = None
 
 QUEUE_DEPTH = 10
 WARNING_THROTTLE_S = 1.0
@@ -168,11 +190,13 @@ class ControllerBindings:
             self._logger.warning(warning)
         for endpoint in controller.ros_surface():
             if isinstance(endpoint, CommandTopic):
-                if self._command_topics:
+                if self._command_topics and COMMAND_MESSAGES[endpoint.message][0] is not None:
                     entities.append(self._subscribe(controller, endpoint))
             elif isinstance(endpoint, StateTopic):
-                if endpoint.message in STATE_SINKS:
+                if STATE_SINKS.get(endpoint.message, (None,))[0] is not None:
                     entities.append(self._publish(controller, endpoint))
+            elif isinstance(endpoint, Service):
+                entities.append(self._provide(controller, endpoint))
             elif isinstance(endpoint, ActionServer):
                 self._serve(controller, endpoint)
         self._noticing.append(controller)
@@ -204,6 +228,16 @@ class ControllerBindings:
         endpoint.connect(sink)
         return publisher
 
+    def _provide(self, controller: Controller, endpoint: Service) -> Any:
+        service_type, extract = SERVICES[endpoint.service]
+        call = endpoint.call
+
+        def serve(request: Any, response: Any) -> Any:
+            response.success, response.message = call(extract(request))
+            return response
+        return self._node.create_service(service_type, self._name(controller, endpoint.name),
+                                         serve)
+
     def _serve(self, controller: Controller, endpoint: ActionServer) -> None:
         if not self._actions_wanted or endpoint.action not in ACTION_SERVERS:
             return
@@ -223,6 +257,8 @@ class ControllerBindings:
         for entity in entities:
             if hasattr(entity, 'publish'):
                 self._node.destroy_publisher(entity)
+            elif isinstance(entity, ServiceEntity):
+                self._node.destroy_service(entity)
             else:
                 if self._reader is not None:
                     self._reader.remove(entity)
@@ -243,6 +279,7 @@ class ControllerBindings:
         counts = self.commands_received
         is_active = self._manager.is_active
         accept, problem = endpoint.accept, endpoint.problem
+        while_chained = endpoint.while_chained
 
         def store(message: Any) -> None:
             counts[name] += 1
@@ -250,7 +287,7 @@ class ControllerBindings:
                 logger.warning(f'{name}: ignored a command: the controller is inactive',
                                throttle_duration_sec=WARNING_THROTTLE_S)
                 return
-            if controller.is_chained:
+            if controller.is_chained and not while_chained:
                 logger.warning(f'{name}: ignored a command: the controller is in chained mode, '
                                'its references come from the controller before it',
                                throttle_duration_sec=WARNING_THROTTLE_S)
@@ -308,8 +345,6 @@ class DynamicJointStateSink:
     """
 
     def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
-        from control_msgs.msg import DynamicJointState, InterfaceValue
-
         self._publisher = publisher
         self._message = DynamicJointState()
         self._message.joint_names = list(fields['joint_names'])
@@ -334,25 +369,51 @@ class DynamicJointStateSink:
             self._publisher.publish(self._message)
 
 
-def _state_sinks() -> dict[str, tuple[type, Callable[[Any, Mapping[str, Any]], Any]]]:
-    sinks: dict[str, tuple[type, Callable[[Any, Mapping[str, Any]], Any]]] = {
-        'sensor_msgs/msg/JointState': (JointState, JointStateSink),
-    }
-    if optional_interfaces.available('control_msgs'):
-        try:
-            from control_msgs.msg import DynamicJointState
-        except ImportError:  # a control_msgs without it (older than the stand-in's)
-            pass
-        else:
-            sinks['control_msgs/msg/DynamicJointState'] = (DynamicJointState,
-                                                            DynamicJointStateSink)
-    return sinks
+class DofStateSink:
+    """A controller's per-DoF samples as ``control_msgs/msg/MultiDOFStateStamped`` messages.
+
+    A sample is the time and, per DoF of ``fields['names']``, ``(reference,
+    feedback, feedback_dot, error, error_dot, time_step, output)``; it is
+    held and leaves as :class:`JointStateSink`'s do: when the next sample
+    comes, or at :meth:`flush`.
+    """
+
+    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
+        self._publisher = publisher
+        self._message = MultiDOFStateStamped(
+            dof_states=[SingleDOFState(name=name) for name in fields['names']])
+        self._pending = False
+
+    def __call__(self, time: float, rows: Iterable[Iterable[float]]) -> None:
+        """Take a sample."""
+        if self._pending:
+            self._publisher.publish(self._message)
+        stamp(time, self._message.header.stamp)
+        for state, row in zip(self._message.dof_states, rows, strict=True):
+            (state.reference, state.feedback, state.feedback_dot, state.error, state.error_dot,
+             state.time_step, state.output) = row
+        self._pending = True
+
+    def flush(self) -> None:
+        """Publish the sample taken since the last flush, if any."""
+        if self._pending:
+            self._pending = False
+            self._publisher.publish(self._message)
 
 
-# Each state message type (by its ROS name) whose interface package is
-# installed: its class, and the sink that turns a controller's samples into
-# messages on a publisher.  A state topic of another type is not created.
-STATE_SINKS = _state_sinks()
+# Each state message type (by its ROS name): its class (None where its interface package is
+# not installed: no such topics then), and the sink that turns a controller's samples into
+# messages on a publisher.
+STATE_SINKS: dict[str, tuple[type | None, Callable[[Any, Mapping[str, Any]], Any]]] = {
+    'sensor_msgs/msg/JointState': (JointState, JointStateSink),
+    'control_msgs/msg/DynamicJointState': (DynamicJointState, DynamicJointStateSink),
+    'control_msgs/msg/MultiDOFStateStamped': (MultiDOFStateStamped, DofStateSink),
+}
+# Each service type: its class, and how to get the value out of a request (the
+# controller's answer fills the response's ``success`` and ``message``).
+SERVICES: dict[str, tuple[type, Callable[[Any], Any]]] = {
+    'std_srvs/srv/SetBool': (SetBool, lambda request: request.data),
+}
 # Each action type: the server that runs a controller's goals.
 ACTION_SERVERS: dict[str, Callable[..., Any]] = {
     'control_msgs/action/FollowJointTrajectory': TrajectoryActionServer,

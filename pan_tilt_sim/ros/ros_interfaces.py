@@ -15,6 +15,11 @@ from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage
 from pan_tilt_sim.controllers import CommandKind
 from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
 
+try:
+    from control_msgs.msg import MultiDOFCommand
+except ImportError:  # an optional interface package (see optional_interfaces)
+    MultiDOFCommand = None
+
 NANOSECONDS_PER_SECOND = 1_000_000_000
 # Requests a service of the node holds while it is busy (a batch of physics steps, other
 # callbacks).  rclpy's default keeps the last 10 and silently drops older ones, so 20
@@ -44,10 +49,14 @@ def joint_trajectory(message: JointTrajectoryMessage) -> JointTrajectory:
 
 
 # Each command message type (by its ROS name), and how to get the command value out of it.
-COMMAND_MESSAGES: dict[str, tuple[type, Callable[[Any], Any]]] = {
+# The class is None where its interface package is not installed (no such topics then).
+COMMAND_MESSAGES: dict[str, tuple[type | None, Callable[[Any], Any]]] = {
     CommandKind.FLOAT64.value: (Float64, lambda msg: msg.data),
     CommandKind.FLOAT64_ARRAY.value: (Float64MultiArray, lambda msg: list(msg.data)),
     CommandKind.JOINT_TRAJECTORY.value: (JointTrajectoryMessage, joint_trajectory),
+    # (dof_names, values, values_dot), as lists.
+    CommandKind.MULTI_DOF_COMMAND.value: (MultiDOFCommand, lambda msg: (
+        list(msg.dof_names), list(msg.values), list(msg.values_dot))),
 }
 
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from pan_tilt_sim.controllers.base import ActuatorKind, JointHandle
+from pan_tilt_sim.controllers.base import ActuatorKind, Drive, JointHandle
 from pan_tilt_sim.model.robot import JointKind
 from pan_tilt_sim.sim.physics import Physics
 
@@ -36,7 +36,9 @@ def largest_stable_time_step(p: float, d: float, inertia: float) -> float:
 def pid_stability_warnings(physics: Physics, handles: Sequence[JointHandle],
                            time_step: float) -> list[str]:
     """Return one warning per PID-driven joint whose gains are unstable at ``time_step``."""
-    checked = [handle for handle in handles if handle.actuator.pid is not None]
+    # A PID whose output is not an effort (a velocity target, say) is no explicit effort loop.
+    checked = [handle for handle in handles
+               if handle.actuator.pid is not None and handle.drive is Drive.EFFORT]
     if not checked:
         return []
     inertias = dict(zip((joint.name for joint in physics.joints), physics.smallest_inertias(),

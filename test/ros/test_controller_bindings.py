@@ -7,7 +7,11 @@ from node_harness import sim_node
 from rcl_interfaces.msg import Log
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile
 
-from pan_tilt_sim.ros.controller_bindings import DynamicJointStateSink, JointStateSink
+from pan_tilt_sim.ros.controller_bindings import (
+    DofStateSink,
+    DynamicJointStateSink,
+    JointStateSink,
+)
 
 
 class RecordingPublisher:
@@ -103,3 +107,27 @@ def test_a_dynamic_sample_is_copied_and_held_until_flushed():
     assert publisher.sent == [
         (0.02, ['a', 'b'], [(['position', 'temperature'], [0.5, 21.5]), (['position'], [-0.25])]),
         (0.04, ['a', 'b'], [(['position', 'temperature'], [9.0, 21.5]), (['position'], [-0.25])])]
+
+
+def test_a_dof_state_sample_leaves_as_multi_dof_state_stamped_with_every_field():
+    pytest.importorskip('control_msgs.msg', reason='control_msgs is not installed')
+    sent = []
+
+    class Publisher:
+        def publish(self, message) -> None:
+            stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+            sent.append((round(stamp, 9), [
+                (s.name, s.reference, s.feedback, s.feedback_dot, s.error, s.error_dot,
+                 s.time_step, s.output) for s in message.dof_states]))
+
+    sink = DofStateSink(Publisher(), {'names': ['a', 'b']})
+    sink(0.5, [(1.0, 2.0, 3.0, 4.0, 5.0, 0.001, 7.0), (8.0, 9.0, 0.0, -1.0, 0.0, 0.001, 2.5)])
+    assert sent == []
+    sink(0.501, [(1.5, 2.0, 3.0, 4.0, 5.0, 0.001, 7.0)] * 2)
+    sink.flush()
+    sink.flush()
+    assert sent == [
+        (0.5, [('a', 1.0, 2.0, 3.0, 4.0, 5.0, 0.001, 7.0),
+               ('b', 8.0, 9.0, 0.0, -1.0, 0.0, 0.001, 2.5)]),
+        (0.501, [('a', 1.5, 2.0, 3.0, 4.0, 5.0, 0.001, 7.0),
+                 ('b', 1.5, 2.0, 3.0, 4.0, 5.0, 0.001, 7.0)])]

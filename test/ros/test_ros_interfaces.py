@@ -2,6 +2,7 @@
 
 import math
 
+import pytest
 from builtin_interfaces.msg import Duration, Time
 from std_msgs.msg import Float64, Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage
@@ -15,6 +16,8 @@ from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES, joint_trajectory, 
 def test_every_command_kind_has_a_message_type():
     assert set(COMMAND_MESSAGES) == {kind.value for kind in CommandKind}
     for type_name, (message_type, _extract) in COMMAND_MESSAGES.items():
+        if message_type is None:  # its interface package is optional, and not installed
+            continue
         package, _, name = type_name.partition('/msg/')
         assert (message_type.__module__.split('.')[0], message_type.__name__) == (package, name)
 
@@ -60,3 +63,12 @@ def test_joint_trajectory_becomes_a_plain_value_in_message_order():
 
 def test_zero_stamp_means_start_now():
     assert joint_trajectory(trajectory_message()).start_time is None
+
+
+def test_multi_dof_commands_become_names_values_and_values_dot():
+    control_msgs = pytest.importorskip('control_msgs.msg', reason='control_msgs is not installed')
+    message_type, extract = COMMAND_MESSAGES[CommandKind.MULTI_DOF_COMMAND.value]
+    assert message_type is control_msgs.MultiDOFCommand
+    value = extract(control_msgs.MultiDOFCommand(dof_names=['b', 'a'], values=[1.0, 2.5],
+                                                 values_dot=[-0.5, 0.0]))
+    assert value == (['b', 'a'], [1.0, 2.5], [-0.5, 0.0])

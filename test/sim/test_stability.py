@@ -69,6 +69,29 @@ def test_gains_beyond_the_rule_are_named_with_the_largest_stable_value(tmp_path)
         '(the ideal actuator)']
 
 
+@pytest.mark.parametrize(('interface', 'checked'), [('effort', True), ('velocity', False)])
+def test_only_a_pid_whose_output_is_the_effort_is_checked(tmp_path, interface, checked):
+    log = Log()
+    robot = write_star_robot(tmp_path, [JointDef('hinge', effort=1e6)])
+    # p far beyond the rule: an effort loop this stiff would run away; as the ideal
+    # actuator's velocity target it is a different loop, which the rule says nothing about.
+    controllers = write_text(tmp_path, 'controllers.yaml', f"""
+        controller_manager:
+          ros__parameters:
+            pid: {{type: pid_controller/PidController}}
+        pid:
+          ros__parameters:
+            dof_names: [hinge]
+            command_interface: {interface}
+            reference_and_state_interfaces: [position]
+            gains: {{hinge: {{p: 1000000.0}}}}
+        """)
+    with make_simulation(str(robot), str(controllers), DT, logger=log):
+        pass
+    unstable = [line for line in log.warnings if 'is unstable at time_step' in line]
+    assert bool(unstable) is checked
+
+
 def test_urdf_damping_does_not_count_it_is_applied_implicitly(tmp_path):
     log = Log()
     with star(tmp_path, '{p: 100.0, d: 10.0}', log, damping=1000.0) as sim:
