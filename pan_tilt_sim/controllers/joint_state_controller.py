@@ -9,7 +9,7 @@ The rate is ``publish_rate`` when given (ROS 1 style); otherwise
 ``update_rate``, since ROS 2's joint_state_broadcaster publishes at every
 update of its controller_manager (a ros2_control-style file gives every
 controller the controller_manager's rate, 100 Hz by default); otherwise
-50 Hz, the seeds' rate.  ``joints`` (as joint_state_broadcaster names it)
+50 Hz, the pan/tilt example's rate.  ``joints`` (as joint_state_broadcaster names it)
 limits the sample to those joints, in that order; empty or absent means
 every movable joint.
 """
@@ -34,7 +34,7 @@ from pan_tilt_sim.controllers.parameter_spec import (
 from pan_tilt_sim.controllers.surface import Endpoint, StateTopic
 from pan_tilt_sim.schedule import DUE_EPSILON, PeriodicSchedule
 
-DEFAULT_PUBLISH_RATE = 50.0  # Hz, as in the seeds' YAML
+DEFAULT_PUBLISH_RATE = 50.0  # Hz, as in the pan/tilt example's YAML
 RATE_FIELDS = ('publish_rate', 'update_rate')  # the first one given sets the rate
 
 JointStateSink = Callable[[float, Sequence[str], Sequence[float], Sequence[float],
