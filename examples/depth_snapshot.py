@@ -12,7 +12,7 @@ away along -x, at -1.5708 the green one, at 1.5708 the yellow one), waits until 
 joint is there, takes the next depth image and point cloud, writes the depth image as a
 PNG (near = yellow, far = blue, nothing within range = black) and prints what the cloud
 sees: how many points are valid, their depth range, and the depth and colour at the
-image centre (2.0 m and the target's colour when it faces one).  The seed's pan turns
+image centre (2.0 m and the target's colour when it faces one).  The pan/tilt example's pan turns
 at 0.1 rad/s, so a new angle takes a while at real_time_factor 1.
 """
 

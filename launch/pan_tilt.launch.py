@@ -1,6 +1,6 @@
 """Start the simulated robot: sim_node, plus robot_state_publisher where it is installed.
 
-The ROS 2 form of the seed's gazebo_pan_tilt.launch + pan_tilt_gazebo_control.launch::
+The ROS 2 form of the pan/tilt example's gazebo_pan_tilt.launch + pan_tilt_gazebo_control.launch::
 
     ros2 launch pan_tilt_sim pan_tilt.launch.py
     ros2 launch pan_tilt_sim pan_tilt.launch.py model:=/path/robot.xacro \

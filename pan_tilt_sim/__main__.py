@@ -7,9 +7,8 @@ code 2 and one line (see :mod:`pan_tilt_sim.ros.runner`).
 
 OpenBLAS runs single-threaded here unless the environment says otherwise:
 numpy (which rclpy's message packages import) otherwise starts a worker per
-core that spins for ~0.1 s of CPU as it loads -- ~600 -> ~455 ms of CPU in
-sim_node's first second on a 2-core machine -- and sim_node's matrices are
-3x3 and 4x4, far too small for threads to help.
+core that spins as it loads, CPU taken from start-up, and sim_node's matrices
+are 3x3 and 4x4, far too small for threads to help.
 """
 
 from __future__ import annotations

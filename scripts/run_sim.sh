@@ -13,7 +13,7 @@ set -euo pipefail
 source "$(dirname -- "${BASH_SOURCE[0]}")/_prepare_venv.sh"
 prepare_venv runtime
 
-# DDS on this machine only, unless the caller chose otherwise.
+# DDS on loopback only, unless the caller chose otherwise.
 export ROS_AUTOMATIC_DISCOVERY_RANGE=${ROS_AUTOMATIC_DISCOVERY_RANGE:-LOCALHOST}
 # The venv is an ament prefix (share/ament_index/...); it goes first so this
 # checkout's pan_tilt_sim wins, other prefixes stay for package:// look-ups.

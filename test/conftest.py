@@ -77,10 +77,10 @@ def cache_dir(tmp_path):
 
 
 @pytest.fixture
-def seed2(tmp_path, monkeypatch, original_examples):
-    """Install the seed-2 package into a temporary prefix; return its share folder."""
+def my_robot_share(tmp_path, monkeypatch, original_examples):
+    """Install the my_robot example's package into a temporary prefix; return its share folder."""
     import mesh_fixtures as mf
 
-    prefix = mf.make_seed2_package(tmp_path, original_examples / 'my_robot.urdf')
+    prefix = mf.make_my_robot_package(tmp_path, original_examples / 'my_robot.urdf')
     monkeypatch.setenv('AMENT_PREFIX_PATH', str(prefix))
-    return prefix / 'share' / mf.SEED2_PACKAGE
+    return prefix / 'share' / mf.MY_ROBOT_PACKAGE

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pathlib
 
-BOX_RGBA = (0.9, 0.1, 0.9, 1.0)  # magenta: no target, the ground or the seed is this colour
+BOX_RGBA = (0.9, 0.1, 0.9, 1.0)  # magenta: no target, the ground or the pan/tilt is this colour
 
 
 def box_urdf(name: str = 'box', size: tuple[float, float, float] = (0.2, 0.2, 0.2),

@@ -9,8 +9,8 @@ Two layers:
   :func:`make_ament_prefix`, which takes a mapping of relative path to content);
 - ``write_*`` functions write that content to a path and return the path.
 
-:func:`make_seed2_package` builds the ``my_robot_pkg`` layout the seed-2 URDF
-(``my_robot.urdf``) refers to, with the box sizes given by the ``SEED2_*``
+:func:`make_my_robot_package` builds the ``my_robot_pkg`` layout the my_robot example's URDF
+(``my_robot.urdf``) refers to, with the box sizes given by the ``MY_ROBOT_*``
 constants, so tests can check the loaded links' sizes.
 """
 
@@ -54,27 +54,27 @@ _CUBE_FACES = np.array([
 ])
 """Twelve triangles over :data:`_CUBE_CORNERS`."""
 
-SEED2_PACKAGE = 'my_robot_pkg'
-"""Package name the seed-2 URDF's ``package://`` URIs use."""
+MY_ROBOT_PACKAGE = 'my_robot_pkg'
+"""Package name the my_robot example's URDF's ``package://`` URIs use."""
 
-SEED2_BASE_SIZE_M: Size = (0.2, 0.2, 0.1)
+MY_ROBOT_BASE_SIZE_M: Size = (0.2, 0.2, 0.1)
 """Size of the generated base meshes in metres (the DAE holds millimetres)."""
 
-SEED2_ARM_SIZE_M: Size = (0.05, 0.05, 0.2)
+MY_ROBOT_ARM_SIZE_M: Size = (0.05, 0.05, 0.2)
 """Size of the generated arm meshes in metres (the DAE holds millimetres)."""
 
 MILLIMETRES_PER_METRE = 1000.0
 
-SEED2_URDF_RELPATH = 'urdf/my_robot.urdf'
-"""Where :func:`make_seed2_package` puts the URDF inside the package's share folder."""
+MY_ROBOT_URDF_RELPATH = 'urdf/my_robot.urdf'
+"""Where :func:`make_my_robot_package` puts the URDF inside the package's share folder."""
 
-SEED2_MESHES: dict[str, str] = {
+MY_ROBOT_MESHES: dict[str, str] = {
     'base_visual': 'meshes/visual/base.dae',
     'arm_visual': 'meshes/visual/arm.dae',
     'base_collision': 'meshes/collision/base.stl',
     'arm_collision': 'meshes/collision/arm.stl',
 }
-"""Mesh files of the seed-2 package, relative to its share folder."""
+"""Mesh files of the my_robot example's package, relative to its share folder."""
 
 
 def box_corners(size: Size = UNIT_BOX) -> np.ndarray:
@@ -278,27 +278,29 @@ def _scaled(size: Size, factor: float) -> Size:
     return (size[0] * factor, size[1] * factor, size[2] * factor)
 
 
-def seed2_mesh_files() -> dict[str, bytes | str]:
-    """Return the seed-2 package's meshes: relative path -> content.
+def my_robot_mesh_files() -> dict[str, bytes | str]:
+    """Return the my_robot example's meshes: relative path -> content.
 
     Visual DAEs hold millimetres under ``<unit meter="1"/>`` (as a CAD export
-    re-saved by Blender does), which is why the seed-2 URDF scales them by
+    re-saved by Blender does), which is why the my_robot example's URDF scales them by
     0.001; collision STLs hold metres and are not scaled.
     """
     return {
-        SEED2_MESHES['base_visual']: dae_text(_scaled(SEED2_BASE_SIZE_M, MILLIMETRES_PER_METRE)),
-        SEED2_MESHES['arm_visual']: dae_text(_scaled(SEED2_ARM_SIZE_M, MILLIMETRES_PER_METRE)),
-        SEED2_MESHES['base_collision']: binary_stl_bytes(SEED2_BASE_SIZE_M),
-        SEED2_MESHES['arm_collision']: binary_stl_bytes(SEED2_ARM_SIZE_M),
+        MY_ROBOT_MESHES['base_visual']:
+            dae_text(_scaled(MY_ROBOT_BASE_SIZE_M, MILLIMETRES_PER_METRE)),
+        MY_ROBOT_MESHES['arm_visual']:
+            dae_text(_scaled(MY_ROBOT_ARM_SIZE_M, MILLIMETRES_PER_METRE)),
+        MY_ROBOT_MESHES['base_collision']: binary_stl_bytes(MY_ROBOT_BASE_SIZE_M),
+        MY_ROBOT_MESHES['arm_collision']: binary_stl_bytes(MY_ROBOT_ARM_SIZE_M),
     }
 
 
-def make_seed2_package(tmp_path: pathlib.Path, urdf_source: pathlib.Path) -> pathlib.Path:
+def make_my_robot_package(tmp_path: pathlib.Path, urdf_source: pathlib.Path) -> pathlib.Path:
     """Create ``my_robot_pkg`` in a temporary ament prefix and return the prefix.
 
-    The package holds the meshes of :func:`seed2_mesh_files` and a copy of
-    ``urdf_source`` at :data:`SEED2_URDF_RELPATH`.
+    The package holds the meshes of :func:`my_robot_mesh_files` and a copy of
+    ``urdf_source`` at :data:`MY_ROBOT_URDF_RELPATH`.
     """
-    files: dict[str, bytes | str] = seed2_mesh_files()
-    files[SEED2_URDF_RELPATH] = urdf_source.read_bytes()
-    return make_ament_prefix(tmp_path, SEED2_PACKAGE, files)
+    files: dict[str, bytes | str] = my_robot_mesh_files()
+    files[MY_ROBOT_URDF_RELPATH] = urdf_source.read_bytes()
+    return make_ament_prefix(tmp_path, MY_ROBOT_PACKAGE, files)

@@ -35,8 +35,8 @@ import math
 TRACKING_GAIN = 0.1
 # rad/s^2 (m/s^2 on a prismatic joint): how fast a position setpoint speeds up
 # and slows down.  URDF has no acceleration limits; 10 keeps step commands on
-# UR, Franka and KUKA arms within 0.003 rad of overshoot (5 g fingers reach
-# their 0.1 m/s in 10 ms).
+# UR, Franka and KUKA arms within 0.003 rad of overshoot, and light fingers
+# still reach their speed limit within a few steps.
 SETPOINT_ACCELERATION = 10.0
 # A setpoint this close to its command is there.
 ARRIVED = 1e-12

@@ -12,7 +12,7 @@ interface (limits, ramp, actuator), which it is built from, with gains from
   without by the ideal actuator (see :mod:`~pan_tilt_sim.controllers.actuator`),
   as Gazebo does.  A PID is stable while (for the position loop)
   ``d * time_step / 2 + p * time_step^2 / 4`` stays below the joint's
-  effective inertia -- at the default 1 ms step and the seed's p 100, d 10,
+  effective inertia -- at the default 1 ms step and the pan/tilt example's p 100, d 10,
   inertias above 0.005 kg m^2 (or 5 g on a prismatic joint); the simulation
   warns at start-up about any joint that is too light for its gains.
 * effort: the command is the effort;

@@ -33,8 +33,8 @@ from pan_tilt_sim.controllers.step_law import (
     pid_row,
 )
 
-# The seed's gains, the effort_controllers type's defaults when the YAML gives
-# none: with the seed's damping they track critically damped or slower for
+# The pan/tilt example's gains, the effort_controllers type's defaults when the YAML gives
+# none: with the pan/tilt example's damping they track critically damped or slower for
 # link inertias up to ~10 kg m^2.
 DEFAULT_POSITION_GAINS = PidGains(p=100.0, i=0.01, d=10.0)
 

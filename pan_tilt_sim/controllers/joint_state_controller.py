@@ -47,7 +47,7 @@ The rate is ``publish_rate`` when given (ROS 1 style); otherwise
 ``update_rate``, since ROS 2's joint_state_broadcaster publishes at every
 update of its controller_manager (a ros2_control-style file gives every
 controller the controller_manager's rate, 100 Hz by default); otherwise
-50 Hz, the seeds' rate.
+50 Hz, the pan/tilt example's rate.
 """
 
 from __future__ import annotations
@@ -71,7 +71,7 @@ from pan_tilt_sim.controllers.parameter_spec import (
 from pan_tilt_sim.controllers.surface import PRIVATE, Endpoint, StateTopic
 from pan_tilt_sim.schedule import DUE_EPSILON, PeriodicSchedule
 
-DEFAULT_PUBLISH_RATE = 50.0  # Hz, as in the seeds' YAML
+DEFAULT_PUBLISH_RATE = 50.0  # Hz, as in the pan/tilt example's YAML
 RATE_FIELDS = ('publish_rate', 'update_rate')  # the first one given sets the rate
 JOINT_STATE_FIELDS = MEASURED_STATES  # JointState's position, velocity, effort
 MAP_FIELD = 'map_interface_to_joint_state'

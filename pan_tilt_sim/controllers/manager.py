@@ -7,7 +7,7 @@ controllers on the same six joints), and only one controller may claim a
 joint's command interface at a time.  :class:`ControllerManager` does the
 same with the controllers of one :class:`ControllersConfig`:
 
-* ``active`` unset: every controller is active (the seeds' way), and two
+* ``active`` unset: every controller is active (the ROS 1 examples' way), and two
   controllers claiming one joint is an error naming both and the parameter
   that chooses between them.
 * ``active`` given: those are active; every other controller of a type the

@@ -1,6 +1,6 @@
-"""Reading controller YAML: the seeds' ROS 1 layout and ros2_control's.
+"""Reading controller YAML: the examples' ROS 1 layout and ros2_control's.
 
-ROS 1 style (``rosparam load``), as in both seeds::
+ROS 1 style (``rosparam load``), as in both examples::
 
     ex_urdf_pan_tilt:                      # optional: one key wrapping them all
       joint_state_controller:

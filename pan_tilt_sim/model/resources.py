@@ -1,7 +1,7 @@
 """Resolve resource URIs and make a URDF's meshes loadable by PyBullet.
 
 PyBullet knows nothing of ``package://``, and its own mesh loaders fail in ways
-a user cannot see (measured with PyBullet 3.2.7, DIRECT mode):
+a user cannot see (PyBullet 3.2.7, DIRECT mode):
 
 - a missing file or an unknown extension makes ``loadURDF`` raise a bare
   ``error('Cannot load URDF file.')``; the reason only goes to stdout;
@@ -24,8 +24,9 @@ with is converted into a binary STL in a cache folder:
   both roles, so PyBullet's crash-prone Collada reader is never used.
 
 PyBullet reads the URDF ``scale`` attribute itself, for every format and both
-roles (measured: ``scale="0.001 0.001 0.001"`` on a 1 m box gives a 1 mm
-collision hull, ``"2 3 4"`` a 2 x 3 x 4 m one), so ``scale`` stays on the
+roles (``scale="0.001 0.001 0.001"`` on a 1 m box gives a 1 mm
+collision hull, ``"2 3 4"`` a 2 x 3 x 4 m one; ``test/dependencies/test_pybullet_meshes.py``
+pins it), so ``scale`` stays on the
 ``<mesh>`` element and converted files keep the file's own units.
 """
 
@@ -374,8 +375,8 @@ def read_collada(data: bytes) -> np.ndarray:
     Units, as Gazebo does: ``<asset><unit meter=...>`` is applied (a file in
     millimetres that says ``meter="0.001"`` comes out in metres); a URDF
     ``scale`` then applies on top.  PyBullet's own Collada loader does the
-    same (measured).  ``<up_axis>`` is ignored, like Gazebo classic and
-    PyBullet's collision loader (measured: a ``Y_UP`` box is not rotated).
+    same.  ``<up_axis>`` is ignored, like Gazebo classic and PyBullet's
+    collision loader (a ``Y_UP`` box is not rotated).
     """
     try:
         root = ET.fromstring(data)

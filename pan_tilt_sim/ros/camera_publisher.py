@@ -11,10 +11,10 @@ now; the image is stamped with the sim time and published in the
 ``camera.fov_deg`` and the image size.  A reset of the simulation starts the
 schedule again (:meth:`CameraPublisher.reset`).
 
-Rendering runs on the physics thread, between batches of steps: a 320x240
-TinyRenderer frame of the seed in the targets world costs ~3 ms (measured by
-scripts/camera_benchmark.py), and PyBullet holds the GIL while it renders,
-so a Python thread would not run it in parallel.  Sim time is not affected
+Rendering runs on the physics thread, between batches of steps: a
+TinyRenderer frame costs milliseconds (``scripts/camera_benchmark.py``
+measures it), and PyBullet holds the GIL while it renders, so a Python
+thread would not run it in parallel.  Sim time is not affected
 (every frame shows the state at its stamp); wall-time pacing absorbs the
 cost at real_time_factor 1, and at real_time_factor 0 frames take their
 share of the machine.  Like Gazebo's camera plugin, nothing is rendered
@@ -130,8 +130,8 @@ class CameraPublisher:
         self._schedule = PeriodicSchedule(settings.period)
         self._image_publisher = node.create_publisher(Image, image_topic, QUEUE_DEPTH)
         self._info_publisher = node.create_publisher(CameraInfo, info_topic, QUEUE_DEPTH)
-        # Who watches, asked once per batch of steps (refresh_readers): asking
-        # DDS costs ~0.7 us per topic.
+        # Who watches, asked once per batch of steps (refresh_readers), not per
+        # step: each question is a call into DDS.
         self.refresh_readers()
         self._info = camera_info_message(intrinsics(settings), settings.optical_frame)
         self._image = Image(height=settings.height, width=settings.width,

@@ -1,10 +1,10 @@
 """Command topics read by a thread of their own, not by rclpy's executor.
 
-Each time rclpy's Python executor wakes it rebuilds its wait set over every
-entity of sim_node and its controller_manager (45 services, parameter
-services included), ~0.3 ms of CPU here: a stream of 100 commands a second
-cost 3.5 % of a core in the executor's thread alone, and the physics thread
-~2 % more.  Commands are the one thing that arrives that often, so in the
+Each time rclpy's Python executor wakes it rebuilds its wait set, in
+Python, over every entity of sim_node and its controller_manager (all their
+services, parameter services included), so a command stream that woke it
+for every message would cost CPU in proportion to the message rate.
+Commands are the one thing that arrives that often, so in the
 sim_node program (the physics in its own thread, see
 :mod:`pan_tilt_sim.ros.physics_thread`) a :class:`CommandReader` waits on
 the command subscriptions alone, takes every message that arrived, and runs
@@ -12,7 +12,7 @@ their callbacks in their turn -- between two batches of steps, as the
 executor would have run them.
 
 The subscriptions are ordinary rclpy subscriptions (``ros2 topic info``
-sees them as before) in a callback group that no executor executes
+sees them as any other) in a callback group that no executor executes
 (:class:`ReaderGroup`), so the executor leaves them out of its wait set.
 A callback that raises stops the reader and is handed to the executor,
 which raises it, as it would its own callback's exception.

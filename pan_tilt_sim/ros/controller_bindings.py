@@ -309,8 +309,8 @@ class JointStateSink:
     sample leaves, in order, with the state of the step it was taken at;
     only the moment changes, by at most a batch (at real_time_factor 1 a
     fraction of a millisecond).  Published with the node's other messages,
-    while DDS's code is warm: right after a 20 ms sleep the first publish
-    costs ~150-250 us of CPU on these VMs and the next ~10-35 us.
+    while DDS's code is warm: right after a sleep the first publish costs
+    several times what the ones right after it cost.
     """
 
     def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:

@@ -2,7 +2,7 @@
 
 :class:`NodeFeatures` declares their parameters, creates their publishers and
 is told every /clock period of physics steps; each feature then publishes
-whatever is due at the present sim time.  Topics (with the seed's files):
+whatever is due at the present sim time.  Topics (with the pan/tilt example's files):
 
 * ``/ex_urdf_pan_tilt/robot_description`` -- std_msgs/String, transient local;
 * ``/tf``, ``/tf_static`` -- where tf2_msgs is installed;

@@ -8,7 +8,7 @@ defaults): ``<prefix>.p``, ``.i``, ``.d``, ``.i_clamp_max``, ``.i_clamp_min``
 ``i_clamp_min = -x``, ``i_clamp_max = x``).  The prefix follows the YAML the
 gains come from (:attr:`Controller.gains_field`):
 
-* ``<controller>.pid`` for a one-joint controller (ROS 1 style, as the seed's
+* ``<controller>.pid`` for a one-joint controller (ROS 1 style, as the pan/tilt example's
   ``joint1_position_controller.pid.p``);
 * ``<controller>.gains.<joint>`` for each joint of a multi-joint controller
   (ros2_controllers style, as ``arm_controller.gains.shoulder_joint.p``).

@@ -9,7 +9,7 @@ than asked, as Gazebo does.
 
 At factor 0 each tick runs as many steps as fill ``FAST_TICK_S`` of wall
 time, judged from the pace of the ticks before: the executor's fixed cost
-per tick (~0.1 ms) then stays a few percent whatever the robot costs per
+per tick then stays a small share of the tick whatever the robot costs per
 step, and commands and parameter changes are still taken within a few ms.
 """
 

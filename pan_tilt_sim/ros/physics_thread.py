@@ -1,9 +1,9 @@
 """The physics in a paced thread of its own, taking turns with the executor's callbacks.
 
-Woken 50 times a second only to step the physics, rclpy's Python executor
-costs ~0.35-0.65 ms per wake-up (it rebuilds its wait set of every
-subscription, service and timer), more than half of sim_node's CPU at
-real_time_factor 1, and more with every service added.  So the sim_node
+Each wake-up of rclpy's Python executor rebuilds its wait set of every
+subscription, service and timer, so waking it 50 times a second only to step
+the physics would cost more than the physics at real_time_factor 1, and more
+with every service added.  So the sim_node
 program steps the physics from a :class:`PhysicsThread`, which sleeps
 between ticks, and the executor wakes only for messages, services and
 parameters (the command topics have a reader of their own:
@@ -13,7 +13,7 @@ Both still take turns, as when a timer drove the physics: every callback
 runs between two batches of steps, never during one.  :class:`Turns` is
 that lock; a callback waiting for its turn goes before the next batch, so
 at real_time_factor 0 a command waits at most for the batch in progress
-(~5 ms).  :class:`TurnTakingExecutor` is rclpy's SingleThreadedExecutor
+(``FAST_TICK_S`` of wall time).  :class:`TurnTakingExecutor` is rclpy's SingleThreadedExecutor
 with each callback run inside its turn; the callbacks ready at once share one
 turn (up to :data:`CALLBACK_TURN_S`), so that a queue of requests is not
 served one per batch of steps.  If the physics thread fails, it
@@ -151,8 +151,7 @@ class Wakeup:
 
     As :class:`threading.Event` set/wait/clear, but a wait is one lock
     acquisition: Event's runs a Condition in Python and makes a lock per call,
-    which right after the thread slept costs ~20-50 us more CPU per wait on
-    these VMs -- 0.1-0.25 % of a core at 50 ticks a second.
+    Python work the paced thread would do twice per tick with cold caches.
     """
 
     def __init__(self) -> None:

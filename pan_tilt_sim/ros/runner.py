@@ -1,43 +1,21 @@
 """Running a node as a command-line program: start-up errors, signals, a clean exit.
 
-* Malformed ``--ros-args`` (rcl refuses them in ``rclpy.init``) and every
-  :class:`~pan_tilt_sim.errors.ConfigurationError` raised while the node is
-  built end the program with exit code 2 and ONE line on stderr.  rcl's own
-  log lines about bad arguments are folded into that line; the traceback is
-  printed only with ``--ros-args --log-level debug``.
-* SIGINT and SIGTERM stop the program: the node is destroyed (for sim_node
-  that disconnects PyBullet) and the exit code is 0, without a traceback.
-  Both handlers are installed before ``rclpy.init`` and unconditionally: a
-  shell starts background jobs with SIGINT ignored (Python then leaves it
-  ignored), and ``ros2 run`` does not forward signals -- Ctrl-C reaches the
-  node through the terminal's process group.  rclpy chains its own handlers
-  (which shut the context down and so end the spin) to these.  A signal
-  while the node is being built aborts the build; while spinning it ends the
-  spin; while the node is being destroyed it is only noted.
-* Started by a launch file, the program must not outlive it: when
-  ``PAN_TILT_SIM_PARENT_PID`` names the launch process's pid, the program
-  stops (SIGTERM, so as cleanly as on Ctrl-C) when that process dies -- at
-  once if it is already gone.  Linux's ``PR_SET_PDEATHSIG`` does it when
-  the launch process is the parent; a watcher thread when something stands
-  between them (``--launch-prefix``) or off Linux.  Without the variable
-  (``nohup sim_node &``) the program outlives its shell, as any program does.
-* Python's cyclic garbage collector is held off while the program starts
-  (imports and building the node: ~50,000 objects, ~125 collections, 25-35 ms
-  of a ~0.37 s build on a 2-core VM); once the node is built, what start-up
-  made is frozen (``gc.freeze``: later full collections skip it; the ~700
-  unreachable objects it holds are never freed) and the collector runs again.
-* The process's DDS participant is made right after ``rclpy.init``, before
-  the node's imports: a hidden placeholder node (``_<program>_starting``,
-  no global arguments, no endpoints of its own) holds it until the node is
-  built.  Fast DDS discovers peers in threads of its own, so discovery
-  runs while PyBullet and the rest load (the participant exists at
-  0.17-0.22 s after the process starts instead of 0.23-0.33 s), and a
-  listener already running gets the first JointState ~0.1 s sooner
-  whenever the two miss each other's first announcement (README, Start-up).
-* Importing rclpy and PyBullet takes about half a second, so this module
-  imports neither until the handlers are in place, and knows no node: the
-  program (``pan_tilt_sim.__main__``) hands :func:`run` a factory that
-  imports its node only when called.
+* Malformed ``--ros-args`` and every :class:`~pan_tilt_sim.errors.ConfigurationError`
+  raised while the node is built end the program with exit code 2 and ONE line on
+  stderr (rcl's own log lines folded in; the traceback only with
+  ``--ros-args --log-level debug``).
+* SIGINT and SIGTERM destroy the node and exit 0, without a traceback.  The
+  handlers are installed before ``rclpy.init`` and unconditionally, because a shell
+  starts background jobs with SIGINT ignored and ``ros2 run`` does not forward
+  signals; rclpy's own handlers are chained to them.
+* With ``PAN_TILT_SIM_PARENT_PID`` set (by the launch file), the program stops as on
+  SIGTERM when that process dies, so it never outlives its launch.
+* The garbage collector is held off while the program starts and what start-up made
+  is then frozen (``gc.freeze``), so start-up's objects are never scanned again.
+* The DDS participant is made right after ``rclpy.init`` by a hidden placeholder node
+  (``_<program>_starting``), so Fast DDS discovers peers while the rest loads.
+* This module imports neither rclpy nor PyBullet before the handlers are in place:
+  :func:`run` takes a factory that imports the node only when called.
 """
 
 from __future__ import annotations
@@ -287,7 +265,7 @@ def interruptible_spin(stop: StopSignals, context: Context) -> Iterator[None]:
     executor woken in between went back to waiting for good, so the loop may
     not rely on that shutdown.  Leaving at once, though, would tear the
     executor down while that thread may still be triggering its guard
-    condition (3 of 15 runs of the signal tests segfaulted so), so on the way
+    condition, which can crash the process, so on the way
     out this waits -- up to RCLPY_SIGNAL_BUDGET_S, and only where rclpy
     handles that signal -- for the shutdown that thread makes after it.
     """

@@ -80,8 +80,8 @@ class SensorPublisher:
         self.messages = 0  # measurements published
         self.cost_s = 0.0  # wall time spent measuring, building and publishing them
         self._node = node
-        # Whether anyone listened at the last due time: asking DDS costs ~1 us per
-        # topic, so it is asked once per due time, not at every batch of steps.
+        # Whether anyone listened at the last due time: each question is a call
+        # into DDS, so it is asked once per due time, not at every batch of steps.
         self._watched = False
 
     def publisher(self, message_type: type, role: str):

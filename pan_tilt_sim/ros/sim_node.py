@@ -1,4 +1,4 @@
-"""sim_node: the seeds' Gazebo + gazebo_ros_control, as one headless rclpy node.
+"""sim_node: Gazebo + gazebo_ros_control, as one headless rclpy node.
 
 Thin ROS glue around :class:`~pan_tilt_sim.sim.engine.Simulation`: parameters
 in, command topics in, JointState and /clock out.  A wall timer ticks every
@@ -47,17 +47,17 @@ from pan_tilt_sim.sim.engine import Simulation
 
 NODE_NAME = 'sim_node'
 # Wall seconds between ticks when paced to real time: one JointState (50 Hz)
-# per tick, and each wake-up of rclpy's executor (~0.35 ms) costs < 2 % CPU.
+# per tick, and few enough wake-ups that waking stays a small share of a core.
 TICK_PERIOD_S = 0.02
 CLOCK_PERIOD_S = 0.01  # sim seconds between /clock messages (100 Hz of sim time)
 # /clock leaves at most once per this much wall time on average (Gazebo's clock
 # publisher throttles the same way), in bursts of up to CLOCK_BURST messages;
 # the newest stamp always leaves at the end of each batch, on a token borrowed if need be.
 CLOCK_MIN_WALL_PERIOD_S = 0.001
-# A tick's worth (20 ms) of bursts: up to ~10x real time every 10 ms stamp leaves.
+# A tick's worth (20 ms) of bursts: up to 10x real time every 10 ms stamp leaves.
 CLOCK_BURST = 20
 # Without a token, the stamps a chunk of steps may run past before it looks again
-# (~1 ms of wall time at ~100x real time, when tokens come one per ms).
+# (one token's worth of wall time at 100x real time, when tokens come one per ms).
 CLOCK_STAMPS_SKIPPED = 10
 QUEUE_DEPTH = 10
 _OWN_PARAMETERS = {field.name for field in dataclasses.fields(parameters.SimParameters)}
@@ -207,9 +207,9 @@ class SimNode(Node):
         """Create a subscription without rclpy's default QoS-event handler.
 
         Each default handler is one more waitable that rclpy's executor walks
-        in Python at every wake-up; dropping them cut sim_node's CPU at
-        real_time_factor 1 from ~3.9 % to ~3.2 % of a core.  A peer with
-        incompatible QoS is still warned about on the peer's side.
+        in Python at every wake-up, and sim_node has a subscription per
+        command topic.  A peer with incompatible QoS is still warned about on
+        the peer's side.
         """
         kwargs.setdefault('event_callbacks',
                           SubscriptionEventCallbacks(use_default_callbacks=False))
@@ -227,17 +227,17 @@ class SimNode(Node):
         -- and the newest grid stamp reached always leaves at the end of the
         batch, taking a token even if none is there (a debt the next stamps
         wait for), so on average /clock never leaves more than once per wall
-        millisecond.  So up to ~10x real time every stamp leaves (at factor 1 nothing
+        millisecond.  So up to 10x real time every stamp leaves (at factor 1 nothing
         is dropped); far above it /clock comes about once per wall millisecond
         and use_sim_time timers see sim time advance in jumps of that size.
 
-        At real_time_factor 0 a batch (~5 ms of wall time) is cut at the stamps,
-        so /clock advances through it; paced, a batch is a few ms of sim time
-        run in a fraction of a wall millisecond, so its stamps leave together
-        after it, back to back with the JointStates it took (see
+        At real_time_factor 0 a batch (about 5 ms of wall time) is cut at the
+        stamps, so /clock advances through it; paced, a batch is a few ms of sim
+        time run in a fraction of a wall millisecond, so its stamps leave
+        together after it, back to back with the JointStates it took (see
         :class:`~pan_tilt_sim.ros.controller_bindings.JointStateSink`): right
-        after the thread slept, the first publish costs ~150-250 us of CPU and
-        the next ones ~10-35 us.  Up to ~10x real time, /clock reaches a stamp before
+        after the thread slept the first DDS publish is the dear one, and the
+        ones right after it are cheap.  Up to 10x real time, /clock reaches a stamp before
         anything stamped at or after it leaves.  Nothing is published that nobody
         reads (see :meth:`_refresh_readers`).
         """
@@ -401,11 +401,12 @@ class SimNode(Node):
     def _refresh_readers(self) -> None:
         """Find out, once per batch, which of the periodic topics anybody reads.
 
-        A publish costs 3-5 us even with no subscriber; asking costs ~0.7 us,
-        but ~60 us right after the physics thread slept between paced ticks:
-        there the ticks ask after their batch, just after publishing, so a new
-        subscriber is served from the batch after next (~20-40 ms of wall time
-        at factor 1, inside DDS's own matching delay).  At factor 0 and when
+        A publish costs CPU even with no subscriber, and asking is much cheaper
+        -- except right after the physics thread slept between paced ticks,
+        when DDS's code is cold: there the ticks ask after their batch, just
+        after publishing, so a new subscriber is served from the batch after
+        next (one or two ticks of wall time at factor 1, inside DDS's own
+        matching delay).  At factor 0 and when
         stepping on request, they ask before the batch: a subscriber that the
         publisher has matched gets everything due from the next batch on.
         """

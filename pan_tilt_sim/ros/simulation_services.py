@@ -1,54 +1,19 @@
 """simulation_interfaces for sim_node: the standard way to control a simulator from tests and tools.
 
-ROS 2's ``simulation_interfaces`` (1.5, Jazzy) is what Gazebo (ros_gz_sim),
-Isaac Sim and O3DE serve.  sim_node serves it too, where the package is
-installed (the standalone venv builds it; a ROS install provides it); without
-it, the node's one line about missing interface packages says these services
-are off, and everything else (the gazebo_ros services, world files) runs.
-
-**Names.**  The services live under the ``simulation_interfaces.namespace``
-parameter, by default ``~`` -- the node's own name, as ros_gz_sim puts them
-on its ``gzserver`` node: ``/sim_node/get_simulator_features``,
-``/sim_node/step_simulation``, ... (``/left/sim_node/...`` under ``-r
-__ns:=/left``).  That leaves gazebo_ros's ``std_srvs/Empty``
-``/reset_simulation`` where it is.  ``-p simulation_interfaces.namespace:=''``
-gives Isaac Sim's and O3DE's names (``/get_simulator_features``...); then
-``simulation_interfaces/ResetSimulation`` takes ``reset_simulation`` and the
-Empty service of that name is not offered (one info line says so).
-
-**State.**  PLAYING: the physics runs (at ``real_time_factor``).  PAUSED:
-held.  STOPPED: held and not stepped since the start or the last full reset
--- the state at start-up with ``-p paused:=true``, where spawners and tests
-can connect before time moves.  The ``paused`` parameter and the Empty
-pause/unpause services are the same switch.  Transitions follow O3DE's table:
-the state it is in -> ALREADY_IN_TARGET_STATE; STOPPED -> PAUSED ->
-INCORRECT_TRANSITION (step it, or play it); -> STOPPED: a full reset (as
-ResetSimulation SCOPE_ALL), paused; -> QUITTING: the answer goes out, the
-physics is held, and 0.1 s later the node's context shuts down (the program
-exits 0).  NO_WORLD and LOADING_WORLD: FEATURE_UNSUPPORTED (no worlds to load).
-
-**Stepping.**  StepSimulation and the SimulateSteps action run their steps
-only while paused (else OPERATION_FAILED, as the srv says), one request at a
-time.  A StepSimulation request runs at most :data:`MAX_STEP_SIMULATION_STEPS`
-steps (more: OPERATION_FAILED, saying so), so that it answers in bounded time
-and a caller that dies mid-call leaves no endless stepping behind; longer runs
-are SimulateSteps goals, which can be cancelled.  Steps run through the
-node's own stepping (controllers, /clock, JointState), as fast as the machine
-allows, in slices that leave the executor free between them
-(:mod:`pan_tilt_sim.ros.stepping`).  SimulateSteps sends feedback after each
-slice (~5 ms of wall time) and stops after the slice in progress when
-cancelled, still paused (result OK, status canceled).
-
-**Reset.**  ResetSimulation's scope is a bit field: TIME (sim time to 0 and
-controllers holding the joints where they are), STATE (joints, controllers,
-every entity's pose at rest), SPAWNED (the objects spawned at run time
-deleted); DEFAULT and ALL: as if restarted (also the world file's objects
-back, entity info as at start).  Paused or playing stays as it was; paused
-after a full reset reads STOPPED.  Other bits: FEATURE_UNSUPPORTED.
-
-**Entities** (:mod:`pan_tilt_sim.sim.entities`): the robot, the targets
-(static) and URDF objects; states in the world frame, stamped with sim time.
-The services act between batches of physics steps, as the gazebo_ros ones do.
+Serves ROS 2's ``simulation_interfaces`` (1.5, Jazzy), as Gazebo (ros_gz_sim), Isaac
+Sim and O3DE do, where the package is installed; without it these services are off
+and everything else runs.  The services live under the
+``simulation_interfaces.namespace`` parameter (``~``, the node's own name, by
+default; ``''`` gives Isaac Sim's root names, and then ResetSimulation takes
+``reset_simulation`` from gazebo_ros's Empty service).  States and transitions follow
+O3DE's table; StepSimulation (at most :data:`MAX_STEP_SIMULATION_STEPS`) and the
+SimulateSteps action run only while paused, through :mod:`pan_tilt_sim.ros.stepping`;
+ResetSimulation's scope bits TIME, STATE and SPAWNED are served, others are
+FEATURE_UNSUPPORTED.  Entities (:mod:`pan_tilt_sim.sim.entities`) are the robot, the
+targets and URDF objects, their states in the world frame stamped with sim time.  Every
+answer fills ``result`` and says why in ``error_message``; a refused request changes
+nothing.  The services act between batches of physics steps.  docs/simulator-control.md
+is the user's reference.
 """
 
 from __future__ import annotations

@@ -63,8 +63,8 @@ def spin(node: Node, on_ready: Callable[[], None] | None = None,
                 # No timeout: the executor sleeps until there is work.  rclpy
                 # wakes it when SIGINT/SIGTERM arrives (its handler runs ours
                 # too, which raises in ``interrupts``) and when Python shuts the
-                # context down; a wake-up every 0.1 s "just in case" cost
-                # ~0.9 % of a core, ~1 ms each to rebuild the wait set.
+                # context down.  No wake-ups "just in case": each one rebuilds
+                # the executor's wait set over every service, in Python.
                 executor.spin_once()
     except ExternalShutdownException:
         pass  # the context shut down while waiting: the normal end

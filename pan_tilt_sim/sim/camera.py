@@ -4,7 +4,7 @@ Where the camera sits: at the tip of its link -- as far along the link's +z
 as the link's visual geometry reaches -- looking along the link's +z.  It is
 rigidly mounted: its "up" is the link axis (+-x or +-y) that points most
 nearly up (world +z) in the robot's initial pose, so the image is upright
-there.  For the seed's pan/tilt the tilt link starts horizontal (tilt
+there.  For the pan/tilt example the tilt link starts horizontal (tilt
 -pi/2), the camera looks along world -x at pan 0, and its up is the link's
 +x; at tilt -pi it looks straight down.
 

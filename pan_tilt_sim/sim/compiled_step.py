@@ -5,18 +5,17 @@ Every physics step makes three PyBullet calls: the joint torques, one
 call parses its arguments, and ``stepSimulation`` builds a dict of solver
 statistics per step that nobody reads.  ``_compiled_step`` (C, built by
 ``pip install`` / colcon when a compiler is there) sends the same commands
-through PyBullet's C API: 0.7-0.8 us less per step on the seed, and ~7 %
-less CPU per 20-step tick at ``real_time_factor`` 1 (README, Performance).
-The results are the same to the last bit.
+through PyBullet's C API, without that parsing and that dict.  The results
+are the same to the last bit.
 
 Where every controller updated each step is a position or velocity PID or
 an effort controller and a step sends PyBullet nothing but the torques (the
-seed's case), the same extension also runs the steps between two
+pan/tilt example's case), the same extension also runs the steps between two
 broadcaster samples without returning to Python (``Stepper.run_laws``,
 driven by :meth:`pan_tilt_sim.sim.engine.Simulation.advance`): the laws of
 :mod:`pan_tilt_sim.controllers.step_law`, computed operation for operation
-as the Python controllers compute them.  ~1.6 us less per step again on the
-seed.  The Python controllers stay the reference; the others (trajectories,
+as the Python controllers compute them, so no Python runs per step.  The
+Python controllers stay the reference; the others (trajectories,
 ideal actuators) run only in Python.
 
 The C side gets its PyBullet client the documented way, as a PyBullet
@@ -25,7 +24,7 @@ used only with the PyBullet C API version it was written against
 (:data:`API_VERSION`) and only when the law row layout it was built with is
 step_law's (:func:`layout_mismatch`, checked at import); otherwise, without
 the extension, or with ``PAN_TILT_SIM_COMPILED_STEP=0`` in the environment,
-the physics steps through PyBullet's Python module as before.
+the physics steps through PyBullet's Python module.
 """
 
 from __future__ import annotations

@@ -277,9 +277,8 @@ class Simulation:
         """Run ``steps`` steps, every controller updated in Python."""
         # Everything the loop touches is a local: bound methods, the physics
         # stepper, the handles; group controllers' members are called directly
-        # and scheduled ones (the broadcasters) only when due.  Per step this
-        # costs ~2 us of Python for the pan/tilt against ~4.5 us for PyBullet's
-        # calls (see README, Performance) -- what the compiled laws save.
+        # and scheduled ones (the broadcasters) only when due.  This loop's
+        # Python is what the compiled laws save (docs/performance.md).
         handles = self._handle_list
         updates = self.manager.updates
         scheduled = self.manager.scheduled_updates
@@ -291,7 +290,7 @@ class Simulation:
         states = self._states
         first = self._steps
         for count in range(first, first + steps):
-            # Equal lengths by construction; strict=True would cost ~0.2 us per step.
+            # Equal lengths by construction; strict=True would check them every step.
             for handle, state in zip(handles, states, strict=False):
                 handle.position = state[STATE_POSITION]
                 handle.velocity = state[STATE_VELOCITY]

@@ -19,8 +19,8 @@ Each joint is driven one of two ways (:meth:`Physics.set_drives`):
   time_step`` exceeds twice the joint's effective inertia ``J = 1 /
   (M^-1)_ii``; it is kept only where it is twenty times inside that bound
   (``d dt <= 0.1 J`` at every pose checked: there explicit and implicit
-  Euler are equally accurate, and it costs nothing per step -- the seed's
-  pan/tilt).  Elsewhere damping is implicit, stable at any time step: the
+  Euler are equally accurate, and it costs nothing per step -- the pan/tilt
+  example).  Elsewhere damping is implicit, stable at any time step: the
   zero-speed motor resists with at most the force that damping and
   friction give at the speed the joint would have at the end of the step
   (implicit Euler of ``J v' = tau + g - d v - f sgn v``, with the passive

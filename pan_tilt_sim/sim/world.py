@@ -5,33 +5,31 @@ and lives in the simulation's PyBullet client, where the cameras render (see
 :mod:`pan_tilt_sim.sim.camera`) and a GUI window shows it.  The targets are
 static bodies (mass 0) with box collision shapes, so lidars and anything
 else that casts rays hits them, as in Gazebo.  They are made with maximal
-coordinates (a static btRigidBody each), not as multibodies: four static
-multibodies -- even visual-only ones -- cost the seed's physics step
-+1.1 us (3.5 -> 4.6 us, +31 %), four static rigid bodies with collision
-shapes +0.08 us (within noise; measured by stepping the seed 20,000 times,
-median of 8 interleaved runs).  Cameras, depth cameras and lidars meet the
+coordinates (a static btRigidBody each), not as multibodies: a static
+multibody, even a visual-only one, joins PyBullet's articulated-body pass
+every step, a static rigid body with a collision shape only the broadphase,
+which costs next to nothing.  Cameras, depth cameras and lidars meet the
 ground plane analytically.  Objects spawned into the world
 (:mod:`pan_tilt_sim.sim.entities`) land on it: :func:`add_ground_plane`
 adds the plane as a collision body when the first object arrives -- so a
 world without objects pays nothing for it.  The robot is fixed to the
 world, and its links that touch the ground or reach below it in the
-initial pose (:func:`grounded_links`: the seed's base and its pan link,
+initial pose (:func:`grounded_links`: the pan/tilt example's base and its pan link,
 whose collision cylinder reaches below z = 0; a base sunk into the floor)
 never collide with the plane: they would be held by it (a wheel half in the
 ground turns 0 rad/s instead of 42 under the same torque).  Every other
 link meets the ground as any object does: a gripper cannot go through it.
 
 The ground is the plane z = 0.  TinyRenderer's cost grows with the pixels it
-shades, and a ground body covers half of every horizontal view (measured: 9 ms
-per 320x240 frame with a ground box, under 3 ms without), so the camera does
-not render a ground body: it paints the ground into the background pixels
+shades, and a ground body covers half of every horizontal view, so the camera
+does not render a ground body: it paints the ground into the background pixels
 whose viewing ray points down (exact for an infinite plane, which a plane
 lit by a directional light shows in one flat colour).  ``build_world(...,
 ground=True)`` adds a ground box for the GUI window.
 
 Targets stand on the ground around the origin, one per compass direction,
-each a different colour, their centres at the height of the seed's camera
-when the tilt is horizontal.  With the seed's pan/tilt the camera looks
+each a different colour, their centres at the height of the pan/tilt
+example's camera when the tilt is horizontal.  With the pan/tilt the camera looks
 along world -x at pan 0, so pan = azimuth - pi faces a target.
 """
 
@@ -56,7 +54,7 @@ STATIC_MASS = 0.0  # PyBullet: mass 0 makes a body static
 NO_SHAPE = -1
 BASE_LINK = -1  # PyBullet's link index of a body's base
 # A body without a visual shape is drawn by TinyRenderer from its collision
-# shape (a plane: the whole lower half of every view, ~16 ms per frame); a
+# shape (a plane: the whole lower half of every view, shaded pixel by pixel); a
 # speck of a visual shape, fully transparent, keeps the ground plane unseen.
 INVISIBLE_RADIUS = 1e-6
 INVISIBLE_RGBA = (0.0, 0.0, 0.0, 0.0)

@@ -14,7 +14,7 @@ processes get it pickled with each call (a few tens of kB, against
   the *spawn* start method (no inherited PyBullet clients or locks), each
   worker building its own simulations.
 * :class:`RayCluster` -- each call a Ray task (``num_cpus=1``) on the cluster
-  at ``address`` (``auto``: the one this machine belongs to; ``ray://host:10001``:
+  at ``address`` (``auto``: the one the local machine belongs to; ``ray://host:10001``:
   a remote cluster through Ray Client; ``host:6379``: the head's GCS), or on
   the Ray instance this process already started.  Connecting to a cluster
   ships this ``pan_tilt_sim`` package to its workers (Ray ``runtime_env``
@@ -88,7 +88,7 @@ def _warm_up() -> None:
 
 
 class LocalProcesses(Backend):
-    """A pool of ``workers`` spawned processes on this machine."""
+    """A pool of ``workers`` spawned processes on the local machine."""
 
     name = 'local processes'
 

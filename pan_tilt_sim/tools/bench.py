@@ -1,7 +1,7 @@
 """bench: how fast sim_node runs, printed as one JSON object.
 
 ``ros2 run pan_tilt_sim bench`` (or ``python -m pan_tilt_sim.tools.bench``)
-runs the seed's pan/tilt model and prints, measured in one run so that
+runs the pan/tilt example and prints, measured in one run so that
 ratios hold on a noisy machine (CPU figures come from the processes' and
 threads' own CPU clocks, which other work on the machine distorts far less
 than wall time):
@@ -105,7 +105,7 @@ from pan_tilt_sim.sim.physics import Physics
 from pan_tilt_sim.sim.profiling import pybullet_step_cost
 from pan_tilt_sim.tools.sensor_cost import sensor_costs
 
-DEFAULT_TIME_STEP = 0.001  # s, the issue's reference step
+DEFAULT_TIME_STEP = 0.001  # s, sim_node's default time_step
 CHAIN_JOINTS = (2, 8, 32)
 STARTUP_RUNS = 5
 EXIT_FAILURE = 1
@@ -209,7 +209,7 @@ def chain_files(joints: int, folder: pathlib.Path) -> tuple[pathlib.Path, pathli
     """Write a serial chain of ``joints`` revolute joints and its controllers into ``folder``.
 
     Links are 5 cm cylinders of 1 kg (inertia 0.1 kg m^2, as stiff to simulate as
-    the seed's links); axes alternate between z and y; every joint has a
+    the pan/tilt example's links); axes alternate between z and y; every joint has a
     position controller, and a JointState controller publishes at 50 Hz.
     """
     links = ['<link name="link_0">' + _CHAIN_LINK_BODY + '</link>']
@@ -318,7 +318,7 @@ def raw_figures(model: Model, time_step: float, sim_seconds: float,
 def raw_rates_disagree(raw: dict[str, float]) -> str | None:
     """Say so if the raw rates from thread CPU and from wall time are more than RAW_AGREEMENT apart.
 
-    Both time the same ``stepSimulation``, one after the other; on a shared VM
+    Both time the same ``stepSimulation``, one after the other; on a shared machine
     a burst of neighbours' load (or the hypervisor's CPU accounting) can
     inflate one of them, and every ``ratio_to_raw`` of the run with it.
     """
@@ -345,7 +345,7 @@ def cpu_seconds(pid: int) -> float:
 
     From the process's CPU-time clock, to the nanosecond, where the system
     gives it (Linux); else from psutil or ``/proc``, which count whole clock
-    ticks (10 ms: +-0.1 % of a core over the bench's 10 s factor-1 window).
+    ticks (a tick is a sizeable share of the bench's 10 s factor-1 window).
     """
     with contextlib.suppress(OSError):
         return time.clock_gettime(process_cpu_clock(pid))
@@ -749,13 +749,13 @@ class Bench:
         """Median wall times from a process start to its first JointState here.
 
         Returns (sim_node, bare rclpy publisher): the second is the floor,
-        what Python, rclpy and DDS discovery alone take on this machine.  The
+        what Python, rclpy and DDS discovery alone take on the machine.  The
         two alternate, run by run, so both see the same machine.  Each run
         listens with a fresh probe.  Fast DDS announces a new participant
         before it listens, so the answer to its first announcement can be
         lost; the two then meet at the older one's next announcement, every
         0.1 s in a participant's first half second and every 3 s after that
-        (the end of the README's Performance section).  A probe older than
+        (docs/testing.md).  A probe older than
         half a second would time that 3 s wait in some runs, not start-up;
         a fresh one bounds it to ~0.1 s steps, hence the steps in the figures.
         """

@@ -82,7 +82,8 @@ def summary(cls: type[Controller]) -> str:
 
 
 def _anchor(cls: type[Controller]) -> str:
-    return cls.__module__.rpartition('.')[2].replace('_', '-')
+    # The section's heading is the module name; GitHub's anchor for it keeps the underscores.
+    return cls.__module__.rpartition('.')[2]
 
 
 def _default(param: Param) -> str:

@@ -92,7 +92,7 @@ P_SPAN = 100.0
 I_LOW, I_HIGH = 1e-4, 10.0  # times p: integral time constants from 10,000 s to 0.1 s
 D_SPAN = 100.0
 CLAMP_LOW = 1e-3  # times the effort limit
-FALLBACK_P = 100.0  # the seed's p, when the YAML's is 0
+FALLBACK_P = 100.0  # the pan/tilt example's p, when the YAML's is 0
 # Optuna takes finite numbers; an unstable candidate gets these.
 WORST_COST = 1e12
 WORST_VIOLATION = 1e6

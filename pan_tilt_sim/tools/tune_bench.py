@@ -2,7 +2,7 @@
 
 ``ros2 run pan_tilt_sim bench --tune`` (or ``python -m pan_tilt_sim.tools.tune_bench``)
 times the unit of work of ``tune`` and ``sweep`` -- one evaluation: the
-seed's pan stepped 0 -> 1 rad with the seed's gains, 15 s of sim time at
+pan/tilt example's pan stepped 0 -> 1 rad with its own gains, 15 s of sim time at
 1 ms, in a fresh simulation (:func:`pan_tilt_sim.tools.evaluation.evaluate`)
 -- and prints one JSON object:
 
@@ -12,7 +12,7 @@ seed's pan stepped 0 -> 1 rad with the seed's gains, 15 s of sim time at
   workers (it should match: the work is the same everywhere);
 * ``evaluations_per_s`` -- throughput of ``in_process`` (a loop here),
   ``local_1`` and ``local_2`` (1 and 2 spawned worker processes) and
-  ``ray_2_nodes`` (Ray tasks on a two-node cluster started on this machine:
+  ``ray_2_nodes`` (Ray tasks on a two-node cluster started on the local machine:
   a head node and a second node, one CPU each, all on 127.0.0.1);
 * ``worker_busy_share`` -- per back end, the share of its workers' wall time
   spent evaluating (their CPU time over wall time x parallelism): 1 on an
@@ -72,7 +72,7 @@ from pan_tilt_sim.tools.evaluation import Case, Scenario, evaluate, load_scenari
 
 PROGRAM = 'tune_bench'
 JOINT = 'pan_joint'
-TARGET = 1.0  # rad: 10 s of ramp at the seed's 0.1 rad/s, plus 5 s to settle
+TARGET = 1.0  # rad: 10 s of ramp at the pan/tilt example's 0.1 rad/s, plus 5 s to settle
 TIME_STEP = 0.001
 FULL_EVALUATIONS = 24  # per back end and round
 QUICK_EVALUATIONS = 4
@@ -152,7 +152,7 @@ class RayNodes:
 
 
 def pan_scenario() -> Scenario:
-    """Return the seed's pan/tilt with its own controllers YAML."""
+    """Return the pan/tilt example with its own controllers YAML."""
     share = package_share()
     return load_scenario(share / DEFAULT_DESCRIPTION, share / DEFAULT_CONTROLLERS, TIME_STEP)
 

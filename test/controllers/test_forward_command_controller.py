@@ -100,7 +100,7 @@ def test_a_non_finite_element_rejects_the_whole_command(interface, type_name, ex
     assert [(handle.effort, handle.velocity_target) for handle in handles.values()] == idle
 
 
-SEED_GAINS = {'p': 100.0, 'i': 0.01, 'd': 10.0}
+PAN_TILT_GAINS = {'p': 100.0, 'i': 0.01, 'd': 10.0}
 POSITION, VELOCITY, EFFORT = (pytest.mark.parametrize(
     ('type_name', 'extra'), ways(interface), ids=way_ids(interface))
     for interface in ('position', 'velocity', 'effort'))
@@ -170,7 +170,7 @@ def test_the_manager_configures_activates_and_cleans_it_up_and_it_holds_where_ac
 def test_position_group_with_gains_ramps_each_setpoint_and_pushes_toward_it(type_name, extra):
     handles = make_handles()
     controller = group(type_name, handles, **extra,
-                       gains={'shoulder': SEED_GAINS, 'slide': SEED_GAINS})
+                       gains={'shoulder': PAN_TILT_GAINS, 'slide': PAN_TILT_GAINS})
     assert controller.set_command([0.5, 0.25]) is CommandResult.ACCEPTED
     controller.update(0.0, DT)
     shoulder, slide = controller.members

@@ -32,7 +32,7 @@ POSITION_TYPE = 'position_controllers/JointPositionController'
 EFFORT_TYPE = 'effort_controllers/JointPositionController'
 PAN = JointSpec('pan_joint', JointKind.REVOLUTE, lower=-3.14, upper=3.14,
                 effort_limit=300.0, velocity_limit=0.1)
-SEED_PARAMS = {'type': POSITION_TYPE, 'joint': 'pan_joint',
+PAN_TILT_PARAMS = {'type': POSITION_TYPE, 'joint': 'pan_joint',
                'pid': {'p': 100.0, 'i': 0.01, 'd': 10.0}}
 # A joint fast enough for the ideal actuator's ramp to show both of its limits.
 ARM = JointSpec('arm', JointKind.REVOLUTE, lower=-1.0, upper=1.0, effort_limit=30.0,
@@ -40,7 +40,7 @@ ARM = JointSpec('arm', JointKind.REVOLUTE, lower=-1.0, upper=1.0, effort_limit=3
 WHEEL = JointSpec('wheel', JointKind.CONTINUOUS)  # no limits at all
 
 
-def _controller(params=SEED_PARAMS, spec=PAN):
+def _controller(params=PAN_TILT_PARAMS, spec=PAN):
     handle = JointHandle(spec)
     controller = create_controller('joint1_position_controller', params['type'], params)
     controller.configure({spec.name: handle})
@@ -265,7 +265,7 @@ def test_one_radian_takes_ten_seconds_no_step_faster_than_the_limit():
 
 @pytest.mark.parametrize('command', [3.0, -3.0])
 def test_effort_is_clamped_to_the_effort_limit(command):
-    params = dict(SEED_PARAMS, pid={'p': 1e6})
+    params = dict(PAN_TILT_PARAMS, pid={'p': 1e6})
     controller, handle = _controller(params)
     controller.set_command(command)
     _run(controller, 100)

@@ -135,7 +135,7 @@ NAN = math.nan
     ({'update_rate': 100}, 100.0),
     ({'publish_rate': 30, 'update_rate': 100}, 30.0),
 ])
-def test_rate_is_publish_rate_else_update_rate_else_the_seeds_50_hz(params, rate):
+def test_rate_is_publish_rate_else_update_rate_else_the_pan_tilt_examples_50_hz(params, rate):
     assert broadcaster(**params).publish_rate == pytest.approx(rate)
 
 

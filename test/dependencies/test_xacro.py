@@ -32,18 +32,18 @@ XACRO_ARM = '''<?xml version="1.0"?>
 '''
 
 
-def test_xacro_find_uses_the_ament_index(seed2, tmp_path, cache_dir):
+def test_xacro_find_uses_the_ament_index(my_robot_share, tmp_path, cache_dir):
     """Xacro resolves $(find PKG) through AMENT_PREFIX_PATH, in includes too."""
-    (seed2 / 'urdf' / 'arm.xacro').write_text(XACRO_ARM)
+    (my_robot_share / 'urdf' / 'arm.xacro').write_text(XACRO_ARM)
     main = tmp_path / 'main.xacro'
     main.write_text(XACRO_MAIN)
     document = xacro.process_file(str(main), mappings={'mesh': 'base'})
     robot = ET.fromstring(document.toxml())
     assert robot.find('link/collision/geometry/mesh').get('filename') == str(
-        seed2 / 'meshes' / 'collision' / 'base.stl')
+        my_robot_share / 'meshes' / 'collision' / 'base.stl')
     done = localize_meshes(robot, main.parent, cache_dir)
-    assert [m.loadable for m in done] == [seed2 / mf.SEED2_MESHES['base_collision'],
-                                          seed2 / mf.SEED2_MESHES['arm_collision']]
+    assert [m.loadable for m in done] == [my_robot_share / mf.MY_ROBOT_MESHES['base_collision'],
+                                          my_robot_share / mf.MY_ROBOT_MESHES['arm_collision']]
 
 
 def test_xacro_find_of_an_unknown_package_raises_xacro_exception(tmp_path, monkeypatch):

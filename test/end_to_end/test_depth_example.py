@@ -1,6 +1,6 @@
 """End to end: examples/depth_snapshot.py against sim_node running the pan/tilt with sensors.
 
-The README's sensor example, as a user runs it: sim_node with
+The sensor example of docs/sensors.md, as a user runs it: sim_node with
 ``urdf/pan_tilt_sensors.xacro`` in one process, the rclpy client in another;
 the client turns the pan to face a target, saves the depth image as a PNG
 and describes the point cloud.

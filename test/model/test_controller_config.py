@@ -1,4 +1,4 @@
-"""Reading controller YAML: the seeds' ROS 1 (rosparam) layout and ros2_control's."""
+"""Reading controller YAML: the examples' ROS 1 (rosparam) layout and ros2_control's."""
 
 import dataclasses
 import math
@@ -35,9 +35,9 @@ def by_name(config):
     return {spec.name: spec for spec in config.controllers}
 
 
-# --- ROS 1 style (the seeds') ---------------------------------------------------------------
+# --- ROS 1 style (the examples') ---------------------------------------------------------------
 
-def test_our_config_wraps_the_seeds_controllers_in_the_robot_namespace(repo_root):
+def test_our_config_wraps_the_pan_tilt_examples_controllers_in_the_robot_namespace(repo_root):
     config = load_controllers_config(repo_root / 'config' / 'pan_tilt_control.yaml')
     assert config.namespace == 'ex_urdf_pan_tilt'
     by_name = {spec.name: spec for spec in config.controllers}
@@ -50,11 +50,11 @@ def test_our_config_wraps_the_seeds_controllers_in_the_robot_namespace(repo_root
         assert by_name[name].params['pid'] == {'p': 100.0, 'i': 0.01, 'd': 10.0}
 
 
-def test_the_seeds_own_yaml_loads_unchanged_and_matches_ours(original_examples, repo_root):
-    seed = load_controllers_config(original_examples / 'pan_tilt_control.yaml')
+def test_the_original_examples_yaml_loads_unchanged_and_matches_ours(original_examples, repo_root):
+    original = load_controllers_config(original_examples / 'pan_tilt_control.yaml')
     ours = load_controllers_config(repo_root / 'config' / 'pan_tilt_control.yaml')
-    assert seed.namespace == ours.namespace
-    assert seed.controllers == ours.controllers
+    assert original.namespace == ours.namespace
+    assert original.controllers == ours.controllers
 
 
 def test_controllers_at_the_top_level_have_no_namespace(original_examples):

@@ -1,4 +1,4 @@
-"""The description layer: the seed's xacro and ours give the same robot facts."""
+"""The description layer: the original example's xacro and ours give the same robot facts."""
 
 import math
 
@@ -14,7 +14,7 @@ def _facts(description):
     return {joint.name: joint for joint in description.joints}
 
 
-def test_our_pan_tilt_xacro_has_the_seeds_joints_limits_and_dynamics(repo_root):
+def test_our_pan_tilt_xacro_has_the_pan_tilt_examples_joints_limits_and_dynamics(repo_root):
     description = load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
     assert description.name == 'ex_urdf_pan_tilt'
     assert description.plugin_namespace == '/ex_urdf_pan_tilt'
@@ -26,14 +26,14 @@ def test_our_pan_tilt_xacro_has_the_seeds_joints_limits_and_dynamics(repo_root):
         assert (joint.damping, joint.friction) == (50.0, 1.0)
 
 
-def test_the_seeds_own_xacro_loads_unchanged_and_matches_ours(original_examples, repo_root):
-    seed = load_description(original_examples / 'pan_tilt.xacro')
+def test_the_original_examples_xacro_loads_unchanged_and_matches_ours(original_examples, repo_root):
+    original = load_description(original_examples / 'pan_tilt.xacro')
     ours = load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
-    assert _facts(seed) == _facts(ours)
-    assert seed.plugin_namespace == ours.plugin_namespace == '/ex_urdf_pan_tilt'
+    assert _facts(original) == _facts(ours)
+    assert original.plugin_namespace == ours.plugin_namespace == '/ex_urdf_pan_tilt'
 
 
-def test_our_xacro_keeps_the_seeds_links_geometry_and_inertia(original_examples, repo_root):
+def test_our_xacro_keeps_the_original_links_geometry_and_inertia(original_examples, repo_root):
     import xml.etree.ElementTree as ElementTree
 
     def links(path):
@@ -54,11 +54,11 @@ def test_our_xacro_keeps_the_seeds_links_geometry_and_inertia(original_examples,
         return ([{k: float(v) for k, v in c.items()} for c in cylinders], colours, origins,
                 float(mass['value']), inertia)
 
-    seed = links(original_examples / 'pan_tilt.xacro')
+    original = links(original_examples / 'pan_tilt.xacro')
     ours = links(repo_root / 'urdf' / 'pan_tilt.xacro')
-    assert seed.keys() == ours.keys() == {'base_link', 'pan_link', 'tilt_link'}
-    for name in seed:
-        assert numeric(seed[name]) == numeric(ours[name]), name
+    assert original.keys() == ours.keys() == {'base_link', 'pan_link', 'tilt_link'}
+    for name in original:
+        assert numeric(original[name]) == numeric(ours[name]), name
 
 
 def test_initial_position_is_zero_or_the_nearest_limit(repo_root):

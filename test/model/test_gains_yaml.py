@@ -27,7 +27,7 @@ ROS1 = textwrap.dedent("""\
       pan_controller:
         type: position_controllers/JointPositionController
         joint: pan_joint
-        pid: {p: 100.0, i: 0.01, d: 10.0}   # seed gains
+        pid: {p: 100.0, i: 0.01, d: 10.0}   # example gains
 
       tilt_controller:
         type: effort_controllers/JointPositionController
@@ -89,8 +89,8 @@ def test_a_flow_pid_gets_new_values_and_a_clamp_on_its_own_line_only(tmp_path):
                          {'p': 812.3, 'i': 1e-05, 'd': 30.0, **clamp_values(12.5, ['p'])})
     after = rewrite_gains(ROS1, 'f.yaml', [update])
     assert changed_lines(ROS1, after) == [(
-        '    pid: {p: 100.0, i: 0.01, d: 10.0}   # seed gains',
-        '    pid: {p: 812.3, i: 1.0e-05, d: 30.0, i_clamp: 12.5}   # seed gains')]
+        '    pid: {p: 100.0, i: 0.01, d: 10.0}   # example gains',
+        '    pid: {p: 812.3, i: 1.0e-05, d: 30.0, i_clamp: 12.5}   # example gains')]
     params = load(tmp_path, after)
     assert params['pan_controller']['pid'] == {'p': 812.3, 'i': 1e-05, 'd': 30.0,
                                                'i_clamp': 12.5}
@@ -155,7 +155,7 @@ def test_gains_that_come_from_an_alias_are_refused():
 
 
 def test_a_controller_without_gains_in_the_file_is_an_error():
-    text = ROS1.replace('    pid: {p: 100.0, i: 0.01, d: 10.0}   # seed gains\n', '')
+    text = ROS1.replace('    pid: {p: 100.0, i: 0.01, d: 10.0}   # example gains\n', '')
     with pytest.raises(ControllerConfigError, match='no gains in the file'):
         rewrite_gains(text, 'f.yaml', [GainsUpdate('pan_controller', 'pan_joint', 'pid',
                                                    {'p': 2.0})])

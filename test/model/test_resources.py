@@ -496,16 +496,16 @@ def test_collada_reference_cycle_is_an_error(tmp_path, cache_dir):
         localize_meshes(mesh_robot('cycle.dae', 'visual'), tmp_path, cache_dir)
 
 
-# --- the seed-2 robot -----------------------------------------------------
+# --- the my_robot example -----------------------------------------------------
 
 
 
 
 
-def test_seed2_urdf_loads_with_both_links_and_their_sizes(seed2, tmp_path, cache_dir, client,
-                                                          capfd):
-    """The seed-2 URDF with generated meshes loads: two links, right sizes, no warnings."""
-    urdf = seed2 / mf.SEED2_URDF_RELPATH
+def test_my_robot_urdf_loads_with_both_links_and_their_sizes(my_robot_share, tmp_path, cache_dir,
+                                                              client, capfd):
+    """The my_robot URDF with generated meshes loads: two links, right sizes, no warnings."""
+    urdf = my_robot_share / mf.MY_ROBOT_URDF_RELPATH
     robot = ET.parse(urdf).getroot()
     done = localize_meshes(robot, urdf.parent, cache_dir)
     assert {(m.link, m.role, m.uri.rsplit('/', 1)[1]) for m in done} == {
@@ -516,25 +516,25 @@ def test_seed2_urdf_loads_with_both_links_and_their_sizes(seed2, tmp_path, cache
     joint = pybullet.getJointInfo(body, 0, physicsClientId=client)
     assert joint[1] == b'arm_joint'
     assert joint[12] == b'arm_link'
-    np.testing.assert_allclose(collision_extent(client, body, -1), mf.SEED2_BASE_SIZE_M,
+    np.testing.assert_allclose(collision_extent(client, body, -1), mf.MY_ROBOT_BASE_SIZE_M,
                                rtol=FLOAT32_TOLERANCE)
-    np.testing.assert_allclose(collision_extent(client, body, 0), mf.SEED2_ARM_SIZE_M,
+    np.testing.assert_allclose(collision_extent(client, body, 0), mf.MY_ROBOT_ARM_SIZE_M,
                                rtol=FLOAT32_TOLERANCE)
     visuals = {shape[1]: shape for shape in pybullet.getVisualShapeData(
         body, physicsClientId=client)}
     assert visuals[-1][3] == pytest.approx((MM, MM, MM))
     # The visual DAE holds millimetres; the URDF scale brings it to metres.
-    converted = read_collada((seed2 / mf.SEED2_MESHES['base_visual']).read_bytes())
+    converted = read_collada((my_robot_share / mf.MY_ROBOT_MESHES['base_visual']).read_bytes())
     extent = converted.reshape(-1, 3).max(axis=0) - converted.reshape(-1, 3).min(axis=0)
-    np.testing.assert_allclose(extent * MM, mf.SEED2_BASE_SIZE_M)
+    np.testing.assert_allclose(extent * MM, mf.MY_ROBOT_BASE_SIZE_M)
     assert_quiet(capfd)
 
 
-def test_seed2_missing_visual_names_uri_and_resolved_path(seed2, cache_dir):
-    """A seed-2 mesh missing from the package gives the documented message."""
-    missing = seed2 / mf.SEED2_MESHES['base_visual']
+def test_my_robot_example_missing_visual_names_uri_and_resolved_path(my_robot_share, cache_dir):
+    """A my_robot example mesh missing from the package gives the documented message."""
+    missing = my_robot_share / mf.MY_ROBOT_MESHES['base_visual']
     missing.unlink()
-    urdf = seed2 / mf.SEED2_URDF_RELPATH
+    urdf = my_robot_share / mf.MY_ROBOT_URDF_RELPATH
     with pytest.raises(DescriptionError) as caught:
         localize_meshes(ET.parse(urdf).getroot(), urdf.parent, cache_dir)
     assert str(caught.value) == (

@@ -13,7 +13,7 @@ from pan_tilt_sim.model.urdf import parse_urdf
 from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
 
 
-def seed_model():
+def pan_tilt_model():
     return load_description(package_share() / DEFAULT_DESCRIPTION).model
 
 
@@ -21,24 +21,24 @@ def arm_model():
     return parse_urdf(ARM_URDF, pathlib.Path('arm.urdf'))
 
 
-def test_the_seed_has_two_moving_joints_and_no_fixed_ones():
-    tree = seed_model()
+def test_the_pan_tilt_example_has_two_moving_joints_and_no_fixed_ones():
+    tree = pan_tilt_model()
     assert tree.root == 'base_link'
     assert [joint.name for joint in tree.moving_joints] == ['pan_joint', 'tilt_joint']
     assert tree.fixed_joints == ()
 
 
-def test_the_seed_tilt_link_is_0_3_m_up_and_turned_by_the_tilt():
-    tree = seed_model()
+def test_the_pan_tilt_example_tilt_link_is_0_3_m_up_and_turned_by_the_tilt():
+    tree = pan_tilt_model()
     pose = tree.link_poses({'pan_joint': 0.0, 'tilt_joint': -math.pi / 2})['tilt_link']
     assert pose.translation == pytest.approx((0.0, 0.0, 0.3))
     assert rotate(pose.rotation, (0, 0, 1)) == pytest.approx((-1.0, 0.0, 0.0), abs=1e-12)
 
 
 def test_link_reach_is_the_far_end_of_the_visual_along_z():
-    seed, arm = seed_model(), arm_model()
-    assert seed.link('tilt_link').reach() == pytest.approx(0.2)  # 0.4 m cylinder, centred
-    assert seed.link('pan_link').reach() == pytest.approx(0.29)  # offset 0.09 + 0.2
+    pan_tilt, arm = pan_tilt_model(), arm_model()
+    assert pan_tilt.link('tilt_link').reach() == pytest.approx(0.2)  # 0.4 m cylinder, centred
+    assert pan_tilt.link('pan_link').reach() == pytest.approx(0.29)  # offset 0.09 + 0.2
     assert arm.link('upper').reach() == pytest.approx(0.5)  # box from 0 to 0.5
     assert arm.link('base').reach() == 0.0  # no visual
 

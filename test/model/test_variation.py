@@ -51,7 +51,7 @@ def test_nothing_varied_is_the_same_description(pan_tilt):
 def test_mass_scales_every_mass_and_inertia_in_the_model_and_the_urdf(pan_tilt):
     varied = vary_description(pan_tilt, PhysicalVariation(mass_scale=1.5))
     for link in varied.model.links:
-        assert link.inertial.mass == pytest.approx(1.5)  # the seed's links are 1 kg, 1 kg m^2
+        assert link.inertial.mass == pytest.approx(1.5)  # the pan/tilt's links are 1 kg, 1 kg m^2
         assert link.inertial.izz == pytest.approx(1.5)
         mass, tensor, _ = urdf_inertial(varied, link.name)
         assert mass == pytest.approx(1.5)

@@ -166,7 +166,7 @@ def test_switch_and_configure_answer_within_the_spawner_timeouts_at_real_time():
         assert Spawner(sim).spawn(JSB) == 0
 
 
-# --- the seeds' way: every controller active, and a UR-style file switched ---------------
+# --- the ROS 1 examples' way: every controller active, and a UR-style file switched ---------------
 
 @pytest.fixture
 def ur_style(tmp_path):
@@ -257,7 +257,7 @@ def test_strict_refuses_what_best_effort_leaves_out(ur_style):
 
 
 def test_a_namespaced_robot_has_its_controller_manager_in_its_namespace():
-    with sim_node() as sim:  # the seed's pan/tilt, under /ex_urdf_pan_tilt
+    with sim_node() as sim:  # the pan/tilt example, under /ex_urdf_pan_tilt
         spawner = Spawner(sim, '/ex_urdf_pan_tilt/controller_manager')
         states = {name: c.state for name, c in spawner.controllers().items()}
         assert states == {'joint_state_controller': 'active',

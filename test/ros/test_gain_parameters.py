@@ -13,7 +13,8 @@ from pan_tilt_sim.ros.gain_parameters import FIELDS, apply_fields, field_values
 
 PAN = 'joint1_position_controller'
 TILT = 'joint2_position_controller'
-# The seed's pan joint: damping 50 N m s/rad, friction 1 N m, velocity limit 0.1 rad/s, D 10.
+# The pan/tilt example's pan joint: damping 50 N m s/rad, friction 1 N m, velocity limit
+# 0.1 rad/s, D 10.
 DAMPING, FRICTION, RAMP_SPEED, D_GAIN = 50.0, 1.0, 0.1, 10.0
 
 

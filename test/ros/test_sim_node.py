@@ -1,4 +1,4 @@
-"""sim_node in-process: the seed's pan/tilt driven through its ROS interface.
+"""sim_node in-process: the pan/tilt example driven through its ROS interface.
 
 The node and a probe node share one executor; the node runs at
 real_time_factor 0 (as fast as possible), and every wait is a bounded spin.
@@ -152,7 +152,7 @@ def test_an_effort_controller_meets_damping_and_friction(tmp_path):
         assert pan_tilt.states[-1].effort[0] == pytest.approx(50.0)
 
 
-def test_the_seeds_own_files_drive_the_same_topics(original_examples):
+def test_the_original_examples_files_drive_the_same_topics(original_examples):
     with sim_node(robot_description_file=str(original_examples / 'pan_tilt.xacro'),
                   controllers_file=str(original_examples / 'pan_tilt_control.yaml')) as pan_tilt:
         topics = pan_tilt.topics_once_seen(PAN_COMMAND, f'{NS}/joint_states')

@@ -1,4 +1,4 @@
-"""sim_node with robots other than the pan/tilt: seed 2's package, the three-joint arm.
+"""sim_node with robots other than the pan/tilt: the my_robot example, the three-joint arm.
 
 In-process like test_sim_node.py (node and probe on one executor,
 real_time_factor 0, bounded spins), except the start-up error test, which
@@ -32,26 +32,26 @@ def start_node():
         yield lambda **parameters: running.enter_context(sim_node(**parameters))
 
 
-# --- seed 2: my_robot_pkg from an ament prefix, with generated meshes ----------------------
+# --- the my_robot example: my_robot_pkg from an ament prefix, with generated meshes ---------
 
 @pytest.fixture
-def seed2_package(tmp_path, monkeypatch, original_examples):
-    """Install my_robot_pkg (URDF, meshes, the seed's YAML) into a temporary ament prefix."""
-    prefix = mf.make_seed2_package(tmp_path, original_examples / 'my_robot.urdf')
-    mf.write_file(prefix / 'share' / mf.SEED2_PACKAGE / 'config' / 'joint_controllers.yaml',
+def my_robot_package(tmp_path, monkeypatch, original_examples):
+    """Install my_robot_pkg (URDF, meshes, its controllers YAML) into a temporary ament prefix."""
+    prefix = mf.make_my_robot_package(tmp_path, original_examples / 'my_robot.urdf')
+    mf.write_file(prefix / 'share' / mf.MY_ROBOT_PACKAGE / 'config' / 'joint_controllers.yaml',
                   (original_examples / 'joint_controllers.yaml').read_bytes())
     monkeypatch.setenv('AMENT_PREFIX_PATH', os.pathsep.join(
         [str(prefix), os.environ.get('AMENT_PREFIX_PATH', '')]))
     monkeypatch.setenv('XDG_CACHE_HOME', str(tmp_path / 'cache'))
     from ament_index_python.packages import get_package_share_directory
-    return pathlib.Path(get_package_share_directory(mf.SEED2_PACKAGE))
+    return pathlib.Path(get_package_share_directory(mf.MY_ROBOT_PACKAGE))
 
 
-def test_seed2_arm_joint_reaches_its_command_under_the_plugin_namespace(seed2_package,
+def test_my_robot_example_arm_joint_reaches_its_command_under_the_plugin_namespace(my_robot_package,
                                                                       start_node):
     robot = start_node(
-        robot_description_file=str(seed2_package / mf.SEED2_URDF_RELPATH),
-        controllers_file=str(seed2_package / 'config' / 'joint_controllers.yaml'))
+        robot_description_file=str(my_robot_package / mf.MY_ROBOT_URDF_RELPATH),
+        controllers_file=str(my_robot_package / 'config' / 'joint_controllers.yaml'))
     assert robot.node.robot_namespace == '/my_robot'
     topics = robot.topics_once_seen('/my_robot/arm_controller/command', '/my_robot/joint_states')
     assert topics['/my_robot/arm_controller/command'] == ['std_msgs/msg/Float64']
@@ -62,13 +62,13 @@ def test_seed2_arm_joint_reaches_its_command_under_the_plugin_namespace(seed2_pa
     assert list(robot.states[-1].name) == ['arm_joint']
 
 
-def test_seed2_missing_mesh_ends_start_up_with_code_2_naming_the_uri(seed2_package, tmp_path):
-    missing = seed2_package / mf.SEED2_MESHES['arm_collision']
+def test_my_robot_missing_mesh_ends_start_up_with_code_2_naming_the_uri(my_robot_package, tmp_path):
+    missing = my_robot_package / mf.MY_ROBOT_MESHES['arm_collision']
     missing.unlink()
     result = subprocess.run(
         sim_process.command(
-            '-p', f'robot_description_file:={seed2_package / mf.SEED2_URDF_RELPATH}',
-            '-p', f"controllers_file:={seed2_package / 'config' / 'joint_controllers.yaml'}"),
+            '-p', f'robot_description_file:={my_robot_package / mf.MY_ROBOT_URDF_RELPATH}',
+            '-p', f"controllers_file:={my_robot_package / 'config' / 'joint_controllers.yaml'}"),
         capture_output=True, text=True, env=sim_process.environment(),
         timeout=STARTUP_BUDGET_S)
     assert result.returncode == EXIT_CONFIGURATION_ERROR

@@ -319,7 +319,7 @@ def test_simulate_steps_while_playing_is_aborted_with_the_reason(playing):
 def test_a_closed_harness_leaves_no_action_client_holding_its_probe():
     # rclpy's destroy_node spares action clients, whose handles keep the node and
     # its DDS participant alive until garbage collection: the next test's nodes
-    # would meet its endpoints (8 more native threads per such test, measured).
+    # would meet its endpoints, and each such test would leave native threads behind.
     with sim_node(paused=True) as sim:
         SimInterfaces(sim).action_client()
         probe = sim.probe

@@ -69,7 +69,7 @@ def test_spin_lets_keyboard_interrupt_through(context):
 
 
 def test_an_idle_spin_sleeps_until_there_is_work(context):
-    """No wake-ups "just in case": each costs ~1 ms of CPU to rebuild the wait set."""
+    """No wake-ups "just in case": each one rebuilds the wait set over every service."""
     node = rclpy.create_node('spinning_test', context=context)
     waits = []
 

@@ -78,7 +78,7 @@ def test_partial_messages_by_name_on_the_plugins_default_topics():
         client = SimInterfaces(sim)
         plugin = PluginSide(sim, '/robot_joint_commands', '/robot_joint_states')
         plugin.send(['pan_joint'], position=[0.3])
-        assert client.step(5000).result == OK  # the seed's pan ramps at 0.1 rad/s
+        assert client.step(5000).result == OK  # the pan/tilt example's pan ramps at 0.1 rad/s
         positions = sim.simulation.joint_positions()
         assert positions['pan_joint'] == pytest.approx(0.3, abs=1e-3)
         assert positions['tilt_joint'] == pytest.approx(-1.5708, abs=1e-3)  # held

@@ -1,6 +1,6 @@
 """Two sim_node processes with different namespaces on one domain do not cross-talk.
 
-Each runs the seed's pan/tilt under its own node namespace (``-r __ns:=/left``,
+Each runs the pan/tilt example under its own node namespace (``-r __ns:=/left``,
 ``/right``), so its topics and services are under that namespace.  /clock is
 absolute by ROS convention, as with two Gazebos: each process remaps it
 (``-r /clock:=/left/clock``), which the test does and checks.

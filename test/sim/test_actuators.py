@@ -206,7 +206,7 @@ def test_effort_controllers_keep_their_pid_with_default_gains(tmp_path):
     assert "joint 'joint2': passive: no active controller" in log.infos
 
 
-def test_the_seeds_pan_still_settles_within_15_mrad_never_faster_than_its_limit(repo_root):
+def test_the_pan_tilt_pan_still_settles_within_15_mrad_never_faster_than_its_limit(repo_root):
     with make_simulation(str(repo_root / 'urdf' / 'pan_tilt.xacro'),
                          str(repo_root / 'config' / 'pan_tilt_control.yaml'), DT) as sim:
         assert sim.handles['pan_joint'].actuator.kind is ActuatorKind.POSITION_PID
@@ -276,7 +276,7 @@ def test_waiting_for_spawners_undriven_joints_hold_and_once_driven_are_passive(t
         assert sim.joint_positions()['joint1'] == pytest.approx(0.0, abs=0.002)
 
 
-def test_started_the_seeds_way_an_undriven_joint_is_passive_and_falls(tmp_path):
+def test_started_the_pan_tilt_examples_way_an_undriven_joint_is_passive_and_falls(tmp_path):
     with simulation(tmp_path, two_link_arm_urdf(), ros2_control_yaml({'arm': POSITION_GROUP}),
                     active_controllers=[]) as sim:
         assert sim.handles['joint1'].actuator.kind is ActuatorKind.PASSIVE

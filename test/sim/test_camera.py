@@ -23,7 +23,7 @@ from pan_tilt_sim.sim.camera import (
 from pan_tilt_sim.sim.physics import Physics
 from pan_tilt_sim.sim.world import GROUND_RGB, TARGET_SET, Target, build_world
 
-HORIZONTAL_TILT = -math.pi / 2  # the seed's tilt start: the camera looks horizontally
+HORIZONTAL_TILT = -math.pi / 2  # the pan/tilt example's tilt start: the camera looks horizontally
 PAN_LIMIT = 3.14
 # The centre patch of the image, in pixels either side of the centre.
 CENTRE_HALF = 8
@@ -33,13 +33,13 @@ DOMINANT = 0.9  # fraction of the centre patch a faced target must cover
 
 
 @pytest.fixture(scope='module')
-def seed_description():
+def pan_tilt_description():
     """Return the project's pan/tilt model."""
     return load_description(package_share() / DEFAULT_DESCRIPTION)
 
 
 class Scene:
-    """The seed robot in its own simulation, its camera, the world around it."""
+    """The pan/tilt example in its own simulation, its camera, the world around it."""
 
     def __init__(self, description, world: str = 'targets') -> None:
         self.physics = Physics(description, 0.001)
@@ -60,9 +60,9 @@ class Scene:
 
 
 @pytest.fixture(scope='module')
-def renderer(seed_description):
+def renderer(pan_tilt_description):
     """Return the default camera in the default (targets) world."""
-    scene = Scene(seed_description)
+    scene = Scene(pan_tilt_description)
     yield scene
     scene.close()
 
@@ -88,7 +88,7 @@ def centre(image: numpy.ndarray) -> numpy.ndarray:
 
 
 def pan_facing(target: Target) -> float:
-    """Return the pan angle at which the seed's camera looks at ``target``."""
+    """Return the pan angle at which the pan/tilt example's camera looks at ``target``."""
     pan = math.remainder(math.radians(target.azimuth_deg) - math.pi, 2 * math.pi)
     return max(-PAN_LIMIT, min(PAN_LIMIT, pan))
 
@@ -130,8 +130,8 @@ def test_bad_camera_settings_name_the_parameter(field, value, parameter):
 
 # --- mounting -------------------------------------------------------------------
 
-def test_the_camera_sits_at_the_tip_of_the_tilt_link_looking_along_its_z(seed_description):
-    mount = camera_mount(seed_description.model, 'tilt_link',
+def test_the_camera_sits_at_the_tip_of_the_tilt_link_looking_along_its_z(pan_tilt_description):
+    mount = camera_mount(pan_tilt_description.model, 'tilt_link',
                          {'pan_joint': 0.0, 'tilt_joint': HORIZONTAL_TILT})
     assert mount.translation == pytest.approx((0.0, 0.0, 0.2))  # half the 0.4 m cylinder
     # REP-103 optical frame in link axes: z forward = link z, y down = -link x
@@ -177,9 +177,9 @@ def test_the_image_is_upright_sky_above_ground_below(renderer):
 
 
 @pytest.mark.parametrize(('near', 'far'), [(0.1, 100.0), (0.05, 10.0), (0.02, 10.0)])
-def test_the_ground_is_painted_whatever_the_clip_planes(renderer, seed_description, near, far):
+def test_the_ground_is_painted_whatever_the_clip_planes(renderer, pan_tilt_description, near, far):
     settings = CameraSettings(near=near, far=far)
-    camera = Renderer(renderer.physics, seed_description.model, settings, 'targets')
+    camera = Renderer(renderer.physics, pan_tilt_description.model, settings, 'targets')
     renderer.physics.reset_joints([math.pi / 4, HORIZONTAL_TILT - 0.3])
     image = as_array(camera.render(), settings)
     below = int(intrinsics(settings).cy) + 5  # the horizon is above the centre row
@@ -238,8 +238,8 @@ def test_a_target_appears_where_the_camera_info_intrinsics_project_it(renderer):
     assert rows.max() == pytest.approx(max(vs) - 0.5, abs=1.5)
 
 
-def test_an_empty_world_shows_only_the_robot(seed_description):
-    renderer = Scene(seed_description, world='empty')
+def test_an_empty_world_shows_only_the_robot(pan_tilt_description):
+    renderer = Scene(pan_tilt_description, world='empty')
     try:
         image = as_array(renderer.render([0.0, HORIZONTAL_TILT]), renderer.settings)
     finally:
@@ -273,7 +273,7 @@ def test_images_and_camera_info_arrive_at_the_camera_rate_in_sim_time():
 
 def test_panning_through_the_node_brings_a_target_in_and_out_of_view():
     blue = next(target for target in TARGET_SET if target.name == 'blue')
-    assert pan_facing(blue) == 0.0  # the seed's pan starts facing the blue target
+    assert pan_facing(blue) == 0.0  # the pan/tilt example's pan starts facing the blue target
     with sim_node() as harness:
         topic = harness.node.topic('camera', 'image_raw')
         images = harness.collect(Image, topic, qos=1)

@@ -1,9 +1,9 @@
 """Controller laws stepped in C: the Python loop's results, to the last bit, many steps per call.
 
 When every controller updated each step is a position or velocity PID or an
-effort controller (the seed's case) and a step sends PyBullet nothing but
+effort controller (the pan/tilt example's case) and a step sends PyBullet nothing but
 the torques, the simulation runs the steps between two broadcaster samples
-in C (``run_laws``); the sampled step runs in Python.  The seed's and the
+in C (``run_laws``); the sampled step runs in Python.  The pan/tilt example's and the
 other scenarios' digests are test_engine_bit_identity's; here: each C law is
 its controller's Python update for any input, a robot with every law, group
 members, clamps, a passive joint holding an effort and an uneven
@@ -107,7 +107,7 @@ def test_every_law_group_members_and_a_passive_joint_give_the_python_samples(tmp
     assert compiled[1] == python[1]
 
 
-def test_the_seed_steps_its_position_pids_in_c(monkeypatch):
+def test_the_pan_tilt_example_steps_its_position_pids_in_c(monkeypatch):
     share = package_share()
     monkeypatch.delenv(compiled_step.ENVIRONMENT_SWITCH, raising=False)
     with make_simulation(str(share / DEFAULT_DESCRIPTION), str(share / DEFAULT_CONTROLLERS),

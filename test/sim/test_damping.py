@@ -61,7 +61,7 @@ def test_light_damping_still_lets_the_wheel_reach_effort_over_damping(tmp_path):
 
 
 @pytest.mark.parametrize('time_step', [0.001, 0.01])
-def test_the_seeds_pan_under_50_newton_metres_turns_at_0_98(repo_root, time_step):
+def test_the_pan_tilt_examples_pan_under_50_newton_metres_turns_at_0_98(repo_root, time_step):
     # damping 50, friction 1: (50 - 1) / 50 rad/s, as before and in Gazebo.
     description = load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
     with Physics(description, time_step) as physics:
@@ -94,11 +94,11 @@ def test_a_heavily_damped_passive_pendulum_creeps_down_at_10_ms(tmp_path, fricti
 
 
 def test_explicit_damping_is_kept_only_far_inside_its_stability_bound(tmp_path, repo_root):
-    # The seed: damping 50 * 1 ms = 0.05 against >= 1 kg m^2: PyBullet's own, free per step.
-    seed = load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
-    with Physics(seed, 0.001) as physics:
+    # The pan_tilt: damping 50 * 1 ms = 0.05 against >= 1 kg m^2: PyBullet's own, free per step.
+    pan_tilt = load_description(repo_root / 'urdf' / 'pan_tilt.xacro')
+    with Physics(pan_tilt, 0.001) as physics:
         assert physics.implicit_damping == ()
-    with Physics(seed, 0.1) as physics:  # 5 against ~1: implicit
+    with Physics(pan_tilt, 0.1) as physics:  # 5 against ~1: implicit
         assert physics.implicit_damping == ('pan_joint', 'tilt_joint')
     with Physics(wheel(tmp_path, damping=0.1), 0.001) as physics:
         assert physics.implicit_damping == ('axle',)

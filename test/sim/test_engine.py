@@ -1,4 +1,4 @@
-"""The simulation loop with the seed's robot, no ROS: the behaviour Gazebo users expect."""
+"""The simulation loop with the pan/tilt example, no ROS: the behaviour Gazebo users expect."""
 
 import pytest
 from robot_fixtures import Log, ros2_control_yaml, two_link_arm_urdf, write_text

@@ -3,8 +3,8 @@
 Each scenario drives one robot through a fixed script of commands, in
 batches as sim_node runs them, and hashes every JointState sample the
 broadcaster takes (sim time, positions, velocities, efforts, as exact
-``float.hex`` strings).  The digests were recorded with the loop as it was
-before it was made flatter (issue 16); any change to the per-step
+``float.hex`` strings).  The digests are the reference results of the
+stepping loop; any change to the per-step
 arithmetic -- an operation reordered, a value read a step late -- changes
 them.  PyBullet is pinned (3.2.7), so a failure here means the loop changed
 what it computes.
@@ -95,7 +95,7 @@ def recorded_digest(simulation, script) -> str:
     return digest.hexdigest()
 
 
-def test_the_seed_pan_tilt_position_pids():
+def test_the_pan_tilt_example_position_pids():
     share = package_share()
     with make_simulation(str(share / DEFAULT_DESCRIPTION), str(share / DEFAULT_CONTROLLERS),
                          0.001) as simulation:
@@ -105,7 +105,7 @@ def test_the_seed_pan_tilt_position_pids():
             pan.set_command(1.0 if step < 1500 else -0.5)
             tilt.set_command(-3.0 if step < 2000 else -2.0)
         digest = recorded_digest(simulation, script)
-    assert digest == SEED_DIGEST
+    assert digest == PAN_TILT_DIGEST
 
 
 def test_the_three_joint_arm_trajectory_gripper_and_mimic():
@@ -142,6 +142,6 @@ def test_every_single_joint_controller_kind_and_a_group(tmp_path):
     assert digest == MIXED_DIGEST
 
 
-SEED_DIGEST = 'c8cc98baa452f46fe6a442e0a5648e119d7b3aa652c975fe920c942284d7bd20'
+PAN_TILT_DIGEST = 'c8cc98baa452f46fe6a442e0a5648e119d7b3aa652c975fe920c942284d7bd20'
 ARM_DIGEST = '71b27e2d70bd5f46382d29249316bffb303c084dda4436d89485f14bc776d795'
 MIXED_DIGEST = 'f5105e2056e5fd11a00048ac96c7d2d06fd33f30cdfbe51c260c440c5423e650'

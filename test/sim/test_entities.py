@@ -26,13 +26,13 @@ from pan_tilt_sim.sim.entities import (
 from pan_tilt_sim.sim.world import TARGETS, build_world
 
 TIME_STEP = 0.001
-SEED = package_share() / DEFAULT_DESCRIPTION
+PAN_TILT = package_share() / DEFAULT_DESCRIPTION
 ARM = package_share() / 'urdf' / 'three_joint_arm.xacro'
 
 
 @pytest.fixture
-def seed():
-    simulation = make_simulation(SEED, None, TIME_STEP)
+def pan_tilt():
+    simulation = make_simulation(PAN_TILT, None, TIME_STEP)
     targets = build_world(TARGETS, simulation.physics.client_id)
     entities = Entities(simulation.physics, simulation.description.name, targets=targets)
     yield simulation, entities
@@ -70,11 +70,11 @@ def test_robot_links_in_the_ground_at_start_never_touch_it_the_others_do(tmp_pat
     assert height == pytest.approx(-0.25, abs=2e-3)  # resting on the ground (0.3 - 0.05)
 
 
-def test_the_seeds_pan_moves_the_same_with_a_ground_body():
-    """The seed's pan cylinder reaches below z = 0."""
+def test_the_pan_tilt_examples_pan_moves_the_same_with_a_ground_body():
+    """The pan/tilt example's pan cylinder reaches below z = 0."""
     runs = []
     for spawn_something in (False, True):
-        simulation = make_simulation(SEED, None, TIME_STEP)
+        simulation = make_simulation(PAN_TILT, None, TIME_STEP)
         try:
             entities = Entities(simulation.physics, simulation.description.name)
             if spawn_something:
@@ -89,8 +89,8 @@ def test_the_seeds_pan_moves_the_same_with_a_ground_body():
     assert runs[0] == runs[1]
 
 
-def test_the_ground_is_added_with_the_first_object(seed):
-    simulation, entities = seed
+def test_the_ground_is_added_with_the_first_object(pan_tilt):
+    simulation, entities = pan_tilt
     assert not entities.has_ground
     bodies = pybullet.getNumBodies(physicsClientId=simulation.physics.client_id)
     entities.spawn('box', resource_string=box_urdf(), pose=Transform((1.0, 0.0, 0.5)))
@@ -100,7 +100,7 @@ def test_the_ground_is_added_with_the_first_object(seed):
 
 
 def test_without_a_ground_an_object_falls_on(tmp_path):
-    simulation = make_simulation(SEED, None, TIME_STEP)
+    simulation = make_simulation(PAN_TILT, None, TIME_STEP)
     try:
         entities = Entities(simulation.physics, simulation.description.name, ground=False)
         entities.spawn('box', resource_string=box_urdf(), pose=Transform((1.0, 0.0, 0.5)))
@@ -112,8 +112,8 @@ def test_without_a_ground_an_object_falls_on(tmp_path):
         simulation.close()
 
 
-def test_an_object_lands_on_the_ground_and_on_a_target(seed):
-    simulation, entities = seed
+def test_an_object_lands_on_the_ground_and_on_a_target(pan_tilt):
+    simulation, entities = pan_tilt
     entities.spawn('floor', resource_string=box_urdf(), pose=Transform((1.0, 1.0, 0.5)))
     entities.spawn('on_red', resource_string=box_urdf(), pose=Transform((2.5, 0.0, 1.0)))
     simulation.advance(1500)
@@ -143,8 +143,8 @@ def test_the_robot_pushes_an_object():
         simulation.close()
 
 
-def test_a_pose_is_the_root_link_frame_whatever_the_centre_of_mass(seed):
-    _simulation, entities = seed
+def test_a_pose_is_the_root_link_frame_whatever_the_centre_of_mass(pan_tilt):
+    _simulation, entities = pan_tilt
     entities.spawn('offset', resource_string=box_urdf(com=(0.05, 0.02, 0.0)),
                    pose=Transform((0.0, 2.0, 1.0), (0.0, 0.0, math.sin(0.4), math.cos(0.4))))
     state = entities.state('offset')
@@ -161,8 +161,8 @@ def test_a_pose_is_the_root_link_frame_whatever_the_centre_of_mass(seed):
     assert high == pytest.approx((0.1, 0.1, 0.1), abs=2e-3)
 
 
-def test_static_objects_stay_put_and_take_no_velocity(seed, tmp_path):
-    simulation, entities = seed
+def test_static_objects_stay_put_and_take_no_velocity(pan_tilt, tmp_path):
+    simulation, entities = pan_tilt
     entities.spawn('shelf', resource_string=box_urdf(static=True),
                    pose=Transform((1.0, 1.0, 1.0)))
     assert entities.get('shelf').static
@@ -176,8 +176,8 @@ def test_static_objects_stay_put_and_take_no_velocity(seed, tmp_path):
                                                              (0.0, 0.0, 1.0)))
 
 
-def test_passive_joints_of_an_object_move_freely(seed):
-    simulation, entities = seed
+def test_passive_joints_of_an_object_move_freely(pan_tilt):
+    simulation, entities = pan_tilt
     door = """<robot name="door">
       <link name="frame"><inertial><mass value="5"/>
         <inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>
@@ -205,8 +205,8 @@ def test_passive_joints_of_an_object_move_freely(seed):
      'the angular velocity'),
     (EntityState(Transform((0.0, 0.0, 1.0), (0.0, 0.0, 0.0, 1e-9))), 'length 0'),
 ], ids=['position', 'linear', 'angular', 'degenerate quaternion'])
-def test_a_state_beyond_the_physics_bounds_is_refused_and_changes_nothing(seed, state, problem):
-    simulation, entities = seed
+def test_a_state_beyond_the_physics_bounds_is_refused_and_changes_nothing(pan_tilt, state, problem):
+    simulation, entities = pan_tilt
     entities.spawn('ball', resource_string=box_urdf(), pose=Transform((0.0, 3.0, 1.0)))
     with pytest.raises(EntityStateError, match=problem):
         entities.set_state('ball', state)
@@ -218,8 +218,8 @@ def test_a_state_beyond_the_physics_bounds_is_refused_and_changes_nothing(seed, 
 
 
 @pytest.mark.parametrize('scale', [1e308, 1e300, 1e-5])
-def test_any_quaternion_of_finite_non_zero_length_is_normalised(seed, scale):
-    simulation, entities = seed
+def test_any_quaternion_of_finite_non_zero_length_is_normalised(pan_tilt, scale):
+    simulation, entities = pan_tilt
     turned = (0.0, 0.0, math.sin(0.4), math.cos(0.4))
     entities.spawn('ball', resource_string=box_urdf(),
                    pose=Transform((0.0, 3.0, 1.0), tuple(scale * q for q in turned)))
@@ -230,16 +230,16 @@ def test_any_quaternion_of_finite_non_zero_length_is_normalised(seed, scale):
     assert entities.state('ball').pose.rotation == pytest.approx(turned, abs=1e-6)
 
 
-def test_a_spawn_beyond_the_position_bound_is_refused(seed):
-    _simulation, entities = seed
+def test_a_spawn_beyond_the_position_bound_is_refused(pan_tilt):
+    _simulation, entities = pan_tilt
     with pytest.raises(SpawnError, match='the position must lie within') as refused:
         entities.spawn('far', resource_string=box_urdf(), pose=Transform((2e6, 0.0, 0.0)))
     assert refused.value.problem is SpawnProblem.INVALID_POSE
     assert 'far' not in entities
 
 
-def test_names_renaming_and_refusals(seed):
-    _simulation, entities = seed
+def test_names_renaming_and_refusals(pan_tilt):
+    _simulation, entities = pan_tilt
     assert entities.spawn('', resource_string=box_urdf(name='crate')) == 'crate'
     assert entities.spawn('crate', resource_string=box_urdf(), allow_renaming=True) == 'crate_1'
     with pytest.raises(SpawnError) as clash:
@@ -258,8 +258,8 @@ def test_names_renaming_and_refusals(seed):
     assert nameless.value.problem is SpawnProblem.RESOURCE_PARSE_ERROR
 
 
-def test_the_robot_and_the_scenery_cannot_be_deleted(seed):
-    _simulation, entities = seed
+def test_the_robot_and_the_scenery_cannot_be_deleted(pan_tilt):
+    _simulation, entities = pan_tilt
     for name in (entities.robot_name, 'target_red'):
         with pytest.raises(NotDeletableError):
             entities.delete(name)
@@ -267,8 +267,8 @@ def test_the_robot_and_the_scenery_cannot_be_deleted(seed):
         entities.delete('nothing')
 
 
-def test_world_file_objects_survive_delete_spawned_and_come_back_on_restore(seed, tmp_path):
-    _simulation, entities = seed
+def test_world_file_objects_survive_delete_spawned_and_come_back_on_restore(pan_tilt, tmp_path):
+    _simulation, entities = pan_tilt
     write_box(tmp_path, 'crate.urdf', name='crate')
     world_file = tmp_path / 'world.yaml'
     world_file.write_text('entities:\n  - uri: crate.urdf\n    pose: {position: [1, 1, 0.1]}\n'
@@ -287,8 +287,8 @@ def test_world_file_objects_survive_delete_spawned_and_come_back_on_restore(seed
     assert entities.state('crate').pose.translation == pytest.approx((1.0, 1.0, 0.1))
 
 
-def test_a_world_file_entry_that_cannot_be_spawned_names_the_file_and_entry(seed, tmp_path):
-    _simulation, entities = seed
+def test_a_world_file_entry_that_cannot_be_spawned_names_the_file_and_entry(pan_tilt, tmp_path):
+    _simulation, entities = pan_tilt
     world = World('ground', (read_world_file(_write(tmp_path, 'entities:\n  - name: a\n'
                                                     '    resource_string: "<robot"\n'))
                              .entities), tmp_path / 'w.yaml')
@@ -303,10 +303,10 @@ def _write(folder, text):
 
 
 def test_the_ground_body_is_not_drawn_by_the_camera():
-    """The camera paints the ground itself; a drawn ground plane would cost ~16 ms a frame."""
+    """The camera paints the ground itself; TinyRenderer would shade a drawn plane pixelwise."""
     from pan_tilt_sim.sim.camera import CameraSettings, Renderer
 
-    simulation = make_simulation(SEED, None, TIME_STEP)
+    simulation = make_simulation(PAN_TILT, None, TIME_STEP)
     try:
         build_world(TARGETS, simulation.physics.client_id)
         renderer = Renderer(simulation.physics, simulation.description.model, CameraSettings())
@@ -320,9 +320,9 @@ def test_the_ground_body_is_not_drawn_by_the_camera():
         simulation.close()
 
 
-def test_an_object_in_flight_keeps_its_horizontal_speed(seed):
+def test_an_object_in_flight_keeps_its_horizontal_speed(pan_tilt):
     """No drag: PyBullet's default 0.04 would take 0.8 % off in 0.2 s."""
-    simulation, entities = seed
+    simulation, entities = pan_tilt
     entities.spawn('ball', resource_string=box_urdf(), pose=Transform((0.0, 3.0, 5.0)))
     entities.set_state('ball', EntityState(Transform((0.0, 3.0, 5.0)), (1.0, 0.0, 0.0),
                                            (0.0, 0.0, 0.5)))
@@ -333,8 +333,8 @@ def test_an_object_in_flight_keeps_its_horizontal_speed(seed):
     assert state.angular == pytest.approx((0.0, 0.0, 0.5), abs=1e-9)
 
 
-def test_the_robot_can_be_moved_and_a_reset_puts_it_back(seed):
-    simulation, entities = seed
+def test_the_robot_can_be_moved_and_a_reset_puts_it_back(pan_tilt):
+    simulation, entities = pan_tilt
     robot = entities.robot_name
     turned = (0.0, 0.0, math.sin(0.25), math.cos(0.25))
     entities.set_state(robot, EntityState(Transform((1.0, 2.0, 0.0), turned)))

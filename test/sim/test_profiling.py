@@ -11,7 +11,7 @@ from pan_tilt_sim.tools.bench import load_model, recorded_efforts
 
 @pytest.fixture
 def recorded():
-    """The efforts the seed's controllers applied over 3 s, and the state they led to."""
+    """The efforts the pan/tilt's controllers applied over 3 s, and the state they led to."""
     share = package_share()
     model = load_model(share / DEFAULT_DESCRIPTION, share / DEFAULT_CONTROLLERS)
     with make_simulation(model.description_file, model.controllers_file, 0.001) as simulation:

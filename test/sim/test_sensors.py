@@ -204,7 +204,7 @@ def test_lidar_beyond_its_range_sees_nothing(rig):
 
 
 def test_lidar_hits_the_scenerys_targets(tmp_path):
-    # The seed's pan link, with a lidar looking along -x at the blue target 2.5 m away.
+    # The pan/tilt example's pan link, with a lidar looking along -x at the blue target 2.5 m away.
     urdf = tmp_path / 'lidar.urdf'
     urdf.write_text(textwrap.dedent(f"""\
         <robot name="post">

@@ -115,8 +115,8 @@ for seconds in (0.013, 0.027, 0.041):
 
 @pytest.mark.skipif(not sys.platform.startswith('linux'), reason="Linux's CPU-time clocks")
 def test_a_process_cpu_time_is_read_to_well_under_a_clock_tick_ended_threads_included():
-    # The factor-1 share is ~0.4 s of CPU in a 10 s window: /proc's 10 ms ticks would make
-    # it +-0.1 % of a core, a quarter of the distance to its target.
+    # The factor-1 share is a fraction of a second of CPU in a 10 s window: whole clock
+    # ticks, as /proc counts them, would be a sizeable part of it.
     child = subprocess.Popen([sys.executable, '-c', BURN_AND_REPORT], stdin=subprocess.PIPE,
                              stdout=subprocess.PIPE, text=True)
     try:
@@ -133,16 +133,15 @@ def test_a_process_cpu_time_is_read_to_well_under_a_clock_tick_ended_threads_inc
 @pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
 def test_quick_measures_the_physics_thread_at_factor_0(quick_run):
     # The thread measured is the one stepping: at factor 0 it is busy nearly all the time, so
-    # its CPU per step is most of the wall time per step (an idle thread's would be ~0).  (The
-    # seed's node now costs ~1.5 us a step more than a bare step, and a quick run's bare step
-    # can read 50 % high on a busy machine: that is no floor to hold it to.)
+    # its CPU per step is most of the wall time per step (an idle thread's would be ~0).  (A
+    # quick run's bare step is too short to be a floor to hold the node's step to.)
     figures = json.loads(quick_run[0])
     measured = {**figures['factor_0'],
                 **{f'chain of {joints}': values for joints, values in figures['scaling'].items()}}
     for case, values in measured.items():
         wall_us_per_step = 1e6 / values['steps_per_s']
         assert values['node_cpu_us_per_step'] > 0.5 * wall_us_per_step, case
-    # The chains cost more per step the more joints they step: ~5, 11 and 50 us for 2, 8, 32.
+    # The chains cost more per step the more joints they step: 2, 8, 32 joints.
     raw = figures['raw']['step_us_cpu']
     chains = [figures['scaling'][joints]['node_cpu_us_per_step'] for joints in ('2', '8', '32')]
     assert chains[1] > 1.5 * chains[0] and chains[2] > 2 * chains[1] > raw, chains
@@ -169,7 +168,7 @@ def test_raw_rates_that_agree_raise_no_warning():
 
 
 def test_raw_rates_far_apart_say_the_ratios_are_not_to_be_trusted():
-    # Seen here: stepSimulation read 5.68 us of thread CPU while the wall rate was normal.
+    # A busy neighbour inflates the thread-CPU reading while the wall rate stays normal.
     problem = bench.raw_rates_disagree({'steps_per_s': 176154, 'wall_steps_per_s': 290148})
     assert problem is not None
     assert '176,154' in problem and '290,148' in problem and '39% apart' in problem

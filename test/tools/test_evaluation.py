@@ -22,7 +22,7 @@ from pan_tilt_sim.tools.evaluation import (
 from pan_tilt_sim.tools.step_response import StepRecord, record_step, step_metrics
 
 DT = 0.001
-SEED_GAINS = PidGains(p=100.0, i=0.01, d=10.0, i_clamp_min=-300.0, i_clamp_max=300.0)
+PAN_TILT_GAINS = PidGains(p=100.0, i=0.01, d=10.0, i_clamp_min=-300.0, i_clamp_max=300.0)
 
 
 @pytest.fixture(scope='module')
@@ -58,7 +58,7 @@ def test_every_target_starts_from_the_initial_state(scenario):
 
 
 def test_the_same_case_gives_the_same_numbers_whatever_ran_before(scenario):
-    case = Case('pan_joint', (1.0,), gains=(('pan_joint', dataclasses.replace(SEED_GAINS,
+    case = Case('pan_joint', (1.0,), gains=(('pan_joint', dataclasses.replace(PAN_TILT_GAINS,
                                                                                p=900.0)),))
     first = evaluate(scenario, case)
     evaluate(scenario, Case('pan_joint', (0.7,), variation=PhysicalVariation(mass_scale=3.0)))
@@ -68,10 +68,10 @@ def test_the_same_case_gives_the_same_numbers_whatever_ran_before(scenario):
 def test_gains_and_variations_reach_the_simulation(scenario):
     nominal = evaluate(scenario, Case('pan_joint', (1.0,))).steps[0]
     stiffer = evaluate(scenario, Case('pan_joint', (1.0,), gains=(
-        ('pan_joint', dataclasses.replace(SEED_GAINS, p=1000.0)),))).steps[0]
+        ('pan_joint', dataclasses.replace(PAN_TILT_GAINS, p=1000.0)),))).steps[0]
     sticky = evaluate(scenario, Case('pan_joint', (1.0,), variation=PhysicalVariation(
         friction_scale=5.0))).steps[0]
-    # Coulomb friction f holds an error of up to f / p; the seed's pan creeps up to that
+    # Coulomb friction f holds an error of up to f / p; the pan/tilt example's pan creeps up to that
     # bound from below (0.0099 of 0.01), so five times the friction leaves nearly 0.05.
     assert 0.009 < nominal.final_error <= 1.0 / 100.0
     assert stiffer.final_error <= 1.0 / 1000.0
@@ -115,7 +115,7 @@ def test_a_diverging_joint_is_unstable_and_fails_everything():
 def test_a_derivative_gain_too_big_for_the_time_step_chatters_at_the_effort_limit(scenario):
     # d * dt must stay below 2 x the pan's inertia (a few kg m^2): d = 50,000 at 1 ms is
     # far past it, and the effort limit (300 N m) is all that keeps the joint in hand.
-    wild = dataclasses.replace(SEED_GAINS, d=50000.0)
+    wild = dataclasses.replace(PAN_TILT_GAINS, d=50000.0)
     evaluation = evaluate(scenario, Case('pan_joint', (1.0,), gains=(('pan_joint', wild),),
                                          duration=1.0))
     assert evaluation.steps[0].saturated_s > 0.5
@@ -125,7 +125,7 @@ def test_a_derivative_gain_too_big_for_the_time_step_chatters_at_the_effort_limi
 
 def test_violations_are_scaled_to_their_bounds(scenario):
     evaluation = evaluate(scenario, Case('pan_joint', (1.0,)))
-    # The seed's pan: no overshoot, settled at 11.0 s, 0.00995 rad left.
+    # The pan/tilt example's pan: no overshoot, settled at 11.0 s, 0.00995 rad left.
     found = violations(evaluation, Spec(max_overshoot_percent=5.0, max_settling_s=10.0,
                                         max_error=0.005))
     assert found['overshoot'] == pytest.approx(-1.0)

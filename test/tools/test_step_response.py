@@ -1,4 +1,4 @@
-"""step_response: metrics on synthetic signals, and the seed's pan against a hand computation."""
+"""step_response: metrics on synthetic signals, and the pan/tilt pan against a hand computation."""
 
 import json
 import math
@@ -98,11 +98,11 @@ def test_a_setpoint_that_jumps_means_the_velocity_limit_was_not_active():
     assert metrics.setpoint_reached_s == pytest.approx(DT)
 
 
-# --- the seed's pan, against a hand computation -----------------------------------
+# --- the pan/tilt example's pan, against a hand computation -----------------------------------
 
 @pytest.fixture(scope='module')
 def pan_step():
-    """Return the JSON the tool prints for the seed's pan stepped from 0 to 1 rad."""
+    """Return the JSON the tool prints for the pan/tilt example's pan stepped from 0 to 1 rad."""
     completed = subprocess.run(
         [sys.executable, '-c', 'import sys; from pan_tilt_sim.tools import step_response; '
          "step_response.main(sys.argv[1:]); assert 'rclpy' not in sys.modules, 'rclpy'",

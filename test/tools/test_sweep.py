@@ -22,7 +22,7 @@ def run_sweep(args, blocked=()):
 
 @pytest.fixture(scope='module')
 def friction_grid(tmp_path_factory):
-    """Sweep the seed's pan over friction x p, with a final-error bound of 0.03 rad."""
+    """Sweep the pan/tilt example's pan over friction x p, with a final-error bound of 0.03 rad."""
     folder = tmp_path_factory.mktemp('sweep')
     report, heatmap = folder / 'sweep.csv', folder / 'sweep.png'
     result = run_sweep(['--joint', 'pan_joint', '--target', '1.0', '--max-error', '0.03',
