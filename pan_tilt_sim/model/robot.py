@@ -19,6 +19,7 @@ import math
 from collections.abc import Mapping
 
 from pan_tilt_sim.model.sensors import SensorSpec
+from pan_tilt_sim.model.surfaces import Surface
 from pan_tilt_sim.model.transforms import (
     Transform,
     Vector,
@@ -27,6 +28,7 @@ from pan_tilt_sim.model.transforms import (
 )
 
 DEFAULT_AXIS: Vector = (1.0, 0.0, 0.0)  # URDF's default joint axis
+WORLD_LINK = 'world'  # a root link of this name, joined by a fixed joint, welds the robot
 POSITION_PROPORTIONAL_GAIN = 'position_proportional_gain'
 
 
@@ -257,6 +259,19 @@ class RobotModel:
     # per sensor tag it skipped (unsupported type, plugin or reference).
     sensors: tuple[SensorSpec, ...] = ()
     sensor_warnings: tuple[str, ...] = ()
+    # Contact surfaces from <gazebo reference="LINK"> (mu1, mu2, kp, kd), for links that give any.
+    surfaces: tuple[Surface, ...] = ()
+
+    def surface(self, link: str) -> Surface:
+        """Return ``link``'s contact surface: the URDF's, else Gazebo's defaults."""
+        return next((surface for surface in self.surfaces if surface.link == link),
+                    Surface(link))
+
+    @property
+    def welded_to_world(self) -> bool:
+        """Whether the root link is ``world``, a fixed joint hanging the robot on it (a weld)."""
+        return self.root == WORLD_LINK and any(
+            joint.parent == WORLD_LINK and joint.kind is JointKind.FIXED for joint in self.joints)
 
     @property
     def plugin_namespace(self) -> str | None:
