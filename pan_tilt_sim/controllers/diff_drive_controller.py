@@ -8,7 +8,9 @@ As ros2_controllers' (jazzy), parameters by their names there:
   warning); an unstamped one is stamped with the sim time it arrives at, and
   one already older than ``cmd_vel_timeout`` is refused.  Once the newest
   command is older than ``cmd_vel_timeout`` (s of sim time; 0: never) the
-  robot brakes to a stop.  Until the first command, nothing is commanded.
+  robot brakes to a stop.  Until the first command the wheels are not
+  commanded; the odometry is published all the same (upstream waits for a
+  command), so that odom and its TF exist from the start.
 * **Limits**: ``linear.x.*`` and ``angular.z.*`` velocity, acceleration
   (forward, deceleration, and the reverse pair) and jerk limits, NaN = off
   (see :mod:`.rate_limiter`); the deprecated ``has_*_limits: false`` turns a
@@ -374,7 +376,10 @@ class DiffDriveController(CommandController):
             self._update_references(time)
         linear, angular = self._linear_reference.value, self._angular_reference.value
         if not (math.isfinite(linear) and math.isfinite(angular)):
-            return  # nothing commanded yet
+            # Nothing commanded yet: the wheels stand, the odometry still runs and is published.
+            self._update_odometry(0.0, 0.0, time, period)
+            self._publish(time)
+            return
         (before_linear, before_angular), (last_linear, last_angular) = self._history
         linear = self._limiters[0].limit(linear, last_linear, before_linear, period)
         angular = self._limiters[1].limit(angular, last_angular, before_angular, period)

@@ -6,12 +6,14 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from builtin_interfaces.msg import Duration, Time
+from geometry_msgs.msg import TwistStamped
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64, Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage
 
 from pan_tilt_sim.controllers import CommandKind
+from pan_tilt_sim.controllers.surface import StampedTwist
 from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
 
 NANOSECONDS_PER_SECOND = 1_000_000_000
@@ -35,11 +37,19 @@ def joint_trajectory(message: JointTrajectoryMessage) -> JointTrajectory:
         start_time=seconds(stamp_) if stamp_.sec or stamp_.nanosec else None)
 
 
+def stamped_twist(message: TwistStamped) -> StampedTwist:
+    """Return a ``geometry_msgs/TwistStamped`` as a plain value (stamp in s; 0: unstamped)."""
+    linear, angular = message.twist.linear, message.twist.angular
+    return StampedTwist(seconds(message.header.stamp), (linear.x, linear.y, linear.z),
+                        (angular.x, angular.y, angular.z))
+
+
 # Each command message type (by its ROS name), and how to get the command value out of it.
 COMMAND_MESSAGES: dict[str, tuple[type, Callable[[Any], Any]]] = {
     CommandKind.FLOAT64.value: (Float64, lambda msg: msg.data),
     CommandKind.FLOAT64_ARRAY.value: (Float64MultiArray, lambda msg: list(msg.data)),
     CommandKind.JOINT_TRAJECTORY.value: (JointTrajectoryMessage, joint_trajectory),
+    CommandKind.TWIST_STAMPED.value: (TwistStamped, stamped_twist),
 }
 
 

@@ -101,11 +101,13 @@ def test_the_wheels_are_driven_by_the_ideal_velocity_actuator():
     assert not registry.drives_base('velocity_controllers/JointGroupVelocityController')
 
 
-def test_nothing_is_commanded_before_the_first_twist():
+def test_nothing_is_commanded_before_the_first_twist_but_the_odometry_is_published():
     drive, handles = controller()
+    samples = []
+    drive.set_odometry_sink(lambda *sample: samples.append(sample))
     run(drive, handles, 0.1)
     assert all(handle.velocity_target == 0.0 for handle in handles.values())
-    assert drive.odometry.x == 0.0
+    assert len(samples) == 5 and samples[-1][1:] == (0.0, 0.0, 0.0, 0.0, 0.0)
 
 
 @pytest.mark.parametrize('value', [math.nan, math.inf, -math.inf])

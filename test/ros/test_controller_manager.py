@@ -192,7 +192,11 @@ def test_without_spawners_the_controllers_are_listed_as_they_run(ur_style):
         'TwoLinkArm', 'system', 'active')
     types = spawner.call('list_controller_types')
     assert 'joint_trajectory_controller/JointTrajectoryController' in types.types
-    assert set(types.base_classes) == {'controller_interface::ControllerInterface'}
+    bases = dict(zip(types.types, types.base_classes, strict=True))
+    assert bases['joint_trajectory_controller/JointTrajectoryController'] == (
+        'controller_interface::ControllerInterface')
+    assert bases['diff_drive_controller/DiffDriveController'] == (
+        'controller_interface::ChainableControllerInterface')
 
 
 def test_switching_from_the_trajectory_controller_to_forward_position_and_back(ur_style):
