@@ -10,14 +10,18 @@ from __future__ import annotations
 import math
 
 import pytest
-from mobile_fixtures import WHEEL_RADIUS, WHEEL_SEPARATION, drive_parameters
+import yaml
+from mobile_fixtures import WHEEL_RADIUS, WHEEL_SEPARATION, drive_parameters, write_rover
 
 from pan_tilt_sim.controllers import JointHandle, registry
 from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult
 from pan_tilt_sim.controllers.diff_drive_controller import DiffDriveController
+from pan_tilt_sim.controllers.manager import ControllerManager
 from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError, RateLimiter, RateLimits
 from pan_tilt_sim.controllers.surface import CommandTopic, StampedTwist, StateTopic
 from pan_tilt_sim.errors import ControllerConfigError
+from pan_tilt_sim.model.controller_config import load_controllers_config
+from pan_tilt_sim.model.description import load_description
 from pan_tilt_sim.model.robot import JointKind, JointSpec
 
 DT = 0.001
@@ -332,3 +336,24 @@ def test_the_deprecated_min_acceleration_is_accepted_with_a_warning_that_it_does
                                 'rover.yaml')
     assert any('angular.z.min_acceleration' in warning and 'no effect' in warning
                for warning in drive.config_warnings)
+
+
+def test_a_velocity_group_chained_before_it_drives_the_base_through_its_references(tmp_path):
+    description_path, _ = write_rover(tmp_path)
+    controllers = tmp_path / 'chain.yaml'
+    controllers.write_text(yaml.safe_dump({
+        'controller_manager': {'ros__parameters': {
+            NAME: {'type': 'diff_drive_controller/DiffDriveController'},
+            'twist': {'type': 'velocity_controllers/JointGroupVelocityController'}}},
+        NAME: {'ros__parameters': drive_parameters(cmd_vel_timeout=0.1)},
+        'twist': {'ros__parameters': {'joints': [f'{NAME}/linear', f'{NAME}/angular']}}}))
+    description = load_description(description_path)
+    handles = {joint.name: JointHandle(joint) for joint in description.actuated_joints}
+    manager = ControllerManager(load_controllers_config(controllers), handles, description.model)
+    drive, twist = manager.controller(NAME), manager.controller('twist')
+    assert drive.is_chained
+    assert twist.set_command([0.1, 0.0]) is CommandResult.ACCEPTED
+    for step in range(300):  # longer than cmd_vel_timeout: chained, it does not apply
+        for update in manager.updates:
+            update(step * DT, DT)
+    assert handles['left_wheel_joint'].velocity_target == pytest.approx(0.1 / WHEEL_RADIUS)
