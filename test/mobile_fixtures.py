@@ -43,10 +43,20 @@ def _wheel(side: str, y: float) -> str:
       </link>'''
 
 
-def rover_urdf(name: str = 'rover', *, world_joint: bool = False) -> str:
-    """Return the rover's URDF; ``world_joint`` hangs it on a ``world`` link by a fixed joint."""
+def rover_urdf(name: str = 'rover', *, world_joint: bool = False,
+               footprint: bool = False) -> str:
+    """Return the rover's URDF.
+
+    ``world_joint`` hangs it on a ``world`` link by a fixed joint; ``footprint``
+    on a massless ``base_footprint`` root on the ground, ``REST_HEIGHT`` below
+    ``base_link``.
+    """
     world = ('<link name="world"/><joint name="world_joint" type="fixed">'
              '<parent link="world"/><child link="base_link"/></joint>') if world_joint else ''
+    if footprint:
+        world += ('<link name="base_footprint"/><joint name="footprint_joint" type="fixed">'
+                  '<parent link="base_footprint"/><child link="base_link"/>'
+                  f'<origin xyz="0 0 {REST_HEIGHT}"/></joint>')
     half = WHEEL_SEPARATION / 2
     return textwrap.dedent(f'''\
         <?xml version="1.0"?>

@@ -67,6 +67,7 @@ import numpy
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.base_pose import ORIGIN, BasePose
 from pan_tilt_sim.model.description import RobotDescription
+from pan_tilt_sim.model.inertials import with_massive_root
 from pan_tilt_sim.model.mimic import follow_leaders, mimic_couplings
 from pan_tilt_sim.model.robot import JointSpec, RobotModel
 from pan_tilt_sim.model.transforms import Transform, quaternion_from_rpy
@@ -510,7 +511,10 @@ class Physics:
         pybullet.setGravity(0.0, 0.0, -STANDARD_GRAVITY, physicsClientId=client)
         pybullet.setTimeStep(self._time_step, physicsClientId=client)
         urdf_path = pathlib.Path(self._workdir.name) / URDF_FILE_NAME
-        urdf_path.write_text(description.physics_urdf, encoding='utf-8')
+        # A free base must have a mass, or PyBullet welds it (see model.inertials).
+        urdf_path.write_text(description.physics_urdf if self._fixed_base else
+                             with_massive_root(description.physics_urdf, description.model),
+                             encoding='utf-8')
         output: list[str] = []
         try:
             with captured_native_output(output):

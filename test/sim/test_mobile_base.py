@@ -111,6 +111,16 @@ def test_the_wheels_drive_the_base_straight_and_the_odometry_agrees(tmp_path):
         assert odometry.x == pytest.approx(x, rel=0.02)
 
 
+def test_a_base_hung_on_a_massless_footprint_link_drives_too(tmp_path):
+    with rover(tmp_path, footprint=True) as simulation:
+        assert simulation.physics.base_frame().translation == pytest.approx((0.0, 0.0, 0.0),
+                                                                            abs=1e-9)
+        drive(simulation, 0.2, 0.0, 2.0)
+        frame = simulation.physics.base_frame()
+        assert frame.translation[0] == pytest.approx(0.4, rel=0.02)
+        assert frame.translation[2] == pytest.approx(0.0, abs=1e-3)  # upright, on the ground
+
+
 def test_the_wheels_turn_the_base_on_the_spot(tmp_path):
     with rover(tmp_path) as simulation:
         drive(simulation, 0.0, 0.5, math.pi)
