@@ -12,7 +12,8 @@ controller type:
 * a :class:`~pan_tilt_sim.controllers.surface.StateTopic`: a publisher and
   the sink the controller hands its samples to (:data:`STATE_SINKS`; a
   message type whose interface package is not installed -- TF without
-  tf2_msgs -- gets none, and the controller takes no samples for it);
+  tf2_msgs -- gets none, with an info line, and the controller takes no
+  samples for it);
 * an :class:`~pan_tilt_sim.controllers.surface.ActionServer`, where its
   interface package is installed (:data:`ACTION_SERVERS`);
 
@@ -46,6 +47,7 @@ from sensor_msgs.msg import JointState
 from pan_tilt_sim.controllers import CommandResult, Controller
 from pan_tilt_sim.controllers.surface import PRIVATE, ActionServer, CommandTopic, StateTopic
 from pan_tilt_sim.errors import ConfigurationError
+from pan_tilt_sim.ros import optional_interfaces
 from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.gain_parameters import GainParameters
 from pan_tilt_sim.ros.robot_state import tf_message_type, transform_message
@@ -178,8 +180,12 @@ class ControllerBindings:
             elif isinstance(endpoint, StateTopic):
                 if endpoint.message in STATE_SINKS:
                     entities.append(self._publish(controller, endpoint))
-                else:  # its interface package is missing (the start-up line says which)
+                else:  # its interface package is missing
                     endpoint.connect(None)
+                    self._logger.info(
+                        f'{name}: no {self._name(controller, endpoint.name)} '
+                        f'({endpoint.message}): its interface package is not installed '
+                        f'({optional_interfaces.BUILD_HINT})')
             elif isinstance(endpoint, ActionServer):
                 self._serve(controller, endpoint)
         self._noticing.append(controller)

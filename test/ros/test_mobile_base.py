@@ -23,6 +23,7 @@ from sim_interfaces_client import OK, SimInterfaces, msg, pose, position, srv
 from tf2_msgs.msg import TFMessage
 
 from pan_tilt_sim.errors import ParameterError
+from pan_tilt_sim.ros import controller_bindings
 
 TIME_STEP = 0.001
 PERIOD_STEPS = 20  # one odometry period at the default publish_rate of 50 Hz
@@ -223,3 +224,14 @@ def test_a_bad_base_parameter_stops_start_up_naming_it(tmp_path, parameters, pro
         with sim_node(robot_description_file=str(description),
                       controllers_file=str(controllers), **parameters):
             pass
+
+
+def test_without_tf2_msgs_the_controller_publishes_its_odometry_but_no_tf(tmp_path, monkeypatch):
+    monkeypatch.delitem(controller_bindings.STATE_SINKS, 'tf2_msgs/msg/TFMessage')
+    description, controllers = write_rover(tmp_path)
+    with sim_node(paused=True, robot_description_file=str(description), publish_tf=False,
+                  controllers_file=str(controllers), world='ground') as sim:
+        published, _ = sim.own_topics()
+        assert ODOM in published and '/tf' not in published
+        sim.node.step(100)  # the controller takes no TF samples, and runs
+        assert sim.simulation.time == pytest.approx(0.1)
