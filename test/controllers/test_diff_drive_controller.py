@@ -357,3 +357,16 @@ def test_a_velocity_group_chained_before_it_drives_the_base_through_its_referenc
         for update in manager.updates:
             update(step * DT, DT)
     assert handles['left_wheel_joint'].velocity_target == pytest.approx(0.1 / WHEEL_RADIUS)
+
+
+def test_the_limited_twist_leaves_on_cmd_vel_out_at_the_update_rate():
+    drive, handles = controller(publish_limited_velocity=True, update_rate=100.0,
+                                **{'linear.x.max_velocity': 0.1})
+    surface = {endpoint.name: endpoint for endpoint in drive.ros_surface()}
+    limited = surface['~/cmd_vel_out']
+    assert limited.message == 'geometry_msgs/msg/TwistStamped'
+    samples = []
+    limited.connect(lambda *sample: samples.append(sample))
+    run(drive, handles, 0.1, command=twist(0.3, 0.2))
+    assert len(samples) == 10
+    assert samples[-1][1:] == pytest.approx((0.1, 0.2))
