@@ -12,7 +12,7 @@ import math
 
 import pytest
 from mobile_fixtures import CONTROLLER, REST_HEIGHT, drive_parameters, write_rover
-from robot_fixtures import JointDef, ros2_control_yaml, write_star_robot, write_text
+from robot_fixtures import JointDef, Log, ros2_control_yaml, write_star_robot, write_text
 
 from pan_tilt_sim.controllers.surface import StampedTwist
 from pan_tilt_sim.model.base_pose import ORIGIN, BasePose
@@ -27,12 +27,12 @@ STIFFNESS, DAMPING = 9, 8  # ... and of the contact stiffness and damping
 
 
 def rover(tmp_path, drive=None, *, fixed_base=None, initial_pose=ORIGIN, active=None,
-          **urdf):
-    """Return a Simulation of the rover (``fixed_base`` None: auto)."""
+          log=None, **urdf):
+    """Return a Simulation of the rover (``fixed_base`` None: auto), logging to ``log``."""
     description, controllers = write_rover(tmp_path, drive, **urdf)
     return make_simulation(str(description), str(controllers), TIME_STEP,
                            fixed_base=fixed_base, initial_pose=initial_pose,
-                           active_controllers=active)
+                           active_controllers=active, logger=log)
 
 
 def drive(simulation, linear: float, angular: float, seconds: float) -> None:
@@ -49,7 +49,8 @@ def yaw(rotation) -> float:
 
 
 def test_an_active_drive_controller_frees_the_base_resting_on_its_wheels(tmp_path):
-    with rover(tmp_path) as simulation:
+    log = Log()
+    with rover(tmp_path, log=log) as simulation:
         physics = simulation.physics
         assert not physics.fixed_base
         assert physics.base_frame().translation == pytest.approx((0.0, 0.0, REST_HEIGHT),
@@ -57,8 +58,8 @@ def test_an_active_drive_controller_frees_the_base_resting_on_its_wheels(tmp_pat
         simulation.advance(500)  # standing: it neither sinks nor drifts
         assert physics.base_frame().translation == pytest.approx((0.0, 0.0, REST_HEIGHT),
                                                                  abs=1e-4)
-        assert any('base: free on the ground' in line for _, line in [
-            *simulation.startup_report, ('', simulation._base_report[1])])
+        assert any(line.startswith("base: free on the ground (fixed_base is auto and "
+                                   "controller 'base_controller'") for line in log.infos)
 
 
 def test_without_a_drive_controller_or_when_asked_the_base_stays_welded(tmp_path):
@@ -72,10 +73,11 @@ def test_without_a_drive_controller_or_when_asked_the_base_stays_welded(tmp_path
 
 
 def test_a_robot_hung_on_a_world_link_stays_welded_even_when_asked_to_be_free(tmp_path):
-    with rover(tmp_path, fixed_base=False, world_joint=True) as simulation:
+    log = Log()
+    with rover(tmp_path, fixed_base=False, world_joint=True, log=log) as simulation:
         assert simulation.physics.fixed_base
-        assert simulation._base_report[0] == 'warning'
-        assert "root link 'world'" in simulation._base_report[1]
+    assert any("welded to the world although fixed_base is false: its root link 'world'"
+               in line for line in log.warnings)
 
 
 def test_an_arm_stays_welded_as_before(tmp_path):
