@@ -86,6 +86,11 @@ def generate_launch_description() -> LaunchDescription:
                               description='start paused (simulation_interfaces: STOPPED)'),
         DeclareLaunchArgument('gui', default_value='false',
                               description='open a PyBullet window (needs a display)'),
+        DeclareLaunchArgument('fixed_base', default_value='auto',
+                              description='weld the base to the world: auto (unless a drive '
+                              'controller will be active), true or false'),
+        DeclareLaunchArgument('initial_pose', default_value='',
+                              description="the base's start, 'x y z yaw' (m, m, m, rad)"),
         OpaqueFunction(function=launch_nodes),
     ])
 
@@ -116,7 +121,8 @@ def launch_nodes(context, *args, **kwargs) -> list:
         active_controllers=active,
         time_step=float(argument('time_step')), robot_namespace=robot_namespace,
         publish_tf=not with_state_publisher, spawners=spawners,
-        paused=bool_argument(argument('paused')))
+        paused=bool_argument(argument('paused')), fixed_base=argument('fixed_base'),
+        initial_pose=list_argument(argument('initial_pose')))
     nodes = [Node(package=PACKAGE, executable='sim_node', name='sim_node', output='screen',
                   parameters=[sim_parameters], additional_env=sim_node_environment())]
     if with_state_publisher:

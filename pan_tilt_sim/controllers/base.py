@@ -233,6 +233,7 @@ class CommandKind(enum.Enum):
     FLOAT64_ARRAY = 'std_msgs/msg/Float64MultiArray'
     JOINT_TRAJECTORY = 'trajectory_msgs/msg/JointTrajectory'
     MULTI_DOF_COMMAND = 'control_msgs/msg/MultiDOFCommand'
+    TWIST_STAMPED = 'geometry_msgs/msg/TwistStamped'
 
 
 class CommandResult(enum.Enum):
@@ -263,6 +264,12 @@ class Controller(abc.ABC):
     gains_field: ClassVar[str] = 'gains'
     # Whether the type exports reference interfaces (ros2_control's ChainableControllerInterface).
     chainable: ClassVar[bool] = False
+    # The namespace of the controller's node (its controller_manager's: the robot's), which
+    # the ROS adapter sets before it asks for the surface; frame ids may depend on it.
+    node_namespace: str = '/'
+    # Whether the type drives a mobile base (its wheels move the robot over the ground): while
+    # one will be active, sim_node's fixed_base:=auto frees the base (see model.base_pose).
+    drives_base: ClassVar[bool] = False
     # Chained mode, and the references offered before configure (see the methods below).
     _chained: bool = False
     _available_references: Mapping[str, Reference] = MappingProxyType({})

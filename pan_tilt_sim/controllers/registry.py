@@ -6,6 +6,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from pan_tilt_sim.controllers.base import CommandController, Controller
+from pan_tilt_sim.controllers.diff_drive_controller import DiffDriveController
 from pan_tilt_sim.controllers.forward_command_controller import ForwardCommandController
 from pan_tilt_sim.controllers.joint_effort_controller import JointEffortController
 from pan_tilt_sim.controllers.joint_group_effort_controller import JointGroupEffortController
@@ -33,6 +34,7 @@ CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
     JointGroupEffortController,
     JointTrajectoryController,
     PidController,
+    DiffDriveController,
 )
 
 CONTROLLER_TYPES: dict[str, type[Controller]] = {
@@ -61,6 +63,12 @@ def create_controller(name: str, type_name: Any, params: Mapping[str, Any],
 def is_known_type(type_name: Any) -> bool:
     """Whether ``type_name`` is a controller type the simulator has."""
     return isinstance(type_name, str) and type_name in CONTROLLER_TYPES
+
+
+def drives_base(type_name: Any) -> bool:
+    """Whether a controller of ``type_name`` moves a mobile base (False for unknown types)."""
+    cls = CONTROLLER_TYPES.get(type_name) if isinstance(type_name, str) else None
+    return cls is not None and cls.drives_base
 
 
 def is_command_type(type_name: Any) -> bool:

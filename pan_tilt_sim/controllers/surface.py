@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
-from typing import Any
+from typing import Any, NamedTuple
 
 PRIVATE = '~/'
 
@@ -81,3 +81,15 @@ class ActionServer:
 
 
 Endpoint = CommandTopic | StateTopic | Service | ActionServer
+
+
+class StampedTwist(NamedTuple):
+    """A ``geometry_msgs/msg/TwistStamped`` as a command value.
+
+    ``stamp``: the header's time in seconds (0: not stamped); ``linear``
+    (m/s) and ``angular`` (rad/s): (x, y, z) in the header's frame.
+    """
+
+    stamp: float
+    linear: tuple[float, float, float]
+    angular: tuple[float, float, float]

@@ -13,6 +13,11 @@ One case needs more: a moving joint whose whole child subtree is massless
 cannot be accelerated.  Its child link gets a negligible mass and inertia
 instead, so that an actuator can move it, and a warning says so (Gazebo
 classic drops such joints).
+
+A free (mobile) base needs the same: PyBullet welds a body whose root link
+has no mass, and mobile robots often hang everything on a massless
+``base_footprint``.  :func:`with_massive_root` gives it the same negligible
+mass and inertia.
 """
 
 from __future__ import annotations
@@ -92,3 +97,20 @@ def _set_inertial(link: ElementTree.Element, mass: float, inertia: float) -> Non
     diagonal = {'ixx', 'iyy', 'izz'}
     ElementTree.SubElement(inertial, 'inertia', {
         field: repr(inertia if field in diagonal else 0.0) for field in INERTIA_FIELDS})
+
+
+def with_massive_root(urdf_xml: str, model: RobotModel) -> str:
+    """Return PyBullet's copy ``urdf_xml`` with a massless root link given a negligible mass.
+
+    Unchanged when the root link has a mass (or when the text has no such link).
+    """
+    root_link = model.link(model.root) if model.root in model.link_names else None
+    if root_link is None or (root_link.inertial is not None and root_link.inertial.mass > 0.0):
+        return urdf_xml
+    document = ElementTree.fromstring(urdf_xml)
+    element = next((link for link in document.findall('link')
+                    if link.get('name') == model.root), None)
+    if element is None:
+        return urdf_xml
+    _set_inertial(element, MOVABLE_MASS, MOVABLE_INERTIA)
+    return ElementTree.tostring(document, encoding='unicode')

@@ -19,6 +19,7 @@ import math
 from collections.abc import Mapping
 
 from pan_tilt_sim.model.sensors import SensorSpec
+from pan_tilt_sim.model.surfaces import Surface
 from pan_tilt_sim.model.transforms import (
     Transform,
     Vector,
@@ -27,6 +28,7 @@ from pan_tilt_sim.model.transforms import (
 )
 
 DEFAULT_AXIS: Vector = (1.0, 0.0, 0.0)  # URDF's default joint axis
+WORLD_LINK = 'world'  # a root link of this name, joined by a fixed joint, welds the robot
 POSITION_PROPORTIONAL_GAIN = 'position_proportional_gain'
 INITIAL_VALUE = 'initial_value'  # the <param> of a ros2_control interface that sets its start
 
@@ -275,6 +277,44 @@ class RobotModel:
     # per sensor tag it skipped (unsupported type, plugin or reference).
     sensors: tuple[SensorSpec, ...] = ()
     sensor_warnings: tuple[str, ...] = ()
+    # Contact surfaces from <gazebo reference="LINK"> (mu1, mu2, kp, kd), for links that give any.
+    surfaces: tuple[Surface, ...] = ()
+
+    def surface(self, link: str) -> Surface:
+        """Return ``link``'s contact surface: the URDF's, else a ball caster's, else Gazebo's.
+
+        A link that stands for a ball caster (:meth:`is_ball_caster`) and whose
+        URDF gives no surface rolls freely: friction 0, so that it carries
+        weight without dragging, as the ball it models does.
+        """
+        given = next((surface for surface in self.surfaces if surface.link == link), None)
+        if given is not None:
+            return given
+        if self.is_ball_caster(link):
+            return Surface(link, mu1=0.0, mu2=0.0)
+        return Surface(link)
+
+    def is_ball_caster(self, link: str) -> bool:
+        """Whether ``link`` models a ball caster: named ``*caster*``, fixed, its collisions spheres.
+
+        Robots meant for mock hardware (ros2_control_demos' DiffBot) model
+        their free-rolling ball casters as spheres fixed to the base; with a
+        sliding contact of Gazebo's default friction such a sphere brakes the
+        robot, which its real ball would not.
+        """
+        if 'caster' not in link.lower():
+            return False
+        found = self._links_by_name.get(link)
+        shapes = found.collisions if found is not None else ()
+        fixed = any(joint.child == link for joint in self.fixed_joints)
+        return fixed and bool(shapes) and all(
+            shape.geometry.kind == 'sphere' for shape in shapes)
+
+    @property
+    def welded_to_world(self) -> bool:
+        """Whether the root link is ``world``, a fixed joint hanging the robot on it (a weld)."""
+        return self.root == WORLD_LINK and any(
+            joint.parent == WORLD_LINK and joint.kind is JointKind.FIXED for joint in self.joints)
 
     @property
     def plugin_namespace(self) -> str | None:

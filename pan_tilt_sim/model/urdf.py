@@ -54,6 +54,7 @@ from pan_tilt_sim.model.sensors import (
     SensorSpec,
     plugin_stem,
 )
+from pan_tilt_sim.model.surfaces import read_surfaces
 from pan_tilt_sim.model.transforms import ZERO_VECTOR, Transform, Vector, quaternion_from_rpy
 
 URDF_ROOT_TAG = 'robot'
@@ -121,7 +122,8 @@ def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
     sensors, sensor_warnings = _SensorReader(source, links, joints).read(root)
     return RobotModel(name=root.get('name', ''), links=links, joints=joints,
                       ros2_control=systems, control_plugins=plugins,
-                      sensors=sensors, sensor_warnings=sensor_warnings)
+                      sensors=sensors, sensor_warnings=sensor_warnings,
+                      surfaces=read_surfaces(root, source, link_names))
 
 
 def _check_position_gain(plugins: tuple[ControlPlugin, ...], systems: tuple[ControlSystem, ...],

@@ -10,8 +10,10 @@ controller type:
 * a :class:`~pan_tilt_sim.controllers.surface.CommandTopic`: a subscription
   whose messages' values go to the controller (:data:`COMMAND_MESSAGES`);
 * a :class:`~pan_tilt_sim.controllers.surface.StateTopic`: a publisher and
-  the sink the controller hands its samples to (:data:`STATE_SINKS`), where
-  the message's interface package is installed;
+  the sink the controller hands its samples to (:data:`STATE_SINKS`; a
+  message type whose interface package is not installed -- TF without
+  tf2_msgs -- gets none, with an info line, and the controller takes no
+  samples for it);
 * a :class:`~pan_tilt_sim.controllers.surface.Service`: a service whose
   requests' values go to the controller (:data:`SERVICES`);
 * an :class:`~pan_tilt_sim.controllers.surface.ActionServer`, where its
@@ -38,9 +40,12 @@ entities in step.  Each is one short call, made between physics steps.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
+from geometry_msgs.msg import TwistStamped
+from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rclpy.service import Service as ServiceEntity
 from sensor_msgs.msg import JointState
@@ -55,8 +60,10 @@ from pan_tilt_sim.controllers.surface import (
     StateTopic,
 )
 from pan_tilt_sim.errors import ConfigurationError
+from pan_tilt_sim.ros import optional_interfaces
 from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.gain_parameters import GainParameters
+from pan_tilt_sim.ros.robot_state import tf_message_type, transform_message
 from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES, joint_state_message, stamp
 from pan_tilt_sim.ros.trajectory_action import TrajectoryActionServer
 from pan_tilt_sim.sim.engine import Simulation
@@ -188,6 +195,7 @@ class ControllerBindings:
         self.commands_received.setdefault(name, 0)
         for warning in controller.config_warnings:
             self._logger.warning(warning)
+        controller.node_namespace = self._topic()
         for endpoint in controller.ros_surface():
             if isinstance(endpoint, CommandTopic):
                 if self._command_topics and COMMAND_MESSAGES[endpoint.message][0] is not None:
@@ -195,6 +203,12 @@ class ControllerBindings:
             elif isinstance(endpoint, StateTopic):
                 if STATE_SINKS.get(endpoint.message, (None,))[0] is not None:
                     entities.append(self._publish(controller, endpoint))
+                else:  # its interface package is missing
+                    endpoint.connect(None)
+                    self._logger.info(
+                        f'{name}: no {self._name(controller, endpoint.name)} '
+                        f'({endpoint.message}): its interface package is not installed '
+                        f'({optional_interfaces.BUILD_HINT})')
             elif isinstance(endpoint, Service):
                 entities.append(self._provide(controller, endpoint))
             elif isinstance(endpoint, ActionServer):
@@ -203,9 +217,11 @@ class ControllerBindings:
         self._gains.add(controller)
 
     def _name(self, controller: Controller, topic: str) -> str:
-        """Resolve a declared name: ``~/x`` in the controller's namespace, else the robot's."""
+        """Resolve a name: ``~/x`` in the controller's namespace, ``/x`` as is, else ours."""
         if topic.startswith(PRIVATE):
             return self._topic(controller.name, topic[len(PRIVATE):])
+        if topic.startswith('/'):
+            return topic
         return self._topic(topic)
 
     def _subscribe(self, controller: Controller, endpoint: CommandTopic) -> Any:
@@ -219,6 +235,7 @@ class ControllerBindings:
         return subscription
 
     def _publish(self, controller: Controller, endpoint: StateTopic) -> Any:
+        """Create the publisher of ``endpoint`` and hand the controller its sink."""
         message_type, make_sink = STATE_SINKS[endpoint.message]
         publisher = self._node.create_publisher(
             message_type, self._name(controller, endpoint.name), QUEUE_DEPTH)
@@ -401,6 +418,93 @@ class DofStateSink:
             self._publisher.publish(self._message)
 
 
+class _HeldSink:
+    """Samples written into one reused message, published at :meth:`flush` (or before the next).
+
+    As :class:`JointStateSink`: every sample leaves, in order, with the
+    node's other messages after the batch of steps it was taken in.
+    """
+
+    def __init__(self, publisher: Any, message: Any) -> None:
+        self._publisher = publisher
+        self._message = message
+        self._pending = False
+
+    def _take(self) -> Any:
+        """Return the message to fill with a new sample (the pending one leaves first)."""
+        if self._pending:
+            self._publisher.publish(self._message)
+        self._pending = True
+        return self._message
+
+    def flush(self) -> None:
+        """Publish the sample taken since the last flush, if any."""
+        if self._pending:
+            self._pending = False
+            self._publisher.publish(self._message)
+
+
+class OdometrySink(_HeldSink):
+    """Planar odometry samples as ``nav_msgs/msg/Odometry``.
+
+    Fields: ``frame_id``, ``child_frame_id`` and the six-element
+    ``pose_covariance_diagonal`` and ``twist_covariance_diagonal``.
+    """
+
+    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
+        message = Odometry()
+        message.header.frame_id = fields['frame_id']
+        message.child_frame_id = fields['child_frame_id']
+        size = len(fields['pose_covariance_diagonal'])
+        pose_covariance, twist_covariance = [0.0] * size * size, [0.0] * size * size
+        for index in range(size):
+            pose_covariance[index * (size + 1)] = fields['pose_covariance_diagonal'][index]
+            twist_covariance[index * (size + 1)] = fields['twist_covariance_diagonal'][index]
+        message.pose.covariance = pose_covariance
+        message.twist.covariance = twist_covariance
+        super().__init__(publisher, message)
+
+    def __call__(self, time: float, x: float, y: float, heading: float, linear: float,
+                 angular: float) -> None:
+        """Take a sample: the pose (m, rad) in the odometry frame, the twist (m/s, rad/s)."""
+        message = self._take()
+        stamp(time, message.header.stamp)
+        pose = message.pose.pose
+        pose.position.x, pose.position.y = x, y
+        pose.orientation.z, pose.orientation.w = math.sin(heading / 2.0), math.cos(heading / 2.0)
+        message.twist.twist.linear.x = linear
+        message.twist.twist.angular.z = angular
+
+
+class TfSink(_HeldSink):
+    """Transforms as ``tf2_msgs/msg/TFMessage``: ``sink(time, [(parent, child, transform)])``."""
+
+    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
+        super().__init__(publisher, tf_message_type()())
+
+    def __call__(self, time: float, frames: Iterable[tuple[str, str, Any]]) -> None:
+        """Take a sample of the frames (parent, child, Transform), stamped ``time``."""
+        message = self._take()
+        message.transforms = [transform_message(parent, child, transform, time)
+                              for parent, child, transform in frames]
+
+
+class TwistSink(_HeldSink):
+    """Planar twists as ``geometry_msgs/msg/TwistStamped`` (frame id ``frame_id``, default '')."""
+
+    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
+        message = TwistStamped()
+        message.header.frame_id = fields.get('frame_id', '')
+        super().__init__(publisher, message)
+
+    def __call__(self, time: float, linear: float, angular: float) -> None:
+        """Take a sample: linear.x (m/s) and angular.z (rad/s)."""
+        message = self._take()
+        stamp(time, message.header.stamp)
+        message.twist.linear.x = linear
+        message.twist.angular.z = angular
+
+
 # Each state message type (by its ROS name): its class (None where its interface package is
 # not installed: no such topics then), and the sink that turns a controller's samples into
 # messages on a publisher.
@@ -408,12 +512,16 @@ STATE_SINKS: dict[str, tuple[type | None, Callable[[Any, Mapping[str, Any]], Any
     'sensor_msgs/msg/JointState': (JointState, JointStateSink),
     'control_msgs/msg/DynamicJointState': (DynamicJointState, DynamicJointStateSink),
     'control_msgs/msg/MultiDOFStateStamped': (MultiDOFStateStamped, DofStateSink),
+    'nav_msgs/msg/Odometry': (Odometry, OdometrySink),
+    'geometry_msgs/msg/TwistStamped': (TwistStamped, TwistSink),
 }
 # Each service type: its class, and how to get the value out of a request (the
 # controller's answer fills the response's ``success`` and ``message``).
 SERVICES: dict[str, tuple[type, Callable[[Any], Any]]] = {
     'std_srvs/srv/SetBool': (SetBool, lambda request: request.data),
 }
+if tf_message_type() is not None:  # tf2_msgs is optional (see optional_interfaces)
+    STATE_SINKS['tf2_msgs/msg/TFMessage'] = (tf_message_type(), TfSink)
 # Each action type: the server that runs a controller's goals.
 ACTION_SERVERS: dict[str, Callable[..., Any]] = {
     'control_msgs/action/FollowJointTrajectory': TrajectoryActionServer,

@@ -15,7 +15,9 @@ from __future__ import annotations
 
 from rclpy.node import Node
 
+from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model import naming
+from pan_tilt_sim.model.base_pose import FIXED_BASE
 from pan_tilt_sim.model.sensors import SensorKind
 from pan_tilt_sim.ros.camera_publisher import CameraPublisher, declare_camera, declare_world
 from pan_tilt_sim.ros.robot_state import RobotStatePublisher
@@ -40,6 +42,11 @@ class NodeFeatures:
         self._time_step = simulation.time_step
         self.world = declare_world(node)
         world = self.world.scenery
+        if not simulation.physics.fixed_base and not has_ground(world):
+            raise ParameterError(
+                f"parameter 'world': '{world}' has no ground for the free base of "
+                f"'{description.name}' to stand on: use 'ground' or 'targets', or weld the "
+                f"base with {FIXED_BASE}:=true")
         urdf_cameras = any(sensor.kind in (SensorKind.CAMERA, SensorKind.DEPTH)
                            for sensor in model.sensors)
         settings = declare_camera(node, model.link_names, urdf_cameras)

@@ -19,6 +19,14 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from pan_tilt_sim.errors import ParameterError
+from pan_tilt_sim.model.base_pose import (
+    AUTO,
+    FIXED_BASE,
+    INITIAL_POSE,
+    BasePose,
+    parse_fixed_base,
+    parse_initial_pose,
+)
 from pan_tilt_sim.model.initial_positions import parse_initial_positions
 from pan_tilt_sim.model.naming import check_namespace
 from pan_tilt_sim.ros.pacing import MAX_REAL_TIME_FACTOR
@@ -29,6 +37,9 @@ INTEGER = ParameterType.PARAMETER_INTEGER
 DOUBLE = ParameterType.PARAMETER_DOUBLE
 STRING = ParameterType.PARAMETER_STRING
 STRING_ARRAY = ParameterType.PARAMETER_STRING_ARRAY
+DOUBLE_ARRAY = ParameterType.PARAMETER_DOUBLE_ARRAY
+# A string parameter that also takes a bool (`-p fixed_base:=true` arrives as one).
+BOOL_OR_STRING = -1
 
 DEFAULT_TIME_STEP = 0.001  # s, PyBullet's recommended range is 1/1000 .. 1/240
 MAX_TIME_STEP = 0.1  # s; beyond this the PID loop is meaningless
@@ -53,6 +64,7 @@ _TYPE_NAMES = {
     ParameterType.PARAMETER_DOUBLE: 'double',
     ParameterType.PARAMETER_STRING: 'string',
     ParameterType.PARAMETER_STRING_ARRAY: 'string array',
+    ParameterType.PARAMETER_DOUBLE_ARRAY: 'double array',
 }
 
 
@@ -95,6 +107,14 @@ def _specs() -> tuple[_Spec, ...]:
         _Spec('initial_positions', ParameterType.PARAMETER_STRING_ARRAY, None,
               "Start positions, each 'joint:=value' (rad or m); they override the URDF's "
               '<ros2_control> initial_value, and the reset services return to them.'),
+        _Spec(FIXED_BASE, BOOL_OR_STRING, AUTO,
+              "Weld the robot's root link to the world: auto (welded unless a controller "
+              'that drives the base, such as diff_drive_controller, will be active), true or '
+              "false. A robot hung on a 'world' link by a fixed joint is always welded."),
+        _Spec(INITIAL_POSE, ParameterType.PARAMETER_DOUBLE_ARRAY, None,
+              '[x, y, z, yaw] (m, m, m, rad) of the base: a free base rests on the ground, '
+              'its lowest collision point z above it; a welded one has its root link frame '
+              'there. Unset: the origin. The reset services return to it.'),
     )
 
 
@@ -115,6 +135,9 @@ class SimParameters:
     gui: bool
     robot_namespace: str
     initial_positions: dict[str, float]
+    # True, False, or None for auto (see pan_tilt_sim.model.base_pose).
+    fixed_base: bool | None
+    initial_pose: BasePose
 
 
 def declare_parameters(node: Node) -> SimParameters:
@@ -126,6 +149,8 @@ def declare_parameters(node: Node) -> SimParameters:
     values['initial_positions'] = parse_initial_positions(values['initial_positions'])
     values['controllers_args'] = tuple(values['controllers_args'])
     values['active_controllers'] = tuple(values['active_controllers']) or None
+    values[FIXED_BASE] = parse_fixed_base(values[FIXED_BASE])
+    values[INITIAL_POSE] = parse_initial_pose(values[INITIAL_POSE])
     checked = SimParameters(**values)
     check_time_step(checked.time_step)
     check_real_time_factor(checked.real_time_factor)
@@ -146,8 +171,8 @@ def declare(node: Node, name: str, wanted: int, default: Any, description: str, 
     the parameter is declared with dynamic typing and :func:`coerce` checks it.
     """
     descriptor = ParameterDescriptor(
-        name=name, type=wanted, description=description, read_only=read_only,
-        dynamic_typing=True)
+        name=name, type=STRING if wanted == BOOL_OR_STRING else wanted,
+        description=description, read_only=read_only, dynamic_typing=True)
     return coerce(name, wanted, node.declare_parameter(name, default, descriptor).value)
 
 
@@ -159,9 +184,14 @@ def coerce(name: str, wanted: int, value: Any) -> Any:
     if wanted == ParameterType.PARAMETER_DOUBLE and isinstance(value, int) and not isinstance(
             value, bool):
         return float(value)
-    if wanted == ParameterType.PARAMETER_STRING_ARRAY and (
+    if wanted in (STRING_ARRAY, DOUBLE_ARRAY) and (
             value is None or (isinstance(value, list | tuple) and not value)):
         return []  # declared without a value, or empty (`-p x:=[]` reads as not set)
+    if wanted == BOOL_OR_STRING and isinstance(value, bool | str):
+        return value
+    if wanted == DOUBLE_ARRAY and isinstance(value, list | tuple) and all(
+            isinstance(item, int | float) and not isinstance(item, bool) for item in value):
+        return [float(item) for item in value]  # `[1, 2, 0, 0]` arrives as integers
     ok = {
         ParameterType.PARAMETER_BOOL: lambda v: isinstance(v, bool),
         ParameterType.PARAMETER_INTEGER: lambda v: isinstance(v, int) and not isinstance(v, bool),
@@ -169,11 +199,14 @@ def coerce(name: str, wanted: int, value: Any) -> Any:
         ParameterType.PARAMETER_STRING: lambda v: isinstance(v, str),
         ParameterType.PARAMETER_STRING_ARRAY: lambda v: isinstance(v, list | tuple) and all(
             isinstance(item, str) for item in v),
+        ParameterType.PARAMETER_DOUBLE_ARRAY: lambda v: False,  # numbers were taken above
+        BOOL_OR_STRING: lambda v: False,  # bools and strings were taken above
     }[wanted](value)
     if not ok:
+        wanted_name = 'bool or string' if wanted == BOOL_OR_STRING else _TYPE_NAMES[wanted]
         raise ParameterError(
-            f"parameter '{name}' must be a {_TYPE_NAMES[wanted]}, got {_describe(value)}")
-    return list(value) if wanted == ParameterType.PARAMETER_STRING_ARRAY else value
+            f"parameter '{name}' must be a {wanted_name}, got {_describe(value)}")
+    return list(value) if wanted == STRING_ARRAY else value
 
 
 def check_time_step(value: float) -> None:

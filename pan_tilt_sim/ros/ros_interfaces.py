@@ -6,6 +6,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from builtin_interfaces.msg import Duration, Time
+from geometry_msgs.msg import TwistStamped
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
@@ -13,6 +14,7 @@ from std_msgs.msg import Float64, Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage
 
 from pan_tilt_sim.controllers import CommandKind
+from pan_tilt_sim.controllers.surface import StampedTwist
 from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
 
 try:
@@ -48,6 +50,13 @@ def joint_trajectory(message: JointTrajectoryMessage) -> JointTrajectory:
         start_time=seconds(stamp_) if stamp_.sec or stamp_.nanosec else None)
 
 
+def stamped_twist(message: TwistStamped) -> StampedTwist:
+    """Return a ``geometry_msgs/TwistStamped`` as a plain value (stamp in s; 0: unstamped)."""
+    linear, angular = message.twist.linear, message.twist.angular
+    return StampedTwist(seconds(message.header.stamp), (linear.x, linear.y, linear.z),
+                        (angular.x, angular.y, angular.z))
+
+
 # Each command message type (by its ROS name), and how to get the command value out of it.
 # The class is None where its interface package is not installed (no such topics then).
 COMMAND_MESSAGES: dict[str, tuple[type | None, Callable[[Any], Any]]] = {
@@ -57,6 +66,7 @@ COMMAND_MESSAGES: dict[str, tuple[type | None, Callable[[Any], Any]]] = {
     # (dof_names, values, values_dot), as lists.
     CommandKind.MULTI_DOF_COMMAND.value: (MultiDOFCommand, lambda msg: (
         list(msg.dof_names), list(msg.values), list(msg.values_dot))),
+    CommandKind.TWIST_STAMPED.value: (TwistStamped, stamped_twist),
 }
 
 

@@ -128,7 +128,8 @@ class SimNode(Node):
                                 else self.settings.active_controllers),
             initial_positions=self.settings.initial_positions, logger=self.get_logger(),
             autostart_controllers=(self._topic_settings is not None
-                                   or self.settings.autostart_controllers))
+                                   or self.settings.autostart_controllers),
+            fixed_base=self.settings.fixed_base, initial_pose=self.settings.initial_pose)
         self._paused = self.settings.paused
         self.steps_run = 0  # physics steps this node has run (never reset; see run_steps)
         self.controller_manager: Node | None = None  # where controller_manager_msgs exists

@@ -12,10 +12,15 @@ business; the active ones say how each of their joints is driven
 (:meth:`~pan_tilt_sim.controllers.base.Controller.actuators`), and a joint no
 active controller claims is passive -- it keeps the last effort applied.
 
-At start-up the simulation says, through the logger it is given, which
-actuator drives each joint and why, where each joint starts, what PyBullet
-said while loading the robot, and which PID gains are too high for their
-joint's inertia at this time step (:mod:`pan_tilt_sim.sim.stability`).
+The robot's base is welded to the world unless it is mobile (see
+:func:`base_is_fixed` and :mod:`pan_tilt_sim.model.base_pose`); a free base
+starts resting on the ground and a reset puts it back there.
+
+At start-up the simulation says, through the logger it is given, whether
+the base is free and why, which actuator drives each joint and why, where
+each joint starts, what PyBullet said while loading the robot, and which
+PID gains are too high for their joint's inertia at this time step
+(:mod:`pan_tilt_sim.sim.stability`).
 While running, a joint at PyBullet's speed cap or with a non-finite state
 gets a warning (at most one per joint per second).
 """
@@ -33,6 +38,8 @@ from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
 from pan_tilt_sim.controllers.base import Drive, idle_actuator
 from pan_tilt_sim.controllers.gains import plugin_gains
 from pan_tilt_sim.controllers.manager import ControllerManager
+from pan_tilt_sim.controllers.registry import drives_base
+from pan_tilt_sim.model.base_pose import FIXED_BASE, ORIGIN, BasePose
 from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.initial_positions import FROM_DEFAULT, StartPosition, start_positions
@@ -66,11 +73,38 @@ class Logger(Protocol):
         """Log ``message`` as a warning."""
 
 
+def base_is_fixed(fixed_base: bool | None, description: RobotDescription,
+                  controllers: ControllersConfig, active: Sequence[str] | None,
+                  autostart: bool) -> tuple[bool, str]:
+    """Decide whether the robot's base is welded to the world; return that and why.
+
+    ``fixed_base`` True or False is the answer, None is ``auto``: free if a
+    controller that drives the base will be active -- with ``autostart``,
+    one of ``active`` (None: every controller of the file); waiting for
+    spawners, any the file declares.  A robot hung on a ``world`` link by a
+    fixed joint is welded whatever ``fixed_base`` says, as in Gazebo.
+    """
+    if description.model.welded_to_world:
+        return True, "its root link 'world' holds it by a fixed joint, as in Gazebo"
+    if fixed_base is not None:
+        return fixed_base, f'{FIXED_BASE} is {str(fixed_base).lower()}'
+    candidates = [spec for spec in controllers.controllers
+                  if not autostart or active is None or spec.name in active]
+    drivers = [spec for spec in candidates if drives_base(spec.type)]
+    if drivers:
+        return False, (f"{FIXED_BASE} is auto and controller '{drivers[0].name}' "
+                       f'({drivers[0].type}) drives the base')
+    return True, f'{FIXED_BASE} is auto and no controller drives the base'
+
+
 class Simulation:
     """One robot in PyBullet, driven by its controllers, advanced step by step.
 
     ``initial_positions`` (joint name -> position) override the URDF's
     ``initial_value`` (see :mod:`pan_tilt_sim.model.initial_positions`).
+    ``fixed_base`` welds the base to the world (True, the default for
+    tools and tests), frees it (False) or decides by the controllers (None,
+    sim_node's ``auto``: see :func:`base_is_fixed`); ``initial_pose`` places it.
     What the simulation has to say at start-up waits in
     :attr:`startup_report` until :meth:`report_startup` logs it (the node
     does that once it is completely built, so that a start-up error stays
@@ -82,17 +116,22 @@ class Simulation:
                  active_controllers: Sequence[str] | None = None,
                  initial_positions: Mapping[str, float] | None = None,
                  logger: Logger | None = None,
-                 autostart_controllers: bool = True) -> None:
+                 autostart_controllers: bool = True,
+                 fixed_base: bool | None = True,
+                 initial_pose: BasePose = ORIGIN) -> None:
         self.description = description
         self._logger: Logger = logger or logging.getLogger(LOGGER_NAME)
         starts = start_positions(description.model, initial_positions)
         movable = [joint.name for joint in description.actuated_joints]
         gains = plugin_gains(controllers.pid_gains, movable, controllers.label)
         load_messages: list[str] = list(controllers.warnings)  # the file's dropped blocks
+        fixed, why = base_is_fixed(fixed_base, description, controllers, active_controllers,
+                                   autostart_controllers)
         self.physics = Physics(
             description, time_step, gui=gui,
             initial_positions=[starts[joint].position for joint in movable],
-            warn=load_messages.append)
+            warn=load_messages.append, fixed_base=fixed, initial_pose=initial_pose)
+        self._base_report = self._describe_base(why, fixed_base, initial_pose)
         try:
             model = description.model
             gain = model.position_proportional_gain or TRACKING_GAIN
@@ -164,9 +203,23 @@ class Simulation:
                 self._logger.info(message)
         self.startup_report = []
 
+    def _describe_base(self, why: str, asked: bool | None,
+                       pose: BasePose) -> tuple[str, str] | None:
+        """Return the start-up line about the base: free, or welded against the parameter."""
+        frame = self.physics.initial_base_frame
+        x, y, z = frame.translation
+        if not self.physics.fixed_base:
+            return (INFO, f'base: free on the ground ({why}); its root link starts at '
+                          f'x {x:.4g} y {y:.4g} z {z:.4g} m, yaw {pose.yaw:.4g} rad')
+        if asked is False:
+            return (WARNING, f'base: welded to the world although {FIXED_BASE} is false: {why}')
+        return None
+
     def _startup_report(self, description: RobotDescription, starts: Mapping[str, StartPosition],
                         load_messages: Sequence[str]) -> list[tuple[str, str]]:
         report = [(WARNING, message) for message in load_messages]
+        if self._base_report is not None:
+            report.append(self._base_report)
         for handle in self._handle_list:
             report.append((INFO, f"joint '{handle.name}': "
                                  f'{handle.actuator.describe(handle.spec)}'))
@@ -327,9 +380,10 @@ class Simulation:
                 f'{health_problem(handle.name, state, self.physics.velocity_cap)}')
 
     def reset(self, *, reset_time: bool = True) -> None:
-        """Joints back to their initial state, controllers reset; sim time to 0 if asked."""
+        """Put base and joints back at their start, reset controllers; sim time to 0 if asked."""
         for handle in self._handle_list:
             handle.reset()
+        self.physics.reset_base()
         self.physics.reset_joints([handle.position for handle in self._handle_list])
         self._states = self.physics.read_states()
         for controller in self.manager.configured:
@@ -378,7 +432,9 @@ def make_simulation(description_file: str, controllers_file: str | None, time_st
                     active_controllers: Sequence[str] | None = None,
                     initial_positions: Mapping[str, float] | None = None,
                     logger: Logger | None = None,
-                    autostart_controllers: bool = True) -> Simulation:
+                    autostart_controllers: bool = True,
+                    fixed_base: bool | None = True,
+                    initial_pose: BasePose = ORIGIN) -> Simulation:
     """Load both files and build a :class:`Simulation` (for tools and tests); log its report.
 
     Without ``controllers_file`` the URDF's control plugin names it (see
@@ -395,7 +451,8 @@ def make_simulation(description_file: str, controllers_file: str | None, time_st
     simulation = Simulation(description, load_controllers_config(files, controllers_args),
                             time_step, gui=gui, active_controllers=active_controllers,
                             initial_positions=initial_positions, logger=logger,
-                            autostart_controllers=autostart_controllers)
+                            autostart_controllers=autostart_controllers,
+                            fixed_base=fixed_base, initial_pose=initial_pose)
     for warning in description.warnings:
         simulation._logger.warning(warning)
     simulation.report_startup()

@@ -4,7 +4,10 @@
 what ``simulation_interfaces`` asks of them, in the simulation's own PyBullet
 client:
 
-* **the robot** (named after its URDF ``<robot name>``; fixed to the world);
+* **the robot** (named after its URDF ``<robot name>``; fixed to the world,
+  or -- a mobile robot -- free on the ground: then the ground plane is a
+  collision body from the start and every link of the robot meets it, and
+  the robot's state has a twist);
 * **the targets** of the ``targets`` scenery (``target_red``...; static);
 * **objects** from a world file or spawned at run time: any URDF, loaded as a
   free-floating PyBullet body with the URDF's inertia.  They fall under
@@ -189,15 +192,19 @@ class Entities:
         self._robot = physics.body_id
         self._ground_wanted = ground
         self._ground: int | None = None
-        # Taken now, in the robot's initial pose (see world.add_ground_plane).
-        self._grounded = grounded_links(self._client, self._robot)
+        # Taken now, in the robot's initial pose (see world.add_ground_plane); a free
+        # robot stands on the ground with every link.
+        self._grounded = (grounded_links(self._client, self._robot) if physics.fixed_base
+                          else [])
         self._workdir = tempfile.TemporaryDirectory(prefix='pan_tilt_sim_entities_')
         self._files = 0
         self._entities: dict[str, Entity] = {}
         self._world_file: dict[str, _WorldFileObject] = {}
-        robot = self._record(robot_name, self._robot, Origin.ROBOT, static=True,
+        robot = self._record(robot_name, self._robot, Origin.ROBOT, static=physics.fixed_base,
                              info=EntityInfo(Category.ROBOT, 'the simulated robot'))
         self._entities[robot.name] = robot
+        if physics.ground is not None:  # a free robot's: the physics made it
+            self._ground = physics.ground
         for name, body in (targets or {}).items():
             colour = name.rpartition('_')[2]
             self._entities[name] = self._record(

@@ -2,9 +2,25 @@
 
 :class:`Physics` owns its own PyBullet client id (never the global default
 client), so several simulations can live in one process.  The robot is
-loaded with a fixed base and the URDF's inertia (links without
-``<inertial>`` come massless, see :mod:`pan_tilt_sim.model.inertials`);
-what PyBullet says while loading goes to the log, one line per message.
+loaded with the URDF's inertia (links without ``<inertial>`` come massless,
+see :mod:`pan_tilt_sim.model.inertials`); what PyBullet says while loading
+goes to the log, one line per message.
+
+The base is welded to the world (``fixed_base``, the default; placed at
+``initial_pose`` if one is given) or free (a mobile robot, see
+:mod:`pan_tilt_sim.model.base_pose`): a free base starts at rest with its
+lowest collision point ``initial_pose.z`` above the ground plane z = 0 (0:
+standing on it), and :meth:`Physics.reset_base` puts it back there; the
+plane (:attr:`Physics.ground`) is then part of the physics from the start.  A free
+robot's URDF cylinders are PyBullet's exact cylinder shapes, not the
+polygon hulls it makes of them otherwise, so that wheels roll round, and
+each of its links' contact friction is the URDF's ``<gazebo reference>``
+``mu1``/``mu2`` (the smaller; Gazebo's 1 by default), and its contact spring
+the ``kp``/``kd`` where the URDF gives them (:mod:`pan_tilt_sim.model.surfaces`);
+the ground plane's friction is then 1, so that on it a link's own coefficient
+decides, as on Gazebo's high-friction ground (PyBullet multiplies the two
+coefficients, Gazebo takes the smaller).  A welded robot keeps PyBullet's
+contacts, as before.
 PyBullet's hidden drag on every link (linear and angular damping 0.04,
 not in the URDF, not in Gazebo) is switched off, and its speed cap
 (``maxJointVelocity``, 100 rad/s) raised to twice the fastest URDF velocity
@@ -49,9 +65,12 @@ from collections.abc import Callable, Sequence
 import numpy
 
 from pan_tilt_sim.errors import DescriptionError
+from pan_tilt_sim.model.base_pose import ORIGIN, BasePose
 from pan_tilt_sim.model.description import RobotDescription
+from pan_tilt_sim.model.inertials import with_massive_root
 from pan_tilt_sim.model.mimic import follow_leaders, mimic_couplings
-from pan_tilt_sim.model.robot import JointSpec
+from pan_tilt_sim.model.robot import JointSpec, RobotModel
+from pan_tilt_sim.model.transforms import Transform, quaternion_from_rpy
 from pan_tilt_sim.sim import compiled_step
 from pan_tilt_sim.sim.bullet import (
     captured_native_output,
@@ -59,6 +78,7 @@ from pan_tilt_sim.sim.bullet import (
     pybullet,
     quiet_native_output,
 )
+from pan_tilt_sim.sim.world import add_ground_plane
 
 STANDARD_GRAVITY = 9.81  # m/s^2, along -z as in Gazebo's default world
 URDF_FILE_NAME = 'robot.urdf'
@@ -90,6 +110,16 @@ RANGE_FRACTIONS = (0.5, 0.25, 0.75)
 FREE_POSES = (0.0, math.pi / 2.0, -math.pi / 2.0)
 NO_MOTOR = 0.0  # force 0 removes a joint's motor row from PyBullet's solver
 MOTOR_VELOCITY_GAIN = 1.0  # a velocity motor that reaches its target in one step if it can
+# A free base's six degrees of freedom come first in PyBullet's mass matrix.
+FREE_BASE_DOFS = 6
+# Where a free base is held while its lowest point is measured: high above any ground (m).
+MEASURING_HEIGHT = 100.0
+# How far below that the closest-point query looks for the ground (m).
+MEASURING_RANGE = 2.0 * MEASURING_HEIGHT
+CLOSEST_DISTANCE = 8  # index of the distance in one of pybullet.getClosestPoints' points
+DYNAMICS_INERTIAL_POSITION = 3  # pybullet.getDynamicsInfo: the centre of mass in the link frame
+DYNAMICS_INERTIAL_ORIENTATION = 4
+GROUND_FRICTION = 1.0  # under a free robot (see the module docstring)
 
 LogFunction = Callable[[str], None]
 
@@ -126,20 +156,45 @@ def velocity_cap(joints: Sequence[JointSpec]) -> float:
     return max([DEFAULT_VELOCITY_CAP] + [VELOCITY_CAP_MARGIN * limit for limit in limits])
 
 
+def apply_surfaces(client: int, body: int, model: RobotModel) -> None:
+    """Give each link of ``body`` its contact friction and, where the URDF has one, its spring.
+
+    ``model`` is the body's URDF model (link names as PyBullet has them).
+    """
+    base = pybullet.getBodyInfo(body, physicsClientId=client)[0].decode('utf-8')
+    names = [(BASE_LINK_INDEX, base)] + [
+        (index, pybullet.getJointInfo(body, index, physicsClientId=client)[12].decode('utf-8'))
+        for index in range(pybullet.getNumJoints(body, physicsClientId=client))]
+    for index, name in names:
+        surface = model.surface(name)
+        spring = surface.spring
+        if spring is None:
+            pybullet.changeDynamics(body, index, lateralFriction=surface.friction,
+                                    physicsClientId=client)
+        else:
+            pybullet.changeDynamics(body, index, lateralFriction=surface.friction,
+                                    contactStiffness=spring[0], contactDamping=spring[1],
+                                    physicsClientId=client)
+
+
 class Physics:
-    """A PyBullet world holding one fixed-base robot.
+    """A PyBullet world holding one robot, its base welded to the world or free.
 
     ``initial_positions`` (one per actuated joint; default: each joint's
     :attr:`~pan_tilt_sim.model.robot.JointSpec.initial_position`) is where
     the joints start and where :meth:`reset_joints` without arguments puts
-    them.  ``warn`` receives PyBullet's load messages, one line each.
+    them.  ``fixed_base`` welds the root link to the world; ``initial_pose``
+    places the base (see the module docstring).  ``warn`` receives
+    PyBullet's load messages, one line each.
     """
 
     def __init__(self, description: RobotDescription, time_step: float, *,
                  gui: bool = False, initial_positions: Sequence[float] | None = None,
-                 warn: LogFunction = _ignore) -> None:
+                 warn: LogFunction = _ignore, fixed_base: bool = True,
+                 initial_pose: BasePose = ORIGIN) -> None:
         self._description = description
         self._time_step = time_step
+        self._fixed_base = fixed_base
         self._workdir = tempfile.TemporaryDirectory(prefix='pan_tilt_sim_')
         mode = pybullet.GUI if gui else pybullet.DIRECT
         with quiet_native_output():
@@ -171,6 +226,78 @@ class Physics:
         self._initial_positions = self._with_mimics(initial_positions)
         self._drives = _Drives(self, [False] * len(self._joints))
         self.reset_joints()
+        if not fixed_base:
+            apply_surfaces(self._client, self._body, description.model)
+        dynamics = pybullet.getDynamicsInfo(self._body, BASE_LINK_INDEX,
+                                            physicsClientId=self._client)
+        # PyBullet places a body by its base's centre of mass; the URDF frame is offset by this.
+        self._base_inertial = Transform(tuple(dynamics[DYNAMICS_INERTIAL_POSITION]),
+                                        tuple(dynamics[DYNAMICS_INERTIAL_ORIENTATION]))
+        # A free robot stands on the ground from the start, every link touching it; the
+        # ground's friction 1 leaves each link its own coefficient (PyBullet multiplies them).
+        self.ground: int | None = None
+        if not fixed_base:
+            self.ground = add_ground_plane(self._client, self._body, [])
+            pybullet.changeDynamics(self.ground, BASE_LINK_INDEX,
+                                    lateralFriction=GROUND_FRICTION,
+                                    physicsClientId=self._client)
+        self._initial_base = self._place_base(initial_pose)
+
+    @property
+    def fixed_base(self) -> bool:
+        """Whether the root link is welded to the world (else the robot is free on the ground)."""
+        return self._fixed_base
+
+    @property
+    def initial_base_frame(self) -> Transform:
+        """Where the root link frame starts and where :meth:`reset_base` puts it (world frame)."""
+        return self._initial_base
+
+    def base_frame(self) -> Transform:
+        """Return the root link frame's pose in the world now."""
+        position, orientation = pybullet.getBasePositionAndOrientation(
+            self._body, physicsClientId=self._client)
+        return Transform(tuple(position), tuple(orientation)).then(
+            _inverse(self._base_inertial))
+
+    def base_velocity(self) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+        """Return the root link's centre-of-mass velocity (m/s) and angular velocity (rad/s).
+
+        Both in world axes; zero for a welded base.
+        """
+        linear, angular = pybullet.getBaseVelocity(self._body, physicsClientId=self._client)
+        return tuple(linear), tuple(angular)  # type: ignore[return-value]
+
+    def reset_base(self) -> None:
+        """Put the base back where it started, at rest (a welded base only moves)."""
+        self._set_base_frame(self._initial_base)
+
+    def _set_base_frame(self, frame: Transform) -> None:
+        com = frame.then(self._base_inertial)
+        pybullet.resetBasePositionAndOrientation(self._body, com.translation, com.rotation,
+                                                 physicsClientId=self._client)
+        if not self._fixed_base:
+            pybullet.resetBaseVelocity(self._body, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0),
+                                       physicsClientId=self._client)
+
+    def _place_base(self, pose: BasePose) -> Transform:
+        """Put the base at ``pose`` (a free one resting on the ground); return its frame."""
+        rotation = quaternion_from_rpy(0.0, 0.0, pose.yaw)
+        if self._fixed_base:
+            frame = Transform((pose.x, pose.y, pose.z), rotation)
+            if not pose.is_origin:
+                self._set_base_frame(frame)
+            return self.base_frame() if pose.is_origin else frame
+        # Held high above the ground plane, the closest points between them give the
+        # height of the robot's lowest collision point (meshes included).
+        lifted = Transform((pose.x, pose.y, MEASURING_HEIGHT), rotation)
+        self._set_base_frame(lifted)
+        points = pybullet.getClosestPoints(self._body, self.ground, MEASURING_RANGE,
+                                           physicsClientId=self._client)
+        lowest = min((point[CLOSEST_DISTANCE] for point in points), default=MEASURING_HEIGHT)
+        frame = Transform((pose.x, pose.y, MEASURING_HEIGHT - lowest + pose.z), rotation)
+        self._set_base_frame(frame)
+        return frame
 
     @property
     def client_id(self) -> int:
@@ -329,7 +456,9 @@ class Physics:
             inertias = [1.0 / value if value > 0.0 else 0.0 for value in diagonal]
         except numpy.linalg.LinAlgError:  # a massless subtree: the locked diagonal at least
             inertias = list(numpy.diag(matrix))
-        return [float(inertias[self._dof_indices[index]]) for index in self._indices]
+        # A free base's rows come first: what a joint moves then includes the base's give.
+        first = 0 if self._fixed_base else FREE_BASE_DOFS
+        return [float(inertias[first + self._dof_indices[index]]) for index in self._indices]
 
     def smallest_inertias(self) -> list[float]:
         """Return each joint's smallest effective inertia over :func:`check_poses`."""
@@ -338,7 +467,13 @@ class Physics:
         return [min(values) for values in zip(*inertias, strict=True)]
 
     def gravity_torques(self, positions: Sequence[float] | None = None) -> list[float]:
-        """Return the effort each joint needs to hold still against gravity at ``positions``."""
+        """Return the effort each joint needs to hold still against gravity at ``positions``.
+
+        Zero for every joint of a free robot: PyBullet's inverse dynamics takes
+        only a welded base, and on the ground the base itself is not held.
+        """
+        if not self._fixed_base:
+            return [0.0] * len(self._indices)
         if positions is None:
             positions = [state[STATE_POSITION] for state in self.read_states()]
         dofs = [0.0] * len(self._dof_indices)
@@ -376,13 +511,19 @@ class Physics:
         pybullet.setGravity(0.0, 0.0, -STANDARD_GRAVITY, physicsClientId=client)
         pybullet.setTimeStep(self._time_step, physicsClientId=client)
         urdf_path = pathlib.Path(self._workdir.name) / URDF_FILE_NAME
-        urdf_path.write_text(description.physics_urdf, encoding='utf-8')
+        # A free base must have a mass, or PyBullet welds it (see model.inertials).
+        urdf_path.write_text(description.physics_urdf if self._fixed_base else
+                             with_massive_root(description.physics_urdf, description.model),
+                             encoding='utf-8')
         output: list[str] = []
         try:
             with captured_native_output(output):
+                flags = pybullet.URDF_USE_INERTIA_FROM_FILE
+                if not self._fixed_base:  # wheels: exact cylinders, not polygon hulls
+                    flags |= pybullet.URDF_USE_IMPLICIT_CYLINDER
                 body = pybullet.loadURDF(
-                    str(urdf_path), useFixedBase=True,
-                    flags=pybullet.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client)
+                    str(urdf_path), useFixedBase=self._fixed_base, flags=flags,
+                    physicsClientId=client)
         except pybullet.error as err:
             reasons = '; '.join(message_lines(''.join(output)))
             because = f' ({reasons})' if reasons else ''
@@ -599,3 +740,10 @@ def health_problem(name: str, state: Sequence[float], cap: float) -> str:
     return (f"joint '{name}' moves at {velocity:.6g}, PyBullet's speed cap ({cap:g}): it is "
             'unstable (gains too high for its inertia?)')
 
+
+def _inverse(transform: Transform) -> Transform:
+    """Return the transform that undoes ``transform``."""
+    x, y, z, w = transform.rotation
+    conjugate = (-x, -y, -z, w)
+    moved = Transform((0.0, 0.0, 0.0), conjugate).apply(transform.translation)
+    return Transform((-moved[0], -moved[1], -moved[2]), conjugate)

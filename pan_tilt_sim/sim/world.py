@@ -12,12 +12,14 @@ which costs next to nothing.  Cameras, depth cameras and lidars meet the
 ground plane analytically.  Objects spawned into the world
 (:mod:`pan_tilt_sim.sim.entities`) land on it: :func:`add_ground_plane`
 adds the plane as a collision body when the first object arrives -- so a
-world without objects pays nothing for it.  The robot is fixed to the
-world, and its links that touch the ground or reach below it in the
-initial pose (:func:`grounded_links`: the pan/tilt example's base and its pan link,
-whose collision cylinder reaches below z = 0; a base sunk into the floor)
-never collide with the plane: they would be held by it (a wheel half in the
-ground turns 0 rad/s instead of 42 under the same torque).  Every other
+world without objects pays nothing for it.  A free (mobile) robot stands
+on the plane, which is then a collision body from the start and touches
+every link.  The links of a robot fixed to the world that touch the ground
+or reach below it in the initial pose (:func:`grounded_links`: the pan/tilt
+example's base and its pan link, whose collision cylinder reaches below z = 0; a base
+sunk into the floor) never collide with the plane: they would be held by
+it (a wheel half in the ground turns 0 rad/s instead of 42 under the same
+torque).  Every other
 link meets the ground as any object does: a gripper cannot go through it.
 
 The ground is the plane z = 0.  TinyRenderer's cost grows with the pixels it

@@ -50,12 +50,15 @@ controller is configured. *Not simulated*: accepted, but the simulator does not 
 
 
 def example_controller(cls: type[Controller]) -> Controller:
-    """Return ``cls`` built from its spec's examples and configured on a one-joint robot."""
+    """Return ``cls`` built from its spec's examples and configured on a two-joint robot.
+
+    Every example names joint1; a diff drive's other side is joint2.
+    """
     controller = cls('<name>', cls.parameters.example())
     controller.type_name = cls.type_names[0]
-    joint = JointSpec('joint1', JointKind.REVOLUTE, -1.0, 1.0, effort_limit=1.0,
-                      velocity_limit=1.0)
-    controller.configure({'joint1': JointHandle(joint)})
+    controller.configure({name: JointHandle(JointSpec(
+        name, JointKind.REVOLUTE, -1.0, 1.0, effort_limit=1.0, velocity_limit=1.0))
+        for name in ('joint1', 'joint2')})
     return controller
 
 

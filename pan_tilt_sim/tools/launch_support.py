@@ -108,7 +108,8 @@ def sim_node_parameters(model: str, controllers: str, *, real_time_factor: float
                         active_controllers: Sequence[str] = (),
                         time_step: float | None = None, robot_namespace: str = '',
                         publish_tf: bool = False, spawners: bool = False,
-                        paused: bool = False) -> dict[str, Any]:
+                        paused: bool = False, fixed_base: str = 'auto',
+                        initial_pose: Sequence[str] = ()) -> dict[str, Any]:
     """Return sim_node's parameters.
 
     With robot_state_publisher beside it (``publish_tf`` False), that node
@@ -119,6 +120,8 @@ def sim_node_parameters(model: str, controllers: str, *, real_time_factor: float
     With ``spawners`` no controller starts: ros2_control's spawners load and
     activate them (``autostart_controllers`` false; ``active_controllers`` are
     then the spawners' business, see :func:`spawner_arguments`).
+    ``fixed_base`` other than ``auto`` and an ``initial_pose`` (four numbers,
+    as text: x y z yaw) are passed on; sim_node checks them.
     """
     parameters: dict[str, Any] = {
         'robot_description_file': model,
@@ -142,6 +145,14 @@ def sim_node_parameters(model: str, controllers: str, *, real_time_factor: float
         parameters['robot_namespace'] = robot_namespace
     if paused:  # start paused (STOPPED): spawners and tests connect before time moves
         parameters['paused'] = True
+    if fixed_base != 'auto':
+        parameters['fixed_base'] = fixed_base
+    if initial_pose:
+        try:
+            parameters['initial_pose'] = [float(value) for value in initial_pose]
+        except ValueError:
+            raise ValueError(f"launch argument 'initial_pose': {' '.join(initial_pose)!r} is "
+                             'not four numbers x y z yaw') from None
     return parameters
 
 

@@ -2,7 +2,7 @@
 
 Each registered type is loaded through the manager with nothing but its
 spec's required examples (everything else from the defaults), on a minimal
-one-joint robot; it configures, activates, runs, declares its ROS surface,
+two-joint robot; it configures, activates, runs, declares its ROS surface,
 and documents every parameter.
 """
 
@@ -23,10 +23,10 @@ from pan_tilt_sim.model.robot import JointKind, JointSpec
 DT = 0.001
 
 
-def one_joint_robot():
-    spec = JointSpec('joint1', JointKind.REVOLUTE, -1.0, 1.0, effort_limit=10.0,
-                     velocity_limit=2.0)
-    return {'joint1': JointHandle(spec)}
+def small_robot():
+    """Return joint1 (every example's joint) and joint2 (a diff drive's other wheel)."""
+    return {name: JointHandle(JointSpec(name, JointKind.REVOLUTE, -1.0, 1.0, effort_limit=10.0,
+                                        velocity_limit=2.0)) for name in ('joint1', 'joint2')}
 
 
 @pytest.mark.parametrize('type_name', sorted(CONTROLLER_TYPES))
@@ -35,7 +35,7 @@ def test_every_type_loads_with_its_spec_defaults_and_runs(type_name, tmp_path):
     params = {'type': type_name, **cls.parameters.example()}
     config = ControllersConfig((ControllerSpec('under_test', type_name, params),),
                                tmp_path / 'controllers.yaml')
-    handles = one_joint_robot()
+    handles = small_robot()
     manager = ControllerManager(config, handles)
     controller = manager.controller('under_test')
     assert manager.state('under_test') == ACTIVE

@@ -7,7 +7,7 @@ from robot_fixtures import write_text
 
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.description import load_description
-from pan_tilt_sim.model.inertials import MOVABLE_INERTIA, MOVABLE_MASS
+from pan_tilt_sim.model.inertials import MOVABLE_INERTIA, MOVABLE_MASS, with_massive_root
 
 INERTIAL = ('<inertial><mass value="{m}"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" '
             'ixz="0" iyz="0"/></inertial>')
@@ -83,3 +83,16 @@ def test_a_urdf_with_two_root_links_is_refused_by_name(tmp_path):
     with pytest.raises(DescriptionError, match=r"links 'base', 'stray' are each the child of "
                                                'no joint'):
         robot(tmp_path, ARM + '<link name="stray"/>')
+
+
+def test_a_free_bases_massless_root_gets_a_negligible_mass_and_a_massive_one_is_kept(tmp_path):
+    description = robot(tmp_path, ARM)
+    freed = ElementTree.fromstring(with_massive_root(description.physics_urdf, description.model))
+    base = next(link for link in freed.findall('link') if link.get('name') == 'base')
+    assert float(base.find('inertial/mass').get('value')) == MOVABLE_MASS
+    assert float(base.find('inertial/inertia').get('izz')) == MOVABLE_INERTIA
+    massive = robot(tmp_path, f'<link name="base">{INERTIAL.format(m=3)}</link>'
+                              '<link name="wheel">' + INERTIAL.format(m=1) + '</link>'
+                              '<joint name="axle" type="continuous"><parent link="base"/>'
+                              '<child link="wheel"/></joint>')
+    assert with_massive_root(massive.physics_urdf, massive.model) == massive.physics_urdf

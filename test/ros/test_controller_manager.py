@@ -194,7 +194,8 @@ def test_without_spawners_the_controllers_are_listed_as_they_run(ur_style):
     assert 'joint_trajectory_controller/JointTrajectoryController' in types.types
     chainable = {name for name, base in zip(types.types, types.base_classes, strict=True)
                  if base != 'controller_interface::ControllerInterface'}
-    assert chainable == {'pid_controller/PidController'}
+    assert chainable == {'pid_controller/PidController',
+                         'diff_drive_controller/DiffDriveController'}
 
 
 def test_switching_from_the_trajectory_controller_to_forward_position_and_back(ur_style):

@@ -202,7 +202,7 @@ def test_the_launch_file_declares_every_argument(stand_in_launch):
     assert set(_defaults(stand_in_launch.generate_launch_description())) == {
         'model', 'xacro_args', 'controllers', 'controllers_args', 'active_controllers',
         'spawners', 'time_step', 'robot_namespace', 'real_time_factor', 'world', 'gui',
-        'paused'}
+        'paused', 'fixed_base', 'initial_pose'}
 
 
 def _launch(module, monkeypatch, prefix, **arguments):
@@ -292,6 +292,18 @@ def test_paused_is_passed_only_when_asked_for():
                                                world='targets', gui=False)
     assert sim_node_parameters('m.urdf', '', real_time_factor=1.0, world='targets', gui=False,
                                paused=True)['paused'] is True
+
+
+def test_fixed_base_and_initial_pose_are_passed_only_when_given():
+    plain = sim_node_parameters('m.urdf', '', real_time_factor=1.0, world='ground', gui=False)
+    assert 'fixed_base' not in plain and 'initial_pose' not in plain
+    given = sim_node_parameters('m.urdf', '', real_time_factor=1.0, world='ground', gui=False,
+                                fixed_base='false', initial_pose=['1', '2', '0', '1.57'])
+    assert given['fixed_base'] == 'false'
+    assert given['initial_pose'] == [1.0, 2.0, 0.0, 1.57]
+    with pytest.raises(ValueError, match="launch argument 'initial_pose': '1 north' is not"):
+        sim_node_parameters('m.urdf', '', real_time_factor=1.0, world='ground', gui=False,
+                            initial_pose=['1', 'north'])
 
 
 def test_a_topic_based_robot_needs_no_controllers_file(tmp_path):

@@ -1,0 +1,450 @@
+"""``diff_drive_controller/DiffDriveController``: a twist in, wheel velocities out, odometry back.
+
+As ros2_controllers' (jazzy), parameters by their names there:
+
+* **Command**: ``~/cmd_vel`` (``geometry_msgs/msg/TwistStamped``); only
+  ``linear.x`` (m/s) and ``angular.z`` (rad/s) count.  A twist whose
+  ``linear.x`` or ``angular.z`` is NaN or infinite is refused (a throttled
+  warning); an unstamped one is stamped with the sim time it arrives at, and
+  one already older than ``cmd_vel_timeout`` is refused.  Once the newest
+  command is older than ``cmd_vel_timeout`` (s of sim time; 0: never) the
+  robot brakes to a stop.  Until the first command the wheels are not
+  commanded; the odometry is published all the same (upstream waits for a
+  command), so that odom and its TF exist from the start.
+* **Limits**: ``linear.x.*`` and ``angular.z.*`` velocity, acceleration
+  (forward, deceleration, and the reverse pair) and jerk limits, NaN = off
+  (see :mod:`.rate_limiter`); the deprecated ``has_*_limits: false`` turns a
+  group off.  ``publish_limited_velocity``: the limited twist on
+  ``~/cmd_vel_out`` (at ``update_rate``, else ``publish_rate``).
+* **Wheels**: ``left_wheel_names`` and ``right_wheel_names`` (as many on
+  each side), driven through their ``velocity`` command interface by the
+  ideal velocity actuator at ``(v -+ w * separation / 2) / radius`` rad/s,
+  with ``wheel_separation``, ``wheel_radius`` and their multipliers.
+* **Odometry**: from the wheels' mean position per side
+  (``position_feedback``, the default), their mean velocity, or the limited
+  command (``open_loop``); see :mod:`.odometry`.  ``~/odom``
+  (``nav_msgs/msg/Odometry``, ``odom_frame_id`` -> ``base_frame_id``, the
+  covariance diagonals) and, with ``enable_odom_tf``, the same transform on
+  ``/tf``, at ``publish_rate`` Hz of sim time.  Frame ids get
+  ``tf_frame_prefix`` (empty: the controller's namespace, without its
+  leading slash) when ``tf_frame_prefix_enable``.
+* **Chaining**: it exports ``<name>/linear/velocity`` and
+  ``<name>/angular/velocity``; in chained mode the preceding controller
+  writes them and ``~/cmd_vel`` (and its timeout) is not used.
+
+Its type frees the robot's base (``drives_base``): with sim_node's
+``fixed_base:=auto`` a robot with one active stands on the ground.  A reset
+(activation, ``reset_simulation``) puts the odometry back at the origin;
+upstream keeps it across a deactivation.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from typing import Any, ClassVar
+
+from pan_tilt_sim.controllers.base import (
+    Actuator,
+    ActuatorKind,
+    CommandController,
+    CommandKind,
+    CommandResult,
+    JointHandle,
+    Reference,
+)
+from pan_tilt_sim.controllers.odometry import Odometry
+from pan_tilt_sim.controllers.parameter_spec import (
+    BOOL,
+    DOUBLE,
+    DOUBLE_ARRAY,
+    INT,
+    REQUIRED,
+    STRING,
+    STRING_ARRAY,
+    Param,
+    ParameterSpec,
+    Validator,
+    fixed_size,
+    gt,
+    gt_eq,
+    not_empty,
+    unique,
+)
+from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError, RateLimiter, RateLimits
+from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
+from pan_tilt_sim.model.transforms import Transform
+from pan_tilt_sim.schedule import PeriodicSchedule
+
+LEFT, RIGHT = 'left_wheel_names', 'right_wheel_names'
+VELOCITY, POSITION = 'velocity', 'position'
+COVARIANCE_SIZE = 6
+LIMIT_GROUPS = ('linear.x', 'angular.z')
+# Sinks: odometry(time, x, y, heading, linear, angular); tf(time, frames);
+# limited(time, linear, angular).
+OdometrySink = Callable[[float, float, float, float, float, float], None]
+TfSink = Callable[[float, list[tuple[str, str, Transform]]], None]
+TwistSink = Callable[[float, float, float], None]
+
+
+def _or_nan(text: str, accept: Callable[[float], bool]) -> Validator:
+    return Validator(f'{text} or NaN (off)', lambda value: None if math.isnan(value) or accept(
+        value) else f'{value!r} must be {text} or NaN (off)')
+
+
+def _limit_params(group: str) -> tuple[Param, ...]:
+    """Return the entries of one limit group (``linear.x`` or ``angular.z``), as jazzy's."""
+    unit = 'm' if group.startswith('linear') else 'rad'
+    positive = _or_nan('>= 0', lambda value: value >= 0.0)
+    negative = _or_nan('<= 0', lambda value: value <= 0.0)
+
+    def limit(name: str, text: str, rule: Validator) -> Param:
+        return Param(f'{group}.{name}', DOUBLE, math.nan, text, (rule,), finite=False)
+
+    return (
+        Param(f'{group}.has_velocity_limits', BOOL, True,
+              'Deprecated: false turns the velocity limits off (set them to NaN instead).'),
+        Param(f'{group}.has_acceleration_limits', BOOL, True,
+              'Deprecated: false turns the acceleration limits off (set them to NaN instead).'),
+        Param(f'{group}.has_jerk_limits', BOOL, True,
+              'Deprecated: false turns the jerk limits off (set them to NaN instead).'),
+        limit('max_velocity', f'Largest velocity ({unit}/s).', positive),
+        limit('min_velocity', f'Smallest velocity ({unit}/s); NaN: -max_velocity.', negative),
+        limit('max_acceleration', f'Largest acceleration in the positive direction '
+              f'({unit}/s^2).', positive),
+        limit('max_deceleration', f'Largest deceleration while moving in the positive direction '
+              f'({unit}/s^2, <= 0); NaN: max_acceleration_reverse.', negative),
+        Param(f'{group}.min_acceleration', DOUBLE, None,
+              'Deprecated upstream, which ignores it: use max_deceleration.', finite=False,
+              simulated=False),
+        limit('max_acceleration_reverse', f'Largest acceleration in the negative direction '
+              f'({unit}/s^2, <= 0); NaN: -max_acceleration.', negative),
+        limit('max_deceleration_reverse', f'Largest deceleration while moving in the negative '
+              f'direction ({unit}/s^2); NaN: max_acceleration.', positive),
+        limit('max_jerk', f'Largest jerk ({unit}/s^3).', positive),
+        limit('min_jerk', f'Smallest jerk ({unit}/s^3); NaN: -max_jerk.', negative),
+    )
+
+
+class DiffDriveController(CommandController):
+    """Drives a differential base from a twist and publishes its odometry, as ros2_controllers."""
+
+    type_names = ('diff_drive_controller/DiffDriveController',)
+    chainable = True
+    drives_base: ClassVar[bool] = True
+    command_topic = 'cmd_vel'
+    command_kind = CommandKind.TWIST_STAMPED
+    parameters = ParameterSpec([
+        Param(LEFT, STRING_ARRAY, REQUIRED, "The left side wheels' joints.",
+              (not_empty(), unique()), example=['joint1']),
+        Param(RIGHT, STRING_ARRAY, REQUIRED, "The right side wheels' joints (as many).",
+              (not_empty(), unique()), example=['joint2']),
+        Param('wheel_separation', DOUBLE, REQUIRED, 'Distance between the left and right '
+              'wheels (m).', (gt(0.0),), example=0.3),
+        Param('wheel_radius', DOUBLE, REQUIRED, 'Radius of the wheels (m).', (gt(0.0),),
+              example=0.05),
+        Param('wheel_separation_multiplier', DOUBLE, 1.0,
+              'Correction factor of wheel_separation.'),
+        Param('left_wheel_radius_multiplier', DOUBLE, 1.0,
+              'Correction factor of wheel_radius for the left wheels.'),
+        Param('right_wheel_radius_multiplier', DOUBLE, 1.0,
+              'Correction factor of wheel_radius for the right wheels.'),
+        Param('tf_frame_prefix_enable', BOOL, True, 'Prefix the frame ids with tf_frame_prefix.'),
+        Param('tf_frame_prefix', STRING, '', "The frame ids' prefix; empty: the controller's "
+              'namespace.'),
+        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.'),
+        Param('base_frame_id', STRING, 'base_link', "The robot's base frame, child of "
+              'odom_frame_id.'),
+        Param('pose_covariance_diagonal', DOUBLE_ARRAY, [0.0] * COVARIANCE_SIZE,
+              "Diagonal of the odometry pose's covariance (x, y, z, roll, pitch, yaw).",
+              (fixed_size(COVARIANCE_SIZE),)),
+        Param('twist_covariance_diagonal', DOUBLE_ARRAY, [0.0] * COVARIANCE_SIZE,
+              "Diagonal of the odometry twist's covariance.", (fixed_size(COVARIANCE_SIZE),)),
+        Param('open_loop', BOOL, False, 'Odometry from the limited command, not the wheels.'),
+        Param('position_feedback', BOOL, True, "Odometry from the wheels' positions (else "
+              'their velocities).'),
+        Param('enable_odom_tf', BOOL, True, 'Publish odom_frame_id -> base_frame_id on /tf.'),
+        Param('cmd_vel_timeout', DOUBLE, 0.5, 'Seconds of sim time after which the last '
+              'command is stale and the robot brakes; 0: never.', (gt_eq(0.0),)),
+        Param('publish_limited_velocity', BOOL, False, 'Publish the limited twist on '
+              '~/cmd_vel_out.'),
+        Param('velocity_rolling_window_size', INT, 10, "Updates in the odometry twist's "
+              'rolling mean.', (gt_eq(1),)),
+        Param('publish_rate', DOUBLE, 50.0, 'Odometry and TF messages per second of sim time.',
+              (gt(0.0),)),
+        Param('update_rate', DOUBLE, None, "The controller's update rate (Hz): the rate of "
+              '~/cmd_vel_out.', (gt(0.0),)),
+        *_limit_params('linear.x'),
+        *_limit_params('angular.z'),
+    ])
+
+    def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
+        super().__init__(name, params, source)
+        left, right = list(self.params[LEFT]), list(self.params[RIGHT])
+        if len(left) != len(right):
+            raise self.error(RIGHT, f'{len(right)} wheels, but {LEFT} names {len(left)}: '
+                                    'each side needs as many')
+        both = [wheel for wheel in left if wheel in right]
+        if both:
+            raise self.error(RIGHT, f"'{both[0]}' is also one of {LEFT}")
+        self._left_names, self._right_names = tuple(left), tuple(right)
+        self._limiters = tuple(self._limiter(group) for group in LIMIT_GROUPS)
+        self._references = {f'{name}/linear/{VELOCITY}': Reference(f'{name}/linear/{VELOCITY}'),
+                            f'{name}/angular/{VELOCITY}': Reference(f'{name}/angular/{VELOCITY}')}
+        self._linear_reference, self._angular_reference = self._references.values()
+        self._odometry = Odometry(*self._geometry(), self.params['velocity_rolling_window_size'])
+        self._publishing = PeriodicSchedule(1.0 / self.params['publish_rate'])
+        self._limited_publishing = PeriodicSchedule(
+            1.0 / (self.params.get('update_rate') or self.params['publish_rate']))
+        self._left: list[JointHandle] = []
+        self._right: list[JointHandle] = []
+        self._odometry_sink: OdometrySink | None = None
+        self._tf_sink: TfSink | None = None
+        self._twist_sink: TwistSink | None = None
+        self._command: StampedTwist | None = None
+        self._problem = ''
+        self.reset()
+
+    def _limiter(self, group: str) -> RateLimiter:
+        axis, direction = group.split('.')
+        params = self.params[axis][direction]
+
+        def value(name: str, switch: str) -> float:
+            return params[name] if params[f'has_{switch}_limits'] else math.nan
+
+        try:
+            return RateLimiter(RateLimits(
+                min_velocity=value('min_velocity', 'velocity'),
+                max_velocity=value('max_velocity', 'velocity'),
+                max_acceleration_reverse=value('max_acceleration_reverse', 'acceleration'),
+                max_acceleration=value('max_acceleration', 'acceleration'),
+                max_deceleration=value('max_deceleration', 'acceleration'),
+                max_deceleration_reverse=value('max_deceleration_reverse', 'acceleration'),
+                min_jerk=value('min_jerk', 'jerk'), max_jerk=value('max_jerk', 'jerk')))
+        except InvalidLimitsError as err:
+            raise self.error(group, f'invalid limits: {err}') from None
+
+    def _geometry(self) -> tuple[float, float, float]:
+        """Return the wheel separation and the left and right radii, multipliers applied (m)."""
+        params = self.params
+        radius = params['wheel_radius']
+        return (params['wheel_separation_multiplier'] * params['wheel_separation'],
+                params['left_wheel_radius_multiplier'] * radius,
+                params['right_wheel_radius_multiplier'] * radius)
+
+    # --- what it claims and exports --------------------------------------------------------
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """The wheels, left then right."""
+        return self._left_names + self._right_names
+
+    def command_interfaces(self) -> dict[str, tuple[str, ...]]:
+        """Return the velocity interface of every wheel."""
+        return {wheel: (VELOCITY,) for wheel in self.joint_names}
+
+    def state_interfaces(self) -> dict[str, tuple[str, ...]]:
+        """Return the feedback each wheel is read by (none in open loop)."""
+        if self.params['open_loop']:
+            return {}
+        feedback = POSITION if self.params['position_feedback'] else VELOCITY
+        return {wheel: (feedback,) for wheel in self.joint_names}
+
+    def actuators(self) -> dict[str, Actuator]:
+        """Return the ideal velocity actuator for every wheel."""
+        return {wheel: Actuator(ActuatorKind.IDEAL_VELOCITY, self.name)
+                for wheel in self.joint_names}
+
+    def reference_interfaces(self) -> Mapping[str, Reference]:
+        """Return ``<name>/linear/velocity`` and ``<name>/angular/velocity``."""
+        return self._references
+
+    # --- ROS surface -----------------------------------------------------------------------
+
+    def frame_ids(self) -> tuple[str, str]:
+        """Return the odometry frame and the base frame, prefixed as upstream prefixes them."""
+        prefix = ''
+        if self.params['tf_frame_prefix_enable']:
+            prefix = self.params['tf_frame_prefix'] or self.node_namespace
+            if not prefix.endswith('/'):
+                prefix += '/'
+            prefix = prefix.removeprefix('/')
+        return prefix + self.params['odom_frame_id'], prefix + self.params['base_frame_id']
+
+    def ros_surface(self) -> tuple[Endpoint, ...]:
+        """Return ``~/cmd_vel`` in; ``~/odom``, ``/tf`` and ``~/cmd_vel_out`` out as configured."""
+        odom, base = self.frame_ids()
+        params = self.params
+        endpoints: list[Endpoint] = [
+            CommandTopic(f'~/{self.command_topic}', self.command_kind.value, self.set_command,
+                         self.command_problem),
+            StateTopic('~/odom', 'nav_msgs/msg/Odometry', self.set_odometry_sink, {
+                'frame_id': odom, 'child_frame_id': base,
+                'pose_covariance_diagonal': tuple(params['pose_covariance_diagonal']),
+                'twist_covariance_diagonal': tuple(params['twist_covariance_diagonal'])})]
+        if params['enable_odom_tf']:
+            endpoints.append(StateTopic('/tf', 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
+        if params['publish_limited_velocity']:
+            endpoints.append(StateTopic('~/cmd_vel_out', CommandKind.TWIST_STAMPED.value,
+                                        self.set_limited_velocity_sink))
+        return tuple(endpoints)
+
+    def set_odometry_sink(self, sink: OdometrySink | None) -> None:
+        """Where odometry samples go: ``sink(time, x, y, heading, linear, angular)``."""
+        self._odometry_sink = sink
+
+    def set_tf_sink(self, sink: TfSink | None) -> None:
+        """Where the odom -> base transform goes: ``sink(time, [(parent, child, transform)])``."""
+        self._tf_sink = sink
+
+    def set_limited_velocity_sink(self, sink: TwistSink | None) -> None:
+        """Where the limited twist goes: ``sink(time, linear, angular)``."""
+        self._twist_sink = sink
+
+    # --- lifecycle -------------------------------------------------------------------------
+
+    def configure(self, joints: Mapping[str, JointHandle]) -> None:
+        """Bind the wheels' handles (an unknown wheel names its parameter), then reset."""
+        self._left = [self.handle(joints, wheel, LEFT) for wheel in self._left_names]
+        self._right = [self.handle(joints, wheel, RIGHT) for wheel in self._right_names]
+        self.reset()
+
+    def reset(self) -> None:
+        """No command, references NaN, odometry at the origin, the wheels asked to stand."""
+        self._command = None
+        self._timed_out = False
+        self._time = 0.0
+        self._linear_reference.value = math.nan
+        self._angular_reference.value = math.nan
+        # The last two limited commands (upstream fills them with zeros, not NaN).
+        self._history = [(0.0, 0.0), (0.0, 0.0)]
+        self._publishing.reset()
+        self._limited_publishing.reset()
+        self._linear_command = self._angular_command = 0.0
+        self._odometry.reset(0.0, *self._side_positions())
+        for handle in self._left + self._right:
+            handle.velocity_target = 0.0
+
+    def deactivate(self) -> None:
+        """Stop the wheels (upstream's halt)."""
+        for handle in self._left + self._right:
+            handle.velocity_target = 0.0
+
+    # --- commands --------------------------------------------------------------------------
+
+    def set_command(self, value: StampedTwist) -> CommandResult:
+        """Take a twist (from the subscription; cheap): refuse non-finite or stale ones."""
+        linear, angular = value.linear[0], value.angular[2]
+        if not (math.isfinite(linear) and math.isfinite(angular)):
+            self._problem = (f'ignored cmd_vel (linear.x {linear!r}, angular.z {angular!r}): '
+                             'not finite numbers')
+            return CommandResult.REJECTED
+        now = self._time
+        stamp = value.stamp if value.stamp > 0.0 else now
+        timeout = self.params['cmd_vel_timeout']
+        if timeout > 0.0 and now - stamp >= timeout:
+            self._problem = (f'ignored cmd_vel stamped {stamp:.4f} s: {now - stamp:.4f} s old at '
+                             f'sim time {now:.4f} s, more than cmd_vel_timeout ({timeout:g} s)')
+            return CommandResult.REJECTED
+        self._command = StampedTwist(stamp, (linear, 0.0, 0.0), (0.0, 0.0, angular))
+        return CommandResult.ACCEPTED
+
+    def command_problem(self, value: Any, result: CommandResult) -> str:
+        """Describe the last refused twist."""
+        return self._problem
+
+    def setpoints(self) -> dict[str, float]:
+        """Return each wheel's commanded velocity (rad/s)."""
+        return {handle.name: handle.velocity_target for handle in self._left + self._right}
+
+    @property
+    def limited_command(self) -> tuple[float, float]:
+        """The last limited command: linear (m/s) and angular (rad/s) velocity."""
+        return self._linear_command, self._angular_command
+
+    @property
+    def odometry(self) -> Odometry:
+        """The odometry (pose and twist in the odom frame)."""
+        return self._odometry
+
+    # --- the step ---------------------------------------------------------------------------
+
+    def update(self, time: float, period: float) -> None:
+        """Take the command (or the references), limit it, integrate odometry, drive the wheels."""
+        self._time = time
+        if not self.is_chained:
+            self._update_references(time)
+        linear, angular = self._linear_reference.value, self._angular_reference.value
+        if not (math.isfinite(linear) and math.isfinite(angular)):
+            # Nothing commanded yet: the wheels stand, the odometry still runs and is published.
+            self._update_odometry(0.0, 0.0, time, period)
+            self._publish(time)
+            return
+        (before_linear, before_angular), (last_linear, last_angular) = self._history
+        linear = self._limiters[0].limit(linear, last_linear, before_linear, period)
+        angular = self._limiters[1].limit(angular, last_angular, before_angular, period)
+        self._history = [self._history[1], (linear, angular)]
+        self._linear_command, self._angular_command = linear, angular
+        self._update_odometry(linear, angular, time, period)
+        self._publish(time)
+        separation, left_radius, right_radius = self._geometry()
+        left_velocity = (linear - angular * separation / 2.0) / left_radius
+        right_velocity = (linear + angular * separation / 2.0) / right_radius
+        for handle in self._left:
+            handle.velocity_target = left_velocity
+        for handle in self._right:
+            handle.velocity_target = right_velocity
+
+    def _update_references(self, time: float) -> None:
+        """Write the newest command to the references; zeros once it is stale (braking)."""
+        command = self._command
+        if command is None:
+            return
+        timeout = self.params['cmd_vel_timeout']
+        if timeout > 0.0 and time - command.stamp > timeout:
+            self._linear_reference.value = 0.0
+            self._angular_reference.value = 0.0
+            if not self._timed_out:
+                self._timed_out = True
+                self.notices.append(f'velocity command timed out ({timeout:g} s without one at '
+                                    f'sim time {time:.3f} s): braking')
+            return
+        self._timed_out = False
+        self._linear_reference.value = command.linear[0]
+        self._angular_reference.value = command.angular[2]
+
+    def _side_positions(self) -> tuple[float, float]:
+        """Return each side's mean wheel position (rad); zeros before configure."""
+        if not self._left:
+            return 0.0, 0.0
+        return (sum(handle.position for handle in self._left) / len(self._left),
+                sum(handle.position for handle in self._right) / len(self._right))
+
+    def _update_odometry(self, linear: float, angular: float, time: float,
+                         period: float) -> None:
+        odometry = self._odometry
+        if self.params['open_loop']:
+            odometry.update_open_loop(linear, angular, time)
+        elif self.params['position_feedback']:
+            odometry.update(*self._side_positions(), time)
+        else:
+            left = sum(handle.velocity for handle in self._left) / len(self._left)
+            right = sum(handle.velocity for handle in self._right) / len(self._right)
+            odometry.update_from_travel(left * odometry.left_radius * period,
+                                        right * odometry.right_radius * period, time)
+
+    def _publish(self, time: float) -> None:
+        if self._limited_publishing.take(time) and self._twist_sink is not None:
+            self._twist_sink(time, self._linear_command, self._angular_command)
+        if not self._publishing.take(time):
+            return
+        odometry = self._odometry
+        if self._odometry_sink is not None:
+            self._odometry_sink(time, odometry.x, odometry.y, odometry.heading, odometry.linear,
+                                odometry.angular)
+        if self._tf_sink is not None:
+            odom, base = self.frame_ids()
+            heading = odometry.heading
+            pose = Transform((odometry.x, odometry.y, 0.0),
+                             (0.0, 0.0, math.sin(heading / 2.0), math.cos(heading / 2.0)))
+            self._tf_sink(time, [(odom, base, pose)])

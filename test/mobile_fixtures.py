@@ -1,0 +1,122 @@
+"""A small differential-drive robot for the mobile-base tests, written on the fly.
+
+:func:`rover_urdf` is a box base on two driven wheels (continuous joints
+about y, at ``WHEEL_SEPARATION`` apart, radius ``WHEEL_RADIUS``) and one
+frictionless caster ball behind them (its ``<gazebo reference>`` sets
+``mu1``/``mu2`` to 0, so it only carries weight).  The wheels' and the
+caster's lowest points are ``REST_HEIGHT`` below the base frame: resting on
+the ground, the base frame is at z = ``REST_HEIGHT``.  :func:`rover_controllers`
+is a ros2_control-style controllers file with a joint_state_broadcaster and
+a ``diff_drive_controller/DiffDriveController`` named ``base_controller``.
+"""
+
+from __future__ import annotations
+
+import pathlib
+import textwrap
+from collections.abc import Mapping
+from typing import Any
+
+import yaml
+
+WHEEL_RADIUS = 0.05  # m
+WHEEL_SEPARATION = 0.3  # m between the wheels' mid-planes
+AXLE_DROP = 0.025  # m: the axle below the base frame
+REST_HEIGHT = AXLE_DROP + WHEEL_RADIUS  # m: the base frame above the ground at rest
+CASTER_RADIUS = 0.025  # m
+CONTROLLER = 'base_controller'
+DIFF_DRIVE = 'diff_drive_controller/DiffDriveController'
+
+
+def _wheel(side: str, y: float) -> str:
+    return f'''
+      <joint name="{side}_wheel_joint" type="continuous">
+        <parent link="base_link"/><child link="{side}_wheel"/>
+        <origin xyz="0.05 {y} -{AXLE_DROP}"/><axis xyz="0 1 0"/>
+        <limit effort="20" velocity="30"/>
+      </joint>
+      <link name="{side}_wheel">
+        <inertial><mass value="0.3"/>
+          <inertia ixx="0.0002" ixy="0" ixz="0" iyy="0.0004" iyz="0" izz="0.0002"/></inertial>
+        <collision><origin rpy="1.5707963267948966 0 0"/>
+          <geometry><cylinder radius="{WHEEL_RADIUS}" length="0.03"/></geometry></collision>
+      </link>'''
+
+
+def rover_urdf(name: str = 'rover', *, world_joint: bool = False,
+               footprint: bool = False) -> str:
+    """Return the rover's URDF.
+
+    ``world_joint`` hangs it on a ``world`` link by a fixed joint; ``footprint``
+    on a massless ``base_footprint`` root on the ground, ``REST_HEIGHT`` below
+    ``base_link``.
+    """
+    world = ('<link name="world"/><joint name="world_joint" type="fixed">'
+             '<parent link="world"/><child link="base_link"/></joint>') if world_joint else ''
+    if footprint:
+        world += ('<link name="base_footprint"/><joint name="footprint_joint" type="fixed">'
+                  '<parent link="base_footprint"/><child link="base_link"/>'
+                  f'<origin xyz="0 0 {REST_HEIGHT}"/></joint>')
+    half = WHEEL_SEPARATION / 2
+    return textwrap.dedent(f'''\
+        <?xml version="1.0"?>
+        <robot name="{name}">
+          {world}
+          <link name="base_link">
+            <inertial><mass value="3.0"/>
+              <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.03"/></inertial>
+            <collision><geometry><box size="0.3 0.2 0.04"/></geometry></collision>
+          </link>
+          {_wheel('left', half)}
+          {_wheel('right', -half)}
+          <joint name="caster_joint" type="fixed">
+            <parent link="base_link"/><child link="caster"/>
+            <origin xyz="-0.1 0 -{REST_HEIGHT - CASTER_RADIUS}"/>
+          </joint>
+          <link name="caster">
+            <inertial><mass value="0.1"/>
+              <inertia ixx="0.00003" ixy="0" ixz="0" iyy="0.00003" iyz="0" izz="0.00003"/>
+            </inertial>
+            <collision><geometry><sphere radius="{CASTER_RADIUS}"/></geometry></collision>
+          </link>
+          <gazebo reference="caster"><mu1>0.0</mu1><mu2>0.0</mu2></gazebo>
+          <gazebo reference="left_wheel"><mu1>1.0</mu1><mu2>1.0</mu2></gazebo>
+          <ros2_control name="rover" type="system">
+            <hardware><plugin>gz_ros2_control/GazeboSimSystem</plugin></hardware>
+            <joint name="left_wheel_joint"><command_interface name="velocity"/>
+              <state_interface name="position"/><state_interface name="velocity"/></joint>
+            <joint name="right_wheel_joint"><command_interface name="velocity"/>
+              <state_interface name="position"/><state_interface name="velocity"/></joint>
+          </ros2_control>
+        </robot>
+        ''').lstrip()
+
+
+def drive_parameters(**overrides: Any) -> dict[str, Any]:
+    """Return the diff drive controller's parameters for the rover, with ``overrides``."""
+    params: dict[str, Any] = {
+        'left_wheel_names': ['left_wheel_joint'], 'right_wheel_names': ['right_wheel_joint'],
+        'wheel_separation': WHEEL_SEPARATION, 'wheel_radius': WHEEL_RADIUS}
+    params.update(overrides)
+    return params
+
+
+def rover_controllers(drive: Mapping[str, Any] | None = None, update_rate: int = 100) -> str:
+    """Return a ros2_control-style controllers file: broadcaster and ``base_controller``."""
+    return yaml.safe_dump({
+        'controller_manager': {'ros__parameters': {
+            'update_rate': update_rate,
+            'joint_state_broadcaster': {'type': 'joint_state_broadcaster/JointStateBroadcaster'},
+            CONTROLLER: {'type': DIFF_DRIVE}}},
+        CONTROLLER: {'ros__parameters': dict(drive if drive is not None else drive_parameters())},
+    })
+
+
+def write_rover(directory: pathlib.Path, drive: Mapping[str, Any] | None = None,
+                **urdf: Any) -> tuple[pathlib.Path, pathlib.Path]:
+    """Write the rover's URDF and controllers file into ``directory``; return both paths."""
+    description = directory / 'rover.urdf'
+    description.write_text(rover_urdf(**urdf), encoding='utf-8')
+    controllers = directory / 'rover_controllers.yaml'
+    controllers.write_text(rover_controllers(drive), encoding='utf-8')
+    return description, controllers
