@@ -33,7 +33,7 @@ import yaml
 from node_harness import sim_node
 
 from pan_tilt_sim.controllers.registry import CONTROLLER_CLASSES
-from pan_tilt_sim.controllers.surface import CommandTopic
+from pan_tilt_sim.controllers.surface import CommandTopic, StateTopic
 from pan_tilt_sim.ros.sim_node import NODE_NAME
 from pan_tilt_sim.share import package_share
 from pan_tilt_sim.tools.controller_reference import example_controller
@@ -280,13 +280,18 @@ class Setup:
 
 
 def ros_parameters(command: Command, words: tuple[str, ...]) -> Setup:
-    """The ``-p name:=value`` pairs after ``--ros-args``; other ROS arguments are refused."""
+    """The ``-p name:=value`` pairs after ``--ros-args``; ``-r`` remaps are checked for form."""
     if not words:
         return Setup()
     assert words[0] == '--ros-args', f'{command.where}: expected --ros-args, got {words[0]}'
     pairs, rest = [], list(words[1:])
     while rest:
         flag = rest.pop(0)
+        if flag == '-r' and rest:  # a remap: a topic of the node's to a name of the user's
+            source, separator, target = rest.pop(0).partition(':=')
+            assert separator and source.startswith('/') and target.startswith('/'), (
+                f'{command.where}: -r {source} is not /from:=/to')
+            continue
         assert flag == '-p' and rest, f'{command.where}: unchecked ROS argument {flag}'
         name, separator, value = rest.pop(0).partition(':=')
         assert separator, f'{command.where}: -p {name} has no :='
@@ -341,12 +346,12 @@ def check_setup(command: Command, setup: Setup) -> None:
         started(setup)  # raises the one-line ConfigurationError where it does not start
 
 
-def command_topic_types() -> dict[str, set[str]]:
-    """Command topic (last name part) -> message types, over every controller type's surface."""
+def command_topic_types(kind: type = CommandTopic) -> dict[str, set[str]]:
+    """Topic (last name part) -> message types of every controller type's ``kind`` of topic."""
     table: dict[str, set[str]] = {}
     for cls in CONTROLLER_CLASSES:
         for endpoint in example_controller(cls).ros_surface():
-            if isinstance(endpoint, CommandTopic):
+            if isinstance(endpoint, kind):
                 table.setdefault(endpoint.name.rpartition('/')[2], set()).add(endpoint.message)
     return table
 
@@ -399,7 +404,8 @@ def check_topic_pub(command: Command, setup: Setup, topic: str, type_name: str,
 def check_topic_echo(command: Command, setup: Setup, topic: str) -> None:
     """sim_node publishes the topic in this set-up."""
     if setup.external():
-        assert topic.endswith('/joint_states'), f'{command.where}: unchecked topic {topic}'
+        assert topic.rpartition('/')[2] in command_topic_types(StateTopic), \
+            f'{command.where}: no controller type publishes {topic}'
     else:
         assert topic in started(setup).publishers, \
             f'{command.where}: sim_node ({setup.parameters}) does not publish {topic}'
@@ -560,7 +566,13 @@ def check_ros2(command: Command, setup: Setup, words: tuple[str, ...],
                 assert pathlib.Path(value).is_file(), f'{command.where}: no {value}'
         return setup
     if words[:2] == ('topic', 'pub'):
-        arguments = [word for word in words[2:] if not word.startswith('--')]
+        arguments, rest = [], list(words[2:])
+        while rest:  # ros2 topic pub's options, those with a value first
+            word = rest.pop(0)
+            if word in ('-r', '--rate', '-t', '--times', '-w', '--wait-matching-subscriptions'):
+                rest.pop(0)
+            elif not word.startswith('-'):
+                arguments.append(word)
         topic, type_name, data = arguments
         check_topic_pub(command, setup, topic, type_name, data)
         return setup
