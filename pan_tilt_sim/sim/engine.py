@@ -12,7 +12,10 @@ business; the active ones say how each of their joints is driven
 (:meth:`~pan_tilt_sim.controllers.base.Controller.actuators`), and a joint no
 active controller claims is passive -- it keeps the last effort applied.
 
-At start-up the simulation says, through the logger it is given, which
+A robot PyBullet cannot integrate -- whose joint states are not finite within
+the first steps with no effort -- ends start-up
+(:func:`~pan_tilt_sim.sim.stability.check_startup_stability`).  Otherwise, at
+start-up the simulation says, through the logger it is given, which
 actuator drives each joint and why, where each joint starts, what PyBullet
 said while loading the robot, and which PID gains are too high for their
 joint's inertia at this time step (:mod:`pan_tilt_sim.sim.stability`).
@@ -44,7 +47,7 @@ from pan_tilt_sim.sim.physics import (
     Physics,
     health_problem,
 )
-from pan_tilt_sim.sim.stability import pid_stability_warnings
+from pan_tilt_sim.sim.stability import check_startup_stability, pid_stability_warnings
 
 LOGGER_NAME = 'pan_tilt_sim'
 # A joint this close to PyBullet's speed cap is riding it.
@@ -94,6 +97,7 @@ class Simulation:
             initial_positions=[starts[joint].position for joint in movable],
             warn=load_messages.append)
         try:
+            check_startup_stability(self.physics, description)
             gain = description.model.position_proportional_gain or TRACKING_GAIN
             self.handles = {
                 joint.name: JointHandle(joint, position, gains.get(joint.name), gain)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from entity_fixtures import RIG_CONTROLLERS, RIG_URDF, box_urdf, write_box
+from entity_fixtures import RIG_CONTROLLERS, RIG_URDF, UNSPAWNABLE, box_urdf, write_box
 
 from pan_tilt_sim.engine import make_simulation
 from pan_tilt_sim.model.transforms import Transform
@@ -254,6 +254,33 @@ def test_a_world_file_entry_that_cannot_be_spawned_names_the_file_and_entry(seed
                              .entities), tmp_path / 'w.yaml')
     with pytest.raises(WorldFileError, match=r"w.yaml: entities\[0\] \('a'\): .*not well-formed"):
         spawn_world_objects(entities, world)
+
+
+@pytest.mark.parametrize('case', list(UNSPAWNABLE))
+def test_an_object_pybullet_would_crash_on_is_refused_and_the_world_goes_on(seed, case):
+    simulation, entities = seed
+    urdf, expected = UNSPAWNABLE[case]
+    before = entities.names()
+    with pytest.raises(SpawnError) as refused:
+        entities.spawn('thing', resource_string=urdf)
+    assert refused.value.problem is SpawnProblem.RESOURCE_PARSE_ERROR
+    assert expected in str(refused.value)
+    assert '\n' not in str(refused.value)
+    assert entities.names() == before
+    assert entities.spawn('box', resource_string=box_urdf()) == 'box'
+    simulation.advance(100)
+    assert all(math.isfinite(v) for v in simulation.joint_positions().values())
+
+
+def test_a_world_file_object_pybullet_would_crash_on_ends_start_up_naming_it(seed, tmp_path):
+    _simulation, entities = seed
+    urdf, expected = UNSPAWNABLE['two joints with one child']
+    (tmp_path / 'thing.urdf').write_text(urdf)
+    world = read_world_file(_write(tmp_path, 'entities:\n  - uri: thing.urdf\n'))
+    with pytest.raises(WorldFileError) as refused:
+        spawn_world_objects(entities, world)
+    assert str(refused.value).startswith(f'{tmp_path / "w.yaml"}: entities[0]: ')
+    assert expected in str(refused.value)
 
 
 def _write(folder, text):
