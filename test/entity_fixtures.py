@@ -110,3 +110,10 @@ UNSPAWNABLE = {
         _thing(_part('a'), _part('b'), _part('c'), _hinge('j1', 'a', 'b'), _hinge('j1', 'b', 'c')),
         "joint 'j1' is declared twice"),
 }
+
+
+def flail_urdf(reach: float) -> str:
+    """Return an object of two links on a hinge, the second's centre of mass ``reach`` m out."""
+    flail = (f'<link name="flail"><inertial><origin xyz="0 0 {reach!r}"/><mass value="1"/>'
+             '<inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>')
+    return _thing(_part('handle'), flail, _hinge('hinge', 'handle', 'flail'))

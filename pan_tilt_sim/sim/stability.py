@@ -8,7 +8,9 @@ simulation starts, :func:`check_startup_stability` steps the robot
 it was; a joint whose position or velocity is then not finite ends start-up
 with a :class:`~pan_tilt_sim.errors.DescriptionError` naming the joint and
 the likely cause: the number of the description farthest from 1 in
-magnitude, where overflow and underflow come from.
+magnitude, where overflow and underflow come from.  An object to spawn gets
+the same trial, alone in a PyBullet client of its own, before it enters the
+world (:func:`object_trial`).
 
 **The gains.**
 
@@ -31,17 +33,18 @@ warning naming it, the gain and the largest stable value.
 from __future__ import annotations
 
 import math
+import pathlib
 from collections.abc import Sequence
 
 from pan_tilt_sim.controllers.base import ActuatorKind, JointHandle
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.robot import JointKind, RobotModel
-from pan_tilt_sim.sim.physics import STATE_POSITION, STATE_VELOCITY, Physics
+from pan_tilt_sim.sim.bullet import pybullet, quiet_native_output
+from pan_tilt_sim.sim.physics import STANDARD_GRAVITY, STATE_POSITION, STATE_VELOCITY, Physics
 
-# Steps of the start-up trial: a description PyBullet cannot integrate gives
-# non-finite states within the first few; a stable robot pays well under a
-# millisecond of wall time for them.
+# Steps of the start-up trial (a robot's, an object's): a description PyBullet cannot
+# integrate gives non-finite states within the first few.
 STARTUP_TRIAL_STEPS = 200
 
 
@@ -59,17 +62,73 @@ def check_startup_stability(physics: Physics, description: RobotDescription) -> 
               if not (math.isfinite(state[STATE_POSITION])
                       and math.isfinite(state[STATE_VELOCITY]))]
     model = description.model
-    cause, owner = _most_extreme_number(model)
+    cause, owner = most_extreme_number(model)
     order = [joint.name for joint in model.tree_joints if joint.name in broken]
     joint = owner if owner in broken else (order or broken)[0]
-    why = f'; likely cause: {cause}, the most extreme number of the description' if cause else ''
     raise DescriptionError(
         f"{description.source}: joint '{joint}' has a non-finite position or velocity after "
-        f"{steps} physics step{'s' if steps > 1 else ''} with no effort applied: PyBullet "
-        f'cannot integrate this robot{why}')
+        f'{_steps(steps)} with no effort applied: PyBullet cannot integrate this '
+        f'robot{_likely(cause)}')
 
 
-def _most_extreme_number(model: RobotModel) -> tuple[str, str]:
+def object_trial(path: pathlib.Path, fixed: bool, time_step: float,
+                 model: RobotModel) -> str:
+    """Try the object in URDF file ``path`` alone: say what went non-finite, '' if nothing did.
+
+    The object is loaded ``fixed`` to the world or free, with the URDF's
+    inertia, under gravity, into a PyBullet client of its own, and stepped
+    :data:`STARTUP_TRIAL_STEPS` times with its joints passive.  A URDF PyBullet
+    cannot load is not this function's business: the answer is '' and loading
+    it for real says why.
+    """
+    with quiet_native_output():
+        client = pybullet.connect(pybullet.DIRECT)
+    try:
+        pybullet.setGravity(0.0, 0.0, -STANDARD_GRAVITY, physicsClientId=client)
+        pybullet.setTimeStep(time_step, physicsClientId=client)
+        try:
+            with quiet_native_output():
+                body = pybullet.loadURDF(str(path), useFixedBase=fixed,
+                                         flags=pybullet.URDF_USE_INERTIA_FROM_FILE,
+                                         physicsClientId=client)
+        except pybullet.error:
+            return ''
+        joints = list(range(pybullet.getNumJoints(body, physicsClientId=client)))
+        if joints:  # passive: PyBullet's default motors off
+            pybullet.setJointMotorControlArray(body, joints, pybullet.VELOCITY_CONTROL,
+                                               forces=[0.0] * len(joints),
+                                               physicsClientId=client)
+        names = [pybullet.getJointInfo(body, index, physicsClientId=client)[1].decode('utf-8')
+                 for index in joints]
+        for count in range(1, STARTUP_TRIAL_STEPS + 1):
+            pybullet.stepSimulation(physicsClientId=client)
+            position, orientation = pybullet.getBasePositionAndOrientation(
+                body, physicsClientId=client)
+            what = '' if all(math.isfinite(v) for v in (*position, *orientation)) else \
+                'its base pose'
+            if not what and joints:
+                states = pybullet.getJointStates(body, joints, physicsClientId=client)
+                what = next((f"joint '{name}'" for name, state in zip(names, states, strict=True)
+                             if not (math.isfinite(state[STATE_POSITION])
+                                     and math.isfinite(state[STATE_VELOCITY]))), '')
+            if what:
+                cause, _joint = most_extreme_number(model)
+                return (f'{what} is not finite after {_steps(count)} alone, with no effort '
+                        f'applied: PyBullet cannot integrate this object{_likely(cause)}')
+        return ''
+    finally:
+        pybullet.disconnect(physicsClientId=client)
+
+
+def _steps(count: int) -> str:
+    return f"{count} physics step{'s' if count > 1 else ''}"
+
+
+def _likely(cause: str) -> str:
+    return f'; likely cause: {cause}, the most extreme number of the description' if cause else ''
+
+
+def most_extreme_number(model: RobotModel) -> tuple[str, str]:
     """Return the description's number farthest from 1 in magnitude, and the joint it moves.
 
     The number as ``<element> value`` with its owner; the joint is the
