@@ -13,8 +13,9 @@ does with each):
 
 * **A tree**: unique link and joint names, one root link, each other link
   the child of exactly one joint, no joint whose parent is its own child,
-  no cycle.  PyBullet's importer follows parent links without checking and
-  crashes (segmentation fault, or a double free) on every one of these.
+  no cycle.  PyBullet's importer follows the joints without checking: it
+  crashes (a segmentation fault) on most of these, and on a cycle its root
+  does not reach it silently loads a robot without the cycle's links.
 * **Names** of the robot, its links and joints of at most
   :data:`MAX_NAME_BYTES` bytes in UTF-8: PyBullet hands them out in
   1024-byte buffers with their terminating NUL, and a longer one overruns
