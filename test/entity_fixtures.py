@@ -68,3 +68,52 @@ RIG_CONTROLLERS = """rig:
   spin_effort: {type: effort_controllers/JointEffortController, joint: spin}
   lift_effort: {type: effort_controllers/JointEffortController, joint: lift}
 """
+
+
+def _part(name: str) -> str:
+    return (f'<link name="{name}"><inertial><mass value="0.5"/><inertia ixx="0.001" ixy="0" '
+            'ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial>'
+            '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>')
+
+
+def _hinge(name: str, parent: str, child: str) -> str:
+    return (f'<joint name="{name}" type="revolute"><parent link="{parent}"/>'
+            f'<child link="{child}"/><origin xyz="0 0 0.1"/><axis xyz="0 1 0"/>'
+            '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>')
+
+
+def _thing(*parts: str) -> str:
+    return '<?xml version="1.0"?>\n<robot name="thing">\n' + '\n'.join(parts) + '\n</robot>\n'
+
+
+# Objects PyBullet crashes on (segmentation fault or double free), with a part of the one
+# line the parser refuses each with instead.
+UNSPAWNABLE = {
+    'a name of 2000 characters': (
+        _thing(_part('a'), _part('b'), _hinge('j' * 2000, 'a', 'b')),
+        'the name is 2000 bytes long'),
+    'two joints with one child': (
+        _thing(_part('a'), _part('b'), _part('c'), _hinge('j1', 'a', 'b'), _hinge('j2', 'a', 'c'),
+               _hinge('j3', 'b', 'c')),
+        "link 'c' is the child of two joints, 'j2' and 'j3'"),
+    'a cycle off the root': (
+        _thing(_part('a'), _part('b'), _part('c'), _hinge('j1', 'a', 'b'), _hinge('j2', 'b', 'c'),
+               _hinge('j3', 'c', 'b')),
+        "link 'b' is the child of two joints, 'j1' and 'j3'"),
+    'a cycle through the root and an orphan link': (
+        _thing(_part('a'), _part('b'), _part('c'), _hinge('j1', 'a', 'b'), _hinge('j2', 'b', 'a')),
+        "joints 'j2', 'j1' form a cycle"),
+    'a joint whose parent is its child': (
+        _thing(_part('a'), _part('b'), _hinge('j1', 'a', 'b'), _hinge('j2', 'b', 'b')),
+        "joint 'j2': link 'b' is both its parent and its child"),
+    'the same joint twice': (
+        _thing(_part('a'), _part('b'), _part('c'), _hinge('j1', 'a', 'b'), _hinge('j1', 'b', 'c')),
+        "joint 'j1' is declared twice"),
+}
+
+
+def flail_urdf(reach: float) -> str:
+    """Return an object of two links on a hinge, the second's centre of mass ``reach`` m out."""
+    flail = (f'<link name="flail"><inertial><origin xyz="0 0 {reach!r}"/><mass value="1"/>'
+             '<inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>')
+    return _thing(_part('handle'), flail, _hinge('hinge', 'handle', 'flail'))

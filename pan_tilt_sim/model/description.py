@@ -40,8 +40,8 @@ class RobotDescription:
     ``urdf_xml`` is the URDF as the user wrote it (xacro's output, meshes
     still ``package://...``): what robot_description publishes and
     robot_state_publisher and RViz read.  ``physics_urdf`` is PyBullet's
-    copy, whose meshes point at loadable local files and whose massless
-    links say so.
+    copy, whose meshes point at loadable local files, whose massless
+    links say so and whose joint axes are unit vectors.
     """
 
     model: RobotModel
@@ -173,8 +173,9 @@ def physics_copy(root: ElementTree.Element, model: RobotModel, base_dir: pathlib
                  source: pathlib.Path) -> tuple[str, tuple[str, ...]]:
     """Turn the parsed tree into PyBullet's copy; return its text and what had to change.
 
-    Every mesh made loadable (relative ones taken from ``base_dir``) and every
-    massless link explicit; errors name ``source``.  Also used for the
+    Every mesh made loadable (relative ones taken from ``base_dir``), every
+    massless link explicit and every moving joint's axis a unit vector; errors
+    name ``source``.  Also used for the
     objects spawned into the world (:mod:`pan_tilt_sim.model.entity_resource`).
     """
     try:
@@ -182,10 +183,25 @@ def physics_copy(root: ElementTree.Element, model: RobotModel, base_dir: pathlib
     except DescriptionError as err:
         raise DescriptionError(f'{source}: {err}') from None
     warnings = complete_inertials(root, model)
+    unit_axes(root, model)
     # One element per line: PyBullet's reader fails on some long one-line files
     # ("Cannot load URDF file."), which minified URDFs would be.
     ElementTree.indent(root)
     return ElementTree.tostring(root, encoding='unicode'), warnings
+
+
+def unit_axes(root: ElementTree.Element, model: RobotModel) -> None:
+    """Write each moving joint's axis into PyBullet's copy (``root``) as the model's unit vector.
+
+    URDF means the axis as a direction; PyBullet would take its length too
+    (see :mod:`pan_tilt_sim.model.urdf`).  Joints without ``<axis>`` keep
+    URDF's default, a unit vector already.
+    """
+    for element in root.findall('joint'):
+        axis = element.find('axis')
+        joint = model.joint(element.get('name', ''))
+        if axis is not None and joint.kind.is_actuated:
+            axis.set('xyz', ' '.join(repr(value) for value in joint.axis))
 
 
 def mesh_cache_dir() -> pathlib.Path:

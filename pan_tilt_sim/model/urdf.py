@@ -5,6 +5,44 @@ error policy: anything malformed that the simulator would use -- a number,
 a vector, a joint type, a link a joint names -- ends start-up with a
 :class:`~pan_tilt_sim.errors.DescriptionError` naming the file, the element
 and the attribute.  Elements the simulator does not use are not checked.
+
+The robot, every spawned object and every world file's object is read here
+before PyBullet sees it, and nothing PyBullet crashes on or cannot integrate
+gets through (test/dependencies/test_pybullet_limits.py shows what PyBullet
+does with each):
+
+* **A tree**: unique link and joint names, one root link, each other link
+  the child of exactly one joint, no joint whose parent is its own child,
+  no cycle.  PyBullet's importer follows the joints without checking: it
+  crashes (a segmentation fault) on most of these, and on a cycle its root
+  does not reach it silently loads a robot without the cycle's links.
+* **Names** of the robot, its links and joints of at most
+  :data:`MAX_NAME_BYTES` bytes in UTF-8: PyBullet hands them out in
+  1024-byte buffers with their terminating NUL, and a longer one overruns
+  them -- the name comes back wrong or the process dies.
+* **Joint types PyBullet simulates**: revolute, continuous, prismatic and
+  fixed.  A ``floating`` joint PyBullet silently makes fixed; a ``planar``
+  one it moves in three degrees of freedom that it reports as no joint
+  state, and its mass matrix and inverse dynamics (which the start-up
+  checks and the damping use) have no planar joints.
+* **Axes with a direction**: a moving joint's ``<axis>`` must be longer than
+  :data:`MIN_AXIS_LENGTH` (SDFormat's test for a zero axis) and is
+  normalized, as URDF, KDL and Gazebo take it.  PyBullet would not
+  normalize it: a revolute joint then moves with the wrong dynamics and a
+  prismatic one reports its position in units of the axis length; a zero
+  axis makes every state NaN at the first step.
+* **Masses and inertias** finite, masses >= 0 (0: a massless frame) and at
+  most :data:`MAX_MASS`, every inertia component at most
+  :data:`MAX_INERTIA` in magnitude.  A negative mass breaks PyBullet's mass
+  matrix; gravity on a mass near 1e308 kg overflows to infinity and every
+  state is NaN.  The bounds are physical -- a thousand tonnes, and that mass
+  ten metres from its centre of mass, beyond any robot link or object a
+  robot handles -- and far inside where PyBullet fails: its ground contact
+  stops holding a body some orders of magnitude heavier (the body sinks
+  through the plane).  An inertia tensor that is no rigid body's (a negative
+  principal moment, one larger than the other two together) is PyBullet's
+  business: it sets the link's inertia to zero and says so, which start-up
+  logs as a warning.
 """
 
 from __future__ import annotations
@@ -65,6 +103,21 @@ GAZEBO_ROS_CONTROL_PLUGINS = ('libgazebo_ros_control.so', 'libgazebo_ros2_contro
 POSITION = 'position'
 INERTIA_FIELDS = ('ixx', 'ixy', 'ixz', 'iyy', 'iyz', 'izz')
 SHAPE_ROLES = ('visual', 'collision')
+# PyBullet's name buffers (b3JointInfo, b3BodyInfo) hold 1024 bytes with the NUL.
+MAX_NAME_BYTES = 1023
+# An axis no longer than this has no direction (SDFormat's zero test, sdf::equal's epsilon).
+MIN_AXIS_LENGTH = 1e-6
+MAX_MASS = 1e6  # kg: a thousand tonnes
+MAX_INERTIA = MAX_MASS * 10.0 ** 2  # kg m^2: that mass 10 m from its centre of mass
+SHOWN_NAME_CHARS = 40  # a longer name is shortened in messages
+# URDF joint types PyBullet does not simulate as the URDF means them, and why.
+UNSIMULATED_KINDS = {
+    JointKind.PLANAR: 'PyBullet moves it in three degrees of freedom that no joint state '
+                      'reports, and its mass matrix has no planar joints (two prismatic joints '
+                      'and a revolute one can stand in for it)',
+    JointKind.FLOATING: 'PyBullet would silently make it fixed (declare it fixed if that is '
+                        'what it is; a free body is an object of its own)',
+}
 
 
 def parse_xml(urdf_xml: str, source: pathlib.Path) -> ElementTree.Element:
@@ -83,8 +136,12 @@ def parse_xml(urdf_xml: str, source: pathlib.Path) -> ElementTree.Element:
 def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
     """Build the robot model from a parsed ``<robot>`` element."""
     reader = _Reader(source)
+    name = root.get('name', '')
+    _check_name_length(name, f'<robot name="{shown(name)}">', source)
     links = tuple(reader.link(element) for element in root.findall('link'))
     joints = tuple(reader.joint(element) for element in root.findall('joint'))
+    _check_unique('link', [link.name for link in links], source)
+    _check_unique('joint', [joint.name for joint in joints], source)
     link_names = {link.name for link in links}
     joint_names = {joint.name for joint in joints}
     for joint in joints:
@@ -97,13 +154,7 @@ def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
             raise DescriptionError(
                 f"{source}: joint '{joint.name}' mimics '{joint.mimic.joint}', "
                 'which is not a joint of this robot')
-    children = {joint.child for joint in joints}
-    roots = [link.name for link in links if link.name not in children]
-    if len(roots) > 1:
-        # urdfdom refuses such a file; PyBullet crashes on it.
-        raise DescriptionError(
-            f"{source}: links {', '.join(repr(root) for root in roots)} are each the child of "
-            'no joint: a URDF must be one tree with one root link')
+    _check_tree(links, joints, source)
     plugins = _control_plugins(root)
     for plugin in plugins:
         namespace = plugin.namespace
@@ -120,10 +171,96 @@ def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
                     'not a joint of this robot')
     _check_position_gain(plugins, systems, source)
     sensors, sensor_warnings = _SensorReader(source, links, joints).read(root)
-    return RobotModel(name=root.get('name', ''), links=links, joints=joints,
+    return RobotModel(name=name, links=links, joints=joints,
                       ros2_control=systems, control_plugins=plugins,
                       sensors=sensors, sensor_warnings=sensor_warnings,
                       surfaces=read_surfaces(root, source, link_names))
+
+
+def shown(name: str) -> str:
+    """Return ``name`` as messages show it: shortened when it is long."""
+    if len(name) <= SHOWN_NAME_CHARS:
+        return name
+    return name[:SHOWN_NAME_CHARS] + '...'
+
+
+def inertial_beyond_bounds(inertial: Inertial) -> str:
+    """Say what of ``inertial`` lies beyond the parser's bounds ('' if nothing).
+
+    For inertials made after parsing (a physical variation's): PyBullet gets
+    nothing the parser would refuse.
+    """
+    if not 0.0 <= inertial.mass <= MAX_MASS:
+        return f'mass {inertial.mass:g} kg is beyond 0 to {MAX_MASS:g} kg'
+    for field in INERTIA_FIELDS:
+        value = getattr(inertial, field)
+        if not abs(value) <= MAX_INERTIA:
+            return f'inertia {field} {value:g} kg*m^2 is beyond {MAX_INERTIA:g} in magnitude'
+    return ''
+
+
+def _check_name_length(name: str, owner: str, source: pathlib.Path) -> None:
+    """Refuse a name longer than PyBullet's buffers take: MAX_NAME_BYTES bytes in UTF-8."""
+    size = len(name.encode('utf-8'))
+    if size > MAX_NAME_BYTES:
+        raise DescriptionError(
+            f'{source}: {owner}: the name is {size} bytes long; PyBullet takes names of at '
+            f'most {MAX_NAME_BYTES} bytes (UTF-8)')
+
+
+def _check_unique(kind: str, names: list[str], source: pathlib.Path) -> None:
+    seen: set[str] = set()
+    for name in names:
+        if name in seen:
+            raise DescriptionError(
+                f"{source}: {kind} '{name}' is declared twice: {kind} names must be unique")
+        seen.add(name)
+
+
+def _check_tree(links: tuple[Link, ...], joints: tuple[JointSpec, ...],
+                source: pathlib.Path) -> None:
+    """Refuse joints that make the links anything but one tree: one root, one parent each.
+
+    urdfdom refuses every other shape; PyBullet crashes on them or silently drops links.
+    """
+    parent_joint: dict[str, JointSpec] = {}
+    for joint in joints:
+        if joint.parent == joint.child:
+            raise DescriptionError(
+                f"{source}: joint '{joint.name}': link '{joint.child}' is both its parent and "
+                'its child: a URDF must be a tree')
+        other = parent_joint.get(joint.child)
+        if other is not None:
+            raise DescriptionError(
+                f"{source}: link '{joint.child}' is the child of two joints, '{other.name}' and "
+                f"'{joint.name}': in a URDF tree each link has one parent")
+        parent_joint[joint.child] = joint
+    roots = [link.name for link in links if link.name not in parent_joint]
+    if len(roots) > 1:
+        raise DescriptionError(
+            f"{source}: links {', '.join(repr(root) for root in roots)} are each the child of "
+            'no joint: a URDF must be one tree with one root link')
+    children: dict[str, list[str]] = {}
+    for joint in joints:
+        children.setdefault(joint.parent, []).append(joint.child)
+    reached, pending = set(roots), list(roots)
+    while pending:
+        for child in children.get(pending.pop(), ()):
+            reached.add(child)
+            pending.append(child)
+    stranded = [link.name for link in links if link.name not in reached]
+    if not stranded:
+        return
+    # Each stranded link has a parent that is stranded too: going up, one comes back.
+    path, link = [], stranded[0]
+    while link not in path:
+        path.append(link)
+        link = parent_joint[link].parent
+    cycle = list(reversed(path[path.index(link):]))  # parents before children
+    names = ', '.join(f"'{parent_joint[child].name}'" for child in [*cycle[1:], cycle[0]])
+    route = ' -> '.join([*cycle, cycle[0]])
+    raise DescriptionError(
+        f'{source}: joints {names} form a cycle ({route}): a URDF must be a tree')
 
 
 def _check_position_gain(plugins: tuple[ControlPlugin, ...], systems: tuple[ControlSystem, ...],
@@ -196,6 +333,7 @@ class _Reader:
         name = element.get('name')
         if not name:
             raise DescriptionError(f'{self.source}: a <link> has no name')
+        _check_name_length(name, f"link '{shown(name)}'", self.source)
         owner = f"link '{name}'"
         inertial = element.find('inertial')
         shapes = {role: tuple(filter(None, (self.shape(child, owner)
@@ -206,12 +344,25 @@ class _Reader:
                     visuals=shapes['visual'], collisions=shapes['collision'])
 
     def inertial(self, element: ElementTree.Element, owner: str) -> Inertial:
-        mass = element.find('mass')
+        mass_element = element.find('mass')
         inertia = element.find('inertia')
         values = {field: 0.0 if inertia is None else self.number(inertia, field, 0.0, owner)
                   for field in INERTIA_FIELDS}
-        return Inertial(mass=0.0 if mass is None else self.number(mass, 'value', 0.0, owner),
-                        origin=self.origin(element.find('origin'), owner), **values)
+        mass = 0.0 if mass_element is None else self.number(mass_element, 'value', 0.0, owner)
+        if mass_element is not None:
+            written = f'<mass value="{mass_element.get("value")}">'
+            if mass < 0.0:
+                raise self.error(owner, f'{written} must be >= 0 kg (0: a massless link)')
+            if mass > MAX_MASS:
+                raise self.error(owner, f'{written} is above {MAX_MASS:g} kg, the heaviest link '
+                                 'simulated (a unit mistake?)')
+        for field, value in values.items():
+            if abs(value) > MAX_INERTIA:
+                raise self.error(
+                    owner, f'<inertia {field}="{inertia.get(field)}"> is beyond '
+                    f'{MAX_INERTIA:g} kg*m^2 in magnitude, the largest inertia simulated '
+                    '(a unit mistake?)')
+        return Inertial(mass=mass, origin=self.origin(element.find('origin'), owner), **values)
 
     def shape(self, element: ElementTree.Element, owner: str) -> Shape | None:
         geometry = element.find('geometry')
@@ -269,6 +420,7 @@ class _Reader:
         name = element.get('name')
         if not name:
             raise DescriptionError(f'{self.source}: a <joint> has no name')
+        _check_name_length(name, f"joint '{shown(name)}'", self.source)
         owner = f"joint '{name}'"
         type_name = element.get('type', '')
         try:
@@ -276,6 +428,9 @@ class _Reader:
         except ValueError:
             raise DescriptionError(
                 f"{self.source}: joint '{name}' has unknown type '{type_name}'") from None
+        if kind in UNSIMULATED_KINDS:
+            raise self.error(owner, f'type {kind.value} is not simulated: '
+                             f'{UNSIMULATED_KINDS[kind]}')
         parent = element.find('parent')
         child = element.find('child')
         if parent is None or child is None or not parent.get('link') or not child.get('link'):
@@ -299,10 +454,17 @@ class _Reader:
                 joint=mimic.get('joint', ''),
                 multiplier=self.number(mimic, 'multiplier', 1.0, owner),
                 offset=self.number(mimic, 'offset', 0.0, owner))
+        axis = self.vector(element.find('axis'), 'xyz', DEFAULT_AXIS, owner)
+        if kind.is_actuated:
+            length = math.hypot(*axis)
+            if length <= MIN_AXIS_LENGTH:
+                raise self.error(
+                    owner, f'<axis xyz="{element.find("axis").get("xyz")}"> has no direction: '
+                    f'a {kind.value} joint needs an axis longer than {MIN_AXIS_LENGTH:g}')
+            axis = (axis[0] / length, axis[1] / length, axis[2] / length)
         return JointSpec(name=name, kind=kind, parent=parent.get('link', ''),
                          child=child.get('link', ''),
-                         origin=self.origin(element.find('origin'), owner),
-                         axis=self.vector(element.find('axis'), 'xyz', DEFAULT_AXIS, owner),
+                         origin=self.origin(element.find('origin'), owner), axis=axis,
                          **fields)
 
 

@@ -16,6 +16,9 @@ the variation:
   body (mass added, centre of mass moved, inertia by the parallel-axis
   theorem), expressed in the link frame.
 
+A variation that takes a link beyond the parser's bounds on mass and inertia
+(:mod:`pan_tilt_sim.model.urdf`) is refused, as the parser would refuse it.
+
 A link without ``<inertial>`` has no mass to scale (PyBullet then applies
 its own default); a payload on it becomes its whole inertial.  The URDF as
 the user wrote it (``urdf_xml``, what robot_description publishes) is kept.
@@ -31,6 +34,7 @@ from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.robot import Inertial, JointSpec, Link
 from pan_tilt_sim.model.transforms import ZERO_VECTOR, Transform, Vector, rotation_matrix
+from pan_tilt_sim.model.urdf import inertial_beyond_bounds
 
 INERTIA_FIELDS = ('ixx', 'ixy', 'ixz', 'iyy', 'iyz', 'izz')
 PAYLOAD_RADIUS_M = 0.01  # the payload is a solid sphere this big
@@ -92,6 +96,11 @@ def vary_description(description: RobotDescription,
             f"{description.source}: payload link '{payload.link}' is not a link of the robot "
             f"(links: {', '.join(model.link_names)})")
     links = tuple(_vary_link(link, variation) for link in model.links)
+    for link in links:
+        problem = '' if link.inertial is None else inertial_beyond_bounds(link.inertial)
+        if problem:
+            raise DescriptionError(f"{description.source}: the variation makes link "
+                                   f"'{link.name}': {problem}")
     joints = tuple(_vary_joint(joint, variation) for joint in model.joints)
     root = ElementTree.fromstring(description.physics_urdf)
     for link, element in zip(links, _children(root, 'link', model.link_names), strict=True):

@@ -16,10 +16,13 @@ The robot's base is welded to the world unless it is mobile (see
 :func:`base_is_fixed` and :mod:`pan_tilt_sim.model.base_pose`); a free base
 starts resting on the ground and a reset puts it back there.
 
-At start-up the simulation says, through the logger it is given, whether
-the base is free and why, which actuator drives each joint and why, where
-each joint starts, what PyBullet said while loading the robot, and which
-PID gains are too high for their joint's inertia at this time step
+A robot PyBullet cannot integrate -- whose joint states are not finite within
+the first steps with no effort -- ends start-up
+(:func:`~pan_tilt_sim.sim.stability.check_startup_stability`).  Otherwise, at
+start-up the simulation says, through the logger it is given, whether the
+base is free and why, which actuator drives each joint and why, where each
+joint starts, what PyBullet said while loading the robot, and which PID
+gains are too high for their joint's inertia at this time step
 (:mod:`pan_tilt_sim.sim.stability`).
 While running, a joint at PyBullet's speed cap or with a non-finite state
 gets a warning (at most one per joint per second).
@@ -51,7 +54,7 @@ from pan_tilt_sim.sim.physics import (
     Physics,
     health_problem,
 )
-from pan_tilt_sim.sim.stability import pid_stability_warnings
+from pan_tilt_sim.sim.stability import check_startup_stability, pid_stability_warnings
 
 LOGGER_NAME = 'pan_tilt_sim'
 # A joint this close to PyBullet's speed cap is riding it.
@@ -133,6 +136,7 @@ class Simulation:
             warn=load_messages.append, fixed_base=fixed, initial_pose=initial_pose)
         self._base_report = self._describe_base(why, fixed_base, initial_pose)
         try:
+            check_startup_stability(self.physics, description)
             model = description.model
             gain = model.position_proportional_gain or TRACKING_GAIN
             self.handles = {

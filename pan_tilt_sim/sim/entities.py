@@ -30,7 +30,10 @@ margin), over all links.
 
 Spawning checks everything before PyBullet is touched, so a refused request
 leaves the simulation as it was; :class:`SpawnError` says which of the
-standard's result codes applies (:class:`SpawnProblem`).
+standard's result codes applies (:class:`SpawnProblem`).  An object is tried
+alone in a PyBullet client of its own first
+(:func:`~pan_tilt_sim.sim.stability.object_trial`): one whose state is not
+finite within the first steps never enters the world (RESOURCE_PARSE_ERROR).
 """
 
 from __future__ import annotations
@@ -55,6 +58,7 @@ from pan_tilt_sim.model.transforms import IDENTITY_ROTATION, ZERO_VECTOR, Transf
 from pan_tilt_sim.model.world_file import World, WorldFileError
 from pan_tilt_sim.sim.bullet import pybullet, quiet_native_output
 from pan_tilt_sim.sim.physics import BASE_LINK_INDEX, Physics
+from pan_tilt_sim.sim.stability import object_trial
 from pan_tilt_sim.sim.world import add_ground_plane, grounded_links
 
 WORLD_FRAMES = ('', 'world')  # frame ids that mean the world frame
@@ -442,6 +446,9 @@ class Entities:
         fixed = is_static(resource)
         client = self._client
         try:
+            problem = object_trial(path, fixed, self._physics.time_step, resource.model)
+            if problem:
+                raise SpawnError(SpawnProblem.RESOURCE_PARSE_ERROR, f'{resource.source}: {problem}')
             with quiet_native_output():
                 body = pybullet.loadURDF(
                     str(path), pose.translation, pose.rotation, useFixedBase=fixed,

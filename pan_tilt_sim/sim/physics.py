@@ -437,6 +437,29 @@ class Physics:
                 self._body, index, position, targetVelocity=0.0, physicsClientId=self._client)
         self._drives.restart()
 
+    def trial(self, steps: int) -> tuple[int, list] | None:
+        """Step ``steps`` times with no effort applied, then put everything back as it was.
+
+        Return the number of steps taken and the states (as :meth:`read_states`)
+        at the first step that left a joint with a non-finite position or
+        velocity; None if no step did.  The joints' motors stay as they are
+        (URDF friction, no effort); PyBullet's saveState and restoreState put
+        the world back, so what follows runs as if there had been no trial.
+        """
+        client, body, indices = self._client, self._body, self._indices
+        saved = pybullet.saveState(physicsClientId=client)
+        try:
+            for count in range(1, steps + 1):
+                pybullet.stepSimulation(physicsClientId=client)
+                states = pybullet.getJointStates(body, indices, physicsClientId=client)
+                if not all(math.isfinite(state[STATE_POSITION])
+                           and math.isfinite(state[STATE_VELOCITY]) for state in states):
+                    return count, list(states)
+            return None
+        finally:
+            pybullet.restoreState(stateId=saved, physicsClientId=client)
+            pybullet.removeState(saved, physicsClientId=client)
+
     def effective_inertias(self, positions: Sequence[float] | None = None) -> list[float]:
         """Return each joint's effective inertia at ``positions`` (default: as it is now).
 

@@ -1,4 +1,18 @@
-"""Start-up check: is each PID stable for its joint's inertia at this time step.
+"""Start-up checks: can PyBullet integrate the robot at all, and is each PID stable.
+
+**The robot.**  The parser refuses what is known to break PyBullet
+(:mod:`pan_tilt_sim.model.urdf`); what is left -- a joint origin so far out
+that its square overflows, say -- shows in the first steps.  Before the
+simulation starts, :func:`check_startup_stability` steps the robot
+:data:`STARTUP_TRIAL_STEPS` times with no effort applied and puts it back as
+it was; a joint whose position or velocity is then not finite ends start-up
+with a :class:`~pan_tilt_sim.errors.DescriptionError` naming the joint and
+the likely cause: the number of the description farthest from 1 in
+magnitude, where overflow and underflow come from.  An object to spawn gets
+the same trial, alone in a PyBullet client of its own, before it enters the
+world (:func:`object_trial`).
+
+**The gains.**
 
 A PID on effort is explicit: PyBullet applies the torque computed from the
 state at the start of the step.  For a position loop ``tau = -p q - d v``
@@ -19,11 +33,148 @@ warning naming it, the gain and the largest stable value.
 from __future__ import annotations
 
 import math
+import pathlib
 from collections.abc import Sequence
 
 from pan_tilt_sim.controllers.base import ActuatorKind, Drive, JointHandle
-from pan_tilt_sim.model.robot import JointKind
-from pan_tilt_sim.sim.physics import Physics
+from pan_tilt_sim.errors import DescriptionError
+from pan_tilt_sim.model.description import RobotDescription
+from pan_tilt_sim.model.robot import JointKind, RobotModel
+from pan_tilt_sim.sim.bullet import pybullet, quiet_native_output
+from pan_tilt_sim.sim.physics import STANDARD_GRAVITY, STATE_POSITION, STATE_VELOCITY, Physics
+
+# Steps of the start-up trial (a robot's, an object's): a description PyBullet cannot
+# integrate gives non-finite states within the first few.
+STARTUP_TRIAL_STEPS = 200
+
+
+def check_startup_stability(physics: Physics, description: RobotDescription) -> None:
+    """Refuse a robot whose joint states are not finite within the first steps without effort.
+
+    Raises :class:`DescriptionError` naming the joint and the likely cause;
+    the simulation is left as it was either way (:meth:`Physics.trial`).
+    """
+    outcome = physics.trial(STARTUP_TRIAL_STEPS)
+    if outcome is None:
+        return
+    steps, states = outcome
+    broken = [joint.name for joint, state in zip(physics.joints, states, strict=True)
+              if not (math.isfinite(state[STATE_POSITION])
+                      and math.isfinite(state[STATE_VELOCITY]))]
+    model = description.model
+    cause, owner = most_extreme_number(model)
+    order = [joint.name for joint in model.tree_joints if joint.name in broken]
+    joint = owner if owner in broken else (order or broken)[0]
+    raise DescriptionError(
+        f"{description.source}: joint '{joint}' has a non-finite position or velocity after "
+        f'{_steps(steps)} with no effort applied: PyBullet cannot integrate this '
+        f'robot{_likely(cause)}')
+
+
+def object_trial(path: pathlib.Path, fixed: bool, time_step: float,
+                 model: RobotModel) -> str:
+    """Try the object in URDF file ``path`` alone: say what went non-finite, '' if nothing did.
+
+    The object is loaded ``fixed`` to the world or free, with the URDF's
+    inertia, under gravity, into a PyBullet client of its own, and stepped
+    :data:`STARTUP_TRIAL_STEPS` times with its joints passive.  A URDF PyBullet
+    cannot load is not this function's business: the answer is '' and loading
+    it for real says why.
+    """
+    with quiet_native_output():
+        client = pybullet.connect(pybullet.DIRECT)
+    try:
+        pybullet.setGravity(0.0, 0.0, -STANDARD_GRAVITY, physicsClientId=client)
+        pybullet.setTimeStep(time_step, physicsClientId=client)
+        try:
+            with quiet_native_output():
+                body = pybullet.loadURDF(str(path), useFixedBase=fixed,
+                                         flags=pybullet.URDF_USE_INERTIA_FROM_FILE,
+                                         physicsClientId=client)
+        except pybullet.error:
+            return ''
+        joints = list(range(pybullet.getNumJoints(body, physicsClientId=client)))
+        if joints:  # passive: PyBullet's default motors off
+            pybullet.setJointMotorControlArray(body, joints, pybullet.VELOCITY_CONTROL,
+                                               forces=[0.0] * len(joints),
+                                               physicsClientId=client)
+        names = [pybullet.getJointInfo(body, index, physicsClientId=client)[1].decode('utf-8')
+                 for index in joints]
+        for count in range(1, STARTUP_TRIAL_STEPS + 1):
+            pybullet.stepSimulation(physicsClientId=client)
+            position, orientation = pybullet.getBasePositionAndOrientation(
+                body, physicsClientId=client)
+            what = '' if all(math.isfinite(v) for v in (*position, *orientation)) else \
+                'its base pose'
+            if not what and joints:
+                states = pybullet.getJointStates(body, joints, physicsClientId=client)
+                what = next((f"joint '{name}'" for name, state in zip(names, states, strict=True)
+                             if not (math.isfinite(state[STATE_POSITION])
+                                     and math.isfinite(state[STATE_VELOCITY]))), '')
+            if what:
+                cause, _joint = most_extreme_number(model)
+                return (f'{what} is not finite after {_steps(count)} alone, with no effort '
+                        f'applied: PyBullet cannot integrate this object{_likely(cause)}')
+        return ''
+    finally:
+        pybullet.disconnect(physicsClientId=client)
+
+
+def _steps(count: int) -> str:
+    return f"{count} physics step{'s' if count > 1 else ''}"
+
+
+def _likely(cause: str) -> str:
+    return f'; likely cause: {cause}, the most extreme number of the description' if cause else ''
+
+
+def most_extreme_number(model: RobotModel) -> tuple[str, str]:
+    """Return the description's number farthest from 1 in magnitude, and the joint it moves.
+
+    The number as ``<element> value`` with its owner; the joint is the
+    nearest movable joint at or above it ('' if there is none).
+    """
+    parent_joint = {joint.child: joint for joint in model.joints}
+
+    def movable_at_or_above(joint_name: str) -> str:
+        joint = model.joint(joint_name)
+        while not joint.kind.is_actuated:
+            above = parent_joint.get(joint.parent)
+            if above is None:
+                return ''
+            joint = above
+        return joint.name
+
+    candidates = []  # (where, value, joint)
+    for link in model.links:
+        inertial = link.inertial
+        above = parent_joint.get(link.name)
+        joint = movable_at_or_above(above.name) if above is not None else ''
+        if inertial is None:
+            continue
+        owner = f"link '{link.name}'"
+        candidates.append((f'{owner} <mass>', inertial.mass, joint))
+        candidates += [(f'{owner} <inertia {field}>', getattr(inertial, field), joint)
+                       for field in ('ixx', 'ixy', 'ixz', 'iyy', 'iyz', 'izz')]
+        candidates += [(f'{owner} <inertial><origin xyz>', value, joint)
+                       for value in inertial.origin.translation]
+    for spec in model.joints:
+        owner, joint = f"joint '{spec.name}'", movable_at_or_above(spec.name)
+        candidates += [(f'{owner} <origin xyz>', value, joint)
+                       for value in spec.origin.translation]
+        candidates += [(f'{owner} <{element}>', getattr(spec, field), joint) for element, field in (
+            ('limit lower', 'lower'), ('limit upper', 'upper'), ('limit effort', 'effort_limit'),
+            ('limit velocity', 'velocity_limit'), ('dynamics damping', 'damping'),
+            ('dynamics friction', 'friction'))]
+        if spec.mimic is not None:
+            candidates += [(f'{owner} <mimic multiplier>', spec.mimic.multiplier, joint),
+                           (f'{owner} <mimic offset>', spec.mimic.offset, joint)]
+    scored = [(abs(math.log10(abs(value))), where, value, joint)
+              for where, value, joint in candidates if value != 0.0 and math.isfinite(value)]
+    if not scored:
+        return '', ''
+    _, where, value, joint = max(scored, key=lambda item: item[0])
+    return f'{where} {value:g}', joint
 
 
 def largest_stable_time_step(p: float, d: float, inertia: float) -> float:

@@ -12,13 +12,14 @@ import sys
 
 import pytest
 import sim_process
-from entity_fixtures import box_urdf
+from entity_fixtures import UNSPAWNABLE, box_urdf
 from node_harness import PROBE_QUEUE, NodeHarness, stamp_s
 from rosgraph_msgs.msg import Clock
-from sim_interfaces_client import OK, SimInterfaces, State, action, pose, position
+from sim_interfaces_client import OK, SimInterfaces, State, action, pose, position, srv
 
 STARTUP_BUDGET_S = 20.0
 EXIT_BUDGET_S = 5.0
+Spawn = srv.SpawnEntity.Response
 
 
 def test_a_paused_program_steps_spawns_and_quits_with_exit_code_0():
@@ -57,6 +58,34 @@ def test_a_paused_program_steps_spawns_and_quits_with_exit_code_0():
     assert process.returncode == 0, stderr
     assert 'Traceback' not in stderr
     assert 'QUITTING' in stderr
+
+
+def test_the_program_refuses_objects_pybullet_would_crash_on_and_goes_on():
+    process = sim_process.start('-p', 'paused:=true', '-p', 'world:=ground')
+    harness = NodeHarness()
+    try:
+        client = SimInterfaces(harness)
+        assert client.state() == State.STATE_STOPPED
+        for case, (urdf, expected) in UNSPAWNABLE.items():
+            refused = client.spawn('thing', resource_string=urdf, at=pose(1.0, 0.0, 0.3))
+            assert refused.result.result == Spawn.RESOURCE_PARSE_ERROR, case
+            assert expected in refused.result.error_message, case
+            assert process.poll() is None, case
+        assert client.spawn('box', resource_string=box_urdf(),
+                            at=pose(1.0, 0.0, 0.3)).result.result == OK
+        assert client.step(100).result == OK
+        assert client.set_state(State.STATE_QUITTING).result == OK
+        try:
+            _stdout, stderr = process.communicate(timeout=EXIT_BUDGET_S)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f'sim_node did not quit within {EXIT_BUDGET_S} s of QUITTING')
+    finally:
+        harness.close()
+        if process.poll() is None:
+            process.kill()
+            process.communicate()
+    assert process.returncode == 0, stderr
+    assert 'Traceback' not in stderr
 
 
 def test_a_bad_world_file_ends_the_program_with_one_line_and_exit_code_2(tmp_path):

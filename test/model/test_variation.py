@@ -128,3 +128,16 @@ def test_an_unknown_payload_link_is_refused(pan_tilt):
 def test_impossible_variations_are_refused(fields):
     with pytest.raises(DescriptionError):
         PhysicalVariation(**fields)
+
+
+@pytest.mark.parametrize(('variation', 'expected'), [
+    (PhysicalVariation(mass_scale=1e9), "link 'base_link': mass"),
+    (PhysicalVariation(inertia_scale=1e12), "link 'base_link': inertia ixx"),
+    (PhysicalVariation(payload=Payload('tilt_link', 2e6)), "link 'tilt_link': mass"),
+])
+def test_a_variation_beyond_what_the_parser_accepts_is_refused(pan_tilt, variation, expected):
+    # PyBullet gets the varied copy: it must stay within the parser's bounds.
+    with pytest.raises(DescriptionError) as refused:
+        vary_description(pan_tilt, variation)
+    assert expected in str(refused.value)
+    assert 'beyond' in str(refused.value)

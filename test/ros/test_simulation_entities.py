@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from entity_fixtures import box_urdf, write_box
+from entity_fixtures import UNSPAWNABLE, box_urdf, write_box
 from geometry_msgs.msg import Twist
 from node_harness import sim_node
 from sim_interfaces_client import OK, Result, SimInterfaces, msg, pose, position, srv
@@ -144,6 +144,18 @@ def test_a_parse_error_is_answered_and_leaves_the_simulation_untouched(sim):
     # The failed attempts took no name: the next renamed spawn is still box_1.
     assert sim.spawn('box', resource_string=box_urdf(), allow_renaming=True,
                      at=pose(3.0, 0.0, 0.5)).entity_name == 'box_1'
+
+
+def test_an_object_pybullet_would_crash_on_is_refused_and_the_node_goes_on(sim):
+    # Each of these used to kill sim_node with a segmentation fault (or a double free).
+    for case, (urdf, expected) in UNSPAWNABLE.items():
+        refused = sim.spawn('thing', resource_string=urdf, at=pose(1.0, 0.0, 0.5))
+        assert refused.result.result == Spawn.RESOURCE_PARSE_ERROR, case
+        assert expected in refused.result.error_message, case
+        assert refused.entity_name == ''
+    assert sim.entities() == [ROBOT, *TARGETS]
+    assert sim.step(100).result == OK
+    _spawn_box(sim, 'box')
 
 
 def test_each_refusal_has_its_code(sim, tmp_path):

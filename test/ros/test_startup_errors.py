@@ -35,6 +35,27 @@ _INERTIAL = ('<inertial><mass value="1"/>'
              '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>')
 _XACRO_HEAD = '<?xml version="1.0"?>\n<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
 
+
+
+def _link(name: str, mass: str = '1') -> str:
+    return (f'<link name="{name}"><inertial><origin xyz="0.1 0 0"/><mass value="{mass}"/>'
+            '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>')
+
+
+def _joint(name: str, parent: str, child: str, kind: str = 'revolute', axis: str = '0 1 0',
+           origin: str = '0 0 0.1') -> str:
+    return (f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+            f'<origin xyz="{origin}"/><axis xyz="{axis}"/>'
+            '<limit lower="-3" upper="3" effort="10" velocity="2"/></joint>')
+
+
+def _robot(*parts: str) -> str:
+    return '<?xml version="1.0"?>\n<robot name="r">\n' + '\n'.join(parts) + '\n</robot>\n'
+
+
+_AB = (_link('a'), _link('b'))
+_ABC = (*_AB, _link('c'))
+
 # Files the cases below point at, written into a temporary folder per test.
 FILES = {
     'not_xml.urdf': 'hello, this is not XML\n',
@@ -97,6 +118,29 @@ FILES = {
     'deep.yaml': '[' * 500 + ']' * 500 + '\n',
     'laughs.yaml': 'a0: &a0 [lol, lol, lol, lol, lol, lol, lol, lol, lol]\n' + ''.join(
         f"a{level}: &a{level} [{', '.join([f'*a{level - 1}'] * 9)}]\n" for level in range(1, 10)),
+    # Descriptions PyBullet crashes on or cannot integrate, and controllers for their joint j1:
+    # a PID on effort (PyBullet's mass matrix is computed for it), or the ideal actuator.
+    'j1_pid.yaml': 'c: {type: effort_controllers/JointPositionController, joint: j1, '
+                   'pid: {p: 100.0, i: 0.0, d: 1.0}}\n',
+    'j1_ideal.yaml': 'c: {type: position_controllers/JointPositionController, joint: j1}\n',
+    'long_name.urdf': _robot(*_AB, _joint('j' * 2000, 'a', 'b')),
+    'two_parents.urdf': _robot(*_ABC, _joint('j1', 'a', 'b'), _joint('j2', 'a', 'c'),
+                               _joint('j3', 'b', 'c')),
+    'cycle_off_root.urdf': _robot(*_ABC, _joint('j1', 'a', 'b'), _joint('j2', 'b', 'c'),
+                                  _joint('j3', 'c', 'b')),
+    'cycle_off_nothing.urdf': _robot(*_ABC, _link('d'), _joint('j1', 'a', 'b'),
+                                     _joint('j2', 'c', 'd'), _joint('j3', 'd', 'c')),
+    'root_cycle_orphan.urdf': _robot(*_ABC, _joint('j1', 'a', 'b'), _joint('j2', 'b', 'a')),
+    'own_parent.urdf': _robot(*_AB, _joint('j1', 'a', 'b'), _joint('j2', 'b', 'b')),
+    'joint_twice.urdf': _robot(*_ABC, _joint('j1', 'a', 'b'), _joint('j1', 'b', 'c')),
+    'zero_axis.urdf': _robot(*_AB, _joint('j1', 'a', 'b', axis='0 0 0')),
+    'tiny_axis.urdf': _robot(*_AB, _joint('j1', 'a', 'b', axis='0 0 1e-300')),
+    'planar.urdf': _robot(*_ABC, _joint('j1', 'a', 'b'), _joint('j2', 'b', 'c', 'planar')),
+    'negative_mass.urdf': _robot(_link('a'), _link('b', '-1'), _link('c'), _joint('j1', 'a', 'b'),
+                                 _joint('j2', 'b', 'c')),
+    'huge_mass.urdf': _robot(_link('a'), _link('b', '1e308'), _joint('j1', 'a', 'b')),
+    'far_out.urdf': _robot(*_ABC, _joint('j1', 'a', 'b'),
+                           _joint('j2', 'b', 'c', origin='1e155 0 0')),
 }
 
 
@@ -231,6 +275,32 @@ CASES = [
           'pan_joint, tilt_joint'),
     _case('initial_positions a string', {'initial_positions': 'pan_joint:=1'},
           ParameterError, "'initial_positions' must be a string array"),
+    # Descriptions PyBullet cannot take (those it crashes on: as a program, below).
+    _case('cycle off nothing', {'robot_description_file': '{dir}/cycle_off_nothing.urdf',
+                                'controllers_file': '{dir}/j1_pid.yaml'},
+          DescriptionError, '{dir}/cycle_off_nothing.urdf', "'j3', 'j2' form a cycle"),
+    _case('zero axis, PID', {'robot_description_file': '{dir}/zero_axis.urdf',
+                             'controllers_file': '{dir}/j1_pid.yaml'},
+          DescriptionError, "joint 'j1'", '<axis xyz="0 0 0"> has no direction'),
+    _case('zero axis, ideal actuator', {'robot_description_file': '{dir}/zero_axis.urdf',
+                                        'controllers_file': '{dir}/j1_ideal.yaml'},
+          DescriptionError, "joint 'j1'", '<axis xyz="0 0 0"> has no direction'),
+    _case('near-zero axis, PID', {'robot_description_file': '{dir}/tiny_axis.urdf',
+                                  'controllers_file': '{dir}/j1_pid.yaml'},
+          DescriptionError, "joint 'j1'", '<axis xyz="0 0 1e-300"> has no direction'),
+    _case('planar joint, PID on another', {'robot_description_file': '{dir}/planar.urdf',
+                                           'controllers_file': '{dir}/j1_pid.yaml'},
+          DescriptionError, "joint 'j2'", 'planar is not simulated'),
+    _case('negative mass, PID', {'robot_description_file': '{dir}/negative_mass.urdf',
+                                 'controllers_file': '{dir}/j1_pid.yaml'},
+          DescriptionError, "link 'b'", '<mass value="-1"> must be >= 0 kg'),
+    _case('mass 1e308, ideal actuator', {'robot_description_file': '{dir}/huge_mass.urdf',
+                                         'controllers_file': '{dir}/j1_ideal.yaml'},
+          DescriptionError, "link 'b'", '<mass value="1e308"> is above 1e+06 kg'),
+    _case('unstable from the first step', {'robot_description_file': '{dir}/far_out.urdf',
+                                           'controllers_file': '{dir}/j1_ideal.yaml'},
+          DescriptionError, '{dir}/far_out.urdf', "joint 'j2' has a non-finite position",
+          "likely cause: joint 'j2' <origin xyz> 1e+155"),
     # gazebo_ros_control's PID gains.
     _case('pid_gains for a joint the robot lacks', {'controllers_file': '{dir}/plugin_gains.yaml'},
           ControllerConfigError, '{dir}/plugin_gains.yaml: gazebo_ros_control.pid_gains.elbow: ',
@@ -348,6 +418,21 @@ def _assert_one_line_exit_2(result, *expected: str) -> str:
     pytest.param(['-p', "initial_positions:=['tilt_joint:=-2.0', 'roll:=1']"],
                  ["parameter 'initial_positions': 'roll' is not a movable joint"],
                  id='initial position of an unknown joint (after PyBullet loaded the robot)'),
+    # Descriptions PyBullet crashes on (segmentation fault, double free): refused before it.
+    *(pytest.param(['-p', f'robot_description_file:={{dir}}/{urdf}',
+                    '-p', 'controllers_file:={dir}/j1_ideal.yaml'], [f'{{dir}}/{urdf}', *parts],
+                   id=case) for case, urdf, parts in (
+        ('a name of 2000 characters', 'long_name.urdf',
+         ['the name is 2000 bytes long', 'at most 1023']),
+        ('two joints with one child', 'two_parents.urdf',
+         ["link 'c' is the child of two joints, 'j2' and 'j3'"]),
+        ('a cycle off the root', 'cycle_off_root.urdf',
+         ["link 'b' is the child of two joints, 'j1' and 'j3'"]),
+        ('a cycle through the root and an orphan link', 'root_cycle_orphan.urdf',
+         ["joints 'j2', 'j1' form a cycle (b -> a -> b)"]),
+        ('a joint whose parent is its child', 'own_parent.urdf',
+         ["joint 'j2': link 'b' is both its parent and its child"]),
+        ('the same joint twice', 'joint_twice.urdf', ["joint 'j1' is declared twice"]))),
 ])
 def test_the_program_prints_one_line_and_exits_2(files, ros_args, expected):
     result = sim_process.run(*(_fill(arg, files) for arg in ros_args))

@@ -5,7 +5,14 @@ from __future__ import annotations
 import math
 
 import pytest
-from entity_fixtures import RIG_CONTROLLERS, RIG_URDF, box_urdf, write_box
+from entity_fixtures import (
+    RIG_CONTROLLERS,
+    RIG_URDF,
+    UNSPAWNABLE,
+    box_urdf,
+    flail_urdf,
+    write_box,
+)
 
 from pan_tilt_sim.engine import make_simulation
 from pan_tilt_sim.model.transforms import Transform
@@ -294,6 +301,51 @@ def test_a_world_file_entry_that_cannot_be_spawned_names_the_file_and_entry(pan_
                              .entities), tmp_path / 'w.yaml')
     with pytest.raises(WorldFileError, match=r"w.yaml: entities\[0\] \('a'\): .*not well-formed"):
         spawn_world_objects(entities, world)
+
+
+@pytest.mark.parametrize('case', list(UNSPAWNABLE))
+def test_an_object_pybullet_would_crash_on_is_refused_and_the_world_goes_on(seed, case):
+    simulation, entities = seed
+    urdf, expected = UNSPAWNABLE[case]
+    before = entities.names()
+    with pytest.raises(SpawnError) as refused:
+        entities.spawn('thing', resource_string=urdf)
+    assert refused.value.problem is SpawnProblem.RESOURCE_PARSE_ERROR
+    assert expected in str(refused.value)
+    assert '\n' not in str(refused.value)
+    assert entities.names() == before
+    assert entities.spawn('box', resource_string=box_urdf()) == 'box'
+    simulation.advance(100)
+    assert all(math.isfinite(v) for v in simulation.joint_positions().values())
+
+
+def test_an_object_pybullet_cannot_integrate_is_refused_before_it_enters_the_world(seed):
+    # A link's centre of mass so far out that its square overflows: NaN at the first step.
+    simulation, entities = seed
+    before = (entities.names(), pybullet.getNumBodies(
+        physicsClientId=simulation.physics.client_id))
+    with pytest.raises(SpawnError) as refused:
+        entities.spawn('far', resource_string=flail_urdf(1e155))
+    assert refused.value.problem is SpawnProblem.RESOURCE_PARSE_ERROR
+    message = str(refused.value)
+    assert 'its base pose is not finite after 1 physics step alone' in message
+    assert "likely cause: link 'flail' <inertial><origin xyz> 1e+155" in message
+    assert (entities.names(), pybullet.getNumBodies(
+        physicsClientId=simulation.physics.client_id)) == before
+    near = entities.spawn('near', resource_string=flail_urdf(1e3), pose=Transform((1, 1, 1)))
+    simulation.advance(200)
+    assert all(math.isfinite(v) for v in entities.state(near).pose.translation)
+
+
+def test_a_world_file_object_pybullet_would_crash_on_ends_start_up_naming_it(seed, tmp_path):
+    _simulation, entities = seed
+    urdf, expected = UNSPAWNABLE['two joints with one child']
+    (tmp_path / 'thing.urdf').write_text(urdf)
+    world = read_world_file(_write(tmp_path, 'entities:\n  - uri: thing.urdf\n'))
+    with pytest.raises(WorldFileError) as refused:
+        spawn_world_objects(entities, world)
+    assert str(refused.value).startswith(f'{tmp_path / "w.yaml"}: entities[0]: ')
+    assert expected in str(refused.value)
 
 
 def _write(folder, text):

@@ -92,6 +92,28 @@ def test_prismatic_effort_is_a_force_in_newtons(tmp_path):
         assert sim.joint_velocities()['slide'] == pytest.approx(expected, rel=0.02)
 
 
+# --- axes ----------------------------------------------------------------------------------
+
+@pytest.mark.parametrize(('kind', 'unit', 'longer'), [
+    ('revolute', '0 0 1', '0 0 3'), ('prismatic', '1 0 0', '0.25 0 0')])
+def test_an_axis_is_a_direction_its_length_changes_nothing(tmp_path, kind, unit, longer):
+    # URDF's axis is a unit vector; PyBullet, given a longer one, would move the joint with
+    # other dynamics (revolute) or report its position in other units (prismatic).
+    def motion(axis):
+        folder = tmp_path / axis.replace(' ', '_')
+        folder.mkdir()
+        urdf = star_robot_urdf([JointDef('j', kind, -5.0, 5.0, damping=2.0)]).replace(
+            f'<axis xyz="{unit}"/>', f'<axis xyz="{axis}"/>')
+        with simulation(folder, [], {'eff': effort_controller('j')}, urdf=urdf) as sim:
+            sim.controller('eff').set_command(1.0)
+            run_seconds(sim, 0.5)
+            return sim.joint_positions()['j'], sim.joint_velocities()['j']
+
+    position, velocity = motion(unit)
+    assert abs(position) > 0.01
+    assert motion(longer) == pytest.approx((position, velocity), rel=1e-9)
+
+
 # --- fixed ---------------------------------------------------------------------------------
 
 def test_fixed_joints_are_skipped(tmp_path):

@@ -1,4 +1,8 @@
-"""Instability is never silent: unstable PID gains at start-up, a runaway joint at run time."""
+"""Instability is never silent: refused or named at start-up, reported at run time.
+
+A description PyBullet cannot integrate ends start-up; PID gains too high for
+their joint are named at start-up; a runaway joint is reported while running.
+"""
 
 import math
 
@@ -13,10 +17,11 @@ from robot_fixtures import (
     write_text,
 )
 
+from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.sim import compiled_step
 from pan_tilt_sim.sim.engine import make_simulation
 from pan_tilt_sim.sim.physics import check_poses
-from pan_tilt_sim.sim.stability import largest_stable_time_step
+from pan_tilt_sim.sim.stability import check_startup_stability, largest_stable_time_step
 
 DT = 0.001
 # A star link about its joint's z axis: box about its centre plus m (L / 2)^2.
@@ -127,6 +132,68 @@ def test_a_non_finite_state_is_reported(tmp_path, monkeypatch):
         sim.advance(1)
     assert any("joint 'hinge' has a non-finite state (position nan" in line
                for line in log.warnings)
+
+
+# --- a description PyBullet cannot integrate: refused at start-up -----------------------------
+
+def far_out(tmp_path, distance):
+    """A two-link arm whose elbow sits ``distance`` metres out along the upper arm."""
+    inertial = ('<inertial><origin xyz="0.1 0 0"/><mass value="1"/><inertia ixx="0.01" ixy="0" '
+                'ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>')
+    joint = ('<joint name="{name}" type="revolute"><parent link="{parent}"/><child link="{child}"/>'
+             '<origin xyz="{x} 0 0"/><axis xyz="0 1 0"/>'
+             '<limit lower="-3" upper="3" effort="10" velocity="2"/></joint>')
+    robot = write_text(tmp_path, 'far.urdf', f"""
+        <robot name="far">
+          <link name="base"/>
+          <link name="upper">{inertial}</link><link name="lower">{inertial}</link>
+          {joint.format(name='shoulder', parent='base', child='upper', x=0)}
+          {joint.format(name='elbow', parent='upper', child='lower', x=distance)}
+        </robot>
+        """)
+    controllers = write_text(tmp_path, 'controllers.yaml', """
+        eff:
+          type: effort_controllers/JointGroupEffortController
+          joints: [shoulder, elbow]
+        """)
+    return robot, controllers
+
+
+def test_a_description_whose_states_go_non_finite_at_once_is_refused_naming_joint_and_cause(
+        tmp_path):
+    # 1e155 m squared overflows: PyBullet's first step makes every state NaN.
+    robot, controllers = far_out(tmp_path, '1e155')
+    with pytest.raises(DescriptionError) as refused:
+        make_simulation(str(robot), str(controllers), DT)
+    message = str(refused.value)
+    assert '\n' not in message
+    assert message.startswith(f'{robot}: ')
+    assert "joint 'elbow'" in message
+    assert 'non-finite' in message
+    assert "likely cause: joint 'elbow' <origin xyz> 1e+155" in message
+
+
+def test_a_description_far_out_but_finite_starts(tmp_path):
+    robot, controllers = far_out(tmp_path, '1e6')
+    with make_simulation(str(robot), str(controllers), DT) as sim:
+        sim.advance(300)
+        assert all(math.isfinite(v) for v in sim.joint_positions().values())
+
+
+def test_the_start_up_trial_leaves_no_trace(tmp_path):
+    # An arm that swings under gravity: a trial not undone would leave it elsewhere.
+    robot, controllers = far_out(tmp_path, '0.2')
+
+    def run(trials):
+        with make_simulation(str(robot), str(controllers), DT) as sim:
+            for _ in range(trials):  # more than the one at start-up
+                check_startup_stability(sim.physics, sim.description)
+            sim.controller('eff').set_command([0.5, -0.2])
+            sim.advance(700)
+            return sim.joint_positions(), sim.joint_velocities()
+    moved = run(0)
+    assert moved[0]['shoulder'] != 0.0
+    assert run(3) == moved  # to the last bit
 
 
 def test_the_check_poses_cover_the_range_and_free_joints():

@@ -1,0 +1,166 @@
+"""Fuzzing the load path: any URDF starts with finite states or is refused in one line.
+
+Whatever description :func:`urdf_strategies.robots` draws, starting a
+simulation of it (as sim_node does) and spawning it as an object (as
+SpawnEntity does) either works -- every joint state and the object's pose
+still finite after a few hundred steps -- or ends in a ConfigurationError
+(SpawnError for the object) with one line.  Never a crash, a traceback, a
+hang or a NaN.
+
+PyBullet segfaults on some inputs, so the examples run in a child process
+(test/load_worker.py), one after another: a crash or a hang there is a
+failing example here, and the next example gets a fresh child.  CI runs
+:data:`EXAMPLES` examples; ``PAN_TILT_SIM_SLOW=1`` runs :data:`SLOW_EXAMPLES`.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import pathlib
+import selectors
+import signal
+import subprocess
+import sys
+import tempfile
+
+import pytest
+import sim_process
+from hypothesis import HealthCheck, event, given, settings
+from urdf_strategies import FuzzRobot, robots
+
+SLOW_ENV = 'PAN_TILT_SIM_SLOW'
+EXAMPLES = 100
+SLOW_EXAMPLES = 2000
+STEPS = 300  # physics steps each loaded robot and spawned object runs
+ANSWER_BUDGET_S = 30.0  # no answer within this: the child hangs
+WORKER = pathlib.Path(__file__).resolve().parents[1] / 'load_worker.py'
+ROBOT_OUTCOMES = ('refused', 'loaded')
+OBJECT_OUTCOMES = ('refused', 'spawned')
+
+
+class LoadWorker:
+    """test/load_worker.py in a child process, started again whenever it died."""
+
+    def __init__(self) -> None:
+        self._process: subprocess.Popen | None = None
+        self._stderr = tempfile.TemporaryFile(mode='w+', encoding='utf-8', errors='replace')
+
+    def run(self, request: dict) -> dict:
+        """Return the child's answer to ``request``; fail if it crashes or falls silent."""
+        process = self._started()
+        try:
+            process.stdin.write(json.dumps(request) + '\n')
+            process.stdin.flush()
+        except BrokenPipeError:
+            pass  # it died: the read below says how
+        with selectors.DefaultSelector() as selector:
+            selector.register(process.stdout, selectors.EVENT_READ)
+            ready = selector.select(ANSWER_BUDGET_S)
+        if not ready:
+            process.kill()
+            process.wait()
+            self._process = None
+            pytest.fail(f'the worker hung: no answer within {ANSWER_BUDGET_S:g} s', False)
+        line = process.stdout.readline()
+        if not line:
+            code = process.wait()
+            self._process = None
+            pytest.fail(f'the worker died ({_ending(code)}); its last output: '
+                        f'{self._tail()!r}', False)
+        return json.loads(line)
+
+    @property
+    def pid(self) -> int:
+        """The child's process id (started if need be)."""
+        return self._started().pid
+
+    def close(self) -> None:
+        """End the child (stdin closed: it returns) and forget its output."""
+        if self._process is not None:
+            self._process.stdin.close()
+            try:
+                self._process.wait(timeout=ANSWER_BUDGET_S)
+            except subprocess.TimeoutExpired:
+                self._process.kill()
+                self._process.wait()
+            self._process = None
+        self._stderr.close()
+
+    def _started(self) -> subprocess.Popen:
+        if self._process is None:
+            self._stderr.seek(0)
+            self._stderr.truncate()
+            self._process = subprocess.Popen(
+                [sys.executable, str(WORKER)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                stderr=self._stderr, text=True, env=sim_process.environment())
+        return self._process
+
+    def _tail(self) -> str:
+        self._stderr.flush()
+        self._stderr.seek(0)
+        return self._stderr.read()[-1500:]
+
+
+def _ending(code: int) -> str:
+    if code < 0:
+        return f'killed by {signal.Signals(-code).name}'
+    return f'exit code {code}'
+
+
+@pytest.fixture(scope='module')
+def worker():
+    child = LoadWorker()
+    yield child
+    child.close()
+
+
+def _examples() -> int:
+    return SLOW_EXAMPLES if os.environ.get(SLOW_ENV) else EXAMPLES
+
+
+# Words of each kind of refusal, for the statistics (--hypothesis-show-statistics).
+REFUSALS = ('child of two joints', 'form a cycle', 'both its parent and its child',
+            'declared twice', 'bytes long', 'is not simulated', 'has no direction', '<mass',
+            '<inertia', 'non-finite position', 'is not a number', 'is not finite',
+            'not three numbers', 'unknown type', 'no movable joints', 'PyBullet cannot load',
+            'child of no joint', 'not a valid ROS name', 'a controller can only drive')
+
+
+def _one_line(answer: dict, what: str) -> None:
+    message = answer['message']
+    assert message and '\n' not in message, message
+    kind = next((words for words in REFUSALS if words in message), 'other')
+    event(f'{what} refused: {kind}')
+
+
+@settings(max_examples=_examples(), deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(robot=robots())
+def test_any_description_loads_with_finite_states_or_is_refused_in_one_line(worker,
+                                                                             robot: FuzzRobot):
+    answer = worker.run(robot.request(STEPS))
+    loaded, spawned = answer['robot'], answer['object']
+    event(f"robot: {loaded['outcome']}")
+    event(f"object: {spawned['outcome']}")
+    assert loaded['outcome'] in ROBOT_OUTCOMES, loaded.get('traceback')
+    assert spawned['outcome'] in OBJECT_OUTCOMES, spawned.get('traceback')
+    for what, part in (('robot', loaded), ('object', spawned)):
+        if part['outcome'] == 'refused':
+            _one_line(part, what)
+        else:
+            assert part['finite'], f'the {what} has a NaN or infinite state'
+
+
+def test_a_worker_that_dies_is_a_failure_and_the_next_request_gets_a_new_one(worker):
+    pid = worker.pid
+    os.kill(pid, signal.SIGSEGV)
+    request = {'urdf': '<robot name="r"><link name="a"/></robot>',
+               'controllers': 'jsb: {type: joint_state_broadcaster/JointStateBroadcaster}\n',
+               'steps': 1}
+    with pytest.raises(pytest.fail.Exception, match='the worker died .killed by SIGSEGV'):
+        worker.run(request)
+    answer = worker.run(request)
+    assert worker.pid != pid
+    assert answer['robot']['outcome'] == 'refused'  # no movable joints
+    assert 'no movable joints' in answer['robot']['message']
