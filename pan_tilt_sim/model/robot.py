@@ -18,6 +18,7 @@ import functools
 import math
 from collections.abc import Mapping
 
+from pan_tilt_sim.model.friction import SurfaceFriction
 from pan_tilt_sim.model.sensors import SensorSpec
 from pan_tilt_sim.model.transforms import (
     Transform,
@@ -261,6 +262,8 @@ class RobotModel:
     # per sensor tag it skipped (unsupported type, plugin or reference).
     sensors: tuple[SensorSpec, ...] = ()
     sensor_warnings: tuple[str, ...] = ()
+    # <gazebo reference="LINK"> <mu1>/<mu2>, by link (links without them are absent).
+    link_frictions: Mapping[str, SurfaceFriction] = dataclasses.field(default_factory=dict)
 
     @property
     def plugin_namespace(self) -> str | None:

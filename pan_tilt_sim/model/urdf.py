@@ -15,6 +15,7 @@ import xml.etree.ElementTree as ElementTree
 
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model import naming
+from pan_tilt_sim.model.friction import link_frictions
 from pan_tilt_sim.model.robot import (
     DEFAULT_AXIS,
     POSITION_PROPORTIONAL_GAIN,
@@ -121,7 +122,8 @@ def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
     sensors, sensor_warnings = _SensorReader(source, links, joints).read(root)
     return RobotModel(name=root.get('name', ''), links=links, joints=joints,
                       ros2_control=systems, control_plugins=plugins,
-                      sensors=sensors, sensor_warnings=sensor_warnings)
+                      sensors=sensors, sensor_warnings=sensor_warnings,
+                      link_frictions=link_frictions(root, link_names, source))
 
 
 def _check_position_gain(plugins: tuple[ControlPlugin, ...], systems: tuple[ControlSystem, ...],
