@@ -11,9 +11,10 @@ each of its joints' handles which :class:`Actuator` drives it:
 * :attr:`Drive.EFFORT` -- the physics applies ``handle.effort`` (N*m or N):
   an effort command, or a PID's output;
 * :attr:`Drive.VELOCITY` -- the ideal actuator: a velocity motor moves the
-  joint at ``handle.velocity_target`` with at most the joint's effort limit,
-  and the simulation writes the effort it applied back into ``handle.effort``
-  (an acceleration command is integrated into that target).
+  joint at ``handle.velocity_target`` with at most ``handle.force_limit``
+  (the joint's effort limit unless its controller asks for less: a gripper's
+  ``max_effort``), and the simulation writes the effort it applied back into
+  ``handle.effort`` (an acceleration command is integrated into that target).
 
 Controllers can be chained, as ros2_control's chainable controllers are: a
 *chainable* controller exports reference interfaces (:class:`Reference`),
@@ -147,11 +148,15 @@ class JointHandle:
     the share of its position error an ideal position actuator closes per
     step (gz_ros2_control's ``position_proportional_gain``).  ``actuator``
     is what drives the joint now: the simulation sets it from the active
-    controllers (:meth:`Controller.actuators`).
+    controllers (:meth:`Controller.actuators`).  ``force_limit`` (N*m or N,
+    may be inf) is the most the ideal actuator's motor may apply: the joint's
+    effort limit, which the simulation restores whenever the actuators
+    change; a controller may lower it in its update, every step it wants it.
     """
 
     __slots__ = ('spec', 'position', 'velocity', 'effort', 'velocity_target',
-                 'initial_position', 'plugin_gains', 'tracking_gain', 'actuator')
+                 'initial_position', 'plugin_gains', 'tracking_gain', 'actuator',
+                 'force_limit')
 
     def __init__(self, spec: JointSpec, initial_position: float | None = None,
                  plugin_gains: PidGains | None = None,
@@ -166,6 +171,7 @@ class JointHandle:
         self.velocity = 0.0
         self.effort = 0.0
         self.velocity_target = 0.0
+        self.force_limit = spec.effort_limit
 
     @property
     def name(self) -> str:
@@ -178,11 +184,12 @@ class JointHandle:
         return self.actuator.drive
 
     def reset(self) -> None:
-        """Return to the joint's initial state (at rest, no effort)."""
+        """Return to the joint's initial state (at rest, no effort, its own effort limit)."""
         self.position = self.initial_position
         self.velocity = 0.0
         self.effort = 0.0
         self.velocity_target = 0.0
+        self.force_limit = self.spec.effort_limit
 
 
 class Reference:
@@ -238,6 +245,9 @@ class Controller(abc.ABC):
     gains_field: ClassVar[str] = 'gains'
     # Whether the type exports reference interfaces (ros2_control's ChainableControllerInterface).
     chainable: ClassVar[bool] = False
+    # Whether the type commands joints (a command controller, a gripper's action controller)
+    # rather than only reading them (a broadcaster); those update first in every step.
+    commands_joints: ClassVar[bool] = False
     # Chained mode, and the references offered before configure (see the methods below).
     _chained: bool = False
     _available_references: Mapping[str, Reference] = MappingProxyType({})
@@ -420,6 +430,7 @@ class Controller(abc.ABC):
 class CommandController(Controller):
     """A controller that takes commands from a topic ``<controller>/<command_topic>``."""
 
+    commands_joints = True
     command_topic: ClassVar[str] = 'command'
     command_kind: ClassVar[CommandKind] = CommandKind.FLOAT64
 

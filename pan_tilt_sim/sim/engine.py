@@ -41,6 +41,7 @@ from pan_tilt_sim.sim.physics import (
     STATE_MOTOR_TORQUE,
     STATE_POSITION,
     STATE_VELOCITY,
+    UNLIMITED_FORCE,
     Physics,
     health_problem,
 )
@@ -137,6 +138,7 @@ class Simulation:
                                          and handle.name not in self._driven)
                 handle.velocity_target = 0.0
             handle.actuator = actuator
+            handle.force_limit = handle.spec.effort_limit  # until a controller lowers it
         velocity_driven = [handle.drive is Drive.VELOCITY for handle in self._handle_list]
         self.physics.set_drives(velocity_driven)
         self._effort_handles = [handle for handle, driven in zip(
@@ -146,6 +148,7 @@ class Simulation:
         self._velocity_slots = [slot for slot, driven in enumerate(velocity_driven) if driven]
         self._efforts = [0.0] * len(self._effort_handles)
         self._targets = [0.0] * len(self._velocity_handles)
+        self._forces = [0.0] * len(self._velocity_handles)
         self._physics_step = self.physics.stepper()
         self._run_laws = self.physics.law_runner()
         self._effort_slot = {handle.name: index
@@ -282,7 +285,7 @@ class Simulation:
         updates = self.manager.updates
         scheduled = self.manager.scheduled_updates
         effort_handles, efforts = self._effort_handles, self._efforts
-        velocity_handles, targets = self._velocity_handles, self._targets
+        velocity_handles, targets, forces = self._velocity_handles, self._targets, self._forces
         readback = list(zip(velocity_handles, self._velocity_slots, strict=True))
         physics_step = self._physics_step
         dt = self._time_step
@@ -305,7 +308,9 @@ class Simulation:
                 efforts[index] = handle.effort
             for index, handle in enumerate(velocity_handles):
                 targets[index] = handle.velocity_target
-            states = physics_step(efforts, targets)
+                force = handle.force_limit
+                forces[index] = force if force < UNLIMITED_FORCE else UNLIMITED_FORCE
+            states = physics_step(efforts, targets, forces)
         self._steps = first + steps
         self._states = states
         self._check_health(states)
