@@ -43,6 +43,7 @@ from pan_tilt_sim.controllers.surface import PRIVATE, ActionServer, CommandTopic
 from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.gain_parameters import GainParameters
+from pan_tilt_sim.ros.gripper_action import GripperCommandServer, ParallelGripperCommandServer
 from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES, joint_state_message
 from pan_tilt_sim.ros.trajectory_action import TrajectoryActionServer
 from pan_tilt_sim.sim.engine import Simulation
@@ -300,4 +301,6 @@ STATE_SINKS: dict[str, tuple[type, Callable[[Any, Mapping[str, Any]], Any]]] = {
 # Each action type: the server that runs a controller's goals.
 ACTION_SERVERS: dict[str, Callable[..., Any]] = {
     'control_msgs/action/FollowJointTrajectory': TrajectoryActionServer,
+    'control_msgs/action/GripperCommand': GripperCommandServer,
+    'control_msgs/action/ParallelGripperCommand': ParallelGripperCommandServer,
 }
