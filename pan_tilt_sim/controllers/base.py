@@ -98,6 +98,9 @@ class Actuator:
     # For a PID: its live object and where its gains came from ('' = the defaults).
     pid: Pid | None = None
     gains_from: str = ''
+    # For a velocity motor: whether the controller sets its force limit every step
+    # (``JointHandle.force_limit``: a gripper's max_effort); else it is the effort limit.
+    force_from_controller: bool = False
 
     @property
     def drive(self) -> Drive:
@@ -122,6 +125,9 @@ class Actuator:
                         "(gz_ros2_control's hold_joints)")
             if self.kind is ActuatorKind.IDEAL_ACCELERATION:
                 return f'{self.kind.label}{owner}, a velocity motor with {limit}'
+            if self.force_from_controller:
+                return (f'{self.kind.label}{owner}, a velocity motor with {limit}, or less as '
+                        "the controller asks (a goal's max_effort)")
             return (f'{self.kind.label}{owner}, a velocity motor with {limit}: no PID gains '
                     'for it in the YAML')
         return f'{self.kind.label}{owner}'
@@ -151,7 +157,8 @@ class JointHandle:
     controllers (:meth:`Controller.actuators`).  ``force_limit`` (N*m or N,
     may be inf) is the most the ideal actuator's motor may apply: the joint's
     effort limit, which the simulation restores whenever the actuators
-    change; a controller may lower it in its update, every step it wants it.
+    change; a controller whose actuator says ``force_from_controller`` sets
+    it in its update, and the simulation reads it every step.
     """
 
     __slots__ = ('spec', 'position', 'velocity', 'effort', 'velocity_target',

@@ -229,7 +229,7 @@ class GripperActionController(Controller):
 
     def bind(self, handle: JointHandle) -> Actuator:
         """Return what drives the joint: here the ideal position actuator."""
-        return Actuator(ActuatorKind.IDEAL_POSITION, self.name)
+        return Actuator(ActuatorKind.IDEAL_POSITION, self.name, force_from_controller=True)
 
     def reset(self) -> None:
         """Hold the joint where it is (:meth:`hold_request`); a running goal is aborted."""

@@ -148,7 +148,12 @@ class Simulation:
         self._velocity_slots = [slot for slot, driven in enumerate(velocity_driven) if driven]
         self._efforts = [0.0] * len(self._effort_handles)
         self._targets = [0.0] * len(self._velocity_handles)
-        self._forces = [0.0] * len(self._velocity_handles)
+        # The velocity motors' force limits: the effort limits, but a controller's own
+        # every step for the joints whose actuator takes it from the controller.
+        self._forces = [min(handle.spec.effort_limit, UNLIMITED_FORCE)
+                        for handle in self._velocity_handles]
+        self._forced = [(index, handle) for index, handle in enumerate(self._velocity_handles)
+                        if handle.actuator.force_from_controller]
         self._physics_step = self.physics.stepper()
         self._run_laws = self.physics.law_runner()
         self._effort_slot = {handle.name: index
@@ -285,7 +290,10 @@ class Simulation:
         updates = self.manager.updates
         scheduled = self.manager.scheduled_updates
         effort_handles, efforts = self._effort_handles, self._efforts
-        velocity_handles, targets, forces = self._velocity_handles, self._targets, self._forces
+        velocity_handles, targets = self._velocity_handles, self._targets
+        forced, forces = self._forced, self._forces
+        # None: the motors keep the limits they have (no controller sets any).
+        motor_forces = forces if forced else None
         readback = list(zip(velocity_handles, self._velocity_slots, strict=True))
         physics_step = self._physics_step
         dt = self._time_step
@@ -308,9 +316,10 @@ class Simulation:
                 efforts[index] = handle.effort
             for index, handle in enumerate(velocity_handles):
                 targets[index] = handle.velocity_target
+            for index, handle in forced:
                 force = handle.force_limit
                 forces[index] = force if force < UNLIMITED_FORCE else UNLIMITED_FORCE
-            states = physics_step(efforts, targets, forces)
+            states = physics_step(efforts, targets, motor_forces)
         self._steps = first + steps
         self._states = states
         self._check_health(states)

@@ -92,7 +92,11 @@ def test_it_serves_gripper_command_and_claims_its_packages_interface(type_name, 
         ActionServer('~/gripper_cmd', 'control_msgs/action/GripperCommand'),)
     assert controller.command_interfaces() == {'finger': (interface,)}
     assert controller.state_interfaces() == {'finger': ('position', 'velocity')}
-    assert controller.actuators()['finger'].kind is kind
+    actuator = controller.actuators()['finger']
+    assert actuator.kind is kind
+    # The ideal actuator's force is the controller's to set (max_effort), every step.
+    assert actuator.force_from_controller is (kind is ActuatorKind.IDEAL_POSITION)
+    assert 'max_effort' in actuator.describe(FINGER) or actuator.pid is not None
     assert controller.commands_joints
 
 
