@@ -270,10 +270,10 @@ class GripperActionController(Controller):
         """
         if self._goal is not None:
             self._goal.end(GoalStatus.ABORTED)
-        goal = GripperGoal(request)
-        self._goal = goal
         self._set_command(request)
         self._last_movement = now
+        goal = GripperGoal(request)
+        self._goal = goal
         return goal
 
     def cancel_goal(self, goal: GripperGoal) -> bool:
