@@ -33,7 +33,7 @@ import yaml
 from node_harness import sim_node
 
 from pan_tilt_sim.controllers.registry import CONTROLLER_CLASSES
-from pan_tilt_sim.controllers.surface import CommandTopic, StateTopic
+from pan_tilt_sim.controllers.surface import ActionServer, CommandTopic, StateTopic
 from pan_tilt_sim.ros.sim_node import NODE_NAME
 from pan_tilt_sim.share import package_share
 from pan_tilt_sim.tools.controller_reference import example_controller
@@ -182,6 +182,7 @@ def commands(path: pathlib.Path) -> Iterator[Command]:
     """Yield the commands of ``path``'s fenced bash blocks, continuation lines joined."""
     lines = path.read_text(encoding='utf-8').splitlines()
     block, buffer, start = False, '', 0
+    variables: dict[str, str] = {}  # shell variables the doc sets (NAME=value alone on a line)
     for number, line in enumerate(lines, start=1):
         if FENCE.match(line):
             block = line.strip() == '```bash' if not block else False
@@ -204,12 +205,16 @@ def commands(path: pathlib.Path) -> Iterator[Command]:
             if word not in SEPARATORS:
                 part.append(word)
                 continue
+            part = [re.sub(r'\$\{?(\w+)\}?', lambda match: variables.get(match[1], match[0]),
+                           word) for word in part]
             environment = []
             while part and ENVIRONMENT.match(part[0]):
                 name, _, value = part.pop(0).partition('=')
                 environment.append((name, value))
             if part:
                 yield Command(str(path.relative_to(REPO)), start, tuple(environment), tuple(part))
+            else:
+                variables.update(environment)
             part = []
 
 
@@ -578,6 +583,19 @@ def check_ros2(command: Command, setup: Setup, words: tuple[str, ...],
         return setup
     if words[:2] == ('topic', 'echo'):
         check_topic_echo(command, setup, words[2])
+        return setup
+    if words[:2] == ('action', 'send_goal'):
+        name, type_name, goal = [word for word in words[2:] if not word.startswith('-')]
+        package, kind, action = type_name.split('/')
+        assert kind == 'action', f'{command.where}: {type_name} is not an action type'
+        goal_class = getattr(importlib.import_module(f'{package}.action'), action).Goal
+        fill(goal_class(), yaml.safe_load(goal), command.where)
+        served = {(endpoint.name.rpartition('/')[2], endpoint.action)
+                  for cls in CONTROLLER_CLASSES
+                  for endpoint in example_controller(cls).ros_surface()
+                  if isinstance(endpoint, ActionServer)}
+        assert (name.rpartition('/')[2], type_name) in served, \
+            f'{command.where}: no controller type serves {name} as {type_name}'
         return setup
     if words[:2] == ('param', 'set'):
         node, name = words[2], words[3]

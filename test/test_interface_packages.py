@@ -57,6 +57,16 @@ UPSTREAM_HASHES = {
         'RIHS01_18024c98a62697680f581108eeed40b28fb4542fa0ac5a8e36f56c62b6813d26',
     'control_msgs/msg/InterfaceValue':
         'RIHS01_74a12144ef6b7af67533195cb30f7f607d3301b66950208a72d280695f3e190c',
+    'control_msgs/action/GripperCommand':
+        'RIHS01_e17c0e644eccf14bea84a0a93e0977182872c2eb7873ca6694900059b46dbc84',
+    'control_msgs/action/GripperCommand_Goal':
+        'RIHS01_607d9f41eb241e1922e90f02125e87ae6bfb78f7f64a71dc92630263d01f8b6d',
+    'control_msgs/action/ParallelGripperCommand':
+        'RIHS01_adfd3c1ebe8abc38ebcc0e454b6423d291d4010dd5697d14eca5b9be4726ae18',
+    'control_msgs/action/ParallelGripperCommand_Result':
+        'RIHS01_51acbcd62aa44097d3877c506eab1146856fa8768628ffbe102c1699152d2afa',
+    'control_msgs/msg/GripperCommand':
+        'RIHS01_57eb8f326c9889ca8bb34ead82cc94cc09bf6bc5c3b6c09546dca3a00b589890',
     'controller_manager_msgs/srv/SwitchController':
         'RIHS01_d4ad10aa5da7808bc522d55d4123d8ef79de73d049d165639d7663ac37cc9895',
     'controller_manager_msgs/srv/ListControllers':
@@ -296,6 +306,49 @@ def test_a_follow_joint_trajectory_goal_goes_round(executor):
             '/follow_joint_trajectory/_action/feedback')
         assert str(endpoint.topic_type_hash) == \
             UPSTREAM_HASHES['control_msgs/action/FollowJointTrajectory_FeedbackMessage']
+    finally:
+        client.destroy()
+        server.destroy()
+
+
+@pytest.mark.parametrize('action_name', ['GripperCommand', 'ParallelGripperCommand'])
+def test_a_gripper_goal_goes_round(executor, action_name):
+    control_msgs = _require('control_msgs')
+    from rclpy.action import ActionClient, ActionServer
+
+    action = getattr(control_msgs.action, action_name)
+    server_node, client_node = executor.add('gripper'), executor.add('moveit')
+    goals = []
+
+    def execute(goal_handle):
+        goals.append(goal_handle.request)
+        goal_handle.succeed()
+        result = action.Result(stalled=True, reached_goal=False)
+        if action_name == 'GripperCommand':
+            result.position, result.effort = 0.02, 6.0
+        else:
+            result.state.position, result.state.effort = [0.02], [6.0]
+        return result
+
+    server = ActionServer(server_node, action, 'gripper_cmd', execute)
+    client = ActionClient(client_node, action, 'gripper_cmd')
+    try:
+        assert _spin_until(executor, client.server_is_ready)
+        goal = action.Goal()
+        if action_name == 'GripperCommand':
+            goal.command = control_msgs.msg.GripperCommand(position=0.0, max_effort=6.0)
+        else:
+            goal.command.name, goal.command.position = ['finger'], [0.0]
+            goal.command.effort = [6.0]
+        goal_handle = _until_answered(executor, lambda: client.send_goal_async(goal))
+        assert goal_handle.accepted
+        result = _until_answered(executor, goal_handle.get_result_async).result
+        assert goals[-1] == goal
+        assert (result.stalled, result.reached_goal) == (True, False)
+        if action_name == 'GripperCommand':
+            assert (result.position, result.effort) == (0.02, 6.0)
+        else:
+            assert (list(result.state.position), list(result.state.effort)) == ([0.02], [6.0])
     finally:
         client.destroy()
         server.destroy()

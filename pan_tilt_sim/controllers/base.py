@@ -11,9 +11,10 @@ each of its joints' handles which :class:`Actuator` drives it:
 * :attr:`Drive.EFFORT` -- the physics applies ``handle.effort`` (N*m or N):
   an effort command, or a PID's output;
 * :attr:`Drive.VELOCITY` -- the ideal actuator: a velocity motor moves the
-  joint at ``handle.velocity_target`` with at most the joint's effort limit,
-  and the simulation writes the effort it applied back into ``handle.effort``
-  (an acceleration command is integrated into that target).
+  joint at ``handle.velocity_target`` with at most ``handle.force_limit``
+  (the joint's effort limit unless its controller asks for less: a gripper's
+  ``max_effort``), and the simulation writes the effort it applied back into
+  ``handle.effort`` (an acceleration command is integrated into that target).
 
 Controllers can be chained, as ros2_control's chainable controllers are: a
 *chainable* controller exports reference interfaces (:class:`Reference`),
@@ -99,6 +100,9 @@ class Actuator:
     # For a PID: its live object and where its gains came from ('' = the defaults).
     pid: Pid | None = None
     gains_from: str = ''
+    # For a velocity motor: whether the controller sets its force limit every step
+    # (``JointHandle.force_limit``: a gripper's max_effort); else it is the effort limit.
+    force_from_controller: bool = False
 
     @property
     def drive(self) -> Drive:
@@ -123,6 +127,9 @@ class Actuator:
                         "(gz_ros2_control's hold_joints)")
             if self.kind is ActuatorKind.IDEAL_ACCELERATION:
                 return f'{self.kind.label}{owner}, a velocity motor with {limit}'
+            if self.force_from_controller:
+                return (f'{self.kind.label}{owner}, a velocity motor with {limit}, or less as '
+                        "the controller asks (a goal's max_effort)")
             return (f'{self.kind.label}{owner}, a velocity motor with {limit}: no PID gains '
                     'for it in the YAML')
         return f'{self.kind.label}{owner}'
@@ -159,11 +166,17 @@ class JointHandle:
     those: each keeps the value it starts with (its ``initial_value``, else
     NaN), as a state interface of ros2_control's mock hardware does when
     nothing commands it.
+
+    ``force_limit`` (N*m or N, may be inf) is the most the ideal actuator's
+    motor may apply: the joint's effort limit, which the simulation restores
+    whenever the actuators change; a controller whose actuator says
+    ``force_from_controller`` sets it in its update, and the simulation
+    reads it every step.
     """
 
     __slots__ = ('spec', 'position', 'velocity', 'effort', 'velocity_target',
                  'initial_position', 'plugin_gains', 'tracking_gain', 'actuator',
-                 'other_states')
+                 'other_states', 'force_limit')
 
     def __init__(self, spec: JointSpec, initial_position: float | None = None,
                  plugin_gains: PidGains | None = None,
@@ -185,6 +198,7 @@ class JointHandle:
         self.velocity = 0.0
         self.effort = 0.0
         self.velocity_target = 0.0
+        self.force_limit = spec.effort_limit
 
     @property
     def name(self) -> str:
@@ -202,11 +216,12 @@ class JointHandle:
         return (*MEASURED_STATES, *self.other_states)
 
     def reset(self) -> None:
-        """Return to the joint's initial state (at rest, no effort)."""
+        """Return to the joint's initial state (at rest, no effort, its own effort limit)."""
         self.position = self.initial_position
         self.velocity = 0.0
         self.effort = 0.0
         self.velocity_target = 0.0
+        self.force_limit = self.spec.effort_limit
 
 
 class Reference:
@@ -270,6 +285,9 @@ class Controller(abc.ABC):
     # Whether the type drives a mobile base (its wheels move the robot over the ground): while
     # one will be active, sim_node's fixed_base:=auto frees the base (see model.base_pose).
     drives_base: ClassVar[bool] = False
+    # Whether the type commands joints (a command controller, a gripper's action controller)
+    # rather than only reading them (a broadcaster); those update first in every step.
+    commands_joints: ClassVar[bool] = False
     # Chained mode, and the references offered before configure (see the methods below).
     _chained: bool = False
     _available_references: Mapping[str, Reference] = MappingProxyType({})
@@ -452,6 +470,7 @@ class Controller(abc.ABC):
 class CommandController(Controller):
     """A controller that takes commands from a topic ``<controller>/<command_topic>``."""
 
+    commands_joints = True
     command_topic: ClassVar[str] = 'command'
     command_kind: ClassVar[CommandKind] = CommandKind.FLOAT64
 

@@ -67,7 +67,7 @@ import dataclasses
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
-from pan_tilt_sim.controllers.base import CommandController, Controller, JointHandle, Reference
+from pan_tilt_sim.controllers.base import Controller, JointHandle, Reference
 from pan_tilt_sim.controllers.registry import (
     create_controller,
     is_command_type,
@@ -504,8 +504,8 @@ class ControllerManager:
 
     def _add(self, controller: Controller, state: str) -> None:
         self._controllers.append(controller)
-        # Command controllers first: broadcasters then sample this step's efforts.
-        self._controllers.sort(key=lambda c: not isinstance(c, CommandController))
+        # Controllers that command joints first: broadcasters then sample this step's efforts.
+        self._controllers.sort(key=lambda c: not c.commands_joints)
         self._by_name[controller.name] = controller
         self._states[controller.name] = state
 

@@ -17,7 +17,9 @@ Names are dotted paths (``constraints.goal_time``).  A path segment
 ``__map_<list>`` stands for each entry of the string-list parameter
 ``<list>``, as generate_parameter_library's ``__map_`` keys do:
 ``gains.__map_joints.p`` is ``gains.<joint>.p`` for every joint in
-``joints``.  A default of None means "optional, absent when not given".
+``joints``; over a string parameter it stands for that one string
+(``gains.__map_joint.p``: ``gains.<joint>.p`` for the one ``joint``).
+A default of None means "optional, absent when not given".
 
 Types are ROS 2 parameter types by their generate_parameter_library names:
 ``bool``, ``int``, ``double``, ``string`` and the ``*_array`` of each.  An
@@ -269,10 +271,7 @@ def load_parameters(spec: ParameterSpec, params: Mapping[str, Any], controller: 
         known[param.name] = param
         _take(param, param.name, flat, values, fail)
     for param in mapped:
-        entries = values.get(param.map_list) or ()
-        if not isinstance(entries, list | tuple):
-            entries = ()
-        for name in param.expand([str(entry) for entry in entries]):
+        for name in param.expand(_map_entries(values, param.map_list)):
             known[name] = param
             _take(param, name, flat, values, fail)
     for name, param in known.items():
@@ -320,7 +319,7 @@ def _check_map_keys(mapped: Sequence[Param], values: Mapping[str, Any],
     for param in mapped:
         marker = MAP_PREFIX + param.map_list
         head = param.name.split(marker, 1)[0]
-        entries = [str(entry) for entry in values.get(param.map_list) or ()]
+        entries = _map_entries(values, param.map_list)
         for key in flat:
             if not head or not key.startswith(head):
                 continue
@@ -328,6 +327,16 @@ def _check_map_keys(mapped: Sequence[Param], values: Mapping[str, Any],
             if entry not in entries:
                 raise fail(f'{head}{entry}', f"'{entry}' is not one of this controller's "
                            f"{param.map_list} ({', '.join(entries) or 'none'})")
+
+
+def _map_entries(values: Mapping[str, Any], name: str) -> list[str]:
+    """Return the entries a ``__map_<name>`` segment expands over: a list's, or one string."""
+    entries = values.get(name)
+    if isinstance(entries, str):
+        return [entries] if entries else []
+    if not isinstance(entries, list | tuple):
+        return []
+    return [str(entry) for entry in entries]
 
 
 def _coerce(param: Param, value: Any) -> Any:

@@ -5,9 +5,13 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from pan_tilt_sim.controllers.base import CommandController, Controller
+from pan_tilt_sim.controllers.base import Controller
 from pan_tilt_sim.controllers.diff_drive_controller import DiffDriveController
+from pan_tilt_sim.controllers.effort_gripper_action_controller import (
+    EffortGripperActionController,
+)
 from pan_tilt_sim.controllers.forward_command_controller import ForwardCommandController
+from pan_tilt_sim.controllers.gripper_action_controller import GripperActionController
 from pan_tilt_sim.controllers.joint_effort_controller import JointEffortController
 from pan_tilt_sim.controllers.joint_group_effort_controller import JointGroupEffortController
 from pan_tilt_sim.controllers.joint_group_position_controller import (
@@ -20,6 +24,9 @@ from pan_tilt_sim.controllers.joint_position_controller import JointPositionCont
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
 from pan_tilt_sim.controllers.joint_trajectory_controller import JointTrajectoryController
 from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
+from pan_tilt_sim.controllers.parallel_gripper_action_controller import (
+    ParallelGripperActionController,
+)
 from pan_tilt_sim.controllers.pid_controller import PidController
 from pan_tilt_sim.errors import ControllerConfigError
 
@@ -35,6 +42,9 @@ CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
     JointTrajectoryController,
     PidController,
     DiffDriveController,
+    GripperActionController,
+    EffortGripperActionController,
+    ParallelGripperActionController,
 )
 
 CONTROLLER_TYPES: dict[str, type[Controller]] = {
@@ -79,6 +89,6 @@ def is_command_type(type_name: Any) -> bool:
     """
     cls = CONTROLLER_TYPES.get(type_name) if isinstance(type_name, str) else None
     if cls is not None:
-        return issubclass(cls, CommandController)
+        return cls.commands_joints
     base = str(type_name).rpartition('/')[2]
     return not base.endswith(('Broadcaster', 'StateController'))

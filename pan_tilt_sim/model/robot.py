@@ -280,6 +280,11 @@ class RobotModel:
     # Contact surfaces from <gazebo reference="LINK"> (mu1, mu2, kp, kd), for links that give any.
     surfaces: tuple[Surface, ...] = ()
 
+    @property
+    def link_frictions(self) -> dict[str, Surface]:
+        """The surfaces the URDF gives, by link (a link without surface tags is absent)."""
+        return {surface.link: surface for surface in self.surfaces}
+
     def surface(self, link: str) -> Surface:
         """Return ``link``'s contact surface: the URDF's, else a ball caster's, else Gazebo's.
 

@@ -63,6 +63,7 @@ from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.ros import optional_interfaces
 from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.gain_parameters import GainParameters
+from pan_tilt_sim.ros.gripper_action import GripperCommandServer, ParallelGripperCommandServer
 from pan_tilt_sim.ros.robot_state import tf_message_type, transform_message
 from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES, joint_state_message, stamp
 from pan_tilt_sim.ros.trajectory_action import TrajectoryActionServer
@@ -525,4 +526,6 @@ if tf_message_type() is not None:  # tf2_msgs is optional (see optional_interfac
 # Each action type: the server that runs a controller's goals.
 ACTION_SERVERS: dict[str, Callable[..., Any]] = {
     'control_msgs/action/FollowJointTrajectory': TrajectoryActionServer,
+    'control_msgs/action/GripperCommand': GripperCommandServer,
+    'control_msgs/action/ParallelGripperCommand': ParallelGripperCommandServer,
 }

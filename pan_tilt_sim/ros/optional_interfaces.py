@@ -18,9 +18,9 @@ from collections.abc import Iterable
 FEATURES = {
     'tf2_msgs': 'TF (/tf, /tf_static; robot_state_publisher can publish it from '
                 'robot_description and joint_states)',
-    'control_msgs': 'the follow_joint_trajectory actions, dynamic_joint_states and the '
-                    "controller topics of control_msgs types (pid_controller's ~/reference, "
-                    '~/controller_state)',
+    'control_msgs': 'the follow_joint_trajectory and gripper_cmd actions, dynamic_joint_states '
+                    "and the controller topics of control_msgs types (pid_controller's "
+                    '~/reference, ~/controller_state)',
     'controller_manager_msgs': "the controller_manager services (ros2_control's spawner)",
     'simulation_interfaces': 'the simulator services (get_simulator_features, '
                              'step_simulation, spawn_entity, ...)',

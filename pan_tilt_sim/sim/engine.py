@@ -51,6 +51,7 @@ from pan_tilt_sim.sim.physics import (
     STATE_MOTOR_TORQUE,
     STATE_POSITION,
     STATE_VELOCITY,
+    UNLIMITED_FORCE,
     Physics,
     health_problem,
 )
@@ -182,6 +183,7 @@ class Simulation:
                                          and handle.name not in self._driven)
                 handle.velocity_target = 0.0
             handle.actuator = actuator
+            handle.force_limit = handle.spec.effort_limit  # until a controller lowers it
         velocity_driven = [handle.drive is Drive.VELOCITY for handle in self._handle_list]
         self.physics.set_drives(velocity_driven)
         self._effort_handles = [handle for handle, driven in zip(
@@ -191,6 +193,12 @@ class Simulation:
         self._velocity_slots = [slot for slot, driven in enumerate(velocity_driven) if driven]
         self._efforts = [0.0] * len(self._effort_handles)
         self._targets = [0.0] * len(self._velocity_handles)
+        # The velocity motors' force limits: the effort limits, but a controller's own
+        # every step for the joints whose actuator takes it from the controller.
+        self._forces = [min(handle.spec.effort_limit, UNLIMITED_FORCE)
+                        for handle in self._velocity_handles]
+        self._forced = [(index, handle) for index, handle in enumerate(self._velocity_handles)
+                        if handle.actuator.force_from_controller]
         self._physics_step = self.physics.stepper()
         self._run_laws = self.physics.law_runner()
         self._effort_slot = {handle.name: index
@@ -341,6 +349,9 @@ class Simulation:
         scheduled = self.manager.scheduled_updates
         effort_handles, efforts = self._effort_handles, self._efforts
         velocity_handles, targets = self._velocity_handles, self._targets
+        forced, forces = self._forced, self._forces
+        # None: the motors keep the limits they have (no controller sets any).
+        motor_forces = forces if forced else None
         readback = list(zip(velocity_handles, self._velocity_slots, strict=True))
         physics_step = self._physics_step
         dt = self._time_step
@@ -363,7 +374,10 @@ class Simulation:
                 efforts[index] = handle.effort
             for index, handle in enumerate(velocity_handles):
                 targets[index] = handle.velocity_target
-            states = physics_step(efforts, targets)
+            for index, handle in forced:
+                force = handle.force_limit
+                forces[index] = force if force < UNLIMITED_FORCE else UNLIMITED_FORCE
+            states = physics_step(efforts, targets, motor_forces)
         self._steps = first + steps
         self._states = states
         self._check_health(states)

@@ -21,6 +21,10 @@ client:
   static too (PyBullet's rule).  PyBullet's hidden drag is off, as for the
   robot.  Its joints are passive (PyBullet's default motors off; URDF
   friction as a velocity motor capped at the friction, as for the robot).
+  Its links' ``<gazebo reference>`` ``<mu1>``/``<mu2>`` set their surface
+  friction, as the robot's do (:func:`~pan_tilt_sim.sim.physics.apply_surface_friction`),
+  and its contacts hold by static friction from one step to the next
+  (PyBullet's friction anchor): a box held between fingers stays put.
 
 Poses are those of an entity's URDF root link frame in the world (PyBullet
 itself reports the base's centre of mass; the difference is converted here),
@@ -57,7 +61,12 @@ from pan_tilt_sim.model.entity_resource import (
 from pan_tilt_sim.model.transforms import IDENTITY_ROTATION, ZERO_VECTOR, Transform, Vector
 from pan_tilt_sim.model.world_file import World, WorldFileError
 from pan_tilt_sim.sim.bullet import pybullet, quiet_native_output
-from pan_tilt_sim.sim.physics import BASE_LINK_INDEX, Physics
+from pan_tilt_sim.sim.physics import (
+    BASE_LINK_INDEX,
+    Physics,
+    apply_surface_friction,
+    link_indices,
+)
 from pan_tilt_sim.sim.stability import object_trial
 from pan_tilt_sim.sim.world import add_ground_plane, grounded_links
 
@@ -462,6 +471,12 @@ class Entities:
         # for the robot (sim/physics.py).
         pybullet.changeDynamics(body, BASE_LINK_INDEX, linearDamping=0.0, angularDamping=0.0,
                                 physicsClientId=client)
+        links = link_indices(body, client)
+        for index in links.values():
+            # Static friction holds a contact where it is (PyBullet's friction anchor):
+            # without it an object held between fingers creeps down, step after step.
+            pybullet.changeDynamics(body, index, frictionAnchor=1, physicsClientId=client)
+        apply_surface_friction(body, links, resource.model.link_frictions, client)
         joints = pybullet.getNumJoints(body, physicsClientId=client)
         if joints:
             friction = {joint.name: joint.friction for joint in resource.joints}

@@ -46,11 +46,19 @@ Each joint is driven one of two ways (:meth:`Physics.set_drives`):
   friction has no motor at all.
 * **velocity** (the ideal actuator, :mod:`pan_tilt_sim.controllers.actuator`):
   a velocity motor drives the joint to the target the controllers ask for,
-  with at most the joint's URDF effort limit; the torque it applied is read
+  with at most the joint's URDF effort limit, or the lower force a step
+  asks for (a gripper's ``max_effort``); the torque it applied is read
   back as the joint's effort.  URDF damping and friction are not applied.
 
 A ``<mimic>`` joint is held at ``multiplier * leader + offset`` by a gear
 constraint (see :mod:`pan_tilt_sim.model.mimic`).
+
+A link with ``<gazebo reference>`` ``<mu1>``/``<mu2>`` (robot or spawned
+object, :func:`apply_surface_friction`) gets the smaller of the two as
+PyBullet's lateral friction -- PyBullet's friction is the same in every
+direction.  At a contact PyBullet multiplies the two surfaces' coefficients
+where Gazebo takes the smaller one; a surface without the tags keeps
+PyBullet's 0.5.
 """
 
 from __future__ import annotations
@@ -60,7 +68,7 @@ import math
 import pathlib
 import tempfile
 import weakref
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy
 
@@ -70,6 +78,7 @@ from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.inertials import with_massive_root
 from pan_tilt_sim.model.mimic import follow_leaders, mimic_couplings
 from pan_tilt_sim.model.robot import JointSpec, RobotModel
+from pan_tilt_sim.model.surfaces import Surface
 from pan_tilt_sim.model.transforms import Transform, quaternion_from_rpy
 from pan_tilt_sim.sim import compiled_step
 from pan_tilt_sim.sim.bullet import (
@@ -177,6 +186,26 @@ def apply_surfaces(client: int, body: int, model: RobotModel) -> None:
                                     physicsClientId=client)
 
 
+def link_indices(body: int, client: int) -> dict[str, int]:
+    """Return PyBullet's index of every link of ``body``, by URDF name (the base: -1)."""
+    base = pybullet.getBodyInfo(body, physicsClientId=client)[0].decode('utf-8')
+    links = {base: BASE_LINK_INDEX}
+    for index in range(pybullet.getNumJoints(body, physicsClientId=client)):
+        info = pybullet.getJointInfo(body, index, physicsClientId=client)
+        links[info[12].decode('utf-8')] = index  # a joint's child link has its index
+    return links
+
+
+def apply_surface_friction(body: int, links: Mapping[str, int],
+                           frictions: Mapping[str, Surface], client: int) -> None:
+    """Give the links of ``body`` (indices by name) their friction (see the module)."""
+    for name, friction in frictions.items():
+        if name in links:  # a link merged away by a fixed joint has no body of its own
+            pybullet.changeDynamics(body, links[name],
+                                    lateralFriction=friction.friction,
+                                    physicsClientId=client)
+
+
 class Physics:
     """A PyBullet world holding one robot, its base welded to the world or free.
 
@@ -220,6 +249,8 @@ class Physics:
         self._mimics = mimic_couplings(self._joints, description.source)
         self.velocity_cap = velocity_cap(self._joints)
         self._remove_hidden_damping()
+        apply_surface_friction(self._body, self._link_indices,
+                               description.model.link_frictions, self._client)
         self._couple_mimic_joints(index_of)
         if initial_positions is None:
             initial_positions = [joint.initial_position for joint in self._joints]
@@ -395,18 +426,25 @@ class Physics:
         """
         self._drives = _Drives(self, velocity_driven)
 
-    def step(self, efforts: Sequence[float], targets: Sequence[float] = ()) -> list:
-        """Apply ``efforts`` and velocity ``targets``, advance one time step, return the states."""
+    def step(self, efforts: Sequence[float], targets: Sequence[float] = (),
+             forces: Sequence[float] | None = None) -> list:
+        """Apply ``efforts`` and velocity ``targets``, advance one time step, return the states.
+
+        ``forces``: the most each velocity motor may apply (N*m or N, in the
+        targets' order, each at most :data:`UNLIMITED_FORCE`); None keeps
+        those of the previous step -- at first the joints' effort limits.
+        """
         drives = self._drives
         if len(efforts) != len(drives.effort_slots) or len(targets) != len(
-                drives.velocity_slots):
+                drives.velocity_slots) or (forces is not None and len(forces) != len(targets)):
             raise ValueError(
-                f'{len(efforts)} efforts and {len(targets)} targets for '
+                f'{len(efforts)} efforts, {len(targets)} targets and '
+                f'{"no" if forces is None else len(forces)} forces for '
                 f'{len(drives.effort_slots)} effort- and {len(drives.velocity_slots)} '
                 'velocity-driven joints')
-        return drives.step(efforts, targets)
+        return drives.step(efforts, targets, forces)
 
-    def stepper(self) -> Callable[[Sequence[float], Sequence[float]], list]:
+    def stepper(self) -> Callable[..., list]:
         """Return a function doing what :meth:`step` does, with every argument pre-bound.
 
         For hot loops: the function reads nothing from ``self``.  It stays
@@ -594,8 +632,8 @@ class _Drives:
 
     Motor rows (one PyBullet velocity motor per joint at most):
 
-    * velocity-driven joint: target from the controllers, force = effort limit,
-      sent every step;
+    * velocity-driven joint: target from the controllers, force = effort limit
+      or the force the step gives, sent every step;
     * effort joint whose damping is implicit, with friction (or a mimic
       coupling): target 0, force ``f + d |v_end|`` from the implicit-Euler end
       speed, sent every step;
@@ -686,13 +724,15 @@ class _Drives:
         if not motor_count and not self._damped:
             # Nothing to do per step but the efforts: the cheapest step.
             self.run_laws = getattr(effort_step, 'run_laws', None)
-            def step(efforts: Sequence[float], targets: Sequence[float] = ()) -> Sequence:
+            def step(efforts: Sequence[float], targets: Sequence[float] = (),
+                     forces: Sequence[float] | None = None) -> Sequence:
                 return effort_step(efforts)
             self.step = step
             self.restart()
             return
 
-        def step(efforts: Sequence[float], targets: Sequence[float] = ()) -> list:
+        def step(efforts: Sequence[float], targets: Sequence[float] = (),
+                 forces: Sequence[float] | None = None) -> list:
             countdown[0] -= 1
             if countdown[0] < 0:
                 refresh()
@@ -700,6 +740,8 @@ class _Drives:
             if motor_count:
                 if velocity_count:
                     motor_targets[:velocity_count] = targets
+                    if forces is not None:
+                        motor_forces[:velocity_count] = forces
                 for row in rows:
                     # Implicit Euler of J v' = tau + g - d v - f sgn(v), divided by dt:
                     # the motor may resist with f plus the damping of the end speed.

@@ -43,7 +43,8 @@ where the parameter exists upstream. A key a type does not know is named in a wa
 closest known one; a wrong value ends start-up naming `<file>: <controller>.<field>`.
 
 Topic names: `~/x` is `<namespace>/<controller>/x`; other names are in the robot's namespace.
-`__map_joints` in a name stands for each joint of `joints`. *Tunable* gains are node
+`__map_joints` in a name stands for each joint of `joints`, `__map_joint` for the one
+`joint`. *Tunable* gains are node
 parameters you can change while the simulation runs; *read-only* ones are fixed once the
 controller is configured. *Not simulated*: accepted, but the simulator does not act on it.
 """

@@ -147,6 +147,20 @@ def test_a_vendor_controller_beside_a_known_one_is_skipped_when_all_are_active(a
     assert [s.name for s in manager.skipped] == ['arm_controller']
 
 
+def test_a_gripper_action_controller_commands_joints_it_is_known_and_updates_first(arm):
+    manager, _ = arm("""
+        controller_manager:
+          ros__parameters:
+            joint_state_broadcaster: {type: joint_state_broadcaster/JointStateBroadcaster}
+            gripper: {type: position_controllers/GripperActionController}
+            arm_controller: {type: acme_controllers/RobotController}
+        gripper:
+          ros__parameters: {joint: joint2}
+        """)
+    assert [c.name for c in manager.active] == ['gripper', JSB]
+    assert [s.name for s in manager.skipped] == ['arm_controller']
+
+
 def test_an_inactive_controller_that_cannot_load_is_skipped_with_its_reason(arm):
     broken = UR_STYLE_YAML.replace('    interface_name: velocity\n',
                                    '    interface_name: velocity\n    joints: [elbow]\n')

@@ -147,3 +147,21 @@ def test_extend_replaces_and_without_removes():
     assert spec['mode'].default == 'slow'
     assert 'open_loop' not in spec
     assert len(spec) == len(SPEC) - 1
+
+
+ONE_JOINT_SPEC = ParameterSpec([
+    Param('joint', STRING, REQUIRED, 'The joint.', (not_empty(),)),
+    Param('gains.__map_joint.p', DOUBLE, None, 'Proportional gain.'),
+])
+
+
+def test_a_map_over_a_string_parameter_stands_for_that_one_string():
+    loaded = load_parameters(ONE_JOINT_SPEC, {'joint': 'finger', 'gains': {'finger': {'p': 3}}},
+                             'gripper', 'file.yaml')
+    assert loaded.values['gains'] == {'finger': {'p': 3.0}}
+    assert loaded.warnings == []
+    with pytest.raises(ControllerConfigError, match=r"^file\.yaml: gripper\.gains\.thumb: "
+                                                    r"'thumb' is not one of this controller's "
+                                                    r'joint \(finger\)$'):
+        load_parameters(ONE_JOINT_SPEC, {'joint': 'finger', 'gains': {'thumb': {'p': 3}}},
+                        'gripper', 'file.yaml')

@@ -125,8 +125,8 @@ def test_a_non_finite_state_is_reported(tmp_path, monkeypatch):
     with star(tmp_path, '{p: 1.0}', log) as sim:
         step = sim._physics_step
 
-        def poisoned(efforts, targets):
-            states = step(efforts, targets)
+        def poisoned(efforts, targets, forces=None):
+            states = step(efforts, targets, forces)
             return [(math.nan, math.nan, *state[2:]) for state in states]
         sim._physics_step = poisoned
         sim.advance(1)
