@@ -66,7 +66,7 @@ import math
 import os
 import pathlib
 import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from pan_tilt_sim.errors import ConfigurationError, ControllerConfigError
@@ -582,3 +582,48 @@ def _update_rate(manager: Mapping[str, Any], path: str) -> float:
             f'{path}: {CONTROLLER_MANAGER}.{ROS2_PARAMETERS}.{UPDATE_RATE_FIELD}: '
             f'{rate!r} must be a number of Hz > 0')
     return float(rate)
+
+
+def controller_manager_config(manager_parameters: Mapping[str, Any],
+                              shared: Callable[[str], Mapping[str, Any]], *,
+                              update_rate: float, source: str) -> ControllersConfig:
+    """Return the controllers a controller_manager node's own parameters declare.
+
+    As ros2_control_node reads them: ``manager_parameters`` are the node's
+    parameters by name (``arm_controller.type``; dotted or nested), and a
+    controller is a ``<name>.type`` among them.  Each controller's
+    parameters are ``shared(name)`` -- what the controller_manager's own
+    arguments give the controller's node (ros2_control passes them on to
+    every controller node): its section of the ``--params-file`` files --
+    over ``update_rate`` (the controller_manager's).  ``source`` names the
+    node in errors.  None declared is fine: spawners then give the types.
+    """
+    nested = _unflatten(manager_parameters)
+    controllers = []
+    for name, entry in nested.items():
+        if not (isinstance(entry, Mapping) and TYPE_FIELD in entry):
+            continue
+        type_name = entry[TYPE_FIELD]
+        if not isinstance(type_name, str):
+            raise ControllerConfigError(
+                f"{source}: parameter '{name}.{TYPE_FIELD}' must be a string, got {type_name!r}")
+        if not naming.is_valid_name(name):
+            raise ControllerConfigError(
+                f"{source}: controller name '{name}' is not a valid ROS name "
+                f'({naming.NAME_RULE}); it becomes part of its topic names')
+        params: dict[str, Any] = {UPDATE_RATE_FIELD: update_rate}
+        _merge_into(params, shared(name))
+        params[TYPE_FIELD] = type_name
+        controllers.append(ControllerSpec(name=name, type=type_name, params=params))
+    return ControllersConfig(controllers=tuple(controllers), source=pathlib.Path(source),
+                             update_rate=update_rate)
+
+
+def unflatten(parameters: Mapping[str, Any]) -> dict[str, Any]:
+    """Turn ROS 2's dotted parameter names (``gains.joint1.p``) into nested mappings."""
+    return _unflatten(parameters)
+
+
+def merge_parameters(target: dict[str, Any], overrides: Mapping[str, Any]) -> None:
+    """Deep-merge ``overrides`` into ``target`` (overrides win, mappings merge), in place."""
+    _merge_into(target, overrides)
