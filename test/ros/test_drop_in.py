@@ -23,7 +23,8 @@ from drop_in_fixtures import (
     drop_in_node,
     write_yaml,
 )
-from node_harness import SimUnderTest
+from node_harness import NodeHarness, SimUnderTest
+from rclpy.parameter import Parameter
 from robot_state_publisher_stand_in import RobotStatePublisherStandIn
 from spawner_client import Spawner, spawner_main
 from std_msgs.msg import Float64MultiArray
@@ -93,8 +94,9 @@ def test_spawners_with_param_file_and_controller_ros_args_drive_the_remapped_top
         publish_description(harness, arm_urdf(tmp_path))
         sim = wait_built(harness, node)
         assert spawner_main(sim, [JSB, '--param-file', controllers]) == 0
+        remap = '-r ~/commands:=/position_commands'
         assert spawner_main(sim, [FORWARD, '--param-file', controllers,
-                                  '--controller-ros-args', '-r ~/commands:=/position_commands']) == 0
+                                  '--controller-ros-args', remap]) == 0
         listed = Spawner(sim).controllers()
         assert {name: c.state for name, c in listed.items()} == {JSB: 'active', FORWARD: 'active'}
         assert listed[JSB].update_rate == 50  # its own section's
@@ -200,14 +202,12 @@ def test_an_unknown_hardware_component_in_its_initial_state_is_warned_about(tmp_
 
 
 def test_named_sim_node_an_empty_description_file_also_means_the_topic(tmp_path):
-    from node_harness import NodeHarness
-
+    controllers = write_yaml(tmp_path, 'c.yaml', MANAGER_YAML)
     harness = NodeHarness()
     try:
         node = harness.add(SimNode(context=harness.context, parameter_overrides=[
-            pytest.importorskip('rclpy.parameter').Parameter('robot_description_file', value=''),
-            pytest.importorskip('rclpy.parameter').Parameter(
-                'controllers_file', value=str(write_yaml(tmp_path, 'c.yaml', MANAGER_YAML)))]))
+            Parameter('robot_description_file', value=''),
+            Parameter('controllers_file', value=str(controllers))]))
         assert node.simulation is None and node.get_name() == 'sim_node'
         publish_description(harness, arm_urdf(tmp_path))
         sim = wait_built(harness, node)
