@@ -76,6 +76,19 @@ def test_it_waits_for_robot_description_with_one_line_and_starts_when_it_arrives
                for line in lines)
 
 
+def test_a_description_published_before_it_started_is_still_received(tmp_path):
+    harness = NodeHarness()
+    try:
+        publish_description(harness, arm_urdf(tmp_path))
+        harness.spin_for(0.2)  # the description is out before sim_node exists
+        node = harness.add(SimNode(
+            context=harness.context, cli_args=['--ros-args', '-r', '__node:=controller_manager'],
+            parameter_overrides=[Parameter('real_time_factor', value=0.0)]))
+        wait_built(harness, node)
+    finally:
+        harness.close()
+
+
 def test_nothing_is_active_until_spawned_and_the_joints_are_held(tmp_path):
     with drop_in_node() as (harness, node):
         publish_description(harness, arm_urdf(tmp_path))
@@ -115,7 +128,8 @@ def test_spawners_with_param_file_and_controller_ros_args_drive_the_remapped_top
 def test_controllers_given_as_node_parameters_in_the_managers_layout_need_no_param_file(
         tmp_path):
     controllers = write_yaml(tmp_path, 'controllers.yaml', MANAGER_YAML)
-    with drop_in_node('--params-file', str(controllers)) as (harness, node):
+    with drop_in_node('--params-file', str(controllers), '-p', 'real_time_factor:=0.0') as (
+            harness, node):
         assert node.get_parameter(f'{FORWARD}.type').value == FORWARD_TYPE
         assert node.get_parameter('update_rate').value == 50
         publish_description(harness, arm_urdf(tmp_path))
