@@ -3,7 +3,8 @@
 ``launch`` and ``launch_ros`` are not on PyPI.  :func:`load` runs a launch
 file's ``generate_launch_description()`` against stand-in modules that record
 what it asks for (Node, RegisterEventHandler + OnProcessExit, Command,
-PathJoinSubstitution, FindPackageShare, LaunchConfiguration), and
+PathJoinSubstitution, PathSubstitution, FindPackageShare, LaunchConfiguration,
+DeclareLaunchArgument, IfCondition, ParameterFile), and
 :class:`StandInLaunch` carries the nodes out, as launch_ros would start them:
 
 * ``pan_tilt_sim``'s ``sim_node`` as a process, ``--ros-args -r
@@ -20,6 +21,7 @@ from __future__ import annotations
 import importlib.util
 import os
 import pathlib
+import re
 import shlex
 import shutil
 import subprocess
@@ -33,9 +35,10 @@ import yaml
 from spawner_client import spawner_main
 
 HERE = pathlib.Path(__file__).resolve().parent
-STAND_IN_MODULES = ('launch', 'launch.actions', 'launch.event_handlers',
+STAND_IN_MODULES = ('launch', 'launch.actions', 'launch.conditions', 'launch.event_handlers',
                     'launch.substitutions', 'launch_ros', 'launch_ros.actions',
-                    'launch_ros.substitutions')
+                    'launch_ros.parameter_descriptions', 'launch_ros.substitutions')
+SUBSTITUTION = re.compile(r'\$\(var ([A-Za-z0-9_]+)\)')
 
 
 class Recorded:
@@ -65,6 +68,25 @@ class PathJoinSubstitution(Recorded):
     """launch.substitutions.PathJoinSubstitution."""
 
 
+class PathSubstitution(Recorded):
+    """launch.substitutions.PathSubstitution: ``/`` joins a part on."""
+
+    def __truediv__(self, part: Any) -> PathSubstitution:
+        return PathSubstitution(PathJoinSubstitution([self, part]))
+
+
+class DeclareLaunchArgument(Recorded):
+    """launch.actions.DeclareLaunchArgument: a name and its default_value."""
+
+
+class IfCondition(Recorded):
+    """launch.conditions.IfCondition: true when its text is 'true' (any case) or '1'."""
+
+
+class ParameterFile(Recorded):
+    """launch_ros ParameterFile: a file; with allow_substs its $(var name) are filled in."""
+
+
 class FindPackageShare(Recorded):
     """launch_ros.substitutions.FindPackageShare."""
 
@@ -78,7 +100,10 @@ def modules() -> dict[str, types.ModuleType]:
     made = {name: types.ModuleType(name) for name in STAND_IN_MODULES}
     made['launch'].LaunchDescription = list
     made['launch.actions'].RegisterEventHandler = RegisterEventHandler
-    made['launch.actions'].DeclareLaunchArgument = Recorded
+    made['launch.actions'].DeclareLaunchArgument = DeclareLaunchArgument
+    made['launch.conditions'].IfCondition = IfCondition
+    made['launch.substitutions'].PathSubstitution = PathSubstitution
+    made['launch_ros.parameter_descriptions'].ParameterFile = ParameterFile
     made['launch.event_handlers'].OnProcessExit = OnProcessExit
     made['launch.substitutions'].Command = Command
     made['launch.substitutions'].PathJoinSubstitution = PathJoinSubstitution
@@ -106,6 +131,10 @@ def perform(value: Any, arguments: dict[str, str]) -> Any:
         return get_package_share_directory(perform(value.args[0], arguments))
     if isinstance(value, PathJoinSubstitution):
         return os.path.join(*[perform(part, arguments) for part in value.args[0]])
+    if isinstance(value, PathSubstitution):
+        return perform(value.args[0], arguments)
+    if isinstance(value, IfCondition):
+        return perform(value.args[0], arguments).strip().lower() in ('true', '1')
     if isinstance(value, LaunchConfiguration):
         return arguments[value.args[0]]
     if isinstance(value, Command):
@@ -126,14 +155,17 @@ class StandInLaunch:
                  arguments: dict[str, str] | None = None) -> None:
         self.actions = actions
         self.folder = folder
-        self.arguments = arguments or {}
+        self.arguments = {action.args[0]: action.kwargs.get('default_value', '')
+                          for action in actions if isinstance(action, DeclareLaunchArgument)}
+        self.arguments.update(arguments or {})
         self.processes: dict[str, subprocess.Popen] = {}
         self.spawner_exits: list[tuple[list[str], int]] = []
         self._files = 0
 
     def nodes(self) -> Iterator[Node]:
-        """The Node actions started at once (not those waiting for an event)."""
-        return (action for action in self.actions if isinstance(action, Node))
+        """The Node actions started at once (not those an event waits for) whose condition holds."""
+        return (action for action in self.actions if isinstance(action, Node) and perform(
+            action.kwargs.get('condition', True), self.arguments))
 
     def start_processes(self) -> None:
         """Start every node that runs as a process (all but the spawners)."""
@@ -158,6 +190,9 @@ class StandInLaunch:
             spawner = queue.pop(0)
             arguments = [str(item) for item in perform(spawner.kwargs.get('arguments', []),
                                                       self.arguments)]
+            # Its own parameter files are --param-files to jazzy's spawner too.
+            for parameters in perform(spawner.kwargs.get('parameters', []), self.arguments):
+                arguments += ['--param-file', str(self._parameter_file(parameters))]
             code = spawner_main(harness, arguments, spawner.kwargs.get('namespace') or '/')
             codes.append(code)
             self.spawner_exits.append((arguments, code))
@@ -185,9 +220,15 @@ class StandInLaunch:
 
     def _parameter_file(self, parameters: Any) -> pathlib.Path:
         """A file name stays; a dict is written under ``/**``, as launch_ros writes it."""
-        if not isinstance(parameters, dict):
-            return pathlib.Path(parameters)
         self._files += 1
         path = self.folder / f'launch_params_{self._files}.yaml'
+        if isinstance(parameters, ParameterFile):
+            text = pathlib.Path(perform(parameters.args[0], self.arguments)).read_text()
+            if parameters.kwargs.get('allow_substs'):
+                text = SUBSTITUTION.sub(lambda match: self.arguments[match[1]], text)
+            path.write_text(text)
+            return path
+        if not isinstance(parameters, dict):
+            return pathlib.Path(parameters)
         path.write_text(yaml.safe_dump({'/**': {'ros__parameters': parameters}}))
         return path

@@ -789,3 +789,20 @@ def test_a_controller_manager_may_declare_none_and_refuses_a_type_that_is_no_str
                        match="^cm: parameter 'forward.type' must be a string, got 3$"):
         controller_manager_config({'forward.type': 3}, lambda name: {}, update_rate=100.0,
                                   source='cm')
+
+
+def test_a_launch_argument_left_in_another_nodes_section_does_not_stop_this_node(tmp_path):
+    from pan_tilt_sim.model.controller_config import node_parameters
+
+    path = write(tmp_path, 'rrbot_controllers.yaml', """\
+        joint_state_broadcaster:
+          ros__parameters:
+            type: joint_state_broadcaster/JointStateBroadcaster
+        forward_position_controller:
+          ros__parameters:
+            joints: [$(var joint_prefix)1]
+        """)
+    assert node_parameters([path], 'joint_state_broadcaster') == {
+        'type': 'joint_state_broadcaster/JointStateBroadcaster'}
+    with pytest.raises(ControllerConfigError, match=r':6: \$\(var joint_prefix\) is not set'):
+        node_parameters([path], 'forward_position_controller')
