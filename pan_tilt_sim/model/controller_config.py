@@ -228,18 +228,25 @@ def controllers_files_for(given: str, description: RobotDescription, *,
             return (resolve_resource(given, pathlib.Path.cwd()),)
         except ConfigurationError as err:
             raise ControllerConfigError(f'{given_as}: {err}') from None
-    named = []
-    for plugin in description.model.control_plugins:
-        for text in plugin.parameters:
-            named.append(_plugin_file(text, plugin.filename, description.source))
+    named = plugin_controllers_files(description)
     if named:
-        return tuple(named)
+        return named
     if description.name == DEFAULT_ROBOT_NAME:
         return (package_share() / DEFAULT_CONTROLLERS,)
     raise ControllerConfigError(
         f'{description.source}: no controllers file: {given_as} is not set and the URDF names '
         'none (no gz_ros2_control, ign_ros2_control or gazebo_ros2_control plugin with '
         f'<parameters>); give the controller YAML with {given_as}')
+
+
+def plugin_controllers_files(description: RobotDescription) -> tuple[pathlib.Path, ...]:
+    """Return the files the URDF's gz_ros2_control / gazebo_ros2_control plugin names (or none).
+
+    What Gazebo's controller_manager is started with: see
+    :func:`controllers_files_for` for how each is found.
+    """
+    return tuple(_plugin_file(text, plugin.filename, description.source)
+                 for plugin in description.model.control_plugins for text in plugin.parameters)
 
 
 def _plugin_file(text: str, plugin: str, description_file: pathlib.Path) -> pathlib.Path:

@@ -39,7 +39,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import String
 
-from pan_tilt_sim.errors import ParameterError
+from pan_tilt_sim.errors import ConfigurationError, ParameterError
 from pan_tilt_sim.model.controller_config import (
     DEFAULT_UPDATE_RATE,
     UPDATE_RATE_FIELD,
@@ -47,6 +47,7 @@ from pan_tilt_sim.model.controller_config import (
     controller_manager_config,
     merge_parameters,
     node_parameters,
+    plugin_controllers_files,
     unflatten,
 )
 from pan_tilt_sim.model.description import RobotDescription, description_from_text
@@ -67,7 +68,7 @@ DESCRIPTION_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
 class ManagerSettings:
     """The controller_manager's own parameters, read at start-up."""
 
-    update_rate: int  # Hz
+    update_rate: int | None  # Hz; None: not given (a plugin's file, else 100 Hz)
     # The spawner's fields given at start-up, by name: {'arm_controller.type': '...'}.
     controller_fields: Mapping[str, Any]
 
@@ -81,14 +82,16 @@ def declare_manager_parameters(node: Node, arguments: RosArguments,
     section and wildcards), its ``-p`` arguments and ``overrides`` -- and each
     is declared, which gives it the value rcl resolved for this node.
     """
-    rate = parameters.declare(
-        node, UPDATE_RATE_FIELD, parameters.INTEGER, int(DEFAULT_UPDATE_RATE),
-        "Hz at which the controllers update (ros2_control_node's 'update_rate').")
-    if rate <= 0:
-        raise ParameterError(f"parameter '{UPDATE_RATE_FIELD}' must be > 0 Hz, got {rate}")
     names = set(_flat(node_parameters(arguments.params_files, node.get_name())))
     names.update(arguments.parameters_for(node.get_name()))
     names.update(parameter.name for parameter in overrides)
+    rate = None  # declared with the simulation then, from a plugin's file or 100 Hz
+    if UPDATE_RATE_FIELD in names:
+        rate = parameters.declare(
+            node, UPDATE_RATE_FIELD, parameters.INTEGER, int(DEFAULT_UPDATE_RATE),
+            "Hz at which the controllers update (ros2_control_node's 'update_rate').")
+        if rate <= 0:
+            raise ParameterError(f"parameter '{UPDATE_RATE_FIELD}' must be > 0 Hz, got {rate}")
     fields = sorted(name for name in names if ControllerManagerServices.is_controller_field(name))
     declare_controller_fields(node, [Parameter(name) for name in fields])
     values = {name: node.get_parameter(name).value for name in fields}
@@ -111,13 +114,38 @@ def declare_controller_fields(node: Node, changed: Sequence[Parameter]) -> None:
                 dynamic_typing=True))
 
 
-def controllers_config(node: Node, settings: ManagerSettings,
-                       arguments: RosArguments) -> ControllersConfig:
-    """Return the controllers the node's parameters declare (none: spawners give them)."""
-    return controller_manager_config(
-        settings.controller_fields, lambda name: shared_parameters(node, arguments, name),
-        update_rate=float(settings.update_rate),
+def manager_controllers(node: Node, settings: ManagerSettings, arguments: RosArguments,
+                        description: RobotDescription) -> tuple[ControllersConfig, RosArguments]:
+    """Return the controllers the node's parameters declare, and the arguments they read.
+
+    None declared is fine: spawners give them.  As Gazebo starts its
+    controller_manager with the files the URDF's gz_ros2_control plugin
+    names (``<parameters>``), those files come first, under the node's own:
+    their controllers, their sections and -- unless the node was given one --
+    their ``update_rate`` count, so a Gazebo launch file whose spawn step
+    sim_node replaces keeps its controllers.  One the plugin names but that
+    cannot be found is skipped with a warning.
+    """
+    try:
+        plugin_files = plugin_controllers_files(description)
+    except ConfigurationError as err:
+        node.get_logger().warning(f'{err}: skipped')
+        plugin_files = ()
+    arguments = dataclasses.replace(
+        arguments, params_files=(*plugin_files, *arguments.params_files))
+    manager = node_parameters(plugin_files, node.get_name())
+    fields = {name: value for name, value in _flat_items(manager)
+              if ControllerManagerServices.is_controller_field(name)}
+    fields.update(settings.controller_fields)
+    rate = settings.update_rate
+    if rate is None:
+        given = manager.get(UPDATE_RATE_FIELD)
+        rate = given if isinstance(given, int) and given > 0 else int(DEFAULT_UPDATE_RATE)
+    controllers = controller_manager_config(
+        fields, lambda name: shared_parameters(node, arguments, name),
+        update_rate=float(rate),
         source=f'the parameters of {node.get_fully_qualified_name()}')
+    return controllers, arguments
 
 
 def shared_parameters(node: Node, arguments: RosArguments, controller: str) -> dict[str, Any]:
@@ -165,13 +193,18 @@ def wait_for_description(node: Node, build: Callable[[RobotDescription], None]) 
     return subscription
 
 
-def _flat(nested: Mapping[str, Any], prefix: str = '') -> list[str]:
+def _flat(nested: Mapping[str, Any]) -> list[str]:
     """Return the dotted names of the leaves of nested parameters."""
-    names = []
+    return [name for name, _value in _flat_items(nested)]
+
+
+def _flat_items(nested: Mapping[str, Any], prefix: str = '') -> list[tuple[str, Any]]:
+    """Return (dotted name, value) of the leaves of nested parameters."""
+    items = []
     for key, value in nested.items():
         name = f'{prefix}{key}'
         if isinstance(value, Mapping) and value:
-            names.extend(_flat(value, f'{name}.'))
+            items.extend(_flat_items(value, f'{name}.'))
         else:
-            names.append(name)
-    return names
+            items.append((name, value))
+    return items

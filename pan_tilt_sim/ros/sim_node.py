@@ -142,8 +142,8 @@ class SimNode(Node):
         if self._topic_settings is not None:
             controllers = topic_hardware.controllers_config(self._topic_settings)
         elif self._manager_settings is not None:
-            controllers = drop_in.controllers_config(self, self._manager_settings,
-                                                     self._arguments)
+            controllers, self._arguments = drop_in.manager_controllers(
+                self, self._manager_settings, self._arguments, description)
         else:
             controllers = load_controllers_config(
                 controllers_files_for(self.settings.controllers_file, description),
@@ -488,7 +488,7 @@ class SimNode(Node):
             ControllerManagerServices(
                 self, self.controllers, self.simulation.manager,
                 self.simulation.description.model, substitutions=substitutions,
-                source=controllers.label, update_rate=self._manager_settings.update_rate,
+                source=controllers.label, update_rate=round(controllers.update_rate),
                 shared_parameters=lambda name: drop_in.shared_parameters(
                     self, self._arguments, name))
             self.controller_manager = self

@@ -143,6 +143,26 @@ def test_controllers_given_as_node_parameters_in_the_managers_layout_need_no_par
     assert f'{FORWARD}.real_time_factor: unknown parameter' not in capfd.readouterr().err
 
 
+def test_a_gazebo_robots_plugin_file_gives_the_controller_manager_its_controllers(tmp_path):
+    from ros2_control_fixtures import write_arm
+
+    from pan_tilt_sim.model.description import load_description
+
+    # A gz_ros2_control launch file with its spawn step dropped: the URDF's plugin names
+    # the controllers YAML, which Gazebo's controller_manager would have been given.
+    plugin_file = tmp_path / 'arm_controllers.yaml'
+    urdf = load_description(write_arm(tmp_path, MANAGER_YAML),
+                            [f'controllers:={plugin_file}']).urdf_xml
+    with drop_in_node() as (harness, node):
+        publish_description(harness, urdf)
+        sim = wait_built(harness, node)
+        spawner = Spawner(sim)
+        assert spawner.spawn(JSB) == 0 and spawner.spawn(FORWARD) == 0
+        listed = spawner.controllers()
+        assert listed[FORWARD].update_rate == 50  # the plugin file's controller_manager's
+        assert listed[FORWARD].claimed_interfaces == ['joint1/position', 'joint2/position']
+
+
 def test_a_params_file_given_to_the_controller_manager_is_loaded(tmp_path):
     extra = write_yaml(tmp_path, 'forward.yaml', FORWARD_PARAMETERS_YAML)
     with drop_in_node('-p', f'{FORWARD}.type:={FORWARD_TYPE}',
