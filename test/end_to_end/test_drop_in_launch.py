@@ -126,3 +126,18 @@ def test_with_no_robot_description_it_says_so_once_and_waits_idle():
     assert used < IDLE_CPU_S, f'{used:.2f} s of CPU in {IDLE_WATCH_S} s of waiting'
     (line,) = [line for line in seen if WAITING in line]
     assert line.startswith('[INFO]') and "'/robot_description'" in line
+
+
+def test_the_real_launch_api_reads_the_launch_file_where_installed(repo_root):
+    try:
+        from launch import LaunchDescription  # noqa: I001 (launch/ reads as first-party)
+        from launch_ros.actions import Node
+    except ImportError:  # from the source tree, its launch/ folder imports as an empty package
+        pytest.skip('the ROS 2 launch and launch_ros packages are not installed')
+    spec = importlib.util.spec_from_file_location('arm_launch', repo_root.joinpath(*LAUNCH_FILE))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    description = module.generate_launch_description()
+    assert isinstance(description, LaunchDescription)
+    nodes = [entity for entity in description.entities if isinstance(entity, Node)]
+    assert (nodes[0].node_package, nodes[0].node_executable) == ('pan_tilt_sim', 'sim_node')
