@@ -86,6 +86,13 @@ class SimNode(Node):
     thread of its own that takes turns with the executor's callbacks through
     :attr:`turns`; spin the node on a ``TurnTakingExecutor(node.turns)``
     then (see :mod:`pan_tilt_sim.ros.physics_thread`).
+
+    With ``robot_description_file`` empty, everything but the parameters is
+    built once the ``robot_description`` topic brings the robot; named
+    ``controller_manager`` it stands in for ros2_control_node, serving the
+    controller_manager services itself (see :mod:`pan_tilt_sim.ros.drop_in`).
+    ``ros_arguments`` are the process's command line, whose parameter files
+    the controllers read there as ros2_control's controller nodes read them.
     """
 
     def __init__(self, *, physics_thread: bool = False, ros_arguments: Sequence[str] = (),

@@ -141,3 +141,26 @@ def test_the_real_launch_api_reads_the_launch_file_where_installed(repo_root):
     assert isinstance(description, LaunchDescription)
     nodes = [entity for entity in description.entities if isinstance(entity, Node)]
     assert (nodes[0].node_package, nodes[0].node_executable) == ('pan_tilt_sim', 'sim_node')
+
+
+def test_a_description_it_cannot_simulate_ends_the_program_with_one_error_line():
+    from robot_state_publisher_stand_in import RobotStatePublisherStandIn
+
+    process = sim_process.start('-r', '__node:=controller_manager')
+    harness = NodeHarness()
+    try:
+        seen: list[str] = []
+        _read(process, seen, WAITING, READ_BUDGET_S)
+        harness.add(RobotStatePublisherStandIn('<robot name="x"><link name="a"/></robot>',
+                                               context=harness.context))
+        assert harness.spin_until(lambda: process.poll() is not None, READ_BUDGET_S), (
+            'sim_node kept running on a robot it cannot simulate')
+        _stdout, rest = process.communicate(timeout=READ_BUDGET_S)
+    finally:
+        harness.close()
+        if process.poll() is None:
+            sim_process.stop(process, 10.0)
+    assert process.returncode == 2
+    errors = [line for line in rest.splitlines() if not line.startswith('[')]
+    assert errors == ['sim_node: error: /robot_description: the robot has no movable joints '
+                      'to control'], rest
