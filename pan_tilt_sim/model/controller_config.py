@@ -413,17 +413,28 @@ def _plugin_pid_gains(holder: Mapping[Any, Any], path: pathlib.Path) -> dict[str
 def _read_document(path: pathlib.Path, args: Mapping[str, str],
                    args_name: str) -> Mapping[Any, Any]:
     """Read one file, substitutions expanded; it must be a non-empty mapping."""
-    text = read_text(path)
-    expanded = expand_substitutions(text, args)
+    expanded, document = _expanded_document(path, args)
+    _check_expanded(document, expanded, path, args_name)
+    return document
+
+
+def _expanded_document(path: pathlib.Path,
+                       args: Mapping[str, str]) -> tuple[str, Mapping[Any, Any]]:
+    """Return a file's text with its substitutions expanded, and its non-empty mapping."""
+    expanded = expand_substitutions(read_text(path), args)
     document = parse_yaml(expanded, path)
     if not isinstance(document, Mapping) or not document:
         raise ControllerConfigError(f'{path}: no controllers in it (expected a YAML mapping)')
-    leftover = _leftover_substitution(document)
+    return expanded, document
+
+
+def _check_expanded(value: Any, expanded: str, path: pathlib.Path, args_name: str) -> None:
+    """Refuse a substitution left in ``value`` (read from ``path``), naming its line."""
+    leftover = _leftover_substitution(value)
     if leftover is not None:
         raise ControllerConfigError(
             f'{path}{_line_of(expanded, leftover.group(0))}: '
             f'{_unexpanded_problem(leftover, args_name)}')
-    return document
 
 
 def _name_from_file(path: pathlib.Path) -> str:
@@ -515,14 +526,18 @@ def node_parameters(paths: Sequence[pathlib.Path | str], node: str,
     it is ignored) or is a wildcard (``/**``) matching it; files are read in
     order, later ones winning, and a node's own section wins over wildcards
     of the same file.  Errors name the file; a file without any
-    ``ros__parameters`` gives nothing.
+    ``ros__parameters`` gives nothing.  A substitution left unexpanded is an
+    error only in what the file gives ``node`` (other nodes' sections may
+    use launch arguments ``node`` is not given).
     """
     merged: dict[str, Any] = {}
     for path in paths:
         path = pathlib.Path(path).expanduser().resolve()
-        document = _read_document(path, args or {}, args_name)
+        expanded, document = _expanded_document(path, args or {})
         patterns, own = _split_nodes(_ros2_nodes(document, path))
-        _merge_into(merged, _parameters_of(node, patterns, own))
+        given = _parameters_of(node, patterns, own)
+        _check_expanded(given, expanded, path, args_name)
+        _merge_into(merged, given)
     return merged
 
 
