@@ -23,9 +23,10 @@ def srv():
 class Spawner:
     """The calls of jazzy's spawner.py, from the harness's probe node."""
 
-    def __init__(self, sim, manager: str = CM) -> None:
+    def __init__(self, sim, manager: str = CM, namespace: str = '/') -> None:
         self.sim = sim
         self.manager = manager
+        self.namespace = namespace  # the spawner's: its files' keys may name it
 
     def call(self, service: str, request=None):
         service_type = {'list_controllers': srv().ListControllers,
@@ -83,11 +84,12 @@ class Spawner:
                 words = [word for args in controller_ros_args for word in args.split()]
                 if not self.set_parameter(name, 'node_options_args', words):
                     return 1
-            files = [str(path) for path in param_files if _section(path, name) is not None]
+            ns = self.namespace
+            files = [str(path) for path in param_files if _section(path, name, ns) is not None]
             if files:
                 self.set_parameter(name, 'params_file', files)
-                kind = next((_section(path, name).get('type') for path in files
-                             if _section(path, name).get('type')), None)
+                kind = next((_section(path, name, ns).get('type') for path in files
+                             if _section(path, name, ns).get('type')), None)
                 if kind and not self.set_parameter(name, 'type', kind):
                     return 1
             if not self.load(name):
@@ -99,13 +101,14 @@ class Spawner:
         return 0 if self.switch(activate=[name]).ok else 1
 
 
-def _section(path, name: str) -> dict | None:
+def _section(path, name: str, namespace: str = '/') -> dict | None:
     """The controller's ros__parameters in a parameter file (its key or /**), else None."""
     import yaml
 
     with open(path) as stream:
         document = yaml.safe_load(stream) or {}
-    for key in (name, f'/{name}', f'/**/{name}'):
+    namespaced = f"{namespace.rstrip('/')}/{name}"
+    for key in (name, namespaced, f'/**/{name}', f'/**{namespaced}'):
         if key in document:
             return document[key].get('ros__parameters') or {}
     wildcard = document.get('/**') or {}
@@ -127,10 +130,11 @@ def spawner_main(sim, arguments, namespace: str = '/') -> int:
     parser.add_argument('--inactive', action='store_true')
     parser.add_argument('--controller-ros-args', action='append', default=[])
     args = parser.parse_args([str(argument) for argument in arguments])
+    namespace = '/' + namespace.strip('/')  # as the spawner makes its namespace absolute
     manager = args.controller_manager
     if not manager.startswith('/'):
         manager = f"{namespace.rstrip('/')}/{manager}"
-    spawner = Spawner(sim, manager)
+    spawner = Spawner(sim, manager, namespace)
     for name in args.controller_names:
         code = spawner.spawn(name, args.param_file, args.controller_ros_args,
                              inactive=args.inactive)
