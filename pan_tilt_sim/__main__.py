@@ -14,6 +14,8 @@ are 3x3 and 4x4, far too small for threads to help.
 from __future__ import annotations
 
 import os
+import sys
+from collections.abc import Sequence
 
 # Before anything imports numpy; a user's own setting wins.
 os.environ.setdefault('OPENBLAS_NUM_THREADS', '1')
@@ -23,15 +25,17 @@ from pan_tilt_sim.ros import runner  # noqa: E402 (after the line above, on purp
 PROGRAM = 'sim_node'
 
 
-def make_sim_node():
+def make_sim_node(args: Sequence[str] | None = None):
     """Build the SimNode (imports rclpy and PyBullet: call it once the handlers are in).
 
     Its physics runs in a paced thread of its own (see
-    :mod:`pan_tilt_sim.ros.physics_thread`).
+    :mod:`pan_tilt_sim.ros.physics_thread`).  ``args`` (default: the
+    program's command line) are the ROS arguments rcl was given; the node
+    reads their ``--params-file`` for its controllers as ros2_control_node does.
     """
     from pan_tilt_sim.ros.sim_node import SimNode
 
-    return SimNode(physics_thread=True)
+    return SimNode(physics_thread=True, ros_arguments=sys.argv if args is None else args)
 
 
 def make_executor(node):
@@ -43,7 +47,7 @@ def make_executor(node):
 
 def main(args: list[str] | None = None) -> None:
     """Run sim_node until SIGINT/SIGTERM (exit 0); a configuration error exits with code 2."""
-    runner.main(make_sim_node, args, program=PROGRAM, make_executor=make_executor)
+    runner.main(lambda: make_sim_node(args), args, program=PROGRAM, make_executor=make_executor)
 
 
 if __name__ == '__main__':

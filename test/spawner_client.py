@@ -23,9 +23,10 @@ def srv():
 class Spawner:
     """The calls of jazzy's spawner.py, from the harness's probe node."""
 
-    def __init__(self, sim, manager: str = CM) -> None:
+    def __init__(self, sim, manager: str = CM, namespace: str = '/') -> None:
         self.sim = sim
         self.manager = manager
+        self.namespace = namespace  # the spawner's: its files' keys may name it
 
     def call(self, service: str, request=None):
         service_type = {'list_controllers': srv().ListControllers,
@@ -67,25 +68,76 @@ class Spawner:
             strictness=strictness, activate_asap=True, timeout=Duration(sec=5))
         return self.call('switch_controller', request)
 
-    def spawn(self, name: str, param_files=()) -> int:
-        """Jazzy spawner.py's main() for one controller; return its exit code."""
+    def spawn(self, name: str, param_files=(), controller_ros_args=(), *,
+              inactive: bool = False) -> int:
+        """Jazzy spawner.py's main() for one controller; return its exit code.
+
+        ``controller_ros_args`` are its ``--controller-ros-args`` (each split
+        on spaces, as the spawner splits them) and ``param_files`` its
+        ``--param-file``s: the files with a section for the controller
+        become its ``params_file``, and the first ``type`` in them its type.
+        """
         if name in self.controllers():
             pass  # "Controller already loaded, skipping load_controller"
         else:
-            if param_files:
-                files = [str(path) for path in param_files]
+            if controller_ros_args:
+                words = [word for args in controller_ros_args for word in args.split()]
+                if not self.set_parameter(name, 'node_options_args', words):
+                    return 1
+            ns = self.namespace
+            files = [str(path) for path in param_files if _section(path, name, ns) is not None]
+            if files:
                 self.set_parameter(name, 'params_file', files)
-                if not self.set_parameter(name, 'type', _type_in(files[0], name)):
+                kind = next((_section(path, name, ns).get('type') for path in files
+                             if _section(path, name, ns).get('type')), None)
+                if kind and not self.set_parameter(name, 'type', kind):
                     return 1
             if not self.load(name):
                 return 1
         if not self.configure(name):
             return 1
+        if inactive:
+            return 0
         return 0 if self.switch(activate=[name]).ok else 1
 
 
-def _type_in(path: str, name: str) -> str:
+def _section(path, name: str, namespace: str = '/') -> dict | None:
+    """The controller's ros__parameters in a parameter file (its key or /**), else None."""
     import yaml
 
     with open(path) as stream:
-        return yaml.safe_load(stream)[name]['ros__parameters']['type']
+        document = yaml.safe_load(stream) or {}
+    namespaced = f"{namespace.rstrip('/')}/{name}"
+    for key in (name, namespaced, f'/**/{name}', f'/**{namespaced}'):
+        if key in document:
+            return document[key].get('ros__parameters') or {}
+    wildcard = document.get('/**') or {}
+    if name in wildcard:
+        return wildcard[name].get('ros__parameters') or {}
+    if 'ros__parameters' in wildcard:
+        return wildcard['ros__parameters'] or {}
+    return None
+
+
+def spawner_main(sim, arguments, namespace: str = '/') -> int:
+    """Jazzy spawner.py run with ``arguments`` (its native mode) by a node in ``namespace``."""
+    import argparse
+
+    parser = argparse.ArgumentParser()
+    parser.add_argument('controller_names', nargs='+')
+    parser.add_argument('-c', '--controller-manager', default='controller_manager')
+    parser.add_argument('-p', '--param-file', action='append', default=[])
+    parser.add_argument('--inactive', action='store_true')
+    parser.add_argument('--controller-ros-args', action='append', default=[])
+    args = parser.parse_args([str(argument) for argument in arguments])
+    namespace = '/' + namespace.strip('/')  # as the spawner makes its namespace absolute
+    manager = args.controller_manager
+    if not manager.startswith('/'):
+        manager = f"{namespace.rstrip('/')}/{manager}"
+    spawner = Spawner(sim, manager, namespace)
+    for name in args.controller_names:
+        code = spawner.spawn(name, args.param_file, args.controller_ros_args,
+                             inactive=args.inactive)
+        if code:
+            return code
+    return 0

@@ -66,7 +66,7 @@ import math
 import os
 import pathlib
 import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from pan_tilt_sim.errors import ConfigurationError, ControllerConfigError
@@ -228,18 +228,25 @@ def controllers_files_for(given: str, description: RobotDescription, *,
             return (resolve_resource(given, pathlib.Path.cwd()),)
         except ConfigurationError as err:
             raise ControllerConfigError(f'{given_as}: {err}') from None
-    named = []
-    for plugin in description.model.control_plugins:
-        for text in plugin.parameters:
-            named.append(_plugin_file(text, plugin.filename, description.source))
+    named = plugin_controllers_files(description)
     if named:
-        return tuple(named)
+        return named
     if description.name == DEFAULT_ROBOT_NAME:
         return (package_share() / DEFAULT_CONTROLLERS,)
     raise ControllerConfigError(
         f'{description.source}: no controllers file: {given_as} is not set and the URDF names '
         'none (no gz_ros2_control, ign_ros2_control or gazebo_ros2_control plugin with '
         f'<parameters>); give the controller YAML with {given_as}')
+
+
+def plugin_controllers_files(description: RobotDescription) -> tuple[pathlib.Path, ...]:
+    """Return the files the URDF's gz_ros2_control / gazebo_ros2_control plugin names (or none).
+
+    What Gazebo's controller_manager is started with: see
+    :func:`controllers_files_for` for how each is found.
+    """
+    return tuple(_plugin_file(text, plugin.filename, description.source)
+                 for plugin in description.model.control_plugins for text in plugin.parameters)
 
 
 def _plugin_file(text: str, plugin: str, description_file: pathlib.Path) -> pathlib.Path:
@@ -406,17 +413,28 @@ def _plugin_pid_gains(holder: Mapping[Any, Any], path: pathlib.Path) -> dict[str
 def _read_document(path: pathlib.Path, args: Mapping[str, str],
                    args_name: str) -> Mapping[Any, Any]:
     """Read one file, substitutions expanded; it must be a non-empty mapping."""
-    text = read_text(path)
-    expanded = expand_substitutions(text, args)
+    expanded, document = _expanded_document(path, args)
+    _check_expanded(document, expanded, path, args_name)
+    return document
+
+
+def _expanded_document(path: pathlib.Path,
+                       args: Mapping[str, str]) -> tuple[str, Mapping[Any, Any]]:
+    """Return a file's text with its substitutions expanded, and its non-empty mapping."""
+    expanded = expand_substitutions(read_text(path), args)
     document = parse_yaml(expanded, path)
     if not isinstance(document, Mapping) or not document:
         raise ControllerConfigError(f'{path}: no controllers in it (expected a YAML mapping)')
-    leftover = _leftover_substitution(document)
+    return expanded, document
+
+
+def _check_expanded(value: Any, expanded: str, path: pathlib.Path, args_name: str) -> None:
+    """Refuse a substitution left in ``value`` (read from ``path``), naming its line."""
+    leftover = _leftover_substitution(value)
     if leftover is not None:
         raise ControllerConfigError(
             f'{path}{_line_of(expanded, leftover.group(0))}: '
             f'{_unexpanded_problem(leftover, args_name)}')
-    return document
 
 
 def _name_from_file(path: pathlib.Path) -> str:
@@ -508,14 +526,18 @@ def node_parameters(paths: Sequence[pathlib.Path | str], node: str,
     it is ignored) or is a wildcard (``/**``) matching it; files are read in
     order, later ones winning, and a node's own section wins over wildcards
     of the same file.  Errors name the file; a file without any
-    ``ros__parameters`` gives nothing.
+    ``ros__parameters`` gives nothing.  A substitution left unexpanded is an
+    error only in what the file gives ``node`` (other nodes' sections may
+    use launch arguments ``node`` is not given).
     """
     merged: dict[str, Any] = {}
     for path in paths:
         path = pathlib.Path(path).expanduser().resolve()
-        document = _read_document(path, args or {}, args_name)
+        expanded, document = _expanded_document(path, args or {})
         patterns, own = _split_nodes(_ros2_nodes(document, path))
-        _merge_into(merged, _parameters_of(node, patterns, own))
+        given = _parameters_of(node, patterns, own)
+        _check_expanded(given, expanded, path, args_name)
+        _merge_into(merged, given)
     return merged
 
 
@@ -582,3 +604,48 @@ def _update_rate(manager: Mapping[str, Any], path: str) -> float:
             f'{path}: {CONTROLLER_MANAGER}.{ROS2_PARAMETERS}.{UPDATE_RATE_FIELD}: '
             f'{rate!r} must be a number of Hz > 0')
     return float(rate)
+
+
+def controller_manager_config(manager_parameters: Mapping[str, Any],
+                              shared: Callable[[str], Mapping[str, Any]], *,
+                              update_rate: float, source: str) -> ControllersConfig:
+    """Return the controllers a controller_manager node's own parameters declare.
+
+    As ros2_control_node reads them: ``manager_parameters`` are the node's
+    parameters by name (``arm_controller.type``; dotted or nested), and a
+    controller is a ``<name>.type`` among them.  Each controller's
+    parameters are ``shared(name)`` -- what the controller_manager's own
+    arguments give the controller's node (ros2_control passes them on to
+    every controller node): its section of the ``--params-file`` files --
+    over ``update_rate`` (the controller_manager's).  ``source`` names the
+    node in errors.  None declared is fine: spawners then give the types.
+    """
+    nested = _unflatten(manager_parameters)
+    controllers = []
+    for name, entry in nested.items():
+        if not (isinstance(entry, Mapping) and TYPE_FIELD in entry):
+            continue
+        type_name = entry[TYPE_FIELD]
+        if not isinstance(type_name, str):
+            raise ControllerConfigError(
+                f"{source}: parameter '{name}.{TYPE_FIELD}' must be a string, got {type_name!r}")
+        if not naming.is_valid_name(name):
+            raise ControllerConfigError(
+                f"{source}: controller name '{name}' is not a valid ROS name "
+                f'({naming.NAME_RULE}); it becomes part of its topic names')
+        params: dict[str, Any] = {UPDATE_RATE_FIELD: update_rate}
+        _merge_into(params, shared(name))
+        params[TYPE_FIELD] = type_name
+        controllers.append(ControllerSpec(name=name, type=type_name, params=params))
+    return ControllersConfig(controllers=tuple(controllers), source=pathlib.Path(source),
+                             update_rate=update_rate)
+
+
+def unflatten(parameters: Mapping[str, Any]) -> dict[str, Any]:
+    """Turn ROS 2's dotted parameter names (``gains.joint1.p``) into nested mappings."""
+    return _unflatten(parameters)
+
+
+def merge_parameters(target: dict[str, Any], overrides: Mapping[str, Any]) -> None:
+    """Deep-merge ``overrides`` into ``target`` (overrides win, mappings merge), in place."""
+    _merge_into(target, overrides)

@@ -47,6 +47,7 @@ class RobotDescription:
     model: RobotModel
     urdf_xml: str
     physics_urdf: str
+    # The file it was read from; for a description taken from a topic, the topic's name.
     source: pathlib.Path
     # What xacro warned about while expanding the file ("redefining global
     # symbol: pi"...) and what making PyBullet's copy had to change (a frozen
@@ -154,17 +155,35 @@ def load_description(path: pathlib.Path | str, xacro_args: Sequence[str] = ()) -
     """Read a .urdf/.xacro file into a :class:`RobotDescription` (parsed once)."""
     path = pathlib.Path(path).expanduser().resolve()
     urdf_xml, warnings = read_description_xml(path, xacro_args)
-    root = parse_xml(urdf_xml, path)
-    model = read_model(root, path)
+    return _description(urdf_xml, path, path.parent, warnings)
+
+
+def description_from_text(urdf_xml: str, source: str,
+                          base_dir: pathlib.Path | None = None) -> RobotDescription:
+    """Read URDF text (xacro's output, as robot_state_publisher publishes it) into a description.
+
+    ``source`` names where the text came from in errors and log lines (the
+    robot_description topic's name); ``package://`` and ``file://`` meshes
+    resolve as from a file, relative ones from ``base_dir`` (default: the
+    current directory, where a launch file runs).
+    """
+    base = pathlib.Path.cwd() if base_dir is None else base_dir
+    return _description(urdf_xml, pathlib.Path(source), base, ())
+
+
+def _description(urdf_xml: str, source: pathlib.Path, base_dir: pathlib.Path,
+                 warnings: tuple[str, ...]) -> RobotDescription:
+    root = parse_xml(urdf_xml, source)
+    model = read_model(root, source)
     if not model.actuated_joints:
-        raise DescriptionError(f'{path}: the robot has no movable joints to control')
+        raise DescriptionError(f'{source}: the robot has no movable joints to control')
     # The model was read before, so it keeps the URIs as written.
-    physics_urdf, physics_warnings = physics_copy(root, model, path.parent, path)
+    physics_urdf, physics_warnings = physics_copy(root, model, base_dir, source)
     return RobotDescription(
         model=model,
         urdf_xml=urdf_xml,
         physics_urdf=physics_urdf,
-        source=path,
+        source=source,
         warnings=warnings + physics_warnings,
     )
 

@@ -60,6 +60,7 @@ from pan_tilt_sim.controllers.surface import (
     StateTopic,
 )
 from pan_tilt_sim.errors import ConfigurationError
+from pan_tilt_sim.model.ros_arguments import RosArguments
 from pan_tilt_sim.ros import optional_interfaces
 from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.gain_parameters import GainParameters
@@ -88,8 +89,13 @@ class ControllerBindings:
 
     def __init__(self, node: Node, simulation: Simulation, topic: Callable[..., str],
                  gain_parameters: GainParameters, *, actions: bool,
-                 command_topics: bool = True, reader: CommandReader | None = None) -> None:
+                 command_topics: bool = True, reader: CommandReader | None = None,
+                 namespace: str = '') -> None:
         self._node = node
+        # The namespace the controllers' nodes would be in, for their remap rules.
+        self._namespace = namespace
+        # Each loaded controller's own node arguments (remap rules), by name.
+        self._arguments: dict[str, RosArguments] = {}
         self._reader = reader
         # False: command controllers take no topic (topic-based hardware feeds them).
         self._command_topics = command_topics
@@ -114,9 +120,17 @@ class ControllerBindings:
 
     # --- the run-time changes (controller_manager's services) ----------------------------------
 
-    def load(self, name: str, type_name: Any, params: Mapping[str, Any], source: str) -> None:
-        """Load controller ``name`` (unconfigured: no ROS entities yet)."""
+    def load(self, name: str, type_name: Any, params: Mapping[str, Any], source: str,
+             arguments: RosArguments | None = None) -> None:
+        """Load controller ``name`` (unconfigured: no ROS entities yet).
+
+        ``arguments`` are the controller node's own (the spawner's
+        ``--controller-ros-args``): their remap rules rename its topics and
+        action, from configure on, until it is unloaded.
+        """
         self._manager.load(name, type_name, params, source)
+        if arguments is not None and arguments.remaps:
+            self._arguments[name] = arguments
 
     def configure(self, name: str) -> None:
         """Configure ``name`` (afresh if inactive) and create its ROS entities."""
@@ -138,6 +152,7 @@ class ControllerBindings:
         """Unload a controller that is not active; its ROS entities go."""
         self._manager.unload(name)
         self._unbind(name)
+        self._arguments.pop(name, None)
 
     def switch(self, activate: Iterable[str], deactivate: Iterable[str], *,
                strict: bool) -> list[str]:
@@ -218,12 +233,21 @@ class ControllerBindings:
         self._gains.add(controller)
 
     def _name(self, controller: Controller, topic: str) -> str:
-        """Resolve a name: ``~/x`` in the controller's namespace, ``/x`` as is, else ours."""
+        """Resolve a declared name: ``~/x`` the controller's, ``/x`` as is, else the robot's.
+
+        Then the controller's remap rules apply, as rcl applies a node's
+        rules to the names it creates (``~/cmd_vel:=/cmd_vel``).
+        """
         if topic.startswith(PRIVATE):
-            return self._topic(controller.name, topic[len(PRIVATE):])
-        if topic.startswith('/'):
-            return topic
-        return self._topic(topic)
+            resolved = self._topic(controller.name, topic[len(PRIVATE):])
+        elif topic.startswith('/'):
+            resolved = topic
+        else:
+            resolved = self._topic(topic)
+        arguments = self._arguments.get(controller.name)
+        if arguments is None:
+            return resolved
+        return arguments.remapped(resolved, self._namespace, controller.name)
 
     def _subscribe(self, controller: Controller, endpoint: CommandTopic) -> Any:
         message_type, extract = COMMAND_MESSAGES[endpoint.message]

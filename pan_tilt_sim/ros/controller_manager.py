@@ -44,7 +44,7 @@ through :class:`~pan_tilt_sim.ros.controller_bindings.ControllerBindings`.
 from __future__ import annotations
 
 import pathlib
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from lifecycle_msgs.msg import State
@@ -57,19 +57,27 @@ from pan_tilt_sim.controllers import CommandController
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
 from pan_tilt_sim.controllers.manager import ACTIVE, INACTIVE, ControllerManager
 from pan_tilt_sim.controllers.registry import CONTROLLER_TYPES, supported_types
-from pan_tilt_sim.errors import ConfigurationError, ControllerSwitchError
+from pan_tilt_sim.errors import ConfigurationError, ControllerConfigError, ControllerSwitchError
 from pan_tilt_sim.model.controller_config import (
     DEFAULT_UPDATE_RATE,
     TYPE_FIELD,
     UPDATE_RATE_FIELD,
+    merge_parameters,
     node_parameters,
+    unflatten,
 )
 from pan_tilt_sim.model.robot import RobotModel
+from pan_tilt_sim.model.ros_arguments import RosArguments, node_rules, parse_ros_arguments
 from pan_tilt_sim.ros.controller_bindings import ControllerBindings
 
 NODE_NAME = 'controller_manager'
 PARAMS_FILE = 'params_file'
 FALLBACK = 'fallback_controllers'
+NODE_OPTIONS_ARGS = 'node_options_args'
+INITIAL_STATE_PARAMETER = 'hardware_components_initial_state'
+INITIAL_STATES = ('unconfigured', 'inactive')
+# What a spawner sets on the controller_manager, per controller: ``<controller>.<field>``.
+CONTROLLER_FIELDS = (TYPE_FIELD, PARAMS_FILE, FALLBACK, NODE_OPTIONS_ARGS)
 STRICTNESS_PARAMETER = 'defaults.switch_controller.strictness'
 BEST_EFFORT, STRICT = 1, 2  # controller_manager_msgs/srv/SwitchController
 BASE_CLASS = 'controller_interface::ControllerInterface'
@@ -82,53 +90,61 @@ NOTHING_TO_SWITCH = ('After checking the controllers, no controllers need to be 
                      'deactivated.')
 
 
-class ControllerManagerNode(Node):
-    """ros2_control's controller_manager services over the simulation's controllers."""
+class ControllerManagerServices:
+    """ros2_control's controller_manager services and parameters, on ``node``.
 
-    def __init__(self, bindings: ControllerBindings, manager: ControllerManager,
-                 model: RobotModel, namespace: str, *, context: Context | None = None,
-                 substitutions: Mapping[str, str] | None = None, source: str = '') -> None:
-        # Not the process's global arguments: a `-r __node:=...` meant for sim_node
-        # must not rename this node, nor its `-p` parameters land here.
-        super().__init__(NODE_NAME, namespace=namespace or '/', context=context,
-                         use_global_arguments=False, allow_undeclared_parameters=True)
+    ``node`` is the controller_manager: a node of its own beside sim_node
+    (:class:`ControllerManagerNode`), or sim_node itself when it runs under
+    that name in ros2_control_node's place.  ``update_rate`` (Hz) is the
+    controller_manager's own (default: the controllers file's, else 100);
+    ``shared_parameters(name)`` is what the controller_manager's own
+    arguments give controller ``name``'s node besides its own (ros2_control
+    passes them on to every controller node), read at load.
+    """
+
+    def __init__(self, node: Node, bindings: ControllerBindings, manager: ControllerManager,
+                 model: RobotModel, *, substitutions: Mapping[str, str] | None = None,
+                 source: str = '', update_rate: int | None = None,
+                 shared_parameters: Callable[[str], Mapping[str, Any]] | None = None) -> None:
         from controller_manager_msgs import srv
 
+        self._node = node
         self._bindings = bindings
         self._manager = manager
+        self._shared_parameters = shared_parameters
         self._model = model
         self._substitutions = dict(substitutions or {})
         self._source = source
-        rate = manager.update_rate or DEFAULT_UPDATE_RATE
+        rate = update_rate or manager.update_rate or DEFAULT_UPDATE_RATE
         self.update_rate = int(round(rate))
-        self.declare_parameter(UPDATE_RATE_FIELD, self.update_rate, ParameterDescriptor(
-            description='Hz at which controllers update (the controllers file says).',
-            read_only=True))
-        self.declare_parameter(STRICTNESS_PARAMETER, 'best_effort', ParameterDescriptor(
-            description='switch_controller strictness 0 means this: strict or best_effort.'))
+        if not node.has_parameter(UPDATE_RATE_FIELD):
+            node.declare_parameter(UPDATE_RATE_FIELD, self.update_rate, ParameterDescriptor(
+                description='Hz at which controllers update (the controllers file says).',
+                read_only=True))
+        if not node.has_parameter(STRICTNESS_PARAMETER):
+            node.declare_parameter(STRICTNESS_PARAMETER, 'best_effort', ParameterDescriptor(
+                description='switch_controller strictness 0 means this: strict or best_effort.'))
         for name, spec in manager.declared.items():
-            if isinstance(spec.type, str):
-                self.declare_parameter(f'{name}.{TYPE_FIELD}', spec.type)
-        self.add_on_set_parameters_callback(self._check_parameters)
-        self._cm_services = [
-            self.create_service(srv.ListControllers, '~/list_controllers', self._list),
-            self.create_service(srv.ListControllerTypes, '~/list_controller_types',
-                                self._list_types),
-            self.create_service(srv.ListHardwareComponents, '~/list_hardware_components',
-                                self._list_components),
-            self.create_service(srv.ListHardwareInterfaces, '~/list_hardware_interfaces',
-                                self._list_interfaces),
-            self.create_service(srv.LoadController, '~/load_controller', self._load),
-            self.create_service(srv.ConfigureController, '~/configure_controller',
-                                self._configure),
-            self.create_service(srv.CleanupController, '~/cleanup_controller', self._cleanup),
-            self.create_service(srv.UnloadController, '~/unload_controller', self._unload),
-            self.create_service(srv.SwitchController, '~/switch_controller', self._switch),
-            self.create_service(srv.ReloadControllerLibraries, '~/reload_controller_libraries',
-                                self._reload),
-            self.create_service(srv.SetHardwareComponentState,
-                                '~/set_hardware_component_state', self._set_component_state),
+            if isinstance(spec.type, str) and not node.has_parameter(f'{name}.{TYPE_FIELD}'):
+                node.declare_parameter(f'{name}.{TYPE_FIELD}', spec.type)
+        node.add_on_set_parameters_callback(self._check_parameters)
+        self._report_initial_states()
+        services = [
+            (srv.ListControllers, 'list_controllers', self._list),
+            (srv.ListControllerTypes, 'list_controller_types', self._list_types),
+            (srv.ListHardwareComponents, 'list_hardware_components', self._list_components),
+            (srv.ListHardwareInterfaces, 'list_hardware_interfaces', self._list_interfaces),
+            (srv.LoadController, 'load_controller', self._load),
+            (srv.ConfigureController, 'configure_controller', self._configure),
+            (srv.CleanupController, 'cleanup_controller', self._cleanup),
+            (srv.UnloadController, 'unload_controller', self._unload),
+            (srv.SwitchController, 'switch_controller', self._switch),
+            (srv.ReloadControllerLibraries, 'reload_controller_libraries', self._reload),
+            (srv.SetHardwareComponentState, 'set_hardware_component_state',
+             self._set_component_state),
         ]
+        self._cm_services = [node.create_service(service_type, f'~/{name}', callback)
+                             for service_type, name, callback in services]
         from controller_manager_msgs.msg import (
             ChainConnection,
             ControllerState,
@@ -141,6 +157,33 @@ class ControllerManagerNode(Node):
         self._component_state = HardwareComponentState
         self._interface = HardwareInterface
 
+    def _report_initial_states(self) -> None:
+        """Read ``hardware_components_initial_state``: say what each name it lists becomes.
+
+        The simulated hardware is one always-active component per
+        ``<ros2_control>`` block (there is nothing to configure), so a
+        component listed as ``unconfigured`` or ``inactive`` starts active,
+        with an info line saying so; an unknown name gets upstream's warning.
+        """
+        node = self._node
+        known = {name for name, _plugin, _joints in self._components()}
+        for state in INITIAL_STATES:
+            parameter = f'{INITIAL_STATE_PARAMETER}.{state}'
+            if not node.has_parameter(parameter):
+                node.declare_parameter(parameter, None, ParameterDescriptor(
+                    description=f'Hardware components to leave {state} at start-up (the '
+                    'simulated hardware is always active).', dynamic_typing=True))
+            names = self._parameter(parameter) or []
+            for name in [names] if isinstance(names, str) else names:
+                if name not in known:
+                    node.get_logger().warning(
+                        f"Hardware component '{name}' is unknown, therefore not set in "
+                        f"'{state}' state.")
+                else:
+                    node.get_logger().info(
+                        f"hardware component '{name}' starts active, not {state} "
+                        f"('{parameter}'): the simulated hardware has no {state} state")
+
     # --- parameters the spawner sets -----------------------------------------------------------
 
     def _check_parameters(self, changed: Sequence[Parameter]) -> SetParametersResult:
@@ -148,7 +191,7 @@ class ControllerManagerNode(Node):
         for parameter in changed:
             name, _, field = parameter.name.rpartition('.')
             value = parameter.value
-            if not name:
+            if not name or value is None:  # None: declared, not set yet
                 continue
             if field == TYPE_FIELD and not isinstance(value, str):
                 return SetParametersResult(
@@ -157,6 +200,10 @@ class ControllerManagerNode(Node):
                 return SetParametersResult(
                     successful=False,
                     reason=f"'{parameter.name}' must be a file name or a list of them")
+            if field == NODE_OPTIONS_ARGS and not _is_string_or_strings(value):
+                return SetParametersResult(
+                    successful=False,
+                    reason=f"'{parameter.name}' must be a list of ROS arguments")
             if field == FALLBACK and not _is_strings(value):
                 return SetParametersResult(
                     successful=False,
@@ -164,10 +211,49 @@ class ControllerManagerNode(Node):
         return SetParametersResult(successful=True)
 
     def _parameter(self, name: str) -> Any:
-        if not self.has_parameter(name):
+        if not self._node.has_parameter(name):
             return None
-        parameter = self.get_parameter(name)
+        parameter = self._node.get_parameter(name)
         return None if parameter.type_ == Parameter.Type.NOT_SET else parameter.value
+
+    def _node_arguments(self, name: str) -> RosArguments:
+        """Return the controller node's own arguments, ``<name>.node_options_args``.
+
+        The spawner's ``--controller-ros-args``: remaps, ``-p`` and
+        ``--params-file`` count; renaming or moving the node is refused.
+        """
+        field = f"'{name}.{NODE_OPTIONS_ARGS}'"
+        value = self._parameter(f'{name}.{NODE_OPTIONS_ARGS}') or []
+        items = value.split() if isinstance(value, str) else list(value)
+        arguments = parse_ros_arguments(items, field, whole=True)
+        moved = node_rules(arguments, name)
+        if moved:
+            raise ControllerConfigError(
+                f"{field}: {', '.join(moved)}: a controller's node is not renamed or moved "
+                "here; remap its topics instead (-r ~/name:=/other)")
+        return arguments
+
+    def _controller_parameters(self, name: str, spec: Any, files: Sequence[str],
+                               arguments: RosArguments) -> dict[str, Any]:
+        """Return the parameters controller ``name`` loads with, in the order rcl reads them.
+
+        The controllers file's section for it (or the controller_manager's
+        update_rate and what its own arguments give the controller), then
+        ``<name>.params_file``, then the controller node's own arguments:
+        later ones win, name by name.
+        """
+        if spec is not None:
+            params: dict[str, Any] = dict(spec.params)
+        else:
+            params = {UPDATE_RATE_FIELD: float(self.update_rate)}
+            if self._shared_parameters is not None:
+                merge_parameters(params, self._shared_parameters(name))
+        own = [pathlib.Path(file) for file in files] + list(arguments.params_files)
+        if own:
+            merge_parameters(params, node_parameters(own, name, self._substitutions,
+                                                     args_name="sim_node's 'controllers_args'"))
+        merge_parameters(params, unflatten(arguments.parameters_for(name)))
+        return params
 
     # --- load / configure / cleanup / unload ---------------------------------------------------
 
@@ -175,37 +261,35 @@ class ControllerManagerNode(Node):
         response.ok = False
         name = request.name
         if self._manager.is_loaded(name):
-            self.get_logger().error(
+            self._node.get_logger().error(
                 f"A controller named '{name}' was already loaded inside the controller manager")
             return response
         type_name = self._parameter(f'{name}.{TYPE_FIELD}')
         if not type_name:
-            self.get_logger().error(
+            self._node.get_logger().error(
                 f"The 'type' param was not defined for '{name}' (set '{name}.{TYPE_FIELD}', "
                 "as the spawner's --param-file does from the file's 'type')")
             return response
         fallbacks = self._parameter(f'{name}.{FALLBACK}') or []
         if name in fallbacks:
-            self.get_logger().error(
+            self._node.get_logger().error(
                 f"Controller '{name}' cannot be a fallback controller of itself")
             return response
         files = self._parameter(f'{name}.{PARAMS_FILE}') or []
         files = [files] if isinstance(files, str) else list(files)
         spec = self._manager.declared.get(name)
-        params: dict[str, Any] = dict(spec.params) if spec is not None else {
-            UPDATE_RATE_FIELD: float(self.update_rate)}
         source = ' + '.join(files) or self._source
         try:
-            if files:
-                params.update(node_parameters([pathlib.Path(file) for file in files], name,
-                                              self._substitutions,
-                                              args_name="sim_node's 'controllers_args'"))
+            arguments = self._node_arguments(name)
+            params = self._controller_parameters(name, spec, files, arguments)
             params[TYPE_FIELD] = type_name
-            self._bindings.load(name, type_name, params, source)
+            self._bindings.load(name, type_name, params, source, arguments)
         except ConfigurationError as err:
-            self.get_logger().error(f"Failed to load controller '{name}': {err}")
+            self._node.get_logger().error(f"Failed to load controller '{name}': {err}")
             return response
-        self.get_logger().info(f"Loaded controller '{name}' ({type_name})")
+        remaps = ', '.join(f'{rule.source}:={rule.target}' for rule in arguments.remaps)
+        self._node.get_logger().info(f"Loaded controller '{name}' ({type_name})"
+                                     + (f', remapping {remaps}' if remaps else ''))
         response.ok = True
         return response
 
@@ -225,10 +309,10 @@ class ControllerManagerNode(Node):
         try:
             change(name)
         except ConfigurationError as err:
-            self.get_logger().error(f"Failed to {action} controller '{name}': {err}")
+            self._node.get_logger().error(f"Failed to {action} controller '{name}': {err}")
             return False
         done = {'configure': 'Configured', 'cleanup': 'Cleaned up', 'unload': 'Unloaded'}
-        self.get_logger().info(f"{done[action]} controller '{name}'")
+        self._node.get_logger().info(f"{done[action]} controller '{name}'")
         return True
 
     # --- switch --------------------------------------------------------------------------------
@@ -246,10 +330,10 @@ class ControllerManagerNode(Node):
             dropped = self._bindings.switch(activate, deactivate, strict=strict)
         except ControllerSwitchError as err:
             response.ok, response.message = False, str(err)
-            self.get_logger().error(f'switch_controller refused: {err}')
+            self._node.get_logger().error(f'switch_controller refused: {err}')
             return response
         for problem in dropped:
-            self.get_logger().warning(f'switch_controller (BEST_EFFORT): {problem}')
+            self._node.get_logger().warning(f'switch_controller (BEST_EFFORT): {problem}')
         after = {c.name for c in self._manager.active}
         response.ok = True
         if before == after and not (set(activate) & set(deactivate) & after):
@@ -258,7 +342,7 @@ class ControllerManagerNode(Node):
             changes = [f'activated {", ".join(sorted(after - before))}' if after - before else '',
                        f'deactivated {", ".join(sorted(before - after))}'
                        if before - after else '']
-            self.get_logger().info('switch_controller: ' + '; '.join(filter(None, changes)))
+            self._node.get_logger().info('switch_controller: ' + '; '.join(filter(None, changes)))
         return response
 
     # --- lists ---------------------------------------------------------------------------------
@@ -338,7 +422,7 @@ class ControllerManagerNode(Node):
         names = [name for name, _plugin, _joints in self._components()]
         response.state = ACTIVE_STATE
         if request.name not in names:
-            self.get_logger().error(
+            self._node.get_logger().error(
                 f"hardware component '{request.name}' does not exist (components: "
                 f"{', '.join(names)})")
             response.ok = False
@@ -346,7 +430,7 @@ class ControllerManagerNode(Node):
         response.ok = request.target_state.id == State.PRIMARY_STATE_ACTIVE or (
             request.target_state.label == 'active')
         if not response.ok:
-            self.get_logger().warning(
+            self._node.get_logger().warning(
                 f"hardware component '{request.name}' is the simulation: it stays active")
         return response
 
@@ -354,7 +438,7 @@ class ControllerManagerNode(Node):
         manager = self._manager
         loaded = [c.name for c in manager.controllers]
         if loaded and not request.force_kill:
-            self.get_logger().error(
+            self._node.get_logger().error(
                 f'cannot reload controller libraries: controllers are loaded '
                 f"({', '.join(loaded)}); unload them or ask with force_kill")
             response.ok = False
@@ -364,7 +448,7 @@ class ControllerManagerNode(Node):
             for name in loaded:
                 self._bindings.unload(name)
         except ConfigurationError as err:
-            self.get_logger().error(f'reload_controller_libraries: {err}')
+            self._node.get_logger().error(f'reload_controller_libraries: {err}')
             response.ok = False
             return response
         response.ok = True
@@ -410,6 +494,34 @@ class ControllerManagerNode(Node):
             interfaces = [f'{joint}/{interface}' for joint in controller.joint_names
                           for interface in ('position', 'velocity')]
         return interfaces
+
+
+    # --- what a spawner may set ----------------------------------------------------------------
+
+    @staticmethod
+    def is_controller_field(name: str) -> bool:
+        """Whether ``name`` is what a spawner sets per controller (``arm.type``, ...)."""
+        controller, _, field = name.rpartition('.')
+        return bool(controller) and field in CONTROLLER_FIELDS
+
+
+class ControllerManagerNode(Node):
+    """The controller_manager as a node of its own in sim_node's process (see the module)."""
+
+    def __init__(self, bindings: ControllerBindings, manager: ControllerManager,
+                 model: RobotModel, namespace: str, *, context: Context | None = None,
+                 substitutions: Mapping[str, str] | None = None, source: str = '') -> None:
+        # Not the process's global arguments: a `-r __node:=...` meant for sim_node
+        # must not rename this node, nor its `-p` parameters land here.
+        super().__init__(NODE_NAME, namespace=namespace or '/', context=context,
+                         use_global_arguments=False, allow_undeclared_parameters=True)
+        self.manager_services = ControllerManagerServices(
+            self, bindings, manager, model, substitutions=substitutions, source=source)
+
+    @property
+    def update_rate(self) -> int:
+        """Hz at which the controllers update (the controller_manager's ``update_rate``)."""
+        return self.manager_services.update_rate
 
 
 def _flatten(interfaces: Mapping[str, Sequence[str]]) -> list[str]:

@@ -36,7 +36,8 @@ class NodeFeatures:
     """
 
     def __init__(self, node: Node, simulation: Simulation, robot_namespace: str, *,
-                 gui: bool = False, sensor_namespace: str = '') -> None:
+                 gui: bool = False, sensor_namespace: str = '',
+                 publish_description: bool = True, publish_tf_default: bool = True) -> None:
         description = simulation.description
         model = description.model
         self._time_step = simulation.time_step
@@ -70,8 +71,9 @@ class NodeFeatures:
             static.append((settings.link, settings.optical_frame, self.camera.mount))
         self.robot_state = RobotStatePublisher(
             node, model, description.urdf_xml,
-            naming.join(robot_namespace, 'robot_description'),
-            lambda: simulation.time, simulation.joint_positions, static)
+            naming.join(robot_namespace, 'robot_description') if publish_description else None,
+            lambda: simulation.time, simulation.joint_positions, static,
+            publish_tf_default=publish_tf_default)
 
     def after_steps(self) -> None:
         """Publish what is due at the present sim time (called every /clock period of steps)."""

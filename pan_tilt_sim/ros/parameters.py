@@ -68,11 +68,15 @@ _TYPE_NAMES = {
 }
 
 
-def _specs() -> tuple[_Spec, ...]:
+def _specs(controller_manager: bool = False) -> tuple[_Spec, ...]:
+    """Return the parameters; ``controller_manager``: sim_node runs as ros2_control_node would."""
     share = package_share()
     return (
+        # Named controller_manager, sim_node takes the robot from robot_description by default.
         _Spec('robot_description_file', ParameterType.PARAMETER_STRING,
-              str(share / DEFAULT_DESCRIPTION), 'A .urdf or .xacro file describing the robot.'),
+              '' if controller_manager else str(share / DEFAULT_DESCRIPTION),
+              'A .urdf or .xacro file describing the robot; empty = the robot_description '
+              'topic (as ros2_control_node takes it).'),
         # No default: rclpy cannot declare an empty string array, so "not set" means none.
         _Spec('xacro_args', ParameterType.PARAMETER_STRING_ARRAY, None,
               "xacro mappings for a .xacro description, each 'name:=value'."),
@@ -85,7 +89,7 @@ def _specs() -> tuple[_Spec, ...]:
         _Spec('active_controllers', ParameterType.PARAMETER_STRING_ARRAY, None,
               'The controllers to activate (as spawners would); unset or empty = all of them. '
               'The others are loaded but inactive.'),
-        _Spec('autostart_controllers', ParameterType.PARAMETER_BOOL, True,
+        _Spec('autostart_controllers', ParameterType.PARAMETER_BOOL, not controller_manager,
               "true: the controllers file's controllers are loaded and active from the start "
               "(or those in 'active_controllers'); false: none is loaded until ros2_control's "
               'spawner loads, configures and activates it through /<ns>/controller_manager, '
@@ -140,11 +144,16 @@ class SimParameters:
     initial_pose: BasePose
 
 
-def declare_parameters(node: Node) -> SimParameters:
-    """Declare every parameter on ``node`` and return their checked values."""
+def declare_parameters(node: Node, *, controller_manager: bool = False) -> SimParameters:
+    """Declare every parameter on ``node`` and return their checked values.
+
+    ``controller_manager``: the node runs in ros2_control_node's place
+    (see :mod:`pan_tilt_sim.ros.drop_in`): other defaults, and the
+    parameters that ros2_control_node's own ones replace are refused.
+    """
     values = {spec.name: declare(node, spec.name, spec.type, spec.default, spec.description,
                                  read_only=spec.read_only)
-              for spec in _specs()}
+              for spec in _specs(controller_manager)}
     values['xacro_args'] = tuple(values['xacro_args'])
     values['initial_positions'] = parse_initial_positions(values['initial_positions'])
     values['controllers_args'] = tuple(values['controllers_args'])
@@ -155,6 +164,15 @@ def declare_parameters(node: Node) -> SimParameters:
     check_time_step(checked.time_step)
     check_real_time_factor(checked.real_time_factor)
     check_namespace('robot_namespace', checked.robot_namespace)
+    if controller_manager:
+        for name, instead in (('controllers_file', "the controller_manager's own parameters "
+                               '(parameters=[controllers.yaml])'),
+                              ('robot_namespace', "the node's namespace")):
+            if getattr(checked, name):
+                raise ParameterError(
+                    f"parameter '{name}' is not used by sim_node named "
+                    f"'{node.get_name()}' (in ros2_control_node's place): give {instead}, as "
+                    'ros2_control_node takes it')
     if not checked.autostart_controllers and checked.active_controllers is not None:
         raise ParameterError(
             "parameter 'active_controllers' is set but 'autostart_controllers' is false: with "

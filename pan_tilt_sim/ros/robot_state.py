@@ -128,17 +128,22 @@ def moving_transforms(model: RobotModel, positions: Mapping[str, float]) -> list
 class RobotStatePublisher:
     """Publishes robot_description once and, given a TF sink, the robot's TF."""
 
-    def __init__(self, node: Node, model: RobotModel, urdf_xml: str, description_topic: str,
-                 clock: Callable[[], float], positions: Callable[[], Mapping[str, float]],
+    def __init__(self, node: Node, model: RobotModel, urdf_xml: str,
+                 description_topic: str | None, clock: Callable[[], float],
+                 positions: Callable[[], Mapping[str, float]],
                  extra_static: Sequence[Frame] = (),
-                 tf_sink_factory: Callable[[Node], TfSink | None] | None = None) -> None:
+                 tf_sink_factory: Callable[[Node], TfSink | None] | None = None, *,
+                 publish_tf_default: bool = True) -> None:
+        """``description_topic`` None: the description came from that topic; none is published."""
         self._model = model
         self._clock = clock
         self._positions = positions
-        self._description_publisher = latched_publisher(node, String, description_topic)
-        self._description_publisher.publish(String(data=urdf_xml))
+        self._description_publisher = None
+        if description_topic is not None:
+            self._description_publisher = latched_publisher(node, String, description_topic)
+            self._description_publisher.publish(String(data=urdf_xml))
         enabled = params.declare(
-            node, 'publish_tf', params.BOOL, True,
+            node, 'publish_tf', params.BOOL, publish_tf_default,
             'Publish /tf and /tf_static (needs tf2_msgs); turn off when '
             'robot_state_publisher does it.')
         self.static_frames = static_transforms(model, extra_static)

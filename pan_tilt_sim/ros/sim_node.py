@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Sequence
 
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
@@ -29,7 +30,9 @@ from pan_tilt_sim.model.controller_config import (
     parse_controllers_args,
 )
 from pan_tilt_sim.model.description import RobotDescription, load_description
+from pan_tilt_sim.model.ros_arguments import parse_ros_arguments
 from pan_tilt_sim.ros import (
+    drop_in,
     optional_interfaces,
     parameters,
     services,
@@ -83,9 +86,17 @@ class SimNode(Node):
     thread of its own that takes turns with the executor's callbacks through
     :attr:`turns`; spin the node on a ``TurnTakingExecutor(node.turns)``
     then (see :mod:`pan_tilt_sim.ros.physics_thread`).
+
+    With ``robot_description_file`` empty, everything but the parameters is
+    built once the ``robot_description`` topic brings the robot; named
+    ``controller_manager`` it stands in for ros2_control_node, serving the
+    controller_manager services itself (see :mod:`pan_tilt_sim.ros.drop_in`).
+    ``ros_arguments`` are the process's command line, whose parameter files
+    the controllers read there as ros2_control's controller nodes read them.
     """
 
-    def __init__(self, *, physics_thread: bool = False, **kwargs) -> None:
+    def __init__(self, *, physics_thread: bool = False, ros_arguments: Sequence[str] = (),
+                 **kwargs) -> None:
         # What destroy_node releases, empty until built: a start-up error
         # destroys whatever was made before it (the rclpy node included), so an
         # in-process caller is left with no live DDS endpoints and no PyBullet.
@@ -98,28 +109,56 @@ class SimNode(Node):
         self._physics_thread: PhysicsThread | None = None
         self._command_reader: CommandReader | None = None
         self._timer = None
+        self._description_subscription = None
+        self.controller_manager: Node | None = None  # where controller_manager_msgs exists
+        self.is_controller_manager = False
         super().__init__(NODE_NAME, **kwargs)
+        # Named controller_manager (launch's name='controller_manager'), sim_node stands
+        # in for ros2_control_node: see the module pan_tilt_sim.ros.drop_in.
+        self.is_controller_manager = self.get_name() == drop_in.NODE_NAME
         try:
-            self._build(physics_thread)
+            self._arguments = parse_ros_arguments(
+                [*ros_arguments, *(kwargs.get('cli_args') or ())], 'the command line')
+            self._start(physics_thread, kwargs.get('parameter_overrides') or ())
         except BaseException:
             self.destroy_node()
             raise
 
-    def _build(self, physics_thread: bool) -> None:
-        """Everything sim_node is, from its parameters; the last step starts the physics."""
-        self.settings = parameters.declare_parameters(self)
-        description = load_description(
-            self.settings.robot_description_file, self.settings.xacro_args)
+    def _start(self, physics_thread: bool, overrides: Sequence[Parameter]) -> None:
+        """Read the parameters; build now from a file, or once the robot_description topic says."""
+        self.settings = parameters.declare_parameters(
+            self, controller_manager=self.is_controller_manager)
+        self._manager_settings = (
+            drop_in.declare_manager_parameters(self, self._arguments, overrides)
+            if self.is_controller_manager else None)
+        # With a physics thread, callbacks take turns with it (the executor needs them now).
+        self.turns: Turns | None = Turns() if physics_thread else None
+        if self.settings.robot_description_file:
+            self._build(physics_thread, load_description(
+                self.settings.robot_description_file, self.settings.xacro_args))
+            return
+        self._description_subscription = drop_in.wait_for_description(
+            self, lambda description: self._build(physics_thread, description,
+                                                  from_topic=True))
+
+    def _build(self, physics_thread: bool, description: RobotDescription, *,
+               from_topic: bool = False) -> None:
+        """Everything sim_node is, for ``description``; the last step starts the physics."""
         # Topic-based hardware (topic_based_ros2_control): no YAML controllers run here.
         self._topic_settings = topic_hardware.declare(self, description)
         if self._topic_settings is not None:
             controllers = topic_hardware.controllers_config(self._topic_settings)
+        elif self._manager_settings is not None:
+            controllers, self._arguments = drop_in.manager_controllers(
+                self, self._manager_settings, self._arguments, description)
         else:
             controllers = load_controllers_config(
                 controllers_files_for(self.settings.controllers_file, description),
                 parse_controllers_args(self.settings.controllers_args,
                                        f"parameter '{CONTROLLERS_ARGS}'"))
-        self.robot_namespace = naming.resolve_robot_namespace(
+        # ros2_control_node's controllers live in its own namespace, and nowhere else.
+        self.robot_namespace = naming.normalize(self.get_namespace()) if (
+            self.is_controller_manager) else naming.resolve_robot_namespace(
             self.get_namespace(), self.settings.robot_namespace,
             controllers.namespace, description.plugin_namespace)
         self.simulation = Simulation(
@@ -132,7 +171,6 @@ class SimNode(Node):
             fixed_base=self.settings.fixed_base, initial_pose=self.settings.initial_pose)
         self._paused = self.settings.paused
         self.steps_run = 0  # physics steps this node has run (never reset; see run_steps)
-        self.controller_manager: Node | None = None  # where controller_manager_msgs exists
         self._pacer = Pacer(self.settings.real_time_factor, self.settings.time_step)
         self._clock_every = clock_period_steps(self.settings.time_step)
         self._clock_publisher = self.create_publisher(Clock, '/clock', QUEUE_DEPTH)
@@ -142,9 +180,7 @@ class SimNode(Node):
         self._clock_throttle = Throttle(CLOCK_MIN_WALL_PERIOD_S, CLOCK_BURST)
         self.gain_parameters = GainParameters(self)
         topic_mode = self._topic_settings is not None
-        # With a physics thread, callbacks take turns with it; commands have a reader of
-        # their own.
-        self.turns: Turns | None = Turns() if physics_thread else None
+        # With a physics thread, commands have a reader of their own.
         if self.turns is not None:
             self._command_reader = CommandReader(self.context, self.turns)
         self.controllers = ControllerBindings(
@@ -153,7 +189,8 @@ class SimNode(Node):
             else self.topic,
             self.gain_parameters,
             actions=not topic_mode and optional_interfaces.available('control_msgs'),
-            command_topics=not topic_mode, reader=self._command_reader)
+            command_topics=not topic_mode, reader=self._command_reader,
+            namespace=self.robot_namespace)
         self.topic_hardware = topic_hardware.TopicHardware(
             self, self._topic_settings, description,
             self.simulation.controllers) if topic_mode else None
@@ -164,7 +201,9 @@ class SimNode(Node):
         self.features = NodeFeatures(
             self, self.simulation, self.robot_namespace, gui=self.settings.gui,
             sensor_namespace=naming.normalize(self.get_namespace())
-            or naming.normalize(self.settings.robot_namespace))
+            or naming.normalize(self.settings.robot_namespace),
+            publish_description=not from_topic,
+            publish_tf_default=not self.is_controller_manager)
         self._start_controller_manager(controllers)
         self._publish_clock()
         self.features.after_steps()  # their first samples at t = 0, as /clock's
@@ -198,6 +237,18 @@ class SimNode(Node):
         if self._physics_thread is not None:
             self._command_reader.start()
             self._physics_thread.start()  # last: nothing may fail after it runs
+
+    def set_parameters(self, parameter_list: list[Parameter]) -> list[SetParametersResult]:
+        """Set parameters; as the controller_manager, a spawner's ``<controller>.type`` too."""
+        if self.is_controller_manager:
+            drop_in.declare_controller_fields(self, parameter_list)
+        return super().set_parameters(parameter_list)
+
+    def set_parameters_atomically(self, parameter_list: list[Parameter]) -> SetParametersResult:
+        """Set parameters at once (what the parameter services call); see set_parameters."""
+        if self.is_controller_manager:
+            drop_in.declare_controller_fields(self, parameter_list)
+        return super().set_parameters_atomically(parameter_list)
 
     def create_publisher(self, *args, **kwargs):
         """Create a publisher without rclpy's default QoS-event handler (see below)."""
@@ -436,14 +487,28 @@ class SimNode(Node):
                     'is not installed: no spawner could load a controller '
                     '(scripts/build_interfaces.sh builds it)')
             return
-        from pan_tilt_sim.ros.controller_manager import ControllerManagerNode
+        from pan_tilt_sim.ros.controller_manager import (
+            ControllerManagerNode,
+            ControllerManagerServices,
+        )
 
+        substitutions = parse_controllers_args(self.settings.controllers_args)
+        if self.is_controller_manager:  # this node is the controller_manager
+            ControllerManagerServices(
+                self, self.controllers, self.simulation.manager,
+                self.simulation.description.model, substitutions=substitutions,
+                source=controllers.label, update_rate=round(controllers.update_rate),
+                shared_parameters=lambda name: drop_in.shared_parameters(
+                    self, self._arguments, name))
+            self.controller_manager = self
+            return
         self.controller_manager = ControllerManagerNode(
             self.controllers, self.simulation.manager, self.simulation.description.model,
-            self.robot_namespace, context=self.context,
-            substitutions=parse_controllers_args(self.settings.controllers_args),
+            self.robot_namespace, context=self.context, substitutions=substitutions,
             source=controllers.label)
         self.companion_nodes.append(self.controller_manager)
+        if self.executor is not None:  # built once spinning (the description came late)
+            self.executor.add_node(self.controller_manager)
 
     def _destroy_companions(self) -> None:
         while self.companion_nodes:
@@ -472,8 +537,8 @@ class SimNode(Node):
         if not self.settings.autostart_controllers and self.topic_hardware is None:
             logger.info(
                 f'no controller loaded: waiting for spawners at '
-                f"{self.controller_manager.get_fully_qualified_name()} (the controllers file "
-                f"declares {', '.join(manager.declared) or 'none'})")
+                f"{self.controller_manager.get_fully_qualified_name()} (declared in "
+                f"{controllers.label}: {', '.join(manager.declared) or 'none'})")
             return
         for skipped in manager.skipped:
             logger.info(f"controller '{skipped.name}' (type '{skipped.type}') skipped: "

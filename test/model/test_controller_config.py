@@ -758,3 +758,51 @@ def test_a_ros2_file_names_a_block_of_controllers_it_ignores(write_yaml):
     warning, = config.warnings
     assert warning.startswith(f"{path}: top-level key 'common' holds a controller")
     assert "no 'ros__parameters'" in warning
+
+
+# --- a controller_manager's own parameters (sim_node in ros2_control_node's place) --------
+
+def test_a_controller_managers_parameters_declare_its_controllers():
+    from pan_tilt_sim.model.controller_config import controller_manager_config
+
+    sections = {'forward': {'joints': ['joint1'], 'interface_name': 'position'}}
+    config = controller_manager_config(
+        {'forward.type': 'forward_command_controller/ForwardCommandController',
+         'forward.params_file': '/x.yaml', 'jsb': {'type': 'joint_state_broadcaster/'
+                                                          'JointStateBroadcaster'}},
+        lambda name: sections.get(name, {}), update_rate=50.0,
+        source='the parameters of /controller_manager')
+    assert [(spec.name, spec.type) for spec in config.controllers] == [
+        ('forward', 'forward_command_controller/ForwardCommandController'),
+        ('jsb', 'joint_state_broadcaster/JointStateBroadcaster')]
+    forward = config.controllers[0].params
+    assert forward['joints'] == ['joint1'] and forward['update_rate'] == 50.0
+    assert config.update_rate == 50.0
+    assert config.label == 'the parameters of /controller_manager'
+
+
+def test_a_controller_manager_may_declare_none_and_refuses_a_type_that_is_no_string():
+    from pan_tilt_sim.model.controller_config import controller_manager_config
+
+    assert controller_manager_config({}, dict, update_rate=100.0, source='cm').controllers == ()
+    with pytest.raises(ControllerConfigError,
+                       match="^cm: parameter 'forward.type' must be a string, got 3$"):
+        controller_manager_config({'forward.type': 3}, lambda name: {}, update_rate=100.0,
+                                  source='cm')
+
+
+def test_a_launch_argument_left_in_another_nodes_section_does_not_stop_this_node(tmp_path):
+    from pan_tilt_sim.model.controller_config import node_parameters
+
+    path = write(tmp_path, 'rrbot_controllers.yaml', """\
+        joint_state_broadcaster:
+          ros__parameters:
+            type: joint_state_broadcaster/JointStateBroadcaster
+        forward_position_controller:
+          ros__parameters:
+            joints: [$(var joint_prefix)1]
+        """)
+    assert node_parameters([path], 'joint_state_broadcaster') == {
+        'type': 'joint_state_broadcaster/JointStateBroadcaster'}
+    with pytest.raises(ControllerConfigError, match=r':6: \$\(var joint_prefix\) is not set'):
+        node_parameters([path], 'forward_position_controller')

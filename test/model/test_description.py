@@ -122,3 +122,33 @@ def test_a_xacro_error_prints_nothing_beside_the_one_error(tmp_path, capfd):
 
 def test_a_plain_urdf_has_no_warnings(repo_root):
     assert load_description(repo_root / 'urdf' / 'pan_tilt.xacro').warnings == ()
+
+
+def test_a_description_from_a_topic_is_read_and_named_after_it(tmp_path):
+    from pan_tilt_sim.model.description import description_from_text
+
+    urdf = load_description(write_arm(tmp_path)).urdf_xml
+    description = description_from_text(urdf, '/rrbot/robot_description')
+    assert description.name == 'two_link_arm'
+    assert str(description.source) == '/rrbot/robot_description'
+    assert description.urdf_xml == urdf
+    with pytest.raises(DescriptionError, match='^/robot_description:1: not well-formed XML'):
+        description_from_text('<robot', '/robot_description')
+
+
+def test_package_meshes_in_a_description_from_a_topic_resolve_as_from_a_file(tmp_path,
+                                                                            monkeypatch):
+    from mesh_fixtures import binary_stl_bytes, make_ament_prefix
+
+    from pan_tilt_sim.model.description import description_from_text
+
+    prefix = make_ament_prefix(tmp_path, 'arm_description',
+                               {'meshes/link.stl': binary_stl_bytes((0.1, 0.1, 0.1))})
+    monkeypatch.setenv('AMENT_PREFIX_PATH', str(prefix))
+    urdf = load_description(write_arm(tmp_path)).urdf_xml.replace(
+        '<box size="0.4 0.04 0.04"/>', '<mesh filename="package://arm_description/meshes/link.stl"/>')
+    description = description_from_text(urdf, '/robot_description')
+    assert 'package://' in description.urdf_xml  # as published
+    assert 'package://' not in description.physics_urdf
+    assert str(prefix / 'share' / 'arm_description' / 'meshes' / 'link.stl') in (
+        description.physics_urdf)
