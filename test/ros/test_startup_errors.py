@@ -189,7 +189,7 @@ CASES = [
           ControllerConfigError, '{dir}/no_type.yaml', 'no controllers', "'type'"),
     _case('controller type unknown', {'controllers_file': '{dir}/unknown_type.yaml'},
           ControllerConfigError, 'a.type', "'foo_controllers/Bar'",
-          'supported: effort_controllers/GripperActionController',
+          'supported: diff_drive_controller/DiffDriveController',
           'effort_controllers/JointEffortController',
           'position_controllers/JointPositionController'),
     _case('controller without joint', {'controllers_file': '{dir}/no_joint.yaml'},

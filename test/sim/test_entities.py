@@ -304,8 +304,8 @@ def test_a_world_file_entry_that_cannot_be_spawned_names_the_file_and_entry(pan_
 
 
 @pytest.mark.parametrize('case', list(UNSPAWNABLE))
-def test_an_object_pybullet_would_crash_on_is_refused_and_the_world_goes_on(seed, case):
-    simulation, entities = seed
+def test_an_object_pybullet_would_crash_on_is_refused_and_the_world_goes_on(pan_tilt, case):
+    simulation, entities = pan_tilt
     urdf, expected = UNSPAWNABLE[case]
     before = entities.names()
     with pytest.raises(SpawnError) as refused:
@@ -319,9 +319,9 @@ def test_an_object_pybullet_would_crash_on_is_refused_and_the_world_goes_on(seed
     assert all(math.isfinite(v) for v in simulation.joint_positions().values())
 
 
-def test_an_object_pybullet_cannot_integrate_is_refused_before_it_enters_the_world(seed):
+def test_an_object_pybullet_cannot_integrate_is_refused_before_it_enters_the_world(pan_tilt):
     # A link's centre of mass so far out that its square overflows: NaN at the first step.
-    simulation, entities = seed
+    simulation, entities = pan_tilt
     before = (entities.names(), pybullet.getNumBodies(
         physicsClientId=simulation.physics.client_id))
     with pytest.raises(SpawnError) as refused:
@@ -337,8 +337,8 @@ def test_an_object_pybullet_cannot_integrate_is_refused_before_it_enters_the_wor
     assert all(math.isfinite(v) for v in entities.state(near).pose.translation)
 
 
-def test_a_world_file_object_pybullet_would_crash_on_ends_start_up_naming_it(seed, tmp_path):
-    _simulation, entities = seed
+def test_a_world_file_object_pybullet_would_crash_on_ends_start_up_naming_it(pan_tilt, tmp_path):
+    _simulation, entities = pan_tilt
     urdf, expected = UNSPAWNABLE['two joints with one child']
     (tmp_path / 'thing.urdf').write_text(urdf)
     world = read_world_file(_write(tmp_path, 'entities:\n  - uri: thing.urdf\n'))
