@@ -95,6 +95,13 @@ def _specs() -> tuple[_Spec, ...]:
         _Spec('initial_positions', ParameterType.PARAMETER_STRING_ARRAY, None,
               "Start positions, each 'joint:=value' (rad or m); they override the URDF's "
               '<ros2_control> initial_value, and the reset services return to them.'),
+        _Spec('record', ParameterType.PARAMETER_STRING, '',
+              'Record the run as a rosbag2 bag (MCAP storage) in this new folder: /clock, '
+              'joint_states, /tf, /tf_static, robot_description, controller states and the '
+              'commands received; empty = no recording. Needs the mcap package.'),
+        _Spec('record_sensors', ParameterType.PARAMETER_BOOL, False,
+              "With 'record': record the sensors' topics too (camera, depth, lidar, IMU, "
+              'force-torque).'),
     )
 
 
@@ -115,6 +122,8 @@ class SimParameters:
     gui: bool
     robot_namespace: str
     initial_positions: dict[str, float]
+    record: str  # '' = no recording
+    record_sensors: bool
 
 
 def declare_parameters(node: Node) -> SimParameters:
