@@ -21,7 +21,7 @@ RECORD_FAILED = 'PAN_TILT_SIM_RECORD_FAILED'
 _UNSAFE = re.compile(r'[^A-Za-z0-9_.-]+')
 
 
-def test_folder(root: Path, nodeid: str) -> Path:
+def bag_folder_of(root: Path, nodeid: str) -> Path:
     """Return the folder of a test's bags: its node id made a file name."""
     return root / _UNSAFE.sub('_', nodeid).strip('_')
 
@@ -42,7 +42,7 @@ def _record_failed_tests(request: pytest.FixtureRequest) -> Iterator[None]:
         return
     import node_harness
 
-    folder = test_folder(Path(root), request.node.nodeid)
+    folder = bag_folder_of(Path(root), request.node.nodeid)
     with node_harness.recording_into(folder):
         yield
     failed = any(getattr(getattr(request.node, f'_record_failed_{when}', None), 'failed', False)

@@ -13,7 +13,7 @@ import subprocess
 import sys
 
 import yaml
-from record_failed import RECORD_FAILED, test_folder
+from record_failed import RECORD_FAILED, bag_folder_of
 
 TEST_DIR = pathlib.Path(__file__).resolve().parent
 INNER_TESTS = '''
@@ -47,7 +47,7 @@ def test_only_the_failed_tests_bag_is_kept(tmp_path):
         cwd=inner, env=env, capture_output=True, text=True, timeout=240, check=False)
     assert result.returncode == 1, result.stdout + result.stderr
     assert '1 failed, 1 passed' in result.stdout
-    failed = test_folder(bags, 'test_inner.py::test_fails')
+    failed = bag_folder_of(bags, 'test_inner.py::test_fails')
     assert [path.name for path in bags.iterdir()] == [failed.name]
     (bag,) = failed.iterdir()
     assert bag.name == 'sim_node_0'

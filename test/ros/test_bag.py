@@ -173,7 +173,7 @@ def test_without_the_mcap_package_the_error_says_what_to_install(tmp_path, monke
 
 def test_a_full_disk_stops_the_recording_with_one_warning_and_raises_nothing(
         tmp_path, monkeypatch):
-    monkeypatch.setattr(bag, '_open_for_writing', lambda path: FullDisk(path, room=2000))
+    monkeypatch.setattr(bag, '_open_for_writing', lambda path: FullDisk(path, room=20_000))
     monkeypatch.setattr(bag, 'CHUNK_SIZE', 500)
     warnings = []
     writer = BagWriter(tmp_path / 'bag', field='--record', on_failure=warnings.append)
