@@ -13,7 +13,7 @@ import sys
 
 import pytest
 import yaml
-from bag_fixtures import FullDisk, read
+from bag_fixtures import FullDisk, read, read_with_rosbags
 from rclpy.serialization import serialize_message
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
@@ -115,6 +115,15 @@ def test_metadata_yaml_has_every_field_of_rosbag2_jazzy_bag_metadata(written):
     assert states['type'] == 'sensor_msgs/msg/JointState'
     assert states['serialization_format'] == 'cdr'
     assert states['type_description_hash'].startswith(RIHS01)
+
+
+def test_rosbags_rosbag2_reader_opens_the_folder_and_decodes_with_the_bags_definitions(written):
+    bag_read = read_with_rosbags(written)
+    assert bag_read['counts'] == {'/ns/joint_states': 2, '/ns/c/command': 1}
+    assert bag_read['start'] == 1_000_000_000
+    command = next(message for topic, _, message in bag_read['messages']
+                   if topic == '/ns/c/command')
+    assert command.data == 2.0
 
 
 def test_offered_qos_profiles_are_version_9_maps_with_policies_as_words(written):

@@ -17,7 +17,13 @@ import math
 import pytest
 import sim_process
 import yaml
-from bag_fixtures import NANOSECONDS_PER_SECOND, FullDisk, read, topic_messages
+from bag_fixtures import (
+    NANOSECONDS_PER_SECOND,
+    FullDisk,
+    read,
+    read_with_rosbags,
+    topic_messages,
+)
 from node_harness import sim_node
 from rclpy.parameter import Parameter
 from ros2_control_fixtures import write
@@ -35,7 +41,10 @@ SMALL_CAMERA = {'camera.width': 32, 'camera.height': 24, 'camera.rate': 10.0}
 
 
 def run_and_close(tmp_path, seconds: float = RUN_S, **parameters) -> tuple[dict, int]:
-    """Run sim_node recording for ``seconds`` of sim time; return the bag and the end in ns."""
+    """Run sim_node recording for ``seconds`` of sim time; return the bag and the end in ns.
+
+    The bag is also opened with rosbags' rosbag2 reader (``content['rosbags']``).
+    """
     folder = tmp_path / 'bag'
     parameters.setdefault('real_time_factor', PACE)
     parameters = {**SMALL_CAMERA, **parameters}
@@ -43,7 +52,7 @@ def run_and_close(tmp_path, seconds: float = RUN_S, **parameters) -> tuple[dict,
         sim.run_until_sim_time(seconds)
         sim.node.set_paused(True)
         end_ns = round(sim.simulation.time * NANOSECONDS_PER_SECOND)
-    return read(folder), end_ns
+    return {**read(folder), 'rosbags': read_with_rosbags(folder)}, end_ns
 
 
 @pytest.fixture(scope='module')
@@ -76,6 +85,17 @@ def test_joint_states_and_tf_come_at_50_hz_of_sim_time_logged_at_their_stamps(re
         stamp = message.header.stamp
         assert time == stamp.sec * NANOSECONDS_PER_SECOND + stamp.nanosec
         assert list(message.name) == ['pan_joint', 'tilt_joint']
+
+
+def test_a_second_rosbag2_reader_decodes_every_message_with_the_bags_definitions(recorded):
+    content, _ = recorded
+    by_rosbags = content['rosbags']
+    assert len(by_rosbags['messages']) == len(content['messages'])
+    assert sorted((topic, time) for topic, time, _ in by_rosbags['messages']) == sorted(
+        (topic, time) for topic, time, _ in content['messages'])
+    tf = [message for topic, _, message in by_rosbags['messages'] if topic == '/tf']
+    assert tf and {transform.child_frame_id for transform in tf[-1].transforms} >= {
+        'pan_link', 'tilt_link'}
 
 
 def test_every_log_time_is_sim_time_within_the_run(recorded):
