@@ -31,6 +31,7 @@ quota) stops the recording -- later messages are dropped, the
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import pathlib
@@ -237,7 +238,7 @@ class BagWriter:
             self._writer.start(profile=PROFILE)
             self._stream.flush()
         except OSError as err:
-            self._stream.close()
+            self.discard()
             raise ConfigurationError(
                 f"{field}: cannot write the bag folder '{self.folder}': "
                 f'{one_line(err.strerror or str(err))}') from None
@@ -328,13 +329,12 @@ class BagWriter:
         """Let go of the file and remove the folder this writer made (start-up failed)."""
         with self._lock:
             self._closed = True
-            try:
+            with contextlib.suppress(OSError):
                 self._stream.close()
-            except OSError:
-                pass
-        for path in self.folder.iterdir():
-            path.unlink(missing_ok=True)
-        self.folder.rmdir()
+        with contextlib.suppress(OSError):
+            for path in self.folder.iterdir():
+                path.unlink(missing_ok=True)
+            self.folder.rmdir()
 
     def _fail(self, err: OSError) -> None:
         """Stop recording after a write failed; say so once."""

@@ -199,3 +199,13 @@ def test_a_full_disk_stops_the_recording_with_one_warning_and_raises_nothing(
     assert warnings[0].startswith(f"--record: stopped recording to '{tmp_path / 'bag'}'")
     assert 'No space left on device' in warnings[0]
     assert not (tmp_path / 'bag' / 'metadata.yaml').exists()
+
+
+def test_a_file_that_cannot_take_the_header_is_one_line_and_leaves_no_folder(tmp_path,
+                                                                           monkeypatch):
+    monkeypatch.setattr(bag, '_open_for_writing', lambda path: FullDisk(path, room=0))
+    with pytest.raises(ConfigurationError) as raised:
+        BagWriter(tmp_path / 'bag', field='--record')
+    assert str(raised.value) == (f"--record: cannot write the bag folder '{tmp_path / 'bag'}': "
+                                 'No space left on device')
+    assert not (tmp_path / 'bag').exists()

@@ -211,6 +211,30 @@ def test_controller_states_are_recorded_with_their_control_msgs_definitions(tmp_
         assert [state.name for state in message.dof_states] == ['joint1']
 
 
+@pytest.mark.skipif(importlib.util.find_spec('controller_manager_msgs') is None
+                    or importlib.util.find_spec('control_msgs') is None,
+                    reason='controller_manager_msgs or control_msgs is not installed')
+def test_a_recorded_controllers_topics_go_at_cleanup_and_come_back_recorded(tmp_path):
+    from spawner_client import Spawner, srv
+
+    urdf = write(tmp_path, 'one_link.urdf', PID_URDF)
+    controllers = write(tmp_path, 'controllers.yaml', PID_CONTROLLERS)
+    folder = tmp_path / 'bag'
+    with sim_node(record=str(folder), robot_description_file=str(urdf),
+                  controllers_file=str(controllers)) as sim:
+        spawner = Spawner(sim)
+        assert spawner.switch(deactivate=['pid']).ok
+        assert spawner.call('cleanup_controller', srv().CleanupController.Request(name='pid')).ok
+        assert '/pid/controller_state' not in sim.own_topics()[0]
+        assert spawner.configure('pid') and spawner.switch(activate=['pid']).ok
+        assert '/pid/controller_state' in sim.own_topics()[0]
+        sim.run_until_sim_time(sim.simulation.time + 0.1)
+        sim.node.set_paused(True)
+        end_ns = round(sim.simulation.time * NANOSECONDS_PER_SECOND)
+    times = [time for time, _ in topic_messages(read(folder), '/pid/controller_state')]
+    assert times and times[-1] > end_ns - 20_000_000
+
+
 def test_a_folder_that_exists_ends_start_up_in_one_line(tmp_path, context):
     with pytest.raises(ConfigurationError) as raised:
         SimNode(context=context, parameter_overrides=[Parameter('record', value=str(tmp_path))])
