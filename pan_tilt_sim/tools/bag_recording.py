@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from builtin_interfaces.msg import Duration
 from rclpy.qos import QoSProfile
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64, Float64MultiArray, String
@@ -60,9 +61,7 @@ def command_message(kind: CommandKind, command: Any) -> Any:
     raise ValueError(f'no message for a {kind.value} command {command!r}')
 
 
-def _duration(seconds: float) -> Any:
-    from builtin_interfaces.msg import Duration
-
+def _duration(seconds: float) -> Duration:
     time = stamp(seconds)
     return Duration(sec=time.sec, nanosec=time.nanosec)
 

@@ -291,3 +291,18 @@ def test_record_refuses_a_folder_that_exists_in_one_line_before_the_run(tmp_path
     assert exit_info.value.code == 2 and captured.out == ''
     assert captured.err == (f"step_response: error: --record: the bag folder '{tmp_path}' "
                             'already exists (give a new one)\n')
+
+
+def test_record_of_a_trajectory_step_holds_the_trajectory_and_tf(ur_style_arm, tmp_path):
+    from bag_fixtures import read, topic_messages
+
+    folder = tmp_path / 'arm'
+    run_tool([*ur_style_arm, '--joint', 'joint2', '--target', '0.5', '--record', str(folder)])
+    content = read(folder)
+    (command,) = topic_messages(content, '/joint_trajectory_controller/joint_trajectory')
+    assert list(command[1].joint_names) == ['joint1', 'joint2']
+    (point,) = command[1].points
+    assert list(point.positions) == [0.0, 0.5]
+    tf = topic_messages(content, '/tf')
+    assert [time for time, _ in tf] == list(range(0, 2_000_000_001, 20_000_000))
+    assert topic_messages(content, '/tf_static')
