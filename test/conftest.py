@@ -26,6 +26,9 @@ _prefixes = [p for p in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep
 if sys.prefix not in _prefixes:
     os.environ['AMENT_PREFIX_PATH'] = os.pathsep.join([sys.prefix, *_prefixes])
 
+# PAN_TILT_SIM_RECORD_FAILED=<folder> keeps the bags of failed tests (see record_failed.py).
+pytest_plugins = ['record_failed']
+
 REPO_ROOT = pathlib.Path(__file__).resolve().parents[1]
 ORIGINAL_EXAMPLES = REPO_ROOT / 'test' / 'data' / 'original_examples'
 

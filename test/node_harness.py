@@ -12,6 +12,7 @@ JointStates it published, and the probe's ways to command and watch it.
 from __future__ import annotations
 
 import contextlib
+import pathlib
 import time
 from collections.abc import Callable, Iterator
 from typing import Any
@@ -40,6 +41,8 @@ QUEUE_DEPTH = 10
 PROBE_QUEUE = QoSProfile(depth=20000, history=QoSHistoryPolicy.KEEP_LAST)
 SAME_STAMP_S = 1e-6  # two stamps this close are the same instant
 SIM_TIME_EPSILON_S = 1e-9
+# Where sim_node() records its runs while a test may want them kept (record_failed.py).
+_recording: dict[str, object] = {'folder': None, 'made': 0}
 
 
 def interface_name(interface: type) -> str:
@@ -330,9 +333,27 @@ class SimUnderTest:
 
 
 @contextlib.contextmanager
+def recording_into(folder: pathlib.Path) -> Iterator[None]:
+    """Have every :func:`sim_node` started meanwhile record into ``folder/sim_node_<n>``."""
+    _recording.update(folder=folder, made=0)
+    try:
+        yield
+    finally:
+        _recording.update(folder=None, made=0)
+
+
+@contextlib.contextmanager
 def sim_node(*, node_namespace: str | None = None, **parameters: Any) -> Iterator[SimUnderTest]:
-    """Run a SimNode (real_time_factor 0 unless given) with ``parameters`` as overrides."""
+    """Run a SimNode (real_time_factor 0 unless given) with ``parameters`` as overrides.
+
+    Inside :func:`recording_into` (``PAN_TILT_SIM_RECORD_FAILED``), the node
+    records its run unless the test gives ``record`` itself.
+    """
     parameters.setdefault('real_time_factor', 0.0)
+    folder = _recording['folder']
+    if folder is not None and 'record' not in parameters:
+        parameters['record'] = str(folder / f"sim_node_{_recording['made']}")
+        _recording['made'] += 1
     harness = NodeHarness()
     try:
         node = harness.add(SimNode(

@@ -25,6 +25,7 @@ import re
 import shlex
 import subprocess
 import sys
+import tempfile
 from collections.abc import Iterator
 
 import pytest
@@ -157,6 +158,8 @@ ENVIRONMENT = re.compile(r'^[A-Z_][A-Z0-9_]*=')
 SEPARATORS = {'&&', ';', '||', '|'}
 GENERAL_TOOLS = {'mkdir', 'cd', 'git', 'source', 'ray'}  # nothing of this package in them
 PLACEHOLDER = '/path/to/'
+# A documented record:=<folder> records into a fresh folder here, not the checkout.
+_BAGS = tempfile.TemporaryDirectory(prefix='pan_tilt_docs_bags_')
 
 
 @dataclasses.dataclass(frozen=True)
@@ -280,6 +283,8 @@ class Setup:
             if name in ('robot_description_file', 'controllers_file') and \
                     not value.startswith(('/', 'package://', 'file://')):
                 value = str(REPO / value)
+            if name == 'record' and value:
+                value = tempfile.mkdtemp(dir=_BAGS.name) + '/' + pathlib.Path(value).name
             out.append((name, value))
         return tuple(out)
 

@@ -119,6 +119,13 @@ def _specs(controller_manager: bool = False) -> tuple[_Spec, ...]:
               '[x, y, z, yaw] (m, m, m, rad) of the base: a free base rests on the ground, '
               'its lowest collision point z above it; a welded one has its root link frame '
               'there. Unset: the origin. The reset services return to it.'),
+        _Spec('record', ParameterType.PARAMETER_STRING, '',
+              'Record the run as a rosbag2 bag (MCAP storage) in this new folder: /clock, '
+              'joint_states, /tf, /tf_static, robot_description, controller states and the '
+              'commands received; empty = no recording. Needs the mcap package.'),
+        _Spec('record_sensors', ParameterType.PARAMETER_BOOL, False,
+              "With 'record': record the sensors' topics too (camera, depth, lidar, IMU, "
+              'force-torque).'),
     )
 
 
@@ -142,6 +149,8 @@ class SimParameters:
     # True, False, or None for auto (see pan_tilt_sim.model.base_pose).
     fixed_base: bool | None
     initial_pose: BasePose
+    record: str  # '' = no recording
+    record_sensors: bool
 
 
 def declare_parameters(node: Node, *, controller_manager: bool = False) -> SimParameters:

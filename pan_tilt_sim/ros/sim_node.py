@@ -45,6 +45,7 @@ from pan_tilt_sim.ros.features import NodeFeatures
 from pan_tilt_sim.ros.gain_parameters import GainParameters
 from pan_tilt_sim.ros.pacing import Pacer, Throttle
 from pan_tilt_sim.ros.physics_thread import PhysicsThread, Turns
+from pan_tilt_sim.ros.recording import RecordedPublisher, Recorder
 from pan_tilt_sim.ros.ros_interfaces import NANOSECONDS_PER_SECOND, clock_message
 from pan_tilt_sim.sim.engine import Simulation
 
@@ -112,6 +113,9 @@ class SimNode(Node):
         self._description_subscription = None
         self.controller_manager: Node | None = None  # where controller_manager_msgs exists
         self.is_controller_manager = False
+        # With record:=<folder>, every publisher and subscription made from then on is
+        # teed into the bag (see create_publisher, create_subscription).
+        self.recorder: Recorder | None = None
         super().__init__(NODE_NAME, **kwargs)
         # Named controller_manager (launch's name='controller_manager'), sim_node stands
         # in for ros2_control_node: see the module pan_tilt_sim.ros.drop_in.
@@ -121,6 +125,9 @@ class SimNode(Node):
                 [*ros_arguments, *(kwargs.get('cli_args') or ())], 'the command line')
             self._start(physics_thread, kwargs.get('parameter_overrides') or ())
         except BaseException:
+            if self.recorder is not None:  # a node that never ran leaves no bag
+                self.recorder.discard()
+                self.recorder = None
             self.destroy_node()
             raise
 
@@ -169,6 +176,11 @@ class SimNode(Node):
             autostart_controllers=(self._topic_settings is not None
                                    or self.settings.autostart_controllers),
             fixed_base=self.settings.fixed_base, initial_pose=self.settings.initial_pose)
+        if self.settings.record:
+            # Before the first publisher: /clock, the state topics and TF are all recorded.
+            self.recorder = Recorder(
+                self.settings.record, clock=lambda: self.simulation.time,
+                sensors=self.settings.record_sensors, warn=self.get_logger().warning)
         self._paused = self.settings.paused
         self.steps_run = 0  # physics steps this node has run (never reset; see run_steps)
         self._pacer = Pacer(self.settings.real_time_factor, self.settings.time_step)
@@ -234,6 +246,10 @@ class SimNode(Node):
             f"{controllers.label}; topics under "
             f"'{self.robot_namespace or '/'}', time_step {self.settings.time_step} s, "
             f'real_time_factor {self._pacer.real_time_factor}')
+        if self.recorder is not None:
+            self.get_logger().info(
+                f"recording to '{self.recorder.folder}' (rosbag2, MCAP storage"
+                f"{', sensors included' if self.settings.record_sensors else ''})")
         if self._physics_thread is not None:
             self._command_reader.start()
             self._physics_thread.start()  # last: nothing may fail after it runs
@@ -251,9 +267,20 @@ class SimNode(Node):
         return super().set_parameters_atomically(parameter_list)
 
     def create_publisher(self, *args, **kwargs):
-        """Create a publisher without rclpy's default QoS-event handler (see below)."""
+        """Create a publisher without rclpy's default QoS-event handler (see below).
+
+        While recording, the publisher is teed into the bag (a
+        :class:`~pan_tilt_sim.ros.recording.RecordedPublisher`).
+        """
         kwargs.setdefault('event_callbacks', PublisherEventCallbacks(use_default_callbacks=False))
-        return super().create_publisher(*args, **kwargs)
+        publisher = super().create_publisher(*args, **kwargs)
+        return publisher if self.recorder is None else self.recorder.tee_publisher(publisher)
+
+    def destroy_publisher(self, publisher) -> bool:
+        """Destroy a publisher this node created (recorded or not)."""
+        if isinstance(publisher, RecordedPublisher):
+            publisher = publisher.publisher
+        return super().destroy_publisher(publisher)
 
     def create_subscription(self, *args, **kwargs):
         """Create a subscription without rclpy's default QoS-event handler.
@@ -265,7 +292,10 @@ class SimNode(Node):
         """
         kwargs.setdefault('event_callbacks',
                           SubscriptionEventCallbacks(use_default_callbacks=False))
-        return super().create_subscription(*args, **kwargs)
+        subscription = super().create_subscription(*args, **kwargs)
+        if self.recorder is not None:  # the messages received are recorded too
+            self.recorder.tee_subscription(subscription)
+        return subscription
 
     def topic(self, *names: str) -> str:
         """Absolute name of a topic of the robot."""
@@ -412,6 +442,8 @@ class SimNode(Node):
             self.features.close()
         if self.simulation is not None:
             self.simulation.close()
+        if self.recorder is not None:  # last: everything that publishes has stopped
+            self.recorder.close()
         logger = self.get_logger()
         super().destroy_node()
         # Once the node is gone: its rosout publisher may share a dead context.

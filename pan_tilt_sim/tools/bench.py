@@ -16,20 +16,24 @@ than wall time):
   and ``wall_steps_per_s``: bare ``stepSimulation`` calls per wall second,
   beside them;
 * ``factor_0``: sim_node at real_time_factor 0, both position controllers
-  moving, in three cases, one after the other: ``no_subscriber``,
+  moving, in four cases, one after the other: ``no_subscriber``,
   ``clock_subscriber`` (a reliable /clock subscriber in its own process, as
   ``ros2 topic echo /clock`` makes; rclpy's use_sim_time TimeSource makes a
-  best-effort one) and ``joint_state_subscriber`` (a reliable JointState
-  subscriber in its own process).  Each gives ``steps_per_s`` (sim time over
-  wall time between two JointStates the probe takes at the ends of the
-  window, subscribing only for them), ``ratio_to_raw`` (over
+  best-effort one), ``joint_state_subscriber`` (a reliable JointState
+  subscriber in its own process) and ``recording`` (no subscriber, the run
+  recorded with ``record:=<folder>``; absent without the mcap package).
+  Each gives ``steps_per_s`` (sim time over wall time between two
+  JointStates the probe takes at the ends of the window, subscribing only
+  for them), ``ratio_to_raw`` (over
   ``raw.steps_per_s``), ``node_cpu_us_per_step`` (the thread that used
   the most CPU over the window: the one stepping the physics) and, with a subscriber,
   ``subscriber_cpu_percent`` (% of one core);
 * ``factor_1``: at real_time_factor 1 with a /clock subscriber:
   ``cpu_percent`` (the node process, % of one core, while nobody reads
   JointState), ``cpu_percent_with_joint_states`` (while the probe reads
-  JointState too), ``clock_subscriber_cpu_percent``, JointState inter-arrival
+  JointState too), ``cpu_percent_recording`` (a second node, recording the
+  run, nobody reading JointState; absent without the mcap package),
+  ``clock_subscriber_cpu_percent``, JointState inter-arrival
   ``joint_states_p50_ms`` / ``joint_states_p99_ms`` and ``rtf_error``
   (|sim/wall - 1|, the slope of JointState stamps against arrival times);
 * ``startup_s``: process start to the first JointState at the probe, median
@@ -72,6 +76,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
+import importlib.util
 import itertools
 import json
 import math
@@ -121,6 +126,8 @@ CLOCK_TOPIC = '/clock'
 CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
 JOINT_STATE_TYPE = 'sensor_msgs/msg/JointState'
 SUBSCRIBER_CASES = ('no_subscriber', 'clock_subscriber', 'joint_state_subscriber')
+RECORDING_CASE = 'recording'  # factor 0, no subscriber, record:=<folder>
+BAG_METADATA = 'metadata.yaml'
 COMMAND_PERIOD_S = 0.25  # wall seconds between alternating position commands
 COMMAND_SPAN = 0.25  # targets sit this fraction of the range inside each limit
 UNLIMITED_TARGET = 1.0  # rad, +- target of a joint without position limits
@@ -533,18 +540,27 @@ class Bench:
         self._node_count = 0
 
     @contextlib.contextmanager
-    def node(self, model: Model, real_time_factor: float | None) -> Iterator[NodeProcess]:
-        """Run sim_node on ``model`` for the duration of the block."""
+    def node(self, model: Model, real_time_factor: float | None,
+             record: bool = False) -> Iterator[NodeProcess]:
+        """Run sim_node on ``model`` for the duration of the block (recording, if asked).
+
+        A recording node must leave a finished bag: BenchError otherwise.
+        """
         parameters = {'time_step': repr(float(self.time_step))}
         if real_time_factor is not None:
             parameters['real_time_factor'] = repr(float(real_time_factor))
         self._node_count += 1
+        bag = self.folder / f'bag_{self._node_count}'
+        if record:
+            parameters['record'] = str(bag)
         process = NodeProcess(model, parameters, self.env,
                               self.folder / f'sim_node_{self._node_count}.log')
         try:
             yield process
         finally:
             process.stop()
+        if record and not (bag / BAG_METADATA).is_file():
+            raise BenchError(f'the recording node left no {bag / BAG_METADATA}')
 
     def spin_until(self, node: ChildProcess, done: Callable[[], bool], timeout: float,
                    what: str, probe: Probe | None = None) -> None:
@@ -592,7 +608,7 @@ class Bench:
              ) -> dict[str, float]:
         """Measure sim_node at factor 0 with the subscriber of ``case`` in its own process."""
         with contextlib.ExitStack() as running:
-            node = running.enter_context(self.node(model, 0.0))
+            node = running.enter_context(self.node(model, 0.0, record=case == RECORDING_CASE))
             listener = None
             if case == 'clock_subscriber':
                 listener = running.enter_context(self.listener(CLOCK_TOPIC, CLOCK_TYPE))
@@ -658,6 +674,22 @@ class Bench:
             'cpu_percent_with_joint_states': cpu_with_joint_states * PERCENT,
             'clock_subscriber_cpu_percent': clock_cpu * PERCENT,
         }
+
+    def paced_recording(self, model: Model) -> float:
+        """Return the node's CPU share at real_time_factor 1 while it records the run.
+
+        As ``cpu_percent`` of :meth:`paced`: a /clock subscriber, nobody reading JointState.
+        """
+        samples: list[tuple[float, float]] = []
+        topic = model.joint_states_topic
+        with (self.node(model, 1.0, record=True) as node,
+              self.listener(CLOCK_TOPIC, CLOCK_TYPE) as clock):
+            commander = Commander(self.probe, model)
+            with self.probe.joint_states(topic, 10, lambda wall, sim: samples.append(sim)):
+                self.spin_until(node, lambda: bool(samples), FIRST_MESSAGE_TIMEOUT_S,
+                                f'JointState on {topic}')
+            cpu, _ = self._paced_cpu(node, clock, commander)
+        return cpu * PERCENT
 
     def _paced_cpu(self, node: NodeProcess, clock: Listener, commander: Commander,
                    samples: list | None = None) -> tuple[float, float]:
@@ -814,13 +846,19 @@ def run_once(bench: Bench, model: Model) -> dict:
     problem = raw_rates_disagree(raw)
     if problem is not None:
         print(f'bench: warning: {problem}', file=sys.stderr, flush=True)
+    recording = importlib.util.find_spec('mcap') is not None
+    if not recording:
+        bench.log('no recording figures: the mcap package is not installed (pip install mcap)')
     factor_0 = {}
-    for case in SUBSCRIBER_CASES:
+    for case in SUBSCRIBER_CASES + (RECORDING_CASE,) * recording:
         bench.log(f'sim_node at real_time_factor 0, {case.replace("_", " ")}')
         figures = bench.fast(model, plan.fast_s, case)
         factor_0[case] = {**figures, 'ratio_to_raw': figures['steps_per_s'] / raw['steps_per_s']}
     bench.log('sim_node at real_time_factor 1 with a /clock subscriber')
     paced = bench.paced(model)
+    if recording:
+        bench.log('sim_node at real_time_factor 1 recording the run, with a /clock subscriber')
+        paced['cpu_percent_recording'] = bench.paced_recording(model)
     bench.log(f'{SERVICE_CALLERS} service callers at real_time_factor 1')
     service_round_trip = bench.service_round_trips(model)
     bench.log('start-up')

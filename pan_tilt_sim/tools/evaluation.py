@@ -32,6 +32,7 @@ import contextlib
 import dataclasses
 import math
 import pathlib
+import sys
 import time
 from collections.abc import Iterator, Mapping, Sequence
 
@@ -134,6 +135,8 @@ class Case:
     time_step: float | None = None  # None: the scenario's
     duration: float | None = None  # s of sim time per step; None: ramp + 5 s
     keep_records: bool = False  # return the sampled responses too (for plots)
+    # Record each step as a rosbag2 bag in <record>/<joint>_<n> (n from 1); None: no bags.
+    record: str | None = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -197,9 +200,32 @@ def evaluate(scenario: Scenario, case: Case) -> Evaluation:
         for index, target in enumerate(case.targets):
             if index:
                 simulation.reset()
-            record = record_step(simulation, case.joint, target, case.duration, driver.name)
+            with _recording(scenario, case, index, simulation) as bag:
+                record = record_step(simulation, case.joint, target, case.duration,
+                                     driver.name, bag)
             steps.append(step_result(record, effort_limit, case.keep_records))
     return Evaluation(case.joint, tuple(steps), time.process_time() - started)
+
+
+@contextlib.contextmanager
+def _recording(scenario: Scenario, case: Case, index: int,
+               simulation: Simulation) -> Iterator[object | None]:
+    """Record step ``index`` of ``case`` where it asks for bags (rclpy and mcap load only then)."""
+    if case.record is None:
+        yield None
+        return
+    from pan_tilt_sim.model import naming
+    from pan_tilt_sim.tools.bag_recording import SimulationRecording
+
+    namespace = naming.resolve_robot_namespace(
+        '', '', scenario.controllers.namespace, scenario.description.plugin_namespace)
+    bag = SimulationRecording(
+        str(pathlib.Path(case.record, f'{case.joint}_{index + 1}')), simulation, namespace,
+        field='--record', warn=lambda line: print(f'warning: {line}', file=sys.stderr))
+    try:
+        yield bag
+    finally:
+        bag.close()
 
 
 def step_result(record: StepRecord, effort_limit: float, keep_record: bool) -> StepResult:

@@ -4,7 +4,7 @@
 
     ros2 run pan_tilt_sim step_response --joint pan_joint --target 1.0 --plot step.png
 
-runs the simulation in this process as fast as it goes (it never imports
+runs the simulation in this process as fast as it goes (without ``--record`` it never imports
 rclpy), commands the joint to ``--target`` at t = 0 through the controller
 that drives it by position, records position, setpoint and effort every
 physics step for ``--duration`` seconds of sim time, and prints JSON.
@@ -33,19 +33,25 @@ stepping controller first).  The metrics:
   actuator when the YAML gives no gains) and ``gains`` (null for the ideal actuator).
 
 ``--plot FILE`` writes a PNG (matplotlib, Agg backend): position and setpoint
-over time, the effort on a second axis, the metrics in the legend.  Errors in
-the arguments or files: one line on stderr, exit code 2.
+over time, the effort on a second axis, the metrics in the legend.
+``--record FOLDER`` writes the run as a rosbag2 bag (MCAP storage), the
+topics sim_node's ``record:=`` would hold (:mod:`.bag_recording`; only then
+are rclpy's message serialization and the mcap package loaded).  Errors in
+the arguments or files (a bag folder that exists or cannot be made
+included): one line on stderr, exit code 2.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import json
 import math
 import pathlib
 import sys
 from collections.abc import Sequence
+from typing import Any
 
 from pan_tilt_sim.controllers import CommandController, CommandResult
 from pan_tilt_sim.controllers.forward_command_controller import ForwardCommandController
@@ -53,6 +59,7 @@ from pan_tilt_sim.controllers.joint_position_controller import JointPositionCont
 from pan_tilt_sim.controllers.joint_trajectory_controller import JointTrajectoryController
 from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
 from pan_tilt_sim.errors import ConfigurationError, ControllerSwitchError
+from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.controller_config import (
     controllers_files_for,
     load_controllers_config,
@@ -238,35 +245,45 @@ def _described(controller: CommandController) -> str:
     return f'{controller.name} ({controller.type_name})'
 
 
-def command_position(controller: CommandController, joint: str,
-                     target: float) -> CommandResult:
-    """Command ``joint`` to ``target``; the controller's other joints keep their setpoints."""
+def position_command(controller: CommandController, joint: str, target: float) -> Any:
+    """Return the command that moves ``joint`` to ``target``, the other joints holding."""
     if isinstance(controller, JointPositionController):
-        return controller.set_command(target)
+        return target
     setpoints = controller.setpoints()
     setpoints[joint] = target
     values = [setpoints[name] for name in controller.joint_names]
     if isinstance(controller, JointTrajectoryController):
         # One point due at once: the desired position steps, as a position command does.
-        return controller.set_command(JointTrajectory(
-            controller.joint_names, (TrajectoryPoint(0.0, tuple(values)),)))
-    return controller.set_command(values)
+        return JointTrajectory(controller.joint_names, (TrajectoryPoint(0.0, tuple(values)),))
+    return values
+
+
+def command_position(controller: CommandController, joint: str,
+                     target: float) -> CommandResult:
+    """Command ``joint`` to ``target``; the controller's other joints keep their setpoints."""
+    return controller.set_command(position_command(controller, joint, target))
 
 
 def record_step(simulation: Simulation, joint: str, target: float,
-                duration: float | None = None, controller: str | None = None) -> StepRecord:
+                duration: float | None = None, controller: str | None = None,
+                bag: Any = None) -> StepRecord:
     """Step ``joint`` to ``target`` at the present state and record the response.
 
     ``duration`` (s of sim time) defaults to the velocity-limited ramp's
     length plus ``SETTLE_ALLOWANCE_S``; ``controller`` names the controller
-    to step with (see :func:`position_controller`).
+    to step with (see :func:`position_controller`).  ``bag`` (a
+    :class:`~pan_tilt_sim.tools.bag_recording.SimulationRecording`) records
+    the command and every step.
     """
     driver = position_controller(simulation, joint, controller)
     spec = simulation.handles[joint].spec
     initial = simulation.joint_positions()[joint]
     if not math.isfinite(target):
         raise ConfigurationError(f'--target: {target!r} is not a finite number')
-    result = command_position(driver, joint, target)
+    command = position_command(driver, joint, target)
+    result = driver.set_command(command)
+    if bag is not None:
+        bag.command(driver, command)
     if result is CommandResult.REJECTED:
         raise ConfigurationError(
             f'--target: {target!r}: {driver.command_problem(target, result)}')
@@ -287,6 +304,8 @@ def record_step(simulation: Simulation, joint: str, target: float,
     recorded_setpoints, efforts = [setpoints()[joint]], [handle.effort]
     for _ in range(steps):
         simulation.advance(1)
+        if bag is not None:
+            bag.after_steps()
         times.append(simulation.time - start)
         positions.append(simulation.joint_positions()[joint])
         recorded_setpoints.append(setpoints()[joint])
@@ -399,6 +418,9 @@ def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     parser.add_argument('--plot', type=pathlib.Path, default=None, metavar='FILE.png',
                         help='also write a plot of the response to this PNG file '
                         '(needs matplotlib)')
+    parser.add_argument('--record', default=None, metavar='FOLDER',
+                        help='also record the run as a rosbag2 bag (MCAP storage) in this new '
+                        "folder, as sim_node's record:= does (needs mcap)")
     return parser.parse_args(argv)
 
 
@@ -421,8 +443,21 @@ def build_simulation(args: argparse.Namespace) -> Simulation:
         files, parse_controllers_args(args.controllers_args, '--controllers-args'),
         args_name='--controllers-args')
     active = args.active_controllers or None
+    args.controllers_namespace = config.namespace
     return Simulation(description, config, args.time_step,
                       active_controllers=[] if active is None else active)
+
+
+def start_recording(args: argparse.Namespace, simulation: Simulation) -> Any:
+    """Start recording the run into ``args.record`` (rclpy and mcap load only now)."""
+    from pan_tilt_sim.tools.bag_recording import SimulationRecording
+
+    description = simulation.description
+    namespace = naming.resolve_robot_namespace(
+        '', '', args.controllers_namespace, description.plugin_namespace)
+    return SimulationRecording(
+        args.record, simulation, namespace, field='--record',
+        warn=lambda line: print(f'{PROGRAM}: warning: {line}', file=sys.stderr))
 
 
 def activate_the_rest(simulation: Simulation) -> None:
@@ -442,11 +477,15 @@ def run(args: argparse.Namespace) -> dict:
         raise ConfigurationError(f'--time-step: {args.time_step} must be > 0 s')
     if args.plot is not None:
         check_plot_target(args.plot)
-    with build_simulation(args) as simulation:
+    with build_simulation(args) as simulation, contextlib.ExitStack() as recording:
         driver = position_controller(simulation, args.joint, args.controller)
         if not args.active_controllers:
             activate_the_rest(simulation)
-        record = record_step(simulation, args.joint, args.target, args.duration, driver.name)
+        bag = None if args.record is None else start_recording(args, simulation)
+        if bag is not None:
+            recording.callback(bag.close)
+        record = record_step(simulation, args.joint, args.target, args.duration, driver.name,
+                             bag)
         pid = driver.pids().get(args.joint)
         actuator = simulation.handles[args.joint].actuator.kind.label
     metrics = step_metrics(record)

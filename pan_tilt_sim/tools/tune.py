@@ -27,7 +27,9 @@ over the record, per unit of step, summed over the targets (see
 ``evaluation``).
 
 Then it prints a before/after table of every metric for every target,
-writes ``--plot`` (one PNG: both step responses of every target) and, if
+writes ``--plot`` (one PNG: both step responses of every target),
+``--record`` (the after steps as rosbag2 bags, ``FOLDER/<joint>_<n>`` for
+the n-th target, the topics sim_node's ``record:=`` would hold) and, if
 every joint met the specification, ``--out``: the controllers YAML with
 only the gains' values changed, in the file's own style (ROS 1 ``pid:`` or
 ros2_control ``gains:``, flow or block, comments and order untouched).  When
@@ -333,16 +335,16 @@ class TuneResult:
 
 
 def evaluate_plans(scenario: Scenario, plans: Sequence[JointPlan],
-                   gains: Mapping[str, PidGains], duration: float | None = None
-                   ) -> dict[str, Evaluation]:
+                   gains: Mapping[str, PidGains], duration: float | None = None,
+                   record: str | None = None) -> dict[str, Evaluation]:
     """Evaluate every planned joint in this process with ``gains``, records kept (for plots).
 
     With no gains given this is the "before" of the report, and it checks the
     targets (a target where the joint already is has no step) before any
-    worker starts.
+    worker starts.  ``record``: a folder for a rosbag2 bag of each step.
     """
     cases = [Case(plan.joint.name, plan.targets, gains=tuple(gains.items()),
-                  duration=duration, keep_records=True) for plan in plans]
+                  duration=duration, keep_records=True, record=record) for plan in plans]
     return {plan.joint.name: result for plan, result in
             zip(plans, InProcess().map(evaluate, scenario, cases), strict=True)}
 
@@ -352,8 +354,13 @@ def tune(scenario: Scenario, plans: Sequence[JointPlan], spec: Spec, backend: Ba
          duration: float | None = None,
          ranges: Mapping[str, tuple[float, float]] | None = None,
          before: Mapping[str, Evaluation] | None = None,
-         progress: Callable[[str], None] = lambda text: None) -> TuneResult:
-    """Tune each planned joint in turn; evaluate before (unless given) and after."""
+         progress: Callable[[str], None] = lambda text: None,
+         record: str | None = None) -> TuneResult:
+    """Tune each planned joint in turn; evaluate before (unless given) and after.
+
+    ``record``: a new folder for the after evaluation's bags, one per joint and
+    target (``<joint>_<n>``, see :mod:`.evaluation`).
+    """
     if before is None:
         before = evaluate_plans(scenario, plans, {}, duration)
     chosen: dict[str, PidGains] = {}
@@ -373,8 +380,8 @@ def tune(scenario: Scenario, plans: Sequence[JointPlan], spec: Spec, backend: Ba
                              tuple(found), notes)
         tunings.append(tuning)
         chosen[plan.joint.name] = tuning.best.gains
-    return TuneResult(tuple(tunings), before, evaluate_plans(scenario, plans, chosen, duration),
-                      spec)
+    return TuneResult(tuple(tunings), before,
+                      evaluate_plans(scenario, plans, chosen, duration, record), spec)
 
 
 # --- reporting ----------------------------------------------------------------------------
@@ -653,6 +660,10 @@ def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
                         help='write the controllers YAML with the new gains here')
     parser.add_argument('--plot', type=pathlib.Path, default=None, metavar='FILE.png',
                         help='write the step responses before and after to this PNG')
+    parser.add_argument('--record', default=None, metavar='FOLDER',
+                        help="record the tuned gains' steps as rosbag2 bags (MCAP storage) "
+                        'in this new folder, one per joint and target: FOLDER/JOINT_N '
+                        '(needs mcap)')
     return parser.parse_args(argv)
 
 
@@ -674,6 +685,9 @@ def check_counts(args: argparse.Namespace) -> None:
         raise ConfigurationError(f'--duration: {args.duration} must be a number of seconds > 0')
     if len(set(args.joint)) != len(args.joint):
         raise ConfigurationError('--joint: a joint is given twice')
+    if args.record is not None and pathlib.Path(args.record).exists():
+        raise ConfigurationError(
+            f"--record: the folder '{args.record}' already exists (give a new one)")
 
 
 def run(args: argparse.Namespace, log: Callable[[str], None]) -> tuple[TuneResult, Scenario]:
@@ -693,7 +707,7 @@ def run(args: argparse.Namespace, log: Callable[[str], None]) -> tuple[TuneResul
             f'{args.trials} candidates per joint in batches of {args.batch}, seed {args.seed}')
         result = tune(scenario, plans, spec, backend, trials=args.trials, batch=args.batch,
                       seed=args.seed, duration=args.duration, ranges=ranges, before=before,
-                      progress=log)
+                      progress=log, record=args.record)
     return result, scenario
 
 

@@ -22,9 +22,11 @@ FACTOR_0 = {
                          'subscriber_cpu_percent'},
     'joint_state_subscriber': {'steps_per_s', 'node_cpu_us_per_step', 'ratio_to_raw',
                                'subscriber_cpu_percent'},
+    'recording': {'steps_per_s', 'node_cpu_us_per_step', 'ratio_to_raw'},
 }
 SERVICE_ROUND_TRIP = {'p50_ms', 'p99_ms', 'answers_per_s', 'unanswered'}
-FACTOR_1 = {'cpu_percent', 'cpu_percent_with_joint_states', 'clock_subscriber_cpu_percent',
+FACTOR_1 = {'cpu_percent', 'cpu_percent_with_joint_states', 'cpu_percent_recording',
+            'clock_subscriber_cpu_percent',
             'joint_states_p50_ms', 'joint_states_p99_ms', 'rtf_error'}
 
 

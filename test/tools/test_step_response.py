@@ -258,3 +258,51 @@ def test_plot_into_a_missing_folder_is_refused_before_the_run(monkeypatch, capsy
         step_response.main(['--joint', 'pan_joint', '--target', '1',
                             '--plot', str(tmp_path / 'no' / 'step.png')])
     assert f"no folder {tmp_path / 'no'}" in capsys.readouterr().err
+
+
+# --- --record: the run as a rosbag2 bag ---------------------------------------------------
+
+def test_record_writes_the_run_as_sim_node_would_name_it(tmp_path, capsys):
+    from bag_fixtures import NANOSECONDS_PER_SECOND, read, topic_messages
+
+    folder = tmp_path / 'step'
+    step_response.main(['--joint', 'pan_joint', '--target', '0.2', '--duration', '0.5',
+                        '--record', str(folder)])
+    assert json.loads(capsys.readouterr().out)['joint'] == 'pan_joint'
+    content = read(folder)
+    ns = '/ex_urdf_pan_tilt'
+    (command,) = topic_messages(content, f'{ns}/joint1_position_controller/command')
+    assert command == (0, command[1]) and command[1].data == 0.2
+    clock = [time for time, _ in topic_messages(content, '/clock')]
+    assert clock == list(range(0, NANOSECONDS_PER_SECOND // 2 + 1, 10_000_000))
+    states = topic_messages(content, f'{ns}/joint_states')
+    assert len(states) == 25  # 50 Hz of the broadcaster over 0.5 s
+    assert all(time == message.header.stamp.sec * NANOSECONDS_PER_SECOND
+               + message.header.stamp.nanosec for time, message in states)
+    assert states[-1][1].position[0] > 0.0  # the pan moved towards its target
+    assert (folder / 'metadata.yaml').is_file()
+
+
+def test_record_refuses_a_folder_that_exists_in_one_line_before_the_run(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        step_response.main(['--joint', 'pan_joint', '--target', '0.2', '--record',
+                            str(tmp_path)])
+    captured = capsys.readouterr()
+    assert exit_info.value.code == 2 and captured.out == ''
+    assert captured.err == (f"step_response: error: --record: the bag folder '{tmp_path}' "
+                            'already exists (give a new one)\n')
+
+
+def test_record_of_a_trajectory_step_holds_the_trajectory_and_tf(ur_style_arm, tmp_path):
+    from bag_fixtures import read, topic_messages
+
+    folder = tmp_path / 'arm'
+    run_tool([*ur_style_arm, '--joint', 'joint2', '--target', '0.5', '--record', str(folder)])
+    content = read(folder)
+    (command,) = topic_messages(content, '/joint_trajectory_controller/joint_trajectory')
+    assert list(command[1].joint_names) == ['joint1', 'joint2']
+    (point,) = command[1].points
+    assert list(point.positions) == [0.0, 0.5]
+    tf = topic_messages(content, '/tf')
+    assert [time for time, _ in tf] == list(range(0, 2_000_000_001, 20_000_000))
+    assert topic_messages(content, '/tf_static')

@@ -47,11 +47,14 @@ def step_response_json(controllers, joint='pan_joint', target='1.0'):
 
 @pytest.fixture(scope='module')
 def tuned(tmp_path_factory):
-    """Tune the pan/tilt's pan to the spec with 2 local workers; return (result, out, plot)."""
+    """Tune the pan/tilt's pan to the spec with 2 local workers; return (result, out, plot).
+
+    The tuned steps are recorded too, in ``bags`` beside ``out``.
+    """
     folder = tmp_path_factory.mktemp('tune')
     out, plot = folder / 'tuned.yaml', folder / 'tune.png'
     result = run_tool('tune', [*SPEC_ARGS, *BUDGET_ARGS, '--workers', '2', '--out', str(out),
-                               '--plot', str(plot)])
+                               '--plot', str(plot), '--record', str(folder / 'bags')])
     return result, out, plot
 
 
@@ -70,6 +73,28 @@ def test_tuning_ends_with_gains_that_an_independent_step_response_finds_within_s
     assert checked['overshoot_percent'] <= tune.DEFAULT_OVERSHOOT_PERCENT
     assert checked['peak_effort'] < 300.0
     assert checked['gains'] != {'p': 100.0, 'i': 0.01, 'd': 10.0}
+
+
+def test_record_keeps_the_tuned_step_as_a_bag_that_ends_within_spec(tuned):
+    from bag_fixtures import read, topic_messages
+
+    result, out, _ = tuned
+    assert result.returncode == 0, result.stderr
+    bags = out.parent / 'bags'
+    assert [path.name for path in bags.iterdir()] == ['pan_joint_1']
+    content = read(bags / 'pan_joint_1')
+    (command,) = topic_messages(content, '/ex_urdf_pan_tilt/joint1_position_controller/command')
+    assert command[1].data == 1.0
+    states = topic_messages(content, '/ex_urdf_pan_tilt/joint_states')
+    assert abs(states[-1][1].position[0] - 1.0) <= 0.002
+
+
+def test_record_into_a_folder_that_exists_is_refused_before_tuning(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        tune.main([*SPEC_ARGS, *BUDGET_ARGS, '--record', str(tmp_path)])
+    assert exit_info.value.code == 2
+    assert capsys.readouterr().err == (
+        f"tune: error: --record: the folder '{tmp_path}' already exists (give a new one)\n")
 
 
 def test_the_written_yaml_changes_only_the_pan_gains_in_their_line(tuned, repo_root):
