@@ -434,6 +434,8 @@ class SimNode(Node):
         if self._timer is not None:
             self._timer.cancel()
         if self.controllers is not None:
+            # Samples a batch took before the physics stopped still leave (and reach a bag).
+            self.controllers.flush_joint_states()
             self.controllers.destroy()
         self._destroy_companions()
         if self.simulation_interfaces is not None:
