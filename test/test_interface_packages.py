@@ -53,6 +53,10 @@ UPSTREAM_HASHES = {
         'RIHS01_80398fcb9674a79081a9906e2ccf0c804dd7cb15e22e362e606ee87186beab71',
     'control_msgs/msg/JointTrajectoryControllerState':
         'RIHS01_51d8dd89cc624cbe9daaeeb4d80d6de9b86168ffdc3be41fefc0953e3c26e480',
+    'control_msgs/srv/QueryTrajectoryState':
+        'RIHS01_4a0935dffef18bc5b9e101c9d03d84e681ecd4cebd724b8f11fde008751a325a',
+    'control_msgs/srv/QueryTrajectoryState_Response':
+        'RIHS01_f7b920129b8d5841312bcb89e6275508e19b3735a371b2df6e417447a44ea5db',
     'control_msgs/msg/DynamicJointState':
         'RIHS01_18024c98a62697680f581108eeed40b28fb4542fa0ac5a8e36f56c62b6813d26',
     'control_msgs/msg/InterfaceValue':
@@ -425,9 +429,9 @@ def test_constants_have_their_upstream_values():
 def test_type_hash_equals_upstream(type_name):
     package, kind, name = type_name.split('/')
     _require(package)
-    # rosidl_generator_type_description's output; actions also list their
-    # generated parts (Goal, FeedbackMessage, ...) with their hashes.
-    file = name.split('_')[0] if kind == 'action' else name
+    # rosidl_generator_type_description's output; actions and services also list
+    # their generated parts (Goal, FeedbackMessage, Response, ...) with their hashes.
+    file = name.split('_')[0] if kind in ('action', 'srv') else name
     description = pathlib.Path(get_package_share_directory(package), kind, f'{file}.json')
     hashes = {entry['type_name']: entry['hash_string']
               for entry in json.loads(description.read_text())['type_hashes']}

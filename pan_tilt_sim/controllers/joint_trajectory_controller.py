@@ -2,7 +2,10 @@
 
 Takes ``trajectory_msgs/msg/JointTrajectory`` on ``<controller>/joint_trajectory``
 as ros2_controllers' controller does, and FollowJointTrajectory goals (below;
-the node serves them as ``<controller>/follow_joint_trajectory``).
+the node serves them as ``<controller>/follow_joint_trajectory``).  As
+upstream, it reports its state on ``<controller>/controller_state`` every
+update (:meth:`JointTrajectoryController.connect_state`) and answers
+``<controller>/query_state`` (:meth:`~JointTrajectoryController.query_state`).
 
 * The message names every joint of the controller, in any order (partial
   goals are rejected); points need increasing ``time_from_start``, finite
@@ -63,7 +66,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from pan_tilt_sim.controllers.base import (
@@ -97,7 +100,13 @@ from pan_tilt_sim.controllers.parameter_spec import (
 )
 from pan_tilt_sim.controllers.pid import Pid
 from pan_tilt_sim.controllers.shared_parameters import joint_gains
-from pan_tilt_sim.controllers.surface import ActionServer, Endpoint
+from pan_tilt_sim.controllers.surface import (
+    ActionServer,
+    Endpoint,
+    Service,
+    StateTopic,
+    TrajectoryStateAnswer,
+)
 from pan_tilt_sim.controllers.trajectory import (
     JointTrajectory,
     TrajectoryPlan,
@@ -139,6 +148,19 @@ PARTIAL_FIELD = 'allow_partial_joints_goal'
 NONZERO_END_FIELD = 'allow_nonzero_velocity_at_trajectory_end'
 # A knot this close after the start is taken as at the start (float stamps).
 TIME_EPSILON = 1e-9
+CONTROLLER_STATE = 'control_msgs/msg/JointTrajectoryControllerState'
+QUERY_STATE = 'control_msgs/srv/QueryTrajectoryState'
+# ros2_controllers' texts for a query_state it cannot answer.
+NOT_ACTIVE_TEXT = "Can't sample trajectory. Controller is not active."
+NO_TRAJECTORY_TEXT = 'Currently there is no valid trajectory instance.'
+BEFORE_START_TEXT = 'Requested sample time is earlier than the current trajectory start time.'
+AFTER_END_TEXT = 'Requested sample time precedes the current trajectory end time.'
+# What ~/controller_state's sink takes: time (s), then the reference (positions, velocities,
+# accelerations), feedback (positions, velocities), error (positions, velocities) and output
+# (positions, efforts), per joint; an empty list is a field the message leaves empty.
+StateSink = Callable[[float, tuple[list[float], list[float], list[float]],
+                      tuple[list[float], list[float]], tuple[list[float], list[float]],
+                      tuple[list[float], list[float]]], None]
 
 
 def command_interfaces_problem(interfaces: Sequence[str]) -> str | None:
@@ -225,12 +247,67 @@ class JointTrajectoryController(MultiJointController):
         scales = feedforward_scales(self, self._joint_names)
         self._feedforward = [scales[joint] for joint in self._joint_names]
         self._goal: TrajectoryGoal | None = None
+        self._state_sink: StateSink | None = None
+        # ~/controller_state's optional fields, as upstream fills them.
+        self._velocity_feedback = 'velocity' in states
+        self._position_output = not interfaces or 'position' in interfaces
+        self._effort_output = self._effort_interface
 
     def ros_surface(self) -> tuple[Endpoint, ...]:
-        """Return the ``~/joint_trajectory`` topic and the FollowJointTrajectory action."""
+        """Return upstream's surface.
+
+        The ``~/joint_trajectory`` topic, the FollowJointTrajectory action,
+        ``~/controller_state`` (see :meth:`connect_state`) and ``~/query_state``
+        (see :meth:`query_state`; refused while inactive, as upstream).
+        """
+        inactive = TrajectoryStateAnswer(False, NOT_ACTIVE_TEXT, (), (), (), ())
         return (*super().ros_surface(),
                 ActionServer('~/follow_joint_trajectory',
-                             'control_msgs/action/FollowJointTrajectory'))
+                             'control_msgs/action/FollowJointTrajectory'),
+                StateTopic('~/controller_state', CONTROLLER_STATE, self.connect_state,
+                           {'joint_names': list(self._joint_names)}),
+                Service('~/query_state', QUERY_STATE, self.query_state, inactive))
+
+    def connect_state(self, sink: StateSink | None) -> None:
+        """Take the ``~/controller_state`` sink (None: nobody listens, take no samples).
+
+        Every update then hands it a sample (see :data:`StateSink`), as
+        ros2_controllers publishes its state every update: the desired
+        state; the measured positions, and velocities with a ``velocity``
+        state interface; desired minus measured (wrapped on continuous
+        joints); and the commands -- the desired positions on a ``position``
+        command interface (or none listed: the ideal actuator's), the efforts
+        on an ``effort`` one.  The velocities commanded on a ``velocity``
+        interface are left out: the joints are driven by the ideal actuator
+        or a PID's effort, not by that command.
+        """
+        self._state_sink = sink
+
+    def query_state(self, time: float) -> TrajectoryStateAnswer:
+        """Answer ``~/query_state``: the desired state at sim ``time`` (s), as upstream.
+
+        Within the trajectory being followed (from its start, before its last
+        point): success, the desired positions, velocities and accelerations.
+        Otherwise failure with upstream's text: without a trajectory (before
+        the first, or holding position) the measured state; before its start
+        or from its last point on, the state it holds there.
+        """
+        names = tuple(self._joint_names)
+        plan = self._plan
+        if plan is None:
+            return TrajectoryStateAnswer(
+                False, NO_TRAJECTORY_TEXT, names,
+                tuple(handle.position for handle in self._handles),
+                tuple(handle.velocity for handle in self._handles), (0.0,) * len(names))
+        positions, velocities, accelerations = plan.at(time)
+        if time < plan.times[0]:
+            success, text = False, BEFORE_START_TEXT
+        elif time >= plan.end_time:
+            success, text = False, AFTER_END_TEXT
+        else:
+            success, text = True, ''
+        return TrajectoryStateAnswer(success, text, names, tuple(positions), tuple(velocities),
+                                     tuple(accelerations))
 
     def command_interfaces(self) -> dict[str, tuple[str, ...]]:
         """Return the ``command_interfaces`` listed, for every joint."""
@@ -526,6 +603,28 @@ class JointTrajectoryController(MultiJointController):
                 handle.velocity - desired_velocity)
             effort += feedforward[index] * desired_velocity
             handle.effort = clamp_effort(effort, effort_limits[index])
+        if self._state_sink is not None:
+            self._publish_state(time)
+
+    def _publish_state(self, time: float) -> None:
+        """Hand ``~/controller_state``'s sink this update's sample (see :meth:`connect_state`)."""
+        handles = self._handles
+        desired_positions = list(self._desired_positions)
+        desired_velocities = list(self._desired_velocities)
+        accelerations = (self._plan.at(time)[2] if self._plan is not None
+                         else [0.0] * len(handles))
+        measured = [handle.position for handle in handles]
+        errors = [self._position_error(index) for index in self._indices]
+        if self._velocity_feedback:
+            speeds = [handle.velocity for handle in handles]
+            speed_errors = [desired - speed
+                            for desired, speed in zip(desired_velocities, speeds, strict=True)]
+        else:
+            speeds, speed_errors = [], []
+        output = (desired_positions if self._position_output else [],
+                  [handle.effort for handle in handles] if self._effort_output else [])
+        self._state_sink(time, (desired_positions, desired_velocities, accelerations),
+                         (measured, speeds), (errors, speed_errors), output)
 
     def _start(self, trajectory: JointTrajectory, time: float) -> None:
         """Replace the plan by ``trajectory``, from the desired state at ``time``.

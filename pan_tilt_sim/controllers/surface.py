@@ -62,14 +62,18 @@ class StateTopic:
 class Service:
     """A service served while the controller is configured, active or not.
 
-    ``call(value)`` takes the value the adapter extracted from a request
-    (see the adapter's table for each service type) and returns
-    ``(success, message)`` for the response.
+    ``call(value)`` takes the value the adapter extracted from a request and
+    returns the answer the adapter writes into the response; both are set by
+    the adapter's table for each service type (``std_srvs/srv/SetBool``: the
+    request's ``data`` in, ``(success, message)`` out).  ``inactive``, if
+    not None, is the answer while the controller is not active, given
+    without calling it (a service upstream refuses then).
     """
 
     name: str
     service: str
-    call: Callable[[Any], tuple[bool, str]]
+    call: Callable[[Any], Any]
+    inactive: Any = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -93,3 +97,19 @@ class StampedTwist(NamedTuple):
     stamp: float
     linear: tuple[float, float, float]
     angular: tuple[float, float, float]
+
+
+class TrajectoryStateAnswer(NamedTuple):
+    """A ``control_msgs/srv/QueryTrajectoryState`` answer.
+
+    ``success`` and ``message`` (why not); per joint of ``names``, the
+    desired ``positions`` (rad or m), ``velocities`` (per s) and
+    ``accelerations`` (per s^2) at the requested time.
+    """
+
+    success: bool
+    message: str
+    names: tuple[str, ...]
+    positions: tuple[float, ...]
+    velocities: tuple[float, ...]
+    accelerations: tuple[float, ...]

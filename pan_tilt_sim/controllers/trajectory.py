@@ -105,6 +105,40 @@ class TrajectoryPlan:
             velocities[joint] = (d00 * (start - end) / duration
                                  + d10 * v0[joint] + d11 * v1[joint])
 
+    def at(self, time: float) -> tuple[list[float], list[float], list[float]]:
+        """Return the desired positions, velocities and accelerations at ``time``.
+
+        Leaves :meth:`sample`'s place alone (a query between updates).  Before
+        the first knot and from the last on, the knot's positions at rest;
+        linear segments have no acceleration.
+        """
+        times = self.times
+        last = len(times) - 1
+        count = len(self._joints)
+        if time >= times[last] or time < times[0]:
+            knot = last if time >= times[last] else 0
+            return list(self.positions[knot]), [0.0] * count, [0.0] * count
+        segment = self._segment if time >= times[self._segment] else 0  # sample's place: a hint
+        while time >= times[segment + 1]:
+            segment += 1
+        positions, velocities = [0.0] * count, [0.0] * count
+        saved, self._segment = self._segment, segment
+        self.sample(time, positions, velocities)
+        self._segment = saved
+        if self.velocities is None:
+            return positions, velocities, [0.0] * count
+        t0 = times[segment]
+        duration = times[segment + 1] - t0
+        s = (time - t0) / duration
+        p0, p1 = self.positions[segment], self.positions[segment + 1]
+        v0, v1 = self.velocities[segment], self.velocities[segment + 1]
+        # Second derivatives d2/ds2 of the cubic Hermite basis functions.
+        e00, e10, e11 = 12.0 * s - 6.0, 6.0 * s - 4.0, 6.0 * s - 2.0
+        accelerations = [(e00 * (p0[joint] - p1[joint]) / duration
+                          + e10 * v0[joint] + e11 * v1[joint]) / duration
+                         for joint in self._joints]
+        return positions, velocities, accelerations
+
     def _hold(self, knot: int, positions: MutableSequence[float],
               velocities: MutableSequence[float]) -> None:
         held = self.positions[knot]

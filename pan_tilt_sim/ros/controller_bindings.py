@@ -15,7 +15,9 @@ controller type:
   tf2_msgs -- gets none, with an info line, and the controller takes no
   samples for it);
 * a :class:`~pan_tilt_sim.controllers.surface.Service`: a service whose
-  requests' values go to the controller (:data:`SERVICES`);
+  requests' values go to the controller and whose answers fill the
+  responses (:data:`SERVICES`; none where its interface package is not
+  installed, with an info line);
 * an :class:`~pan_tilt_sim.controllers.surface.ActionServer`, where its
   interface package is installed (:data:`ACTION_SERVERS`);
 
@@ -58,6 +60,7 @@ from pan_tilt_sim.controllers.surface import (
     CommandTopic,
     Service,
     StateTopic,
+    TrajectoryStateAnswer,
 )
 from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.model.ros_arguments import RosArguments
@@ -66,7 +69,12 @@ from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.gain_parameters import GainParameters
 from pan_tilt_sim.ros.gripper_action import GripperCommandServer, ParallelGripperCommandServer
 from pan_tilt_sim.ros.robot_state import tf_message_type, transform_message
-from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES, joint_state_message, stamp
+from pan_tilt_sim.ros.ros_interfaces import (
+    COMMAND_MESSAGES,
+    joint_state_message,
+    seconds,
+    stamp,
+)
 from pan_tilt_sim.ros.trajectory_action import TrajectoryActionServer
 from pan_tilt_sim.sim.engine import Simulation
 
@@ -74,11 +82,14 @@ try:
     from control_msgs.msg import (
         DynamicJointState,
         InterfaceValue,
+        JointTrajectoryControllerState,
         MultiDOFStateStamped,
         SingleDOFState,
     )
+    from control_msgs.srv import QueryTrajectoryState
 except ImportError:  # an optional interface package (see optional_interfaces)
     DynamicJointState = InterfaceValue = MultiDOFStateStamped = SingleDOFState = None
+    JointTrajectoryControllerState = QueryTrajectoryState = None
 
 QUEUE_DEPTH = 10
 WARNING_THROTTLE_S = 1.0
@@ -226,7 +237,13 @@ class ControllerBindings:
                         f'({endpoint.message}): its interface package is not installed '
                         f'({optional_interfaces.BUILD_HINT})')
             elif isinstance(endpoint, Service):
-                entities.append(self._provide(controller, endpoint))
+                if SERVICES.get(endpoint.service, (None,))[0] is not None:
+                    entities.append(self._provide(controller, endpoint))
+                else:  # its interface package is missing
+                    self._logger.info(
+                        f'{name}: no {self._name(controller, endpoint.name)} '
+                        f'({endpoint.service}): its interface package is not installed '
+                        f'({optional_interfaces.BUILD_HINT})')
             elif isinstance(endpoint, ActionServer):
                 self._serve(controller, endpoint)
         self._noticing.append(controller)
@@ -271,11 +288,15 @@ class ControllerBindings:
         return publisher
 
     def _provide(self, controller: Controller, endpoint: Service) -> Any:
-        service_type, extract = SERVICES[endpoint.service]
-        call = endpoint.call
+        service_type, extract, answer = SERVICES[endpoint.service]
+        call, inactive = endpoint.call, endpoint.inactive
+        name, is_active = controller.name, self._manager.is_active
 
         def serve(request: Any, response: Any) -> Any:
-            response.success, response.message = call(extract(request))
+            if inactive is not None and not is_active(name):
+                answer(inactive, response)
+            else:
+                answer(call(extract(request)), response)
             return response
         return self._node.create_service(service_type, self._name(controller, endpoint.name),
                                          serve)
@@ -501,6 +522,34 @@ class OdometrySink(_HeldSink):
         message.twist.twist.angular.z = angular
 
 
+class TrajectoryStateSink(_HeldSink):
+    """A trajectory controller's samples as ``control_msgs/msg/JointTrajectoryControllerState``.
+
+    Field ``joint_names``, once.  A sample is the time and the reference
+    (positions, velocities, accelerations), feedback (positions, velocities),
+    error (positions, velocities) and output (positions, efforts) per joint;
+    an empty list leaves its field empty.  No multi-DOF joints; the speed
+    scaling factor is 1 (no scaling here).
+    """
+
+    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
+        message = JointTrajectoryControllerState(joint_names=list(fields['joint_names']),
+                                                 speed_scaling_factor=1.0)
+        super().__init__(publisher, message)
+
+    def __call__(self, time: float, reference: Sequence[list[float]],
+                 feedback: Sequence[list[float]], error: Sequence[list[float]],
+                 output: Sequence[list[float]]) -> None:
+        """Take a sample (see the class)."""
+        message = self._take()
+        stamp(time, message.header.stamp)
+        (message.reference.positions, message.reference.velocities,
+         message.reference.accelerations) = reference
+        message.feedback.positions, message.feedback.velocities = feedback
+        message.error.positions, message.error.velocities = error
+        message.output.positions, message.output.effort = output
+
+
 class TfSink(_HeldSink):
     """Transforms as ``tf2_msgs/msg/TFMessage``: ``sink(time, [(parent, child, transform)])``."""
 
@@ -537,13 +586,32 @@ STATE_SINKS: dict[str, tuple[type | None, Callable[[Any, Mapping[str, Any]], Any
     'sensor_msgs/msg/JointState': (JointState, JointStateSink),
     'control_msgs/msg/DynamicJointState': (DynamicJointState, DynamicJointStateSink),
     'control_msgs/msg/MultiDOFStateStamped': (MultiDOFStateStamped, DofStateSink),
+    'control_msgs/msg/JointTrajectoryControllerState': (
+        JointTrajectoryControllerState, TrajectoryStateSink),
     'nav_msgs/msg/Odometry': (Odometry, OdometrySink),
     'geometry_msgs/msg/TwistStamped': (TwistStamped, TwistSink),
 }
-# Each service type: its class, and how to get the value out of a request (the
-# controller's answer fills the response's ``success`` and ``message``).
-SERVICES: dict[str, tuple[type, Callable[[Any], Any]]] = {
-    'std_srvs/srv/SetBool': (SetBool, lambda request: request.data),
+def _success_and_message(answer: tuple[bool, str], response: Any) -> None:
+    """Fill a response's ``success`` and ``message`` from ``(success, message)``."""
+    response.success, response.message = answer
+
+
+def _trajectory_state(answer: TrajectoryStateAnswer, response: Any) -> None:
+    """Fill a ``control_msgs/srv/QueryTrajectoryState`` response."""
+    response.success, response.message = answer.success, answer.message
+    response.name = list(answer.names)
+    response.position = list(answer.positions)
+    response.velocity = list(answer.velocities)
+    response.acceleration = list(answer.accelerations)
+
+
+# Each service type: its class (None where its interface package is not installed: no such
+# services then), how to get the value out of a request, and how the controller's answer
+# fills the response.
+SERVICES: dict[str, tuple[type | None, Callable[[Any], Any], Callable[[Any, Any], None]]] = {
+    'std_srvs/srv/SetBool': (SetBool, lambda request: request.data, _success_and_message),
+    'control_msgs/srv/QueryTrajectoryState': (
+        QueryTrajectoryState, lambda request: seconds(request.time), _trajectory_state),
 }
 if tf_message_type() is not None:  # tf2_msgs is optional (see optional_interfaces)
     STATE_SINKS['tf2_msgs/msg/TFMessage'] = (tf_message_type(), TfSink)

@@ -34,6 +34,7 @@ from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
 from pan_tilt_sim.controllers.base import MAX_COMMAND_MAGNITUDE, Drive
 from pan_tilt_sim.controllers.joint_position_controller import DEFAULT_POSITION_GAINS
 from pan_tilt_sim.controllers.manager import ACTIVE, INACTIVE, UNCONFIGURED
+from pan_tilt_sim.controllers.surface import Service, StateTopic
 from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPlan, TrajectoryPoint
 from pan_tilt_sim.controllers.trajectory_goal import GoalStatus
 from pan_tilt_sim.errors import ControllerConfigError
@@ -368,6 +369,124 @@ def test_reset_forgets_the_trajectory():
     clock.run_to(0.5)
     controller.reset()
     assert Clock(controller).run_to(2.0) == [0.0, 0.0]
+
+
+
+# --- ~/controller_state and ~/query_state ------------------------------------------------
+
+def test_it_declares_controller_state_and_query_state_as_upstream():
+    surface = {endpoint.name: endpoint for endpoint in controller_for().ros_surface()}
+    state, query = surface['~/controller_state'], surface['~/query_state']
+    assert isinstance(state, StateTopic) and isinstance(query, Service)
+    assert state.message == 'control_msgs/msg/JointTrajectoryControllerState'
+    assert state.fields == {'joint_names': list(JOINTS)}
+    assert query.service == 'control_msgs/srv/QueryTrajectoryState'
+    assert query.inactive == (False, "Can't sample trajectory. Controller is not active.",
+                              (), (), (), ())
+
+
+def test_controller_state_is_sampled_every_update_while_someone_listens():
+    handles = make_handles()
+    handles['a'].position, handles['a'].velocity = 0.1, 0.4
+    controller = controller_for(handles)
+    samples = []
+    controller.connect_state(lambda *sample: samples.append(sample))
+    controller.set_command(trajectory((1.0, (1.0, 0.2))))
+    clock = Clock(controller)
+    clock.run_to(0.5)
+    assert len(samples) == 501  # every update, from 0 s to 0.5 s
+    time, reference, feedback, error, output = samples[-1]
+    assert time == pytest.approx(0.5)
+    # The linear segment from where the joints were held (0.1, 0) at 0 s to (1, 0.2) at 1 s.
+    assert reference == (pytest.approx([0.55, 0.1]), pytest.approx([0.9, 0.2]), [0.0, 0.0])
+    assert feedback == ([0.1, 0.0], [0.4, 0.0])
+    assert error == (pytest.approx([0.45, 0.1]), pytest.approx([0.5, 0.2]))
+    assert output == (pytest.approx([0.55, 0.1]), [])  # the position commands; no effort
+    controller.connect_state(None)
+    clock.run_to(0.6)
+    assert len(samples) == 501
+
+
+def test_controller_state_has_the_efforts_on_an_effort_interface_and_no_velocities_unmeasured():
+    handles = make_handles()
+    controller = controller_for(handles, command_interfaces=['effort'],
+                                state_interfaces=['position'])
+    samples = []
+    controller.connect_state(lambda *sample: samples.append(sample))
+    controller.set_command(trajectory((1.0, (1.0, 0.2))))
+    Clock(controller).run_to(0.1)
+    _time, _reference, feedback, error, output = samples[-1]
+    assert feedback[1] == [] and error[1] == []
+    assert output == ([], [handles['a'].effort, handles['b'].effort])
+    assert handles['a'].effort > 0.0
+
+
+def test_controller_state_error_is_wrapped_on_a_continuous_joint():
+    handles = make_handles()
+    handles['c'].position = 3.0
+    controller = controller_for(handles, joints=['c'])
+    samples = []
+    controller.connect_state(lambda *sample: samples.append(sample))
+    controller.set_command(trajectory((0.001, (-3.0,)), names=('c',)))
+    Clock(controller).run_to(0.01)
+    assert samples[-1][3][0] == pytest.approx([2 * math.pi - 6.0])
+
+
+def test_query_state_answers_the_desired_state_at_a_time_within_the_trajectory():
+    controller = controller_for()
+    controller.set_command(trajectory((1.0, (1.0, 0.2), (0.5, 0.0)), (2.0, (0.0, 0.4), (0.0, 0.0))))
+    Clock(controller).run_to(0.2)
+    answer = controller.query_state(1.5)
+    assert answer.success and answer.message == ''
+    assert answer.names == JOINTS
+    # Cubic between (1, 0.2) at 1 s and (0, 0.4) at 2 s, with velocities (0.5, 0) and (0, 0).
+    assert answer.positions == pytest.approx([0.5625, 0.3])
+    assert answer.velocities == pytest.approx([-1.625, 0.3])
+    assert answer.accelerations == pytest.approx([-0.5, 0.0])
+
+
+def test_query_state_does_not_move_the_desired_state():
+    controller = controller_for()
+    clock = Clock(controller)
+    controller.set_command(trajectory((1.0, (1.0, 0.2)), (2.0, (-1.0, 0.4))))
+    before = clock.run_to(0.2)
+    controller.query_state(1.9)
+    assert controller.desired_positions == before
+    assert clock.run_to(0.5) == pytest.approx([0.5, 0.1])
+
+
+def test_query_state_fails_without_a_trajectory_with_upstreams_text_and_the_measured_state():
+    handles = make_handles()
+    handles['a'].position, handles['a'].velocity = 0.3, 0.1
+    controller = controller_for(handles)
+    Clock(controller).run_to(0.01)
+    assert controller.query_state(0.0) == (
+        False, 'Currently there is no valid trajectory instance.', JOINTS, (0.3, 0.0),
+        (0.1, 0.0), (0.0, 0.0))
+
+
+@pytest.mark.parametrize('time, text', [
+    (0.05, 'Requested sample time is earlier than the current trajectory start time.'),
+    (1.1, 'Requested sample time precedes the current trajectory end time.'),
+    (5.0, 'Requested sample time precedes the current trajectory end time.')])
+def test_query_state_fails_outside_the_trajectory_with_upstreams_text(time, text):
+    controller = controller_for()
+    clock = Clock(controller)
+    clock.run_to(0.09)
+    controller.set_command(trajectory((1.0, (1.0, 0.2))))  # from the next update, 0.091 s
+    clock.run_to(0.2)
+    answer = controller.query_state(time)
+    assert (answer.success, answer.message) == (False, text)
+
+
+def test_plan_accelerations_are_the_derivative_of_its_velocity():
+    plan = TrajectoryPlan([0.0, 2.0], [[0.0, 1.0], [1.0, -2.0]], [[0.3, 0.0], [-0.2, 1.0]])
+    for time in (0.1, 0.7, 1.3, 1.9):
+        step = 1e-6
+        ahead, behind = plan.at(time + step)[1], plan.at(time - step)[1]
+        numeric = [(x - y) / (2 * step) for x, y in zip(ahead, behind, strict=True)]
+        assert plan.at(time)[2] == pytest.approx(numeric, abs=1e-5)
+        assert plan.at(time)[:2] == sample(plan, time)
 
 
 

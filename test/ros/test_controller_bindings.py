@@ -11,6 +11,7 @@ from pan_tilt_sim.ros.controller_bindings import (
     DofStateSink,
     DynamicJointStateSink,
     JointStateSink,
+    TrajectoryStateSink,
 )
 
 
@@ -131,3 +132,29 @@ def test_a_dof_state_sample_leaves_as_multi_dof_state_stamped_with_every_field()
                ('b', 8.0, 9.0, 0.0, -1.0, 0.0, 0.001, 2.5)]),
         (0.501, [('a', 1.5, 2.0, 3.0, 4.0, 5.0, 0.001, 7.0),
                  ('b', 1.5, 2.0, 3.0, 4.0, 5.0, 0.001, 7.0)])]
+
+
+def test_a_trajectory_state_sample_leaves_with_every_field_and_empty_ones_left_empty():
+    pytest.importorskip('control_msgs.msg', reason='control_msgs is not installed')
+    sent = []
+
+    class Publisher:
+        def publish(self, message) -> None:
+            stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+            sent.append((round(stamp, 9), list(message.joint_names), [
+                [list(values) for values in (point.positions, point.velocities,
+                                             point.accelerations, point.effort)]
+                for point in (message.reference, message.feedback, message.error,
+                              message.output)], message.speed_scaling_factor))
+
+    sink = TrajectoryStateSink(Publisher(), {'joint_names': ['a', 'b']})
+    sink(0.25, ([1.0, 2.0], [0.1, 0.2], [0.0, -1.0]), ([0.5, 1.5], [0.3, 0.4]),
+         ([0.5, 0.5], [-0.2, -0.2]), ([], [7.0, 8.0]))
+    assert sent == []
+    sink.flush()
+    sink.flush()
+    assert sent == [(0.25, ['a', 'b'], [
+        [[1.0, 2.0], [0.1, 0.2], [0.0, -1.0], []],
+        [[0.5, 1.5], [0.3, 0.4], [], []],
+        [[0.5, 0.5], [-0.2, -0.2], [], []],
+        [[], [], [], [7.0, 8.0]]], 1.0)]
