@@ -53,6 +53,10 @@ UPSTREAM_HASHES = {
         'RIHS01_80398fcb9674a79081a9906e2ccf0c804dd7cb15e22e362e606ee87186beab71',
     'control_msgs/msg/JointTrajectoryControllerState':
         'RIHS01_51d8dd89cc624cbe9daaeeb4d80d6de9b86168ffdc3be41fefc0953e3c26e480',
+    'control_msgs/msg/InterfaceValue':
+        'RIHS01_74a12144ef6b7af67533195cb30f7f607d3301b66950208a72d280695f3e190c',
+    'control_msgs/msg/DynamicInterfaceGroupValues':
+        'RIHS01_0ebef56c55cdde46b4622f7e0a4dbf26fefbf0296205463e955047252b434cbc',
     'controller_manager_msgs/srv/SwitchController':
         'RIHS01_d4ad10aa5da7808bc522d55d4123d8ef79de73d049d165639d7663ac37cc9895',
     'controller_manager_msgs/srv/ListControllers':
