@@ -6,7 +6,12 @@ from collections.abc import Mapping
 from typing import Any
 
 from pan_tilt_sim.controllers.base import CommandController, Controller
+from pan_tilt_sim.controllers.force_torque_sensor_broadcaster import (
+    ForceTorqueSensorBroadcaster,
+)
 from pan_tilt_sim.controllers.forward_command_controller import ForwardCommandController
+from pan_tilt_sim.controllers.gpio_command_controller import GpioCommandController
+from pan_tilt_sim.controllers.imu_sensor_broadcaster import IMUSensorBroadcaster
 from pan_tilt_sim.controllers.joint_effort_controller import JointEffortController
 from pan_tilt_sim.controllers.joint_group_effort_controller import JointGroupEffortController
 from pan_tilt_sim.controllers.joint_group_position_controller import (
@@ -19,6 +24,8 @@ from pan_tilt_sim.controllers.joint_position_controller import JointPositionCont
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
 from pan_tilt_sim.controllers.joint_trajectory_controller import JointTrajectoryController
 from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
+from pan_tilt_sim.controllers.pose_broadcaster import PoseBroadcaster
+from pan_tilt_sim.controllers.range_sensor_broadcaster import RangeSensorBroadcaster
 from pan_tilt_sim.errors import ControllerConfigError
 
 CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
@@ -31,6 +38,11 @@ CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
     JointGroupVelocityController,
     JointGroupEffortController,
     JointTrajectoryController,
+    ForceTorqueSensorBroadcaster,
+    IMUSensorBroadcaster,
+    RangeSensorBroadcaster,
+    PoseBroadcaster,
+    GpioCommandController,
 )
 
 CONTROLLER_TYPES: dict[str, type[Controller]] = {

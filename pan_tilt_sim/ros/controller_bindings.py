@@ -35,15 +35,30 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
+from geometry_msgs.msg import PoseStamped, WrenchStamped
 from rclpy.node import Node
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import Imu, JointState, Range
 
 from pan_tilt_sim.controllers import CommandResult, Controller
 from pan_tilt_sim.controllers.surface import PRIVATE, ActionServer, CommandTopic, StateTopic
 from pan_tilt_sim.errors import ConfigurationError
+from pan_tilt_sim.ros import optional_interfaces
 from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.gain_parameters import GainParameters
-from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES, joint_state_message
+from pan_tilt_sim.ros.ros_interfaces import (
+    COMMAND_MESSAGES,
+    GROUP_VALUES,
+    joint_state_message,
+    optional_message,
+)
+from pan_tilt_sim.ros.state_sinks import (
+    GroupValuesSink,
+    ImuSink,
+    PoseSink,
+    RangeSink,
+    TransformSink,
+    WrenchSink,
+)
 from pan_tilt_sim.ros.trajectory_action import TrajectoryActionServer
 from pan_tilt_sim.sim.engine import Simulation
 
@@ -134,7 +149,7 @@ class ControllerBindings:
                 return
 
     def flush_joint_states(self) -> None:
-        """Publish the JointState samples the broadcasters took since the last flush."""
+        """Publish the samples the broadcasters took since the last flush (JointStates...)."""
         for _controller, _publisher, sink in self._state_sinks:
             sink.flush()
 
@@ -165,7 +180,14 @@ class ControllerBindings:
         for warning in controller.config_warnings:
             self._logger.warning(warning)
         for endpoint in controller.ros_surface():
-            if isinstance(endpoint, CommandTopic):
+            if isinstance(endpoint, CommandTopic | StateTopic) and (
+                    endpoint.message not in (COMMAND_MESSAGES if isinstance(
+                        endpoint, CommandTopic) else STATE_SINKS)):
+                package = endpoint.message.split('/')[0]
+                self._logger.warning(
+                    f'{name}: no topic {endpoint.name} ({endpoint.message}): {package} is not '
+                    f'installed ({optional_interfaces.BUILD_HINT})')
+            elif isinstance(endpoint, CommandTopic):
                 if self._command_topics:
                     entities.append(self._subscribe(controller, endpoint))
             elif isinstance(endpoint, StateTopic):
@@ -176,9 +198,14 @@ class ControllerBindings:
         self._gains.add(controller)
 
     def _name(self, controller: Controller, topic: str) -> str:
-        """Resolve a declared name: ``~/x`` in the controller's namespace, else the robot's."""
+        """Resolve a declared name: ``~/x`` in the controller's namespace, ``/x`` as it is.
+
+        Anything else is in the robot's namespace.
+        """
         if topic.startswith(PRIVATE):
             return self._topic(controller.name, topic[len(PRIVATE):])
+        if topic.startswith('/'):
+            return topic
         return self._topic(topic)
 
     def _subscribe(self, controller: Controller, endpoint: CommandTopic) -> Any:
@@ -222,6 +249,9 @@ class ControllerBindings:
                     self._reader.remove(entity)
                 self._node.destroy_subscription(entity)
         self._state_sinks = [item for item in self._state_sinks if item[0].name != name]
+        for owner, endpoint, _publisher, _sink in self._connections:
+            if owner == name:  # its publisher is gone: the controller takes no more samples
+                endpoint.connect(None)
         self._connections = [item for item in self._connections if item[0] != name]
         self._noticing = [controller for controller in self._noticing
                           if controller.name != name]
@@ -293,10 +323,19 @@ class JointStateSink:
 
 
 # Each state message type (by its ROS name): its class, and the sink that
-# turns a controller's samples into messages on a publisher.
+# turns a controller's samples into messages on a publisher.  A type whose
+# interface package is not installed is left out: no topic is made for it.
 STATE_SINKS: dict[str, tuple[type, Callable[[Any, Mapping[str, Any]], Any]]] = {
     'sensor_msgs/msg/JointState': (JointState, JointStateSink),
+    'geometry_msgs/msg/WrenchStamped': (WrenchStamped, WrenchSink),
+    'sensor_msgs/msg/Imu': (Imu, ImuSink),
+    'sensor_msgs/msg/Range': (Range, RangeSink),
+    'geometry_msgs/msg/PoseStamped': (PoseStamped, PoseSink),
 }
+for _name, _sink in (('tf2_msgs/msg/TFMessage', TransformSink),
+                     (GROUP_VALUES, GroupValuesSink)):
+    if (_message := optional_message(_name)) is not None:
+        STATE_SINKS[_name] = (_message, _sink)
 # Each action type: the server that runs a controller's goals.
 ACTION_SERVERS: dict[str, Callable[..., Any]] = {
     'control_msgs/action/FollowJointTrajectory': TrajectoryActionServer,

@@ -18,7 +18,7 @@ from collections.abc import Iterable
 FEATURES = {
     'tf2_msgs': 'TF (/tf, /tf_static; robot_state_publisher can publish it from '
                 'robot_description and joint_states)',
-    'control_msgs': 'the follow_joint_trajectory actions',
+    'control_msgs': "the follow_joint_trajectory actions and the gpio controllers' topics",
     'controller_manager_msgs': "the controller_manager services (ros2_control's spawner)",
     'simulation_interfaces': 'the simulator services (get_simulator_features, '
                              'step_simulation, spawn_entity, ...)',

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -35,12 +36,36 @@ def joint_trajectory(message: JointTrajectoryMessage) -> JointTrajectory:
         start_time=seconds(stamp_) if stamp_.sec or stamp_.nanosec else None)
 
 
+def group_values(message: Any) -> tuple[list[str], list[tuple[list[str], list[float]]]]:
+    """Return a ``control_msgs/DynamicInterfaceGroupValues`` as plain lists.
+
+    ``(interface_groups, [(interface_names, values) per interface_values entry])``,
+    as the gpio controller takes a command.
+    """
+    return (list(message.interface_groups),
+            [(list(entry.interface_names), list(entry.values))
+             for entry in message.interface_values])
+
+
+def optional_message(name: str) -> type | None:
+    """Return the message class ``<package>/msg/<Type>``, or None if its package is missing."""
+    package, _, type_name = name.split('/')
+    try:
+        return getattr(importlib.import_module(f'{package}.msg'), type_name)
+    except (ImportError, AttributeError):
+        return None
+
+
+GROUP_VALUES = 'control_msgs/msg/DynamicInterfaceGroupValues'
 # Each command message type (by its ROS name), and how to get the command value out of it.
+# A type whose interface package is not installed is left out: no topic is made for it.
 COMMAND_MESSAGES: dict[str, tuple[type, Callable[[Any], Any]]] = {
     CommandKind.FLOAT64.value: (Float64, lambda msg: msg.data),
     CommandKind.FLOAT64_ARRAY.value: (Float64MultiArray, lambda msg: list(msg.data)),
     CommandKind.JOINT_TRAJECTORY.value: (JointTrajectoryMessage, joint_trajectory),
 }
+if (_group_values := optional_message(GROUP_VALUES)) is not None:
+    COMMAND_MESSAGES[GROUP_VALUES] = (_group_values, group_values)
 
 
 def stamp(seconds: float, into: Time | None = None) -> Time:

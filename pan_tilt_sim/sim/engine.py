@@ -37,6 +37,7 @@ from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.initial_positions import FROM_DEFAULT, StartPosition, start_positions
 from pan_tilt_sim.schedule import DUE_EPSILON
+from pan_tilt_sim.sim.hardware import SimulatedHardware
 from pan_tilt_sim.sim.physics import (
     STATE_MOTOR_TORQUE,
     STATE_POSITION,
@@ -93,21 +94,25 @@ class Simulation:
             description, time_step, gui=gui,
             initial_positions=[starts[joint].position for joint in movable],
             warn=load_messages.append)
+        self._time_step = time_step
+        self._steps = 0
         try:
             gain = description.model.position_proportional_gain or TRACKING_GAIN
             self.handles = {
                 joint.name: JointHandle(joint, position, gains.get(joint.name), gain)
                 for joint, position in zip(self.physics.joints,
                                            self.physics.initial_positions, strict=True)}
+            # The <ros2_control> sensors and gpios, measured here, read by the controllers.
+            self.hardware = SimulatedHardware(self.physics, description.model,
+                                              lambda: self._steps)
             self.manager = ControllerManager(controllers, self.handles, description.model,
                                              active=active_controllers,
-                                             autostart=autostart_controllers)
+                                             autostart=autostart_controllers,
+                                             hardware=self.hardware.interfaces)
         except BaseException:
             self.physics.close()
             raise
         self._handle_list = list(self.handles.values())
-        self._time_step = time_step
-        self._steps = 0
         self.compiled_steps = 0  # of all steps run, those whose controllers ran in C
         self._states = self.physics.read_states()
         # Waiting for spawners, a joint no controller has driven yet is held where it is, as
@@ -176,6 +181,7 @@ class Simulation:
                                else INFO, line))
         report.extend((WARNING, message) for message in pid_stability_warnings(
             self.physics, self._handle_list, self._time_step))
+        report.extend(self.hardware.startup_report())
         return report
 
     @property
@@ -338,6 +344,7 @@ class Simulation:
             self._apply_actuators()
         if reset_time:
             self._steps = 0
+        self.hardware.reset()
 
     def reset_time(self) -> None:
         """Sim time back to 0, the joints left where they are; controllers hold them there.
@@ -349,6 +356,9 @@ class Simulation:
         for controller in self.controllers:
             controller.reset()
         self._steps = 0
+        for sensor in self.hardware.interfaces.sensors.values():  # their readings' past is gone
+            if sensor.source is not None:
+                sensor.source.reset()
 
     def joint_positions(self) -> dict[str, float]:
         """Return the measured position of every movable joint, by name."""
@@ -362,6 +372,7 @@ class Simulation:
 
     def close(self) -> None:
         """Release PyBullet."""
+        self.hardware.close()
         self.physics.close()
 
     def __enter__(self) -> Simulation:

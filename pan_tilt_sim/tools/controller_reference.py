@@ -19,6 +19,7 @@ from collections.abc import Sequence
 
 from pan_tilt_sim.controllers import JointHandle
 from pan_tilt_sim.controllers.base import Controller
+from pan_tilt_sim.controllers.hardware import example_hardware
 from pan_tilt_sim.controllers.parameter_spec import Param
 from pan_tilt_sim.controllers.registry import CONTROLLER_CLASSES
 from pan_tilt_sim.controllers.surface import ActionServer, CommandTopic, Endpoint, StateTopic
@@ -44,9 +45,13 @@ controller is configured. *Not simulated*: accepted, but the simulator does not 
 
 
 def example_controller(cls: type[Controller]) -> Controller:
-    """Return ``cls`` built from its spec's examples and configured on a one-joint robot."""
+    """Return ``cls`` built from its spec's examples and configured on a one-joint robot.
+
+    The robot also has the example sensor and gpio the examples name.
+    """
     controller = cls('<name>', cls.parameters.example())
     controller.type_name = cls.type_names[0]
+    controller.set_hardware(example_hardware())
     joint = JointSpec('joint1', JointKind.REVOLUTE, -1.0, 1.0, effort_limit=1.0,
                       velocity_limit=1.0)
     controller.configure({'joint1': JointHandle(joint)})

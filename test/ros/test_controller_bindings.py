@@ -1,10 +1,15 @@
 """controller_bindings: the declared surface on the node; JointStates held until flushed."""
 
+import pytest
 from node_harness import sim_node
 from rcl_interfaces.msg import Log
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile
 
-from pan_tilt_sim.ros.controller_bindings import JointStateSink
+from pan_tilt_sim.controllers.registry import CONTROLLER_CLASSES
+from pan_tilt_sim.controllers.surface import CommandTopic, StateTopic
+from pan_tilt_sim.ros.controller_bindings import STATE_SINKS, JointStateSink
+from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES
+from pan_tilt_sim.tools.controller_reference import example_controller
 
 
 class RecordingPublisher:
@@ -69,3 +74,12 @@ def test_a_misspelt_controller_parameter_is_logged_with_the_closest_known_one(tm
             [entry.msg for entry in log]
         assert not sim.node.simulation.manager.controller('arm')._flags[
             'allow_partial_joints_goal']
+
+
+@pytest.mark.parametrize('cls', CONTROLLER_CLASSES, ids=lambda cls: cls.type_names[0])
+def test_every_topic_a_registered_type_declares_has_its_message_type_in_the_tables(cls):
+    for endpoint in example_controller(cls).ros_surface():
+        if isinstance(endpoint, CommandTopic):
+            assert endpoint.message in COMMAND_MESSAGES
+        elif isinstance(endpoint, StateTopic):
+            assert endpoint.message in STATE_SINKS
