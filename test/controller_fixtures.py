@@ -19,7 +19,7 @@ from typing import Any
 import pytest
 
 from pan_tilt_sim.controllers import JointHandle
-from pan_tilt_sim.controllers.hardware import (
+from pan_tilt_sim.controllers.hardware_interfaces import (
     NO_HARDWARE,
     GpioHandle,
     HardwareInterfaces,

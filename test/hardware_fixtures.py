@@ -13,7 +13,7 @@ are the world's.  Its ``<ros2_control>`` block:
   Robots declare theirs): the broadcaster's ``frame_id: hand`` places it;
 * ``imu_sensor`` -- the ten IMU interfaces, on ``imu_link`` (frame_id);
 * ``range_sensor`` -- ``range`` on ``range_link``, ``RANGE_HEIGHT`` above the
-  ground on the base, its +x pointing straight down;
+  ground and ``RANGE_X`` out on the base, its +x pointing straight down;
 * ``tool_pose`` -- position and orientation of ``ft_link`` (frame_id);
 * ``thermometer`` -- a ``temperature`` the simulator does not produce
   (initial_value ``TEMPERATURE``);
@@ -39,6 +39,7 @@ HAND_MASS = 0.5  # kg
 PAYLOAD_MASS = 2.0  # kg
 PAYLOAD_OFFSET = 0.1  # m along the ft_link's x
 RANGE_HEIGHT = 0.25  # m above the ground
+RANGE_X = 0.3  # m: the range_link along the base's x
 TEMPERATURE = 21.5
 VACUUM_START = 1.0
 UPDATE_RATE = 100.0  # Hz
@@ -99,7 +100,7 @@ ARM_URDF = f"""<?xml version="1.0"?>
   <link name="range_link"/>
   <joint name="range_joint" type="fixed">
     <parent link="base"/><child link="range_link"/>
-    <origin xyz="0.3 0 {RANGE_HEIGHT}" rpy="0 1.5707963267948966 0"/>
+    <origin xyz="{RANGE_X} 0 {RANGE_HEIGHT}" rpy="0 1.5707963267948966 0"/>
   </joint>
 
   <ros2_control name="SensorArm" type="system">

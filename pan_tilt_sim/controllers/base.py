@@ -37,7 +37,7 @@ from types import MappingProxyType
 from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
-from pan_tilt_sim.controllers.hardware import (
+from pan_tilt_sim.controllers.hardware_interfaces import (
     NO_HARDWARE,
     CommandInterface,
     HardwareInterfaces,

@@ -13,8 +13,9 @@ At every update (the controller_manager's rate) it publishes the states on
 ``interface_groups`` per gpio, with its ``interface_names`` and ``values``.
 A command is checked whole when it arrives: a group or interface it does not
 claim, names and values of different lengths, or a value that is not a
-finite number reject it with a warning, and nothing changes.  Deactivated, it
-forgets its command (the interfaces keep their values).
+finite number reject it with a warning, and nothing changes.  Activated again
+after a deactivation it starts without a command, as upstream resets it (the
+interfaces keep their values).
 
 The simulation echoes a gpio command into the state interface of the same
 name, as mock hardware does; a state without a command keeps its
@@ -32,7 +33,7 @@ from pan_tilt_sim.controllers.base import (
     CommandResult,
     JointHandle,
 )
-from pan_tilt_sim.controllers.hardware import CommandInterface, StateInterface
+from pan_tilt_sim.controllers.hardware_interfaces import CommandInterface, StateInterface
 from pan_tilt_sim.controllers.parameter_spec import (
     REQUIRED,
     STRING_ARRAY,
@@ -153,13 +154,9 @@ class GpioCommandController(CommandController):
         return self._schedule
 
     def reset(self) -> None:
-        """Forget the command; update at once, then every period."""
+        """Forget the command (on every activation); update at once, then every period."""
         self._pending = []
         self._schedule.reset()
-
-    def deactivate(self) -> None:
-        """Forget the command, as upstream resets it on deactivation."""
-        self._pending = []
 
     def set_command(self, value: GroupValues) -> CommandResult:
         """Check a whole command; keep it for the next updates or reject it with the reason."""

@@ -68,7 +68,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
 from pan_tilt_sim.controllers.base import CommandController, Controller, JointHandle, Reference
-from pan_tilt_sim.controllers.hardware import NO_HARDWARE, HardwareInterfaces
+from pan_tilt_sim.controllers.hardware_interfaces import NO_HARDWARE, HardwareInterfaces
 from pan_tilt_sim.controllers.registry import (
     create_controller,
     is_command_type,

@@ -1,16 +1,16 @@
 """The shared part of the broadcasters of ``<ros2_control>`` sensors (force-torque, IMU...).
 
 A sensor broadcaster reads state interfaces of the robot's sensors
-(:mod:`~pan_tilt_sim.controllers.hardware`) at its update rate -- the
+(:mod:`~pan_tilt_sim.controllers.hardware_interfaces`) at its update rate -- the
 controller_manager's, as upstream's broadcasters publish at every update --
 and hands each sample to its sink.  While nobody listens (no sink) it takes
 no sample, and the sensors it reads are not watched, so the simulation does
 not measure them.  A sample is taken only when every sensor it reads has a
-valid reading (:meth:`~pan_tilt_sim.controllers.hardware.SensorHandle.refresh`):
+valid reading (:meth:`~pan_tilt_sim.controllers.hardware_interfaces.SensorHandle.refresh`):
 the first one after someone starts listening may be skipped.
 
 At configure the broadcaster tells its sensors the ``frame_id`` it stamps
-(:meth:`~pan_tilt_sim.controllers.hardware.SensorHandle.use_frame`): the
+(:meth:`~pan_tilt_sim.controllers.hardware_interfaces.SensorHandle.use_frame`): the
 simulation places a sensor that nothing in the URDF places there, or gives
 its readings in that frame; what it cannot do becomes a notice (the node
 logs it).
@@ -24,7 +24,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from pan_tilt_sim.controllers.base import Controller, JointHandle
-from pan_tilt_sim.controllers.hardware import SensorHandle, StateInterface
+from pan_tilt_sim.controllers.hardware_interfaces import SensorHandle, StateInterface
 from pan_tilt_sim.controllers.shared_parameters import update_period
 from pan_tilt_sim.schedule import DUE_EPSILON, PeriodicSchedule
 

@@ -84,6 +84,9 @@ def unplaced_reason(sensor: ControlSensor) -> str:
     frame = sensor.params.get(FRAME_ID, '').strip()
     given = (f"its <param name=\"{FRAME_ID}\"> '{frame}' is not a link of the robot" if frame
              else f'it has no <param name="{FRAME_ID}">')
+    if measures(sensor, POSITION):  # a pose broadcaster's frame_id is the pose's reference
+        return (f'no Gazebo <sensor> of its name, {given}, and no link has its name: it '
+                'reads NaN')
     return (f'no Gazebo <sensor> of its name, {given}, and no link has its name: it reads '
             "NaN until a broadcaster's frame_id names a link for it")
 

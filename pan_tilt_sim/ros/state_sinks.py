@@ -164,6 +164,6 @@ class GroupValuesSink(HeldSample):
         def fill() -> None:
             stamp(time, self.message.header.stamp)
             for entry, row in zip(self.message.interface_values, values, strict=True):
-                entry.values = [float(value) for value in row]
+                entry.values = row  # the message keeps a copy (an array of doubles)
         self.take(fill)
 

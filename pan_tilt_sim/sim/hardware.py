@@ -1,7 +1,7 @@
 """The ``<ros2_control>`` sensors and gpios, simulated: what fills their interfaces. No ROS.
 
 Every ``<sensor>`` and ``<gpio>`` of the URDF's ``<ros2_control>`` blocks
-gets its interfaces (:mod:`pan_tilt_sim.controllers.hardware`), which the
+gets its interfaces (:mod:`pan_tilt_sim.controllers.hardware_interfaces`), which the
 controllers claim by name as ros2_control's do.
 
 **Sensors** are measured in the simulation's PyBullet client with the code
@@ -26,7 +26,7 @@ at the place :func:`~pan_tilt_sim.model.control_sensors.placement` finds
   :data:`DEFAULT_MAX_RANGE`; nothing hit reads +inf.
 
 A sensor is measured only when a reader asks and someone listens (see
-:class:`~pan_tilt_sim.controllers.hardware.SensorHandle`); a Gazebo sensor's
+:class:`~pan_tilt_sim.controllers.hardware_interfaces.SensorHandle`); a Gazebo sensor's
 ``update_rate`` makes its readings change at that rate only.  The first
 reading after someone starts listening is not valid (PyBullet's joint
 feedback is switched on then, and an IMU needs an earlier velocity): the
@@ -52,7 +52,7 @@ from collections.abc import Callable
 
 import numpy
 
-from pan_tilt_sim.controllers.hardware import (
+from pan_tilt_sim.controllers.hardware_interfaces import (
     CommandInterface,
     GpioHandle,
     HardwareInterfaces,
@@ -213,6 +213,7 @@ class SimulatedSensor:
             self._reference = LinkReader(physics, self._frame)
         if self._watched and self._force_torque is not None:
             self._force_torque.enable(True)
+            self._valid_from = context.steps() + 1  # its feedback was switched off and on
 
     def _build_wrench(self, gazebo: SensorSpec | None, interface, rng, extra: float) -> None:
         joint = self.joint()
@@ -259,10 +260,9 @@ class SimulatedSensor:
         """Place an unplaced sensor at ``frame``, or give the wrench / pose there."""
         links = self._context.links
         if self.placement is None:
-            if self.pose:  # a pose broadcaster's frame_id is where the pose is given, not from
-                self._frame = frame
-                return (f"nothing in the URDF places pose sensor '{self.control.name}' (its "
-                        "broadcaster's frame_id is the frame the pose is given in): it reads NaN")
+            if self.pose:  # the frame the pose is given in, not where the sensor is:
+                self._frame = frame  # the start-up warning said it reads NaN
+                return None
             if frame not in links:
                 return (f"is not a link of the robot, and nothing in the URDF places sensor "
                         f"'{self.control.name}': it reads NaN")

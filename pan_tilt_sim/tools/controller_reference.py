@@ -19,7 +19,7 @@ from collections.abc import Sequence
 
 from pan_tilt_sim.controllers import JointHandle
 from pan_tilt_sim.controllers.base import Controller
-from pan_tilt_sim.controllers.hardware import example_hardware
+from pan_tilt_sim.controllers.hardware_interfaces import example_hardware
 from pan_tilt_sim.controllers.parameter_spec import Param
 from pan_tilt_sim.controllers.registry import CONTROLLER_CLASSES
 from pan_tilt_sim.controllers.surface import ActionServer, CommandTopic, Endpoint, StateTopic

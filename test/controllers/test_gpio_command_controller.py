@@ -10,7 +10,11 @@ import pytest
 from controller_fixtures import DT, hardware, loaded, raises_naming, sample_sink
 
 from pan_tilt_sim.controllers import CommandResult, create_controller
-from pan_tilt_sim.controllers.hardware import CommandInterface, GpioHandle, StateInterface
+from pan_tilt_sim.controllers.hardware_interfaces import (
+    CommandInterface,
+    GpioHandle,
+    StateInterface,
+)
 from pan_tilt_sim.controllers.manager import ACTIVE
 
 TYPE = 'gpio_controllers/GpioCommandController'
@@ -117,7 +121,7 @@ def test_a_bad_command_is_rejected_whole_and_nothing_changes(value, problem):
     assert math.isnan(samples[-1][1][0][0])
 
 
-def test_deactivated_it_forgets_its_command():
+def test_activated_again_it_starts_without_a_command():
     manager, controller, samples = active()
     controller.set_command(command(('flange_vacuum', ['vacuum'], [0.0])))
     manager.switch([], ['gpio'])

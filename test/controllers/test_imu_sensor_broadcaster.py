@@ -14,7 +14,9 @@ AT_REST = dict(zip(IMU, (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.5, 0.0, 0.0, 9.81), str
 
 def test_publishes_orientation_angular_velocity_and_acceleration_with_the_covariances():
     covariance = [0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01]
+    tilt = [0.05, 0, 0, 0, 0.05, 0, 0, 0, 0.1]
     manager = loaded('imu', TYPE, {'sensor_name': 'imu_sensor', 'frame_id': 'imu_link',
+                                   'static_covariance_orientation': tilt,
                                    'static_covariance_angular_velocity': covariance}, {},
                      hardware(sensor('imu_sensor', IMU, FakeSource(AT_REST))))
     manager.configure('imu')
@@ -22,7 +24,7 @@ def test_publishes_orientation_angular_velocity_and_acceleration_with_the_covari
     (topic,) = controller.ros_surface()
     assert (topic.name, topic.message) == ('~/imu', 'sensor_msgs/msg/Imu')
     assert topic.fields['frame_id'] == 'imu_link'
-    assert topic.fields['covariances'] == ((0.0,) * 9, tuple(covariance), (0.0,) * 9)
+    assert topic.fields['covariances'] == (tuple(tilt), tuple(covariance), (0.0,) * 9)
     samples = []
     topic.connect(sample_sink(samples))
     controller.update(0.0, DT)

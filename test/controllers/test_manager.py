@@ -483,7 +483,7 @@ def test_an_interface_the_simulator_cannot_drive_is_refused_naming_joint_and_int
 # --- gpio command interfaces ---------------------------------------------------------------
 
 def gpio_manager(tmp_path):
-    from pan_tilt_sim.controllers.hardware import (
+    from pan_tilt_sim.controllers.hardware_interfaces import (
         CommandInterface,
         GpioHandle,
         HardwareInterfaces,
@@ -495,8 +495,9 @@ def gpio_manager(tmp_path):
     io = GpioHandle('io', [CommandInterface('io/vacuum', state)], [state])
     spec = {'type': 'gpio_controllers/GpioCommandController', 'gpios': ['io'],
             'command_interfaces': {'io': {'interfaces': ['vacuum']}}}
+    # The second controller is named like the gpio: a controller's name is no gpio's.
     config = ControllersConfig((ControllerSpec('gripper', spec['type'], spec),
-                                ControllerSpec('suction', spec['type'], spec)),
+                                ControllerSpec('io', spec['type'], spec)),
                                tmp_path / 'c.yaml')
     return ControllerManager(config, {}, active=['gripper'],
                              hardware=HardwareInterfaces([], [io]))
@@ -505,8 +506,8 @@ def gpio_manager(tmp_path):
 def test_two_active_controllers_on_one_gpio_command_interface_is_refused(tmp_path):
     manager = gpio_manager(tmp_path)
     assert manager.chain_connections('gripper') == {}  # a gpio is no chained controller
-    with pytest.raises(ControllerSwitchError, match=r"'gripper' and 'suction' would both claim "
+    with pytest.raises(ControllerSwitchError, match=r"'gripper' and 'io' would both claim "
                                                     r"the command interface 'io/vacuum'"):
-        manager.switch(['suction'])
-    manager.switch(['suction'], ['gripper'])
-    assert [c.name for c in manager.active] == ['suction']
+        manager.switch(['io'])
+    manager.switch(['io'], ['gripper'])
+    assert [c.name for c in manager.active] == ['io']

@@ -147,3 +147,15 @@ def test_extend_replaces_and_without_removes():
     assert spec['mode'].default == 'slow'
     assert 'open_loop' not in spec
     assert len(spec) == len(SPEC) - 1
+
+
+def test_the_example_holds_required_entries_and_optional_ones_with_an_example():
+    spec = ParameterSpec([
+        Param('gpios', STRING_ARRAY, REQUIRED, 'gpios', example=['io']),
+        Param('sensor_name', STRING, '', 'one of two', example='fts'),
+        Param('frame_id', STRING, '', 'no example'),
+        Param('command_interfaces.__map_gpios.interfaces', STRING_ARRAY, [], 'per gpio',
+              example=['out']),
+    ])
+    assert spec.example() == {'gpios': ['io'], 'sensor_name': 'fts',
+                              'command_interfaces': {'io': {'interfaces': ['out']}}}

@@ -12,7 +12,7 @@ import pytest
 
 from pan_tilt_sim.controllers import JointHandle
 from pan_tilt_sim.controllers.base import CommandController
-from pan_tilt_sim.controllers.hardware import example_hardware
+from pan_tilt_sim.controllers.hardware_interfaces import example_hardware
 from pan_tilt_sim.controllers.manager import ACTIVE, ControllerManager
 from pan_tilt_sim.controllers.parameter_spec import ParameterSpec
 from pan_tilt_sim.controllers.registry import CONTROLLER_TYPES, create_controller

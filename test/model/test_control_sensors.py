@@ -47,6 +47,8 @@ def test_nothing_else_places_it_and_the_reason_says_what_was_looked_for():
     assert kinds.placement(model(), sensor('x', 'range', frame_id='nowhere')) is None
     reason = kinds.unplaced_reason(sensor('x', 'range', frame_id='nowhere'))
     assert "'nowhere' is not a link" in reason and "broadcaster's frame_id" in reason
+    # A pose broadcaster's frame_id is the frame the pose is in, not the sensor's place.
+    assert kinds.unplaced_reason(sensor('tcp_pose', *kinds.POSE)).endswith('it reads NaN')
 
 
 def test_interface_names_the_simulator_does_not_produce_are_listed_in_file_order():

@@ -12,11 +12,19 @@ import pytest
 from control_msgs.msg import DynamicInterfaceGroupValues, InterfaceValue
 from controller_manager_msgs.srv import ListHardwareInterfaces
 from geometry_msgs.msg import PoseStamped, WrenchStamped
-from hardware_fixtures import FT_HEIGHT, PAYLOAD_MASS, VACUUM_START, write_sensor_arm
+from hardware_fixtures import (
+    FT_HEIGHT,
+    PAYLOAD_MASS,
+    RANGE_HEIGHT,
+    VACUUM_START,
+    write_sensor_arm,
+)
 from node_harness import PROBE_QUEUE, sim_node, stamp_s
-from sensor_msgs.msg import Imu
+from sensor_msgs.msg import Imu, Range
 from tf2_msgs.msg import TFMessage
 
+from pan_tilt_sim.ros import controller_bindings, ros_interfaces
+from pan_tilt_sim.ros.ros_interfaces import GROUP_VALUES
 from pan_tilt_sim.sim.physics import STANDARD_GRAVITY
 
 ONE_PERCENT = 0.01
@@ -57,6 +65,13 @@ def test_the_imu_at_rest_reads_gravity(arm):
     assert last.linear_acceleration.z == pytest.approx(STANDARD_GRAVITY, rel=ONE_PERCENT)
     assert (last.orientation.w, last.angular_velocity.y) == (pytest.approx(1.0),
                                                             pytest.approx(0.0, abs=1e-9))
+
+
+def test_the_range_ray_meets_the_worlds_ground(arm):
+    ranges = listen(arm, Range, '/range_broadcaster/range')
+    arm.run_for(0.1)
+    assert ranges[-1].header.frame_id == 'range_link'
+    assert ranges[-1].range == pytest.approx(RANGE_HEIGHT, rel=1e-4)
 
 
 def test_the_pose_and_its_transform_are_the_sensor_links(arm):
@@ -103,3 +118,39 @@ def test_what_the_simulator_cannot_produce_is_in_the_node_log_once(tmp_path, cap
                 if line.startswith('[WARN]')]
     assert len([line for line in warnings if "sensor 'thermometer'" in line]) == 1
     assert len([line for line in warnings if "gpio 'tool_io'" in line]) == 1
+
+
+def test_a_broadcaster_cleaned_up_stops_watching_its_sensor(arm):
+    source = next(sensor for sensor in arm.simulation.hardware.sensors
+                  if sensor.control.name == 'ft_sensor')
+    listen(arm, WrenchStamped, '/ft_broadcaster/wrench')
+    arm.run_for(0.05)
+    assert source._force_torque.enabled
+    arm.node.set_paused(True)
+    arm.node.controllers.switch([], ['ft_broadcaster'], strict=True)
+    arm.node.controllers.cleanup('ft_broadcaster')
+    assert not source._force_torque.enabled  # PyBullet's joint feedback costs every step
+
+
+def test_without_control_msgs_the_gpio_controller_runs_without_topics_and_says_so(
+        tmp_path, capfd, monkeypatch):
+    monkeypatch.delitem(controller_bindings.STATE_SINKS, GROUP_VALUES)
+    monkeypatch.delitem(ros_interfaces.COMMAND_MESSAGES, GROUP_VALUES)
+    urdf, controllers = write_sensor_arm(tmp_path)
+    with sim_node(robot_description_file=str(urdf), controllers_file=str(controllers)) as sim:
+        publishers, subscriptions = sim.own_topics()
+        assert sim.simulation.manager.is_active('gpio_controller')
+    assert not [topic for topic in [*publishers, *subscriptions] if 'gpio_controller' in topic]
+    lines = [line for line in capfd.readouterr().err.splitlines() if 'gpio_controller: no topic'
+             in line]
+    assert len(lines) == 2 and 'control_msgs is not installed' in lines[0]
+    assert all(line.startswith('[WARN]') for line in lines)
+
+
+def test_a_broadcasters_absolute_topic_stays_absolute_in_a_robot_namespace(tmp_path):
+    urdf, controllers = write_sensor_arm(tmp_path)
+    with sim_node(robot_description_file=str(urdf), controllers_file=str(controllers),
+                  robot_namespace='left') as sim:
+        publishers, _subscriptions = sim.own_topics()
+    assert publishers['/left/pose_broadcaster/pose'] == 'geometry_msgs/msg/PoseStamped'
+    assert '/tf' in publishers and '/left/tf' not in publishers

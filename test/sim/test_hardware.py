@@ -17,6 +17,7 @@ from hardware_fixtures import (
     PAYLOAD_MASS,
     PAYLOAD_OFFSET,
     RANGE_HEIGHT,
+    RANGE_X,
     SHOULDER_Z,
     TEMPERATURE,
     VACUUM_START,
@@ -96,16 +97,19 @@ def test_a_sensor_the_urdf_does_not_place_sits_at_its_broadcasters_frame_id(arm)
 def test_a_frame_id_naming_another_link_gets_the_wrench_expressed_there(arm):
     simulation = arm()
     sensor = simulation.hardware.interfaces.sensors['ft_sensor']
-    assert sensor.use_frame('upper') is None
+    # range_link: on the base, RANGE_X out along x, its x pointing down, its z along world x.
+    assert sensor.use_frame('range_link') is None
     sensor.watch('test', True)
     simulation.advance(300)
     assert sensor.refresh(simulation.time)
     value = {name: interface.value for name, interface in sensor.interfaces.items()}
     weight = PAYLOAD_MASS * STANDARD_GRAVITY
-    # The same force; its moment about the upper arm's origin, straight below the sensor,
-    # is still the offset's: the lever along z adds nothing to a vertical force.
-    assert value['force.z'] == pytest.approx(-weight, rel=ONE_PERCENT)
-    assert value['torque.y'] == pytest.approx(PAYLOAD_OFFSET * weight, rel=ONE_PERCENT)
+    # The payload's pull, straight down, is along the range_link's +x.
+    assert (value['force.x'], value['force.y'], value['force.z']) == pytest.approx(
+        (weight, 0.0, 0.0), abs=ONE_PERCENT * weight)
+    # About the range_link's origin the pull's lever is the payload's x less RANGE_X.
+    assert value['torque.y'] == pytest.approx((PAYLOAD_OFFSET - RANGE_X) * weight,
+                                              rel=ONE_PERCENT)
     assert sensor.use_frame('no_such_link') == (
         "is not a link of the robot: the wrench is given in 'ft_link'")
 
@@ -155,6 +159,47 @@ def test_a_gazebo_sensor_of_the_same_name_brings_its_direction_and_rate(arm):
     changes = sum(1 for before, after in zip(recent, recent[1:], strict=False)
                   if before != after)
     assert 2 <= changes <= 4
+
+
+NOISY_FT = """
+  <gazebo reference="ft_joint">
+    <sensor name="ft_sensor" type="force_torque">
+      <force_torque><force><x><noise type="gaussian"><mean>0.0</mean><stddev>0.5</stddev>
+      </noise></x></force></force_torque>
+    </sensor>
+  </gazebo>
+</robot>"""
+
+
+def force_x_readings(simulation, count):
+    sensor = simulation.hardware.interfaces.sensors['ft_sensor']
+    sensor.watch('test', True)
+    readings = []
+    for _ in range(count + 1):
+        simulation.advance(1)
+        if sensor.refresh(simulation.time):
+            readings.append(sensor.interfaces['force.x'].value)
+    sensor.watch('test', False)
+    return numpy.array(readings)
+
+
+def test_a_gazebo_sensors_noise_applies_and_a_seed_repeats_it(arm):
+    runs = []
+    for _ in range(2):
+        simulation = arm(ARM_URDF.replace('</robot>', NOISY_FT))
+        simulation.hardware.configure(seed=7)
+        runs.append(force_x_readings(simulation, 400))
+    assert runs[0].std() == pytest.approx(0.5, rel=0.15)
+    assert numpy.array_equal(runs[0], runs[1])
+
+
+def test_a_sensor_on_a_link_that_carries_nothing_says_it_reads_zero(arm):
+    log = Log()
+    arm(ARM_URDF.replace('<param name="frame_id">ft_link</param>',
+                         '<param name="frame_id">imu_link</param>'), log=log)
+    assert ('info', "sensor 'ft_sensor': the wrench on joint 'imu_joint' (nothing beyond it "
+            "has mass: 0 until something pushes on it) at 'imu_link' (<param "
+            'name="frame_id">imu_link</param>)') in log.lines
 
 
 # --- IMU, range, pose ----------------------------------------------------------------------
@@ -234,6 +279,17 @@ def test_a_gpio_command_is_echoed_and_an_input_keeps_its_initial_value(arm):
     simulation.reset()
     simulation.advance(1)
     assert samples[-1][1][0][0] == VACUUM_START
+
+
+def test_mock_gpio_commands_gives_every_gpio_state_a_command_interface(arm):
+    simulation = arm(ARM_URDF.replace(
+        '<plugin>mock_components/GenericSystem</plugin>',
+        '<plugin>mock_components/GenericSystem</plugin>'
+        '<param name="mock_gpio_commands">true</param>'))
+    interfaces = simulation.hardware.interfaces
+    assert list(interfaces.command_interfaces) == ['tool_io/vacuum', 'tool_io/pressure']
+    interfaces.command_interfaces['tool_io/pressure'].write(2.5)
+    assert interfaces.state_interfaces['tool_io/pressure'].value == 2.5
 
 
 def test_what_cannot_be_simulated_is_warned_about_once_at_start_up(arm):

@@ -1,10 +1,10 @@
-"""hardware: the sensor and gpio interfaces controllers and the simulation share."""
+"""hardware_interfaces: the sensor and gpio interfaces controllers and the simulation share."""
 
 import math
 
 from controller_fixtures import FakeSource, sensor
 
-from pan_tilt_sim.controllers.hardware import (
+from pan_tilt_sim.controllers.hardware_interfaces import (
     CommandInterface,
     GpioHandle,
     HardwareInterfaces,
