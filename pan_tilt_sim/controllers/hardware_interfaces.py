@@ -24,7 +24,7 @@ each controller before it is configured.  Pure Python: no PyBullet, no ROS.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable
 from typing import Protocol
 
 
@@ -174,18 +174,6 @@ class HardwareInterfaces:
     def sensor_of(self, interface: str) -> SensorHandle | None:
         """Return the sensor whose state interface ``interface`` (full name) is, if any."""
         return self._sensor_of.get(interface)
-
-    def is_command_interface(self, component: str, interface: str) -> bool:
-        """Whether ``<component>/<interface>`` is one of these command interfaces."""
-        return f'{component}/{interface}' in self.command_interfaces
-
-    def components(self) -> Mapping[str, tuple[str, ...]]:
-        """Return every sensor's and gpio's interfaces (state and command), by component."""
-        found: dict[str, tuple[str, ...]] = {
-            name: tuple(sensor.interfaces) for name, sensor in self.sensors.items()}
-        found.update({name: tuple(dict.fromkeys([*gpio.commands, *gpio.states]))
-                      for name, gpio in self.gpios.items()})
-        return found
 
     def reset(self) -> None:
         """Every sensor and gpio back to its initial state (the simulation was reset)."""

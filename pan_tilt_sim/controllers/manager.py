@@ -21,7 +21,10 @@ same with the controllers of one :class:`ControllersConfig`:
   type, it ends start-up, listing the supported types.
 * A controller may claim only command interfaces that the URDF's
   ``<ros2_control>`` block gives its joints (joints outside every block are
-  not checked).
+  not checked), or its ``<gpio>`` entries' command interfaces
+  (``<gpio>/<interface>``), each by one active controller at a time.  The
+  robot's sensors and gpios (:mod:`.hardware_interfaces`) are handed to every
+  controller before it is configured.
 * The block's hardware may refuse a combination of command interfaces --
   two on one joint, different command modes on its joints -- as its
   ``prepare_command_mode_switch`` does; which hardware refuses what, and
@@ -616,7 +619,8 @@ class ControllerManager:
 
         Every reference interface a controller of ``names`` claims must be
         exported by a loaded controller -- the very one it was configured
-        against -- and claimed by no other; the chains must not loop.
+        against -- and claimed by no other, as every gpio command interface;
+        the chains must not loop.
         """
         exported = self.references()
         claimers: dict[str, str] = {}

@@ -15,6 +15,9 @@ controller type:
   interface package is installed (:data:`ACTION_SERVERS`);
 
 plus its tunable PID gains as sim_node parameters (:mod:`.gain_parameters`).
+A topic whose message type's interface package is not installed (control_msgs
+for the gpio controller, where the venv lacks it) is left out with one warning;
+the controller still runs.
 A command controller's commands are ignored while it is inactive, or in
 chained mode (then the controller before it in the chain writes its
 references).  Given a :class:`~pan_tilt_sim.ros.command_reader.CommandReader` (the sim_node

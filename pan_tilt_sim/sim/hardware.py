@@ -61,7 +61,13 @@ from pan_tilt_sim.controllers.hardware_interfaces import (
 )
 from pan_tilt_sim.model import control_sensors as kinds
 from pan_tilt_sim.model.control_sensors import Placement
-from pan_tilt_sim.model.robot import ControlGpio, ControlSensor, ControlSystem, RobotModel
+from pan_tilt_sim.model.robot import (
+    ControlGpio,
+    ControlSensor,
+    ControlSystem,
+    JointSpec,
+    RobotModel,
+)
 from pan_tilt_sim.model.sensors import (
     CHILD,
     CHILD_TO_PARENT,
@@ -138,7 +144,7 @@ class SimulatedSensor:
         self._target: LinkReader | None = None
         self._schedule: PeriodicSchedule | None = None
         self.problem = ''  # why something it has cannot be measured where it is
-        self._build()
+        self.rebuild()
 
     # --- where it is and what measures it ----------------------------------------------------
 
@@ -147,7 +153,7 @@ class SimulatedSensor:
         """The Gazebo sensor of the same name, if the URDF has one."""
         return None if self.placement is None else self.placement.gazebo
 
-    def joint(self):
+    def joint(self) -> JointSpec | None:
         """Return the joint whose reaction the wrench is (None: no joint above the link)."""
         gazebo = self.gazebo
         if gazebo is not None and gazebo.kind is SensorKind.FORCE_TORQUE:
@@ -161,15 +167,21 @@ class SimulatedSensor:
             return sensor_interface(gazebo, self._context.model.name).frame_id
         return self.placement.link
 
-    def _release(self) -> None:
+    @property
+    def feedback_on(self) -> bool:
+        """Whether this sensor has PyBullet's joint feedback on (it costs every step)."""
+        return self._force_torque is not None and self._force_torque.enabled
+
+    def release(self) -> None:
+        """Drop the readers, switching off the joint feedback this sensor switched on."""
         if self._force_torque is not None:
             self._force_torque.enable(False)
         self._force_torque = self._imu = self._lidar = None
         self._link = self._reference = self._child = self._target = None
 
-    def _build(self) -> None:
+    def rebuild(self) -> None:
         """Make the readers for the placement, the frame asked for, the world and the seed."""
-        self._release()
+        self.release()
         self.problem = ''
         placed = self.placement
         if placed is None:
@@ -268,12 +280,12 @@ class SimulatedSensor:
                         f"'{self.control.name}': it reads NaN")
             self.placement = Placement(frame, via="its broadcaster's frame_id")
             self._frame = frame
-            self._build()
+            self.rebuild()
             return self.problem or None
         if frame == self._frame:
             return None
         self._frame = frame
-        self._build()
+        self.rebuild()
         problems = [self.problem] if self.problem else []
         own = self.frame_name()
         if self.wrench and frame != own and frame not in links:
@@ -462,7 +474,7 @@ class SimulatedHardware:
             return
         context.world, context.seed = world, seed
         for sensor in self.sensors:
-            sensor._build()
+            sensor.rebuild()
 
     def reset(self) -> None:
         """Every interface back to its initial value; sensors start afresh."""
@@ -478,4 +490,4 @@ class SimulatedHardware:
     def close(self) -> None:
         """Switch off what the sensors switched on in PyBullet."""
         for sensor in self.sensors:
-            sensor._release()
+            sensor.release()

@@ -43,8 +43,6 @@ def test_interfaces_are_found_by_full_name_and_sensor_interfaces_lead_to_their_s
     assert list(found.command_interfaces) == ['io/out']
     assert found.sensor_of('fts/torque.z') is fts
     assert found.sensor_of('io/in') is None
-    assert found.is_command_interface('io', 'out') and not found.is_command_interface('io', 'in')
-    assert found.components() == {'fts': ('force.x', 'torque.z'), 'io': ('out', 'in')}
 
 
 def test_the_source_hears_only_when_the_first_reader_comes_and_the_last_one_goes():

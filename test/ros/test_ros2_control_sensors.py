@@ -125,11 +125,11 @@ def test_a_broadcaster_cleaned_up_stops_watching_its_sensor(arm):
                   if sensor.control.name == 'ft_sensor')
     listen(arm, WrenchStamped, '/ft_broadcaster/wrench')
     arm.run_for(0.05)
-    assert source._force_torque.enabled
+    assert source.feedback_on
     arm.node.set_paused(True)
     arm.node.controllers.switch([], ['ft_broadcaster'], strict=True)
     arm.node.controllers.cleanup('ft_broadcaster')
-    assert not source._force_torque.enabled  # PyBullet's joint feedback costs every step
+    assert not source.feedback_on  # PyBullet's joint feedback costs every step
 
 
 def test_without_control_msgs_the_gpio_controller_runs_without_topics_and_says_so(

@@ -127,12 +127,12 @@ def test_an_unwatched_sensor_keeps_pybullets_joint_feedback_off(arm):
     simulation = arm()
     source = simulation.hardware.sensors[0]
     assert source.control.name == 'ft_sensor'
-    assert not source._force_torque.enabled
+    assert not source.feedback_on
     endpoint = simulation.controller('ft_broadcaster').ros_surface()[0]
     endpoint.connect(lambda *sample: None)
-    assert source._force_torque.enabled
+    assert source.feedback_on
     endpoint.connect(None)
-    assert not source._force_torque.enabled
+    assert not source.feedback_on
 
 
 GAZEBO_FT = """
