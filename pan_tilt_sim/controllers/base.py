@@ -38,6 +38,12 @@ from types import MappingProxyType
 from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
+from pan_tilt_sim.controllers.hardware_interfaces import (
+    NO_HARDWARE,
+    CommandInterface,
+    HardwareInterfaces,
+    StateInterface,
+)
 from pan_tilt_sim.controllers.parameter_spec import (
     LoadedParameters,
     ParameterSpec,
@@ -291,6 +297,8 @@ class Controller(abc.ABC):
     # Chained mode, and the references offered before configure (see the methods below).
     _chained: bool = False
     _available_references: Mapping[str, Reference] = MappingProxyType({})
+    # The robot's sensors and gpios, offered before configure (see set_hardware).
+    _hardware: HardwareInterfaces = NO_HARDWARE
 
     def __init__(self, name: str, params: Mapping[str, Any] | LoadedParameters,
                  source: str = '') -> None:
@@ -426,6 +434,35 @@ class Controller(abc.ABC):
             'reference interface of a loaded chainable controller (movable joints: '
             f"{', '.join(sorted(joints)) or 'none'}; reference interfaces: "
             f"{', '.join(self._available_references) or 'none'})")
+
+    # --- sensors and gpios --------------------------------------------------------------------
+
+    def set_hardware(self, hardware: HardwareInterfaces) -> None:
+        """Take the robot's sensor and gpio interfaces (the manager calls it before configure)."""
+        self._hardware = hardware
+
+    def state_interface(self, name: str, field: str) -> StateInterface:
+        """Look up the sensor or gpio state interface ``name`` (``<component>/<interface>``).
+
+        The error names ``field`` and lists what exists (upstream's
+        controller_manager refuses to activate a controller whose state
+        interface is missing).
+        """
+        found = self._hardware.state_interfaces.get(name)
+        if found is None:
+            existing = ', '.join(self._hardware.state_interfaces) or 'none'
+            raise self.error(field, f"'{name}' is not a state interface of the robot's "
+                                    f'<ros2_control> sensors and gpios (they have: {existing})')
+        return found
+
+    def command_interface(self, name: str, field: str) -> CommandInterface:
+        """Look up the gpio command interface ``name`` (``<component>/<interface>``)."""
+        found = self._hardware.command_interfaces.get(name)
+        if found is None:
+            existing = ', '.join(self._hardware.command_interfaces) or 'none'
+            raise self.error(field, f"'{name}' is not a command interface of the robot's "
+                                    f'<ros2_control> gpios (they have: {existing})')
+        return found
 
     def reset(self) -> None:  # noqa: B027 -- stateless controllers need no reset
         """Forget commands and internal state, as after a fresh start."""

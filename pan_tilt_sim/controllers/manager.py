@@ -21,7 +21,10 @@ same with the controllers of one :class:`ControllersConfig`:
   type, it ends start-up, listing the supported types.
 * A controller may claim only command interfaces that the URDF's
   ``<ros2_control>`` block gives its joints (joints outside every block are
-  not checked).
+  not checked), or its ``<gpio>`` entries' command interfaces
+  (``<gpio>/<interface>``), each by one active controller at a time.  The
+  robot's sensors and gpios (:mod:`.hardware_interfaces`) are handed to every
+  controller before it is configured.
 * The block's hardware may refuse a combination of command interfaces --
   two on one joint, different command modes on its joints -- as its
   ``prepare_command_mode_switch`` does; which hardware refuses what, and
@@ -68,6 +71,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
 from pan_tilt_sim.controllers.base import Controller, JointHandle, Reference
+from pan_tilt_sim.controllers.hardware_interfaces import NO_HARDWARE, HardwareInterfaces
 from pan_tilt_sim.controllers.registry import (
     create_controller,
     is_command_type,
@@ -107,10 +111,13 @@ class ControllerManager:
     def __init__(self, config: ControllersConfig, handles: Mapping[str, JointHandle],
                  model: RobotModel | None = None, *, active: Sequence[str] | None = None,
                  active_name: str = f"the parameter '{ACTIVE_CONTROLLERS}'",
-                 autostart: bool = True) -> None:
+                 autostart: bool = True,
+                 hardware: HardwareInterfaces = NO_HARDWARE) -> None:
         self._source = config.label
         self._model = model
         self._handles = handles
+        # The robot's <ros2_control> sensors and gpios, offered to every controller.
+        self.hardware = hardware
         # The file's controllers by name: what load() takes a type and parameters from.
         self.declared: dict[str, ControllerSpec] = {spec.name: spec
                                                     for spec in config.controllers}
@@ -274,7 +281,7 @@ class ControllerManager:
         """
         connections: dict[str, list[str]] = {}
         for entry, interfaces in self._by_name[name].command_interfaces().items():
-            if entry in self._handles:
+            if entry in self._handles or entry in self.hardware.gpios:
                 continue
             owner = entry.partition('/')[0]
             if owner != name and owner in self._by_name:
@@ -323,6 +330,7 @@ class ControllerManager:
         self._bound.pop(name, None)
         references = self.references()
         controller.set_available_references(references)
+        controller.set_hardware(self.hardware)
         controller.configure(self._handles)
         self._bound[name] = {claimed: references[claimed] for entry, interfaces
                              in controller.command_interfaces().items()
@@ -611,7 +619,8 @@ class ControllerManager:
 
         Every reference interface a controller of ``names`` claims must be
         exported by a loaded controller -- the very one it was configured
-        against -- and claimed by no other; the chains must not loop.
+        against -- and claimed by no other, as every gpio command interface;
+        the chains must not loop.
         """
         exported = self.references()
         claimers: dict[str, str] = {}
@@ -624,6 +633,13 @@ class ControllerManager:
                     continue
                 for interface in interfaces:
                     claimed = f'{entry}/{interface}'
+                    if entry in self.hardware.gpios:
+                        if claimed in claimers:
+                            return (f"'{claimers[claimed]}' and '{controller.name}' would both "
+                                    f"claim the command interface '{claimed}'; only one "
+                                    'active controller can command it')
+                        claimers[claimed] = controller.name
+                        continue
                     reference = exported.get(claimed)
                     if reference is None or reference is not bound.get(claimed):
                         return (f"Unable to activate controller '{controller.name}' since the "

@@ -147,7 +147,8 @@ class Param:
     tunable: bool = False
     finite: bool = True
     simulated: bool = True
-    # A value for the docs' examples and the every-type test (required entries need one).
+    # A value for the docs' examples and the every-type test (required entries need one;
+    # an optional entry has one where the type needs it or its alternative given).
     example: Any = None
 
     def __post_init__(self) -> None:
@@ -184,8 +185,21 @@ class ParameterSpec:
     """The parameters of one controller type, in declaration order."""
 
     def example(self) -> dict[str, Any]:
-        """Return the smallest parameters this spec accepts: each required entry's example."""
-        return _nest({param.name: param.example for param in self if param.required})
+        """Return the smallest parameters this spec accepts: the entries' examples.
+
+        Each required entry has one; an optional entry has one where the type
+        needs it given (one of two alternatives, such as a force-torque
+        broadcaster's ``sensor_name`` or ``interface_names``).  A ``__map_``
+        entry's example is given for each example entry of its list.
+        """
+        chosen = [param for param in self if param.required or param.example is not None]
+        values = {param.name: param.example for param in chosen if param.map_list is None}
+        for param in chosen:
+            if param.map_list is not None:
+                entries = values.get(param.map_list) or ()
+                values.update({name: param.example
+                               for name in param.expand([str(entry) for entry in entries])})
+        return _nest(values)
 
     def __init__(self, params: Iterable[Param] = ()) -> None:
         self._params: dict[str, Param] = {}

@@ -10,8 +10,13 @@ from pan_tilt_sim.controllers.diff_drive_controller import DiffDriveController
 from pan_tilt_sim.controllers.effort_gripper_action_controller import (
     EffortGripperActionController,
 )
+from pan_tilt_sim.controllers.force_torque_sensor_broadcaster import (
+    ForceTorqueSensorBroadcaster,
+)
 from pan_tilt_sim.controllers.forward_command_controller import ForwardCommandController
+from pan_tilt_sim.controllers.gpio_command_controller import GpioCommandController
 from pan_tilt_sim.controllers.gripper_action_controller import GripperActionController
+from pan_tilt_sim.controllers.imu_sensor_broadcaster import IMUSensorBroadcaster
 from pan_tilt_sim.controllers.joint_effort_controller import JointEffortController
 from pan_tilt_sim.controllers.joint_group_effort_controller import JointGroupEffortController
 from pan_tilt_sim.controllers.joint_group_position_controller import (
@@ -28,6 +33,8 @@ from pan_tilt_sim.controllers.parallel_gripper_action_controller import (
     ParallelGripperActionController,
 )
 from pan_tilt_sim.controllers.pid_controller import PidController
+from pan_tilt_sim.controllers.pose_broadcaster import PoseBroadcaster
+from pan_tilt_sim.controllers.range_sensor_broadcaster import RangeSensorBroadcaster
 from pan_tilt_sim.errors import ControllerConfigError
 
 CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
@@ -45,6 +52,11 @@ CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
     GripperActionController,
     EffortGripperActionController,
     ParallelGripperActionController,
+    ForceTorqueSensorBroadcaster,
+    IMUSensorBroadcaster,
+    RangeSensorBroadcaster,
+    PoseBroadcaster,
+    GpioCommandController,
 )
 
 CONTROLLER_TYPES: dict[str, type[Controller]] = {

@@ -7,6 +7,9 @@ the pan/tilt example's controllers file writes them.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import Any
+
 from pan_tilt_sim.controllers.parameter_spec import (
     BOOL,
     DOUBLE,
@@ -14,12 +17,17 @@ from pan_tilt_sim.controllers.parameter_spec import (
     STRING,
     STRING_ARRAY,
     Param,
+    gt,
     gt_eq,
     names,
     not_empty,
     unique,
 )
+from pan_tilt_sim.model.controller_config import DEFAULT_UPDATE_RATE
 
+UPDATE_RATE = Param('update_rate', DOUBLE, None, "Updates per second of sim time; the "
+                    "controller_manager's rate (100 Hz unless the file says otherwise) by "
+                    'default.', (gt(0.0),))
 JOINT = Param('joint', STRING, REQUIRED, 'The joint this controller drives.',
               (not_empty(),), read_only=True, example='joint1')
 JOINTS = Param('joints', STRING_ARRAY, REQUIRED, 'The joints this controller drives, in '
@@ -63,3 +71,13 @@ def joint_gains() -> tuple[Param, ...]:
                   'Wrap the position error of continuous joints.', simulated=False),
             Param(f'{prefix}.angle_wraparound', BOOL, None,
                   'Deprecated name of normalize_error.', simulated=False))
+
+
+def update_period(params: Mapping[str, Any]) -> float:
+    """Return the seconds of sim time between updates: 1 / ``update_rate``, else 1 / 100 Hz.
+
+    A ros2_control style file gives every controller its controller_manager's
+    rate; a ROS 1 file gives none, and 100 Hz is the controller_manager's default.
+    """
+    rate = params.get(UPDATE_RATE.name)
+    return 1.0 / float(rate if rate is not None else DEFAULT_UPDATE_RATE)

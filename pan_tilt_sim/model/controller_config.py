@@ -493,7 +493,13 @@ def _ros2_nodes(document: Mapping[Any, Any],
 
 
 def _unflatten(parameters: Mapping[Any, Any]) -> dict[str, Any]:
-    """Turn ROS 2's dotted parameter names into nested mappings."""
+    """Turn ROS 2's dotted parameter names into nested mappings.
+
+    A list of mappings is read as the mappings merged, as rcl's YAML
+    parameter parser reads it: ros2_controllers' gpio_command_controller
+    documents ``command_interfaces: {gpio1: [{interfaces: [...]}]}``, which
+    is the parameter ``command_interfaces.gpio1.interfaces``.
+    """
     nested: dict[str, Any] = {}
     for key, value in parameters.items():
         *parents, leaf = str(key).split(PARAMETER_SEPARATOR)
@@ -503,6 +509,12 @@ def _unflatten(parameters: Mapping[Any, Any]) -> dict[str, Any]:
             if not isinstance(inner, dict):
                 inner = target[parent] = {}
             target = inner
+        if isinstance(value, list) and value and all(isinstance(item, Mapping)
+                                                    for item in value):
+            merged: dict[Any, Any] = {}
+            for item in value:
+                merged.update(item)
+            value = merged
         value = _unflatten(value) if isinstance(value, Mapping) else value
         _merge_into(target, {leaf: value})
     return nested

@@ -193,7 +193,7 @@ class JointSpec:
 
 @dataclasses.dataclass(frozen=True)
 class ControlInterface:
-    """A ``<command_interface>`` or ``<state_interface>`` of a ros2_control joint."""
+    """A ``<command_interface>`` or ``<state_interface>`` of a joint, sensor or gpio."""
 
     name: str
     params: Mapping[str, str] = dataclasses.field(default_factory=dict)
@@ -238,14 +238,53 @@ class ControlJoint:
 
 
 @dataclasses.dataclass(frozen=True)
+class ControlSensor:
+    """A ``<sensor>`` of a ``<ros2_control>`` block: its state interfaces and parameters.
+
+    Its state interfaces are ``<name>/<interface>`` (``tcp_fts_sensor/force.x``).
+    """
+
+    name: str
+    state_interfaces: tuple[ControlInterface, ...] = ()
+    params: Mapping[str, str] = dataclasses.field(default_factory=dict)
+
+    @property
+    def state_interface_names(self) -> tuple[str, ...]:
+        """Names of the state interfaces, in file order."""
+        return tuple(interface.name for interface in self.state_interfaces)
+
+
+@dataclasses.dataclass(frozen=True)
+class ControlGpio:
+    """A ``<gpio>`` of a ``<ros2_control>`` block: I/O ports that belong to no joint or sensor."""
+
+    name: str
+    command_interfaces: tuple[ControlInterface, ...] = ()
+    state_interfaces: tuple[ControlInterface, ...] = ()
+    params: Mapping[str, str] = dataclasses.field(default_factory=dict)
+
+    @property
+    def command_interface_names(self) -> tuple[str, ...]:
+        """Names of the command interfaces, in file order."""
+        return tuple(interface.name for interface in self.command_interfaces)
+
+    @property
+    def state_interface_names(self) -> tuple[str, ...]:
+        """Names of the state interfaces, in file order."""
+        return tuple(interface.name for interface in self.state_interfaces)
+
+
+@dataclasses.dataclass(frozen=True)
 class ControlSystem:
-    """A ``<ros2_control>`` block: its hardware plugin, the plugin's parameters, its joints."""
+    """A ``<ros2_control>`` block: its hardware plugin and parameters, joints, sensors, gpios."""
 
     name: str
     type: str = 'system'
     plugin: str = ''
     hardware_params: Mapping[str, str] = dataclasses.field(default_factory=dict)
     joints: tuple[ControlJoint, ...] = ()
+    sensors: tuple[ControlSensor, ...] = ()
+    gpios: tuple[ControlGpio, ...] = ()
 
 
 @dataclasses.dataclass(frozen=True)
@@ -349,6 +388,20 @@ class RobotModel:
         """Return the ``<ros2_control>`` entry of joint ``name``, or None if it has none."""
         return next((joint for system in self.ros2_control for joint in system.joints
                      if joint.name == name), None)
+
+    @property
+    def control_sensors(self) -> tuple[ControlSensor, ...]:
+        """Every ``<sensor>`` of the ``<ros2_control>`` blocks, in file order."""
+        return tuple(sensor for system in self.ros2_control for sensor in system.sensors)
+
+    @property
+    def control_gpios(self) -> tuple[ControlGpio, ...]:
+        """Every ``<gpio>`` of the ``<ros2_control>`` blocks, in file order."""
+        return tuple(gpio for system in self.ros2_control for gpio in system.gpios)
+
+    def parent_joint(self, link: str) -> JointSpec | None:
+        """Return the joint whose child is ``link`` (None for the root link)."""
+        return next((joint for joint in self.joints if joint.child == link), None)
 
     @property
     def joint_names(self) -> tuple[str, ...]:

@@ -57,9 +57,11 @@ from pan_tilt_sim.model.robot import (
     DEFAULT_AXIS,
     INITIAL_VALUE,
     POSITION_PROPORTIONAL_GAIN,
+    ControlGpio,
     ControlInterface,
     ControlJoint,
     ControlPlugin,
+    ControlSensor,
     ControlSystem,
     Geometry,
     Inertial,
@@ -170,6 +172,7 @@ def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
                     f"{source}: <ros2_control name=\"{system.name}\">: joint '{joint.name}' is "
                     'not a joint of this robot')
     _check_position_gain(plugins, systems, source)
+    _check_component_names(systems, source)
     sensors, sensor_warnings = _SensorReader(source, links, joints).read(root)
     return RobotModel(name=name, links=links, joints=joints,
                       ros2_control=systems, control_plugins=plugins,
@@ -282,6 +285,25 @@ def _check_position_gain(plugins: tuple[ControlPlugin, ...], systems: tuple[Cont
             raise DescriptionError(f"{source}: {place}: '{text}' must be a number > 0")
 
 
+def _check_component_names(systems: tuple[ControlSystem, ...], source: pathlib.Path) -> None:
+    """Refuse a sensor or gpio whose name another joint, sensor or gpio of the blocks has.
+
+    Its interfaces are named ``<name>/<interface>``: ros2_control's resource
+    manager refuses a second component exporting the same names.
+    """
+    seen: dict[str, str] = {}
+    for system in systems:
+        components = [('joint', joint.name) for joint in system.joints]
+        components += [('sensor', sensor.name) for sensor in system.sensors]
+        components += [('gpio', gpio.name) for gpio in system.gpios]
+        for kind, name in components:
+            where = f'<{kind} name="{name}"> of <ros2_control name="{system.name}">'
+            if name in seen and (kind != 'joint' or not seen[name].startswith('<joint')):
+                raise DescriptionError(f'{source}: {where}: the name is already taken by '
+                                       f'{seen[name]}')
+            seen.setdefault(name, where)
+
+
 def parse_urdf(urdf_xml: str, source: pathlib.Path) -> RobotModel:
     """Parse URDF text into a robot model (errors name ``source``)."""
     return read_model(parse_xml(urdf_xml, source), source)
@@ -385,11 +407,50 @@ class _Reader:
         name = element.get('name', '')
         hardware = element.find('hardware')
         joints = tuple(self.control_joint(joint, name) for joint in element.findall('joint'))
+        sensors = tuple(ControlSensor(
+            name=self.component_name(child, name),
+            state_interfaces=self.interfaces(child, 'state_interface', name),
+            params=_params(child)) for child in element.findall('sensor'))
+        gpios = tuple(ControlGpio(
+            name=self.component_name(child, name),
+            command_interfaces=self.interfaces(child, 'command_interface', name),
+            state_interfaces=self.interfaces(child, 'state_interface', name),
+            params=_params(child)) for child in element.findall('gpio'))
         return ControlSystem(
             name=name, type=element.get('type', 'system'),
             plugin=(hardware.findtext('plugin') or '').strip() if hardware is not None else '',
             hardware_params=_params(hardware) if hardware is not None else {},
-            joints=joints)
+            joints=joints, sensors=sensors, gpios=gpios)
+
+    def component_name(self, element: ElementTree.Element, system: str) -> str:
+        name = element.get('name', '')
+        if not name:
+            raise DescriptionError(f'{self.source}: <ros2_control name="{system}">: a '
+                                   f'<{element.tag}> has no name')
+        return name
+
+    def interfaces(self, element: ElementTree.Element, tag: str,
+                   system: str) -> tuple[ControlInterface, ...]:
+        """Read a sensor's or gpio's ``<tag>`` children; an initial_value must be a number.
+
+        As ros2_control, which refuses to start a component whose
+        ``initial_value`` does not parse as a double.
+        """
+        found = []
+        for child in element.findall(tag):
+            interface = ControlInterface(child.get('name', ''), _params(child))
+            text = interface.params.get(INITIAL_VALUE)
+            if text is not None:
+                try:
+                    float(text)
+                except ValueError:
+                    raise DescriptionError(
+                        f'{self.source}: <ros2_control name="{system}">: <{element.tag} '
+                        f'name="{element.get("name")}">: <{tag} name="{interface.name}">: '
+                        f'<param name="{INITIAL_VALUE}">{text}</param> is not a number'
+                    ) from None
+            found.append(interface)
+        return tuple(found)
 
     def control_joint(self, element: ElementTree.Element, system: str) -> ControlJoint:
         name = element.get('name', '')

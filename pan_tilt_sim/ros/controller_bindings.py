@@ -24,6 +24,9 @@ controller type:
 
 each where its interface package is installed (an optional one may not be);
 plus its tunable PID gains as sim_node parameters (:mod:`.gain_parameters`).
+A topic whose message type's interface package is not installed (control_msgs
+for the gpio controller, where the venv lacks it) is left out with one warning;
+the controller still runs.
 A command controller's commands are ignored while it is inactive, or in
 chained mode (then the controller before it in the chain writes its
 references) unless the topic is taken ``while_chained``.  Given a
@@ -46,11 +49,11 @@ import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
-from geometry_msgs.msg import TwistStamped
+from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rclpy.service import Service as ServiceEntity
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import Imu, JointState, Range
 from std_srvs.srv import SetBool
 
 from pan_tilt_sim.controllers import CommandResult, Controller
@@ -71,10 +74,13 @@ from pan_tilt_sim.ros.gripper_action import GripperCommandServer, ParallelGrippe
 from pan_tilt_sim.ros.robot_state import tf_message_type, transform_message
 from pan_tilt_sim.ros.ros_interfaces import (
     COMMAND_MESSAGES,
+    GROUP_VALUES,
     joint_state_message,
+    optional_message,
     seconds,
     stamp,
 )
+from pan_tilt_sim.ros.state_sinks import GroupValuesSink, ImuSink, PoseSink, RangeSink, WrenchSink
 from pan_tilt_sim.ros.trajectory_action import TrajectoryActionServer
 from pan_tilt_sim.sim.engine import Simulation
 
@@ -225,7 +231,8 @@ class ControllerBindings:
         controller.node_namespace = self._topic()
         for endpoint in controller.ros_surface():
             if isinstance(endpoint, CommandTopic):
-                if self._command_topics and COMMAND_MESSAGES[endpoint.message][0] is not None:
+                if self._command_topics and COMMAND_MESSAGES.get(
+                        endpoint.message, (None,))[0] is not None:
                     entities.append(self._subscribe(controller, endpoint))
             elif isinstance(endpoint, StateTopic):
                 if STATE_SINKS.get(endpoint.message, (None,))[0] is not None:
@@ -327,6 +334,9 @@ class ControllerBindings:
                     self._reader.remove(entity)
                 self._node.destroy_subscription(entity)
         self._state_sinks = [item for item in self._state_sinks if item[0].name != name]
+        for owner, endpoint, _publisher, _sink in self._connections:
+            if owner == name:  # its publisher is gone: the controller takes no more samples
+                endpoint.connect(None)
         self._connections = [item for item in self._connections if item[0] != name]
         self._noticing = [controller for controller in self._noticing
                           if controller.name != name]
@@ -590,6 +600,11 @@ STATE_SINKS: dict[str, tuple[type | None, Callable[[Any, Mapping[str, Any]], Any
         JointTrajectoryControllerState, TrajectoryStateSink),
     'nav_msgs/msg/Odometry': (Odometry, OdometrySink),
     'geometry_msgs/msg/TwistStamped': (TwistStamped, TwistSink),
+    'geometry_msgs/msg/WrenchStamped': (WrenchStamped, WrenchSink),
+    'sensor_msgs/msg/Imu': (Imu, ImuSink),
+    'sensor_msgs/msg/Range': (Range, RangeSink),
+    'geometry_msgs/msg/PoseStamped': (PoseStamped, PoseSink),
+    GROUP_VALUES: (optional_message(GROUP_VALUES), GroupValuesSink),
 }
 def _success_and_message(answer: tuple[bool, str], response: Any) -> None:
     """Fill a response's ``success`` and ``message`` from ``(success, message)``."""

@@ -457,9 +457,13 @@ class ControllerManagerServices:
     # --- the joints' interfaces ----------------------------------------------------------------
 
     def _components(self) -> list[tuple[str, str, list[str]]]:
-        """(name, plugin, joints) per <ros2_control> block; one for the robot when it has none."""
+        """(name, plugin, joints, sensors and gpios) per <ros2_control> block.
+
+        One more for the robot's joints outside every block (or all of them).
+        """
         actuated = [joint.name for joint in self._model.actuated_joints]
-        systems = [(system.name, system.plugin, [j.name for j in system.joints])
+        systems = [(system.name, system.plugin,
+                    [j.name for j in (*system.joints, *system.sensors, *system.gpios)])
                    for system in self._model.ros2_control]
         listed = {joint for _name, _plugin, joints in systems for joint in joints}
         rest = [joint for joint in actuated if joint not in listed]
@@ -474,12 +478,14 @@ class ControllerManagerServices:
         return control.command_interface_names if commands else control.state_interface_names
 
     def _command_interface_names(self) -> list[str]:
-        return [f'{joint.name}/{interface}' for joint in self._model.actuated_joints
-                if joint.mimic is None for interface in self._interfaces_of(joint.name, True)]
+        joints = [f'{joint.name}/{interface}' for joint in self._model.actuated_joints
+                  if joint.mimic is None for interface in self._interfaces_of(joint.name, True)]
+        return joints + list(self._manager.hardware.command_interfaces)
 
     def _state_interface_names(self) -> list[str]:
-        return [f'{joint.name}/{interface}' for joint in self._model.actuated_joints
-                for interface in self._interfaces_of(joint.name, False)]
+        joints = [f'{joint.name}/{interface}' for joint in self._model.actuated_joints
+                  for interface in self._interfaces_of(joint.name, False)]
+        return joints + list(self._manager.hardware.state_interfaces)
 
     def _state_interfaces_of(self, controller) -> list[str]:
         if isinstance(controller, JointStateController):

@@ -58,8 +58,11 @@ class NodeFeatures:
         self.entities = Entities(simulation.physics, description.name, targets=targets,
                                  ground=has_ground(world))
         spawn_world_objects(self.entities, self.world)
+        seed = declare_noise_seed(node)
         self.sensors = SensorSet(node, simulation, world, namespace_override=sensor_namespace,
-                                 seed=declare_noise_seed(node))
+                                 seed=seed)
+        # The <ros2_control> sensors: their rays meet this world's ground; their noise, this seed.
+        simulation.hardware.configure(world=world, seed=seed)
         self.camera: CameraPublisher | None = None
         static = list(self.sensors.static_frames)
         if settings is not None:

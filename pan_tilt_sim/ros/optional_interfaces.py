@@ -20,7 +20,7 @@ FEATURES = {
                 'robot_description and joint_states)',
     'control_msgs': 'the follow_joint_trajectory and gripper_cmd actions, dynamic_joint_states '
                     "and the controller topics of control_msgs types (pid_controller's "
-                    '~/reference, ~/controller_state)',
+                    "~/reference, ~/controller_state, the gpio controllers')",
     'controller_manager_msgs': "the controller_manager services (ros2_control's spawner)",
     'simulation_interfaces': 'the simulator services (get_simulator_features, '
                              'step_simulation, spawn_entity, ...)',

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -57,6 +58,27 @@ def stamped_twist(message: TwistStamped) -> StampedTwist:
                         (angular.x, angular.y, angular.z))
 
 
+def group_values(message: Any) -> tuple[list[str], list[tuple[list[str], list[float]]]]:
+    """Return a ``control_msgs/DynamicInterfaceGroupValues`` as plain lists.
+
+    ``(interface_groups, [(interface_names, values) per interface_values entry])``,
+    as the gpio controller takes a command.
+    """
+    return (list(message.interface_groups),
+            [(list(entry.interface_names), list(entry.values))
+             for entry in message.interface_values])
+
+
+def optional_message(name: str) -> type | None:
+    """Return the message class ``<package>/msg/<Type>``, or None if its package is missing."""
+    package, _, type_name = name.split('/')
+    try:
+        return getattr(importlib.import_module(f'{package}.msg'), type_name)
+    except (ImportError, AttributeError):
+        return None
+
+
+GROUP_VALUES = 'control_msgs/msg/DynamicInterfaceGroupValues'
 # Each command message type (by its ROS name), and how to get the command value out of it.
 # The class is None where its interface package is not installed (no such topics then).
 COMMAND_MESSAGES: dict[str, tuple[type | None, Callable[[Any], Any]]] = {
@@ -68,6 +90,8 @@ COMMAND_MESSAGES: dict[str, tuple[type | None, Callable[[Any], Any]]] = {
         list(msg.dof_names), list(msg.values), list(msg.values_dot))),
     CommandKind.TWIST_STAMPED.value: (TwistStamped, stamped_twist),
 }
+if (_group_values := optional_message(GROUP_VALUES)) is not None:
+    COMMAND_MESSAGES[GROUP_VALUES] = (_group_values, group_values)
 
 
 def stamp(seconds: float, into: Time | None = None) -> Time:

@@ -47,6 +47,7 @@ from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.initial_positions import FROM_DEFAULT, StartPosition, start_positions
 from pan_tilt_sim.schedule import DUE_EPSILON
+from pan_tilt_sim.sim.hardware import SimulatedHardware
 from pan_tilt_sim.sim.physics import (
     STATE_MOTOR_TORQUE,
     STATE_POSITION,
@@ -136,6 +137,8 @@ class Simulation:
             initial_positions=[starts[joint].position for joint in movable],
             warn=load_messages.append, fixed_base=fixed, initial_pose=initial_pose)
         self._base_report = self._describe_base(why, fixed_base, initial_pose)
+        self._time_step = time_step
+        self._steps = 0
         try:
             check_startup_stability(self.physics, description)
             model = description.model
@@ -145,15 +148,17 @@ class Simulation:
                                         control=model.control_joint(joint.name))
                 for joint, position in zip(self.physics.joints,
                                            self.physics.initial_positions, strict=True)}
+            # The <ros2_control> sensors and gpios, measured here, read by the controllers.
+            self.hardware = SimulatedHardware(self.physics, description.model,
+                                              lambda: self._steps)
             self.manager = ControllerManager(controllers, self.handles, description.model,
                                              active=active_controllers,
-                                             autostart=autostart_controllers)
+                                             autostart=autostart_controllers,
+                                             hardware=self.hardware.interfaces)
         except BaseException:
             self.physics.close()
             raise
         self._handle_list = list(self.handles.values())
-        self._time_step = time_step
-        self._steps = 0
         self.compiled_steps = 0  # of all steps run, those whose controllers ran in C
         self._states = self.physics.read_states()
         # Waiting for spawners, a joint no controller has driven yet is held where it is, as
@@ -243,6 +248,7 @@ class Simulation:
                                else INFO, line))
         report.extend((WARNING, message) for message in pid_stability_warnings(
             self.physics, self._handle_list, self._time_step))
+        report.extend(self.hardware.startup_report())
         return report
 
     @property
@@ -411,6 +417,7 @@ class Simulation:
             self._apply_actuators()
         if reset_time:
             self._steps = 0
+        self.hardware.reset()
 
     def reset_time(self) -> None:
         """Sim time back to 0, the joints left where they are; controllers hold them there.
@@ -422,6 +429,9 @@ class Simulation:
         for controller in self.controllers:
             controller.reset()
         self._steps = 0
+        for sensor in self.hardware.interfaces.sensors.values():  # their readings' past is gone
+            if sensor.source is not None:
+                sensor.source.reset()
 
     def joint_positions(self) -> dict[str, float]:
         """Return the measured position of every movable joint, by name."""
@@ -435,6 +445,7 @@ class Simulation:
 
     def close(self) -> None:
         """Release PyBullet."""
+        self.hardware.close()
         self.physics.close()
 
     def __enter__(self) -> Simulation:

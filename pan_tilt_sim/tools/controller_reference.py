@@ -19,6 +19,7 @@ from collections.abc import Sequence
 
 from pan_tilt_sim.controllers import JointHandle
 from pan_tilt_sim.controllers.base import Controller
+from pan_tilt_sim.controllers.hardware_interfaces import example_hardware
 from pan_tilt_sim.controllers.parameter_spec import Param
 from pan_tilt_sim.controllers.registry import CONTROLLER_CLASSES
 from pan_tilt_sim.controllers.surface import (
@@ -53,10 +54,12 @@ controller is configured. *Not simulated*: accepted, but the simulator does not 
 def example_controller(cls: type[Controller]) -> Controller:
     """Return ``cls`` built from its spec's examples and configured on a two-joint robot.
 
-    Every example names joint1; a diff drive's other side is joint2.
+    Every example names joint1 (a diff drive's other side is joint2); the
+    robot also has the example sensor and gpio the examples name.
     """
     controller = cls('<name>', cls.parameters.example())
     controller.type_name = cls.type_names[0]
+    controller.set_hardware(example_hardware())
     controller.configure({name: JointHandle(JointSpec(
         name, JointKind.REVOLUTE, -1.0, 1.0, effort_limit=1.0, velocity_limit=1.0))
         for name in ('joint1', 'joint2')})

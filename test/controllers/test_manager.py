@@ -492,3 +492,36 @@ def test_an_interface_the_simulator_cannot_drive_is_refused_naming_joint_and_int
     (skipped,) = manager.skipped
     assert skipped.name == 'pid_gain_controller'
     assert "joint 'joint1' interface 'pid_gain'" in skipped.reason
+
+
+# --- gpio command interfaces ---------------------------------------------------------------
+
+def gpio_manager(tmp_path):
+    from pan_tilt_sim.controllers.hardware_interfaces import (
+        CommandInterface,
+        GpioHandle,
+        HardwareInterfaces,
+        StateInterface,
+    )
+    from pan_tilt_sim.model.controller_config import ControllersConfig, ControllerSpec
+
+    state = StateInterface('io/vacuum', 1.0)
+    io = GpioHandle('io', [CommandInterface('io/vacuum', state)], [state])
+    spec = {'type': 'gpio_controllers/GpioCommandController', 'gpios': ['io'],
+            'command_interfaces': {'io': {'interfaces': ['vacuum']}}}
+    # The second controller is named like the gpio: a controller's name is no gpio's.
+    config = ControllersConfig((ControllerSpec('gripper', spec['type'], spec),
+                                ControllerSpec('io', spec['type'], spec)),
+                               tmp_path / 'c.yaml')
+    return ControllerManager(config, {}, active=['gripper'],
+                             hardware=HardwareInterfaces([], [io]))
+
+
+def test_two_active_controllers_on_one_gpio_command_interface_is_refused(tmp_path):
+    manager = gpio_manager(tmp_path)
+    assert manager.chain_connections('gripper') == {}  # a gpio is no chained controller
+    with pytest.raises(ControllerSwitchError, match=r"'gripper' and 'io' would both claim "
+                                                    r"the command interface 'io/vacuum'"):
+        manager.switch(['io'])
+    manager.switch(['io'], ['gripper'])
+    assert [c.name for c in manager.active] == ['io']

@@ -165,3 +165,15 @@ def test_a_map_over_a_string_parameter_stands_for_that_one_string():
                                                     r'joint \(finger\)$'):
         load_parameters(ONE_JOINT_SPEC, {'joint': 'finger', 'gains': {'thumb': {'p': 3}}},
                         'gripper', 'file.yaml')
+
+
+def test_the_example_holds_required_entries_and_optional_ones_with_an_example():
+    spec = ParameterSpec([
+        Param('gpios', STRING_ARRAY, REQUIRED, 'gpios', example=['io']),
+        Param('sensor_name', STRING, '', 'one of two', example='fts'),
+        Param('frame_id', STRING, '', 'no example'),
+        Param('command_interfaces.__map_gpios.interfaces', STRING_ARRAY, [], 'per gpio',
+              example=['out']),
+    ])
+    assert spec.example() == {'gpios': ['io'], 'sensor_name': 'fts',
+                              'command_interfaces': {'io': {'interfaces': ['out']}}}

@@ -1,9 +1,9 @@
 """registry: every YAML type string maps to a controller class that loads and runs.
 
 Each registered type is loaded through the manager with nothing but its
-spec's required examples (everything else from the defaults), on a minimal
-two-joint robot; it configures, activates, runs, declares its ROS surface,
-and documents every parameter.
+spec's examples (everything else from the defaults), on a minimal two-joint
+robot with the example sensor and gpio; it configures, activates, runs,
+declares its ROS surface, and documents every parameter.
 """
 
 import math
@@ -12,6 +12,7 @@ import pytest
 
 from pan_tilt_sim.controllers import JointHandle
 from pan_tilt_sim.controllers.base import CommandController
+from pan_tilt_sim.controllers.hardware_interfaces import example_hardware
 from pan_tilt_sim.controllers.manager import ACTIVE, ControllerManager
 from pan_tilt_sim.controllers.parameter_spec import ParameterSpec
 from pan_tilt_sim.controllers.registry import CONTROLLER_TYPES, create_controller
@@ -36,7 +37,7 @@ def test_every_type_loads_with_its_spec_defaults_and_runs(type_name, tmp_path):
     config = ControllersConfig((ControllerSpec('under_test', type_name, params),),
                                tmp_path / 'controllers.yaml')
     handles = small_robot()
-    manager = ControllerManager(config, handles)
+    manager = ControllerManager(config, handles, hardware=example_hardware())
     controller = manager.controller('under_test')
     assert manager.state('under_test') == ACTIVE
     assert controller.config_warnings == []

@@ -133,6 +133,30 @@ def test_ros2_controller_takes_the_parameters_of_its_node(write_yaml):
     assert specs['gripper_controller'].params['interface_name'] == 'position'
 
 
+def test_ros2_list_of_mappings_is_read_as_the_mappings_merged_as_rcl_reads_it(write_yaml):
+    # ros2_controllers' gpio_command_controller documents its interfaces this way.
+    config = load_controllers_config(write_yaml("""\
+        controller_manager:
+          ros__parameters:
+            gpio_controller: {type: gpio_controllers/GpioCommandController}
+        gpio_controller:
+          ros__parameters:
+            gpios: [flange_vacuum, io]
+            command_interfaces:
+              flange_vacuum:
+                - interfaces:
+                  - vacuum
+              io:
+                - interfaces: [out1]
+                - state_note: kept
+        """))
+    params = by_name(config)['gpio_controller'].params
+    assert params['gpios'] == ['flange_vacuum', 'io']
+    assert params['command_interfaces'] == {
+        'flange_vacuum': {'interfaces': ['vacuum']},
+        'io': {'interfaces': ['out1'], 'state_note': 'kept'}}
+
+
 def test_ros2_file_gives_no_namespace(write_yaml):
     assert load_controllers_config(write_yaml(ROS2_FILE)).namespace is None
 

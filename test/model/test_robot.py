@@ -169,3 +169,58 @@ def test_a_position_proportional_gain_that_is_no_positive_number_is_an_error(val
     assert str(caught.value) == (
         'c.urdf: <ros2_control name="Sys">: <hardware> <param name="position_proportional_gain">: '
         f"'{value}' must be a number > 0")
+
+
+# --- <sensor> and <gpio> in <ros2_control> -------------------------------------------------
+
+WITH_IO = CONTROLLED.replace('</ros2_control>', """
+    <sensor name="fts">
+      <state_interface name="force.x"/>
+      <state_interface name="torque.z"><param name="initial_value">-2.5</param></state_interface>
+      <param name="frame_id">f</param>
+    </sensor>
+    <gpio name="io">
+      <command_interface name="out1"/>
+      <state_interface name="out1"/>
+      <state_interface name="in1"><param name="initial_value">1.0</param></state_interface>
+    </gpio>
+  </ros2_control>""")
+
+
+def test_sensors_and_gpios_of_a_block_keep_their_interfaces_params_and_initial_values():
+    model = parse_urdf(WITH_IO, pathlib.Path('c.urdf'))
+    (sensor,) = model.control_sensors
+    assert (sensor.name, sensor.state_interface_names) == ('fts', ('force.x', 'torque.z'))
+    assert sensor.params == {'frame_id': 'f'}
+    assert math.isnan(sensor.state_interfaces[0].initial_value)
+    assert sensor.state_interfaces[1].initial_value == -2.5
+    (gpio,) = model.control_gpios
+    assert (gpio.name, gpio.command_interface_names, gpio.state_interface_names) == (
+        'io', ('out1',), ('out1', 'in1'))
+    assert gpio.state_interfaces[1].initial_value == 1.0
+    assert model.ros2_control[0].joints[0].name == 'j'
+
+
+@pytest.mark.parametrize(('old', 'new', 'message'), [
+    ('<param name="initial_value">1.0</param>', '<param name="initial_value">on</param>',
+     '<ros2_control name="Sys">: <gpio name="io">: <state_interface name="in1">: '
+     '<param name="initial_value">on</param> is not a number'),
+    ('<sensor name="fts">', '<sensor name="io">',
+     '<gpio name="io"> of <ros2_control name="Sys">: the name is already taken by '
+     '<sensor name="io"> of <ros2_control name="Sys">'),
+    ('<sensor name="fts">', '<sensor name="j">',
+     '<sensor name="j"> of <ros2_control name="Sys">: the name is already taken by '
+     '<joint name="j"> of <ros2_control name="Sys">'),
+    ('<gpio name="io">', '<gpio>',
+     '<ros2_control name="Sys">: a <gpio> has no name'),
+])
+def test_a_bad_sensor_or_gpio_is_an_error_naming_it(old, new, message):
+    with pytest.raises(DescriptionError) as caught:
+        parse_urdf(WITH_IO.replace(old, new), pathlib.Path('c.urdf'))
+    assert str(caught.value) == f'c.urdf: {message}'
+
+
+def test_the_parent_joint_of_a_link_is_the_joint_whose_child_it_is():
+    model = parse_urdf(CONTROLLED, pathlib.Path('c.urdf'))
+    assert model.parent_joint('f').name == 'g'
+    assert model.parent_joint('a') is None

@@ -7,12 +7,17 @@ from node_harness import sim_node
 from rcl_interfaces.msg import Log
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile
 
+from pan_tilt_sim.controllers.registry import CONTROLLER_CLASSES
+from pan_tilt_sim.controllers.surface import CommandTopic, StateTopic
 from pan_tilt_sim.ros.controller_bindings import (
+    STATE_SINKS,
     DofStateSink,
     DynamicJointStateSink,
     JointStateSink,
     TrajectoryStateSink,
 )
+from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES
+from pan_tilt_sim.tools.controller_reference import example_controller
 
 
 class RecordingPublisher:
@@ -158,3 +163,12 @@ def test_a_trajectory_state_sample_leaves_with_every_field_and_empty_ones_left_e
         [[0.5, 1.5], [0.3, 0.4], [], []],
         [[0.5, 0.5], [-0.2, -0.2], [], []],
         [[], [], [], [7.0, 8.0]]], 1.0)]
+
+
+@pytest.mark.parametrize('cls', CONTROLLER_CLASSES, ids=lambda cls: cls.type_names[0])
+def test_every_topic_a_registered_type_declares_has_its_message_type_in_the_tables(cls):
+    for endpoint in example_controller(cls).ros_surface():
+        if isinstance(endpoint, CommandTopic):
+            assert endpoint.message in COMMAND_MESSAGES
+        elif isinstance(endpoint, StateTopic):
+            assert endpoint.message in STATE_SINKS

@@ -4,17 +4,24 @@ import math
 
 import pytest
 from builtin_interfaces.msg import Duration, Time
+from control_msgs.msg import DynamicInterfaceGroupValues, InterfaceValue
 from std_msgs.msg import Float64, Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage
 from trajectory_msgs.msg import JointTrajectoryPoint
 
 from pan_tilt_sim.controllers import CommandKind
 from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
-from pan_tilt_sim.ros.ros_interfaces import COMMAND_MESSAGES, joint_trajectory, seconds
+from pan_tilt_sim.ros.ros_interfaces import (
+    COMMAND_MESSAGES,
+    GROUP_VALUES,
+    joint_trajectory,
+    optional_message,
+    seconds,
+)
 
 
-def test_every_command_kind_has_a_message_type():
-    assert set(COMMAND_MESSAGES) == {kind.value for kind in CommandKind}
+def test_every_command_kind_and_the_gpio_commands_have_a_message_type():
+    assert set(COMMAND_MESSAGES) == {kind.value for kind in CommandKind} | {GROUP_VALUES}
     for type_name, (message_type, _extract) in COMMAND_MESSAGES.items():
         if message_type is None:  # its interface package is optional, and not installed
             continue
@@ -72,3 +79,19 @@ def test_multi_dof_commands_become_names_values_and_values_dot():
     value = extract(control_msgs.MultiDOFCommand(dof_names=['b', 'a'], values=[1.0, 2.5],
                                                  values_dot=[-0.5, 0.0]))
     assert value == (['b', 'a'], [1.0, 2.5], [-0.5, 0.0])
+
+
+def test_gpio_group_values_become_plain_lists_of_groups_names_and_values():
+    _type, extract = COMMAND_MESSAGES[GROUP_VALUES]
+    message = DynamicInterfaceGroupValues(
+        interface_groups=['flange_analog_IOs', 'flange_vacuum'],
+        interface_values=[InterfaceValue(interface_names=['analog_output1'], values=[0.5]),
+                          InterfaceValue(interface_names=['vacuum'], values=[1.0])])
+    assert extract(message) == (['flange_analog_IOs', 'flange_vacuum'],
+                                [(['analog_output1'], [0.5]), (['vacuum'], [1.0])])
+
+
+def test_a_message_of_a_package_that_is_not_installed_is_none():
+    assert optional_message(GROUP_VALUES) is DynamicInterfaceGroupValues
+    assert optional_message('no_such_msgs/msg/Thing') is None
+    assert optional_message('std_msgs/msg/NoSuchType') is None

@@ -411,3 +411,15 @@ def test_the_rig_fixture_is_where_the_tests_think(rig):
     assert model(rig).joint('lidar_joint').origin.translation[2] == LIDAR_Z
     assert model(rig).link('weight').inertial.origin.translation[2] == -HANG_DROP
     assert pathlib.Path(rig.description.source).name == 'sensor_rig.urdf'
+
+
+def test_one_reader_switching_off_leaves_the_joint_feedback_on_for_another(rig):
+    rig.reset()
+    joint = model(rig).joint('hang_joint')
+    first = ForceTorque(rig.physics, sensor(rig, 'ft'), joint, enabled=True)
+    second = ForceTorque(rig.physics, sensor(rig, 'ft'), joint, enabled=True)
+    first.enable(False)
+    rig.advance(2)
+    weight = HANG_MASS * STANDARD_GRAVITY
+    assert numpy.linalg.norm(second.read().force) == pytest.approx(weight, rel=ONE_PERCENT)
+    second.enable(False)

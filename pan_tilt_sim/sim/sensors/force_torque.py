@@ -20,7 +20,9 @@ A mass m hanging still below a joint: the parent holds it up with m g.
 
 from __future__ import annotations
 
+import collections
 import dataclasses
+import weakref
 
 import numpy
 
@@ -33,6 +35,9 @@ from pan_tilt_sim.sim.sensors.mount import LinkReader
 from pan_tilt_sim.sim.sensors.noise import NoiseModel
 
 REACTION = 2  # index of the reaction wrench in getJointState's answer
+# Per simulation, per joint index: how many readers want PyBullet's joint feedback on.
+_FEEDBACK_USERS: weakref.WeakKeyDictionary[Physics, collections.Counter[int]] = (
+    weakref.WeakKeyDictionary())
 INERTIAL_POSITION = 2  # getLinkState: the inertial frame in the link frame
 INERTIAL_ORIENTATION = 3
 
@@ -52,6 +57,7 @@ class ForceTorque:
                  frame: str = CHILD, measure_direction: str = PARENT_TO_CHILD,
                  noise: NoiseModel | None = None, enabled: bool = True) -> None:
         self.sensor = sensor
+        self._physics = physics
         self._client = physics.client_id
         self._body = physics.body_id
         self._child = LinkReader(physics, joint.child)
@@ -70,17 +76,22 @@ class ForceTorque:
         self.enable(enabled)
 
     def enable(self, on: bool) -> None:
-        """Switch PyBullet's joint feedback on or off.
+        """Switch PyBullet's joint feedback on or off (for this reader).
 
         It costs every physics step while on (Bullet runs a second articulated-body
         pass to compute the joint forces), so the ROS layer keeps it off while
         nobody listens; a reading is valid from the step after it was switched on.
+        Several readers may share a joint (a Gazebo sensor and a ros2_control
+        one of the same name): the feedback stays on while any of them wants it.
         """
         if on == self.enabled:
             return
-        with quiet_native_output():  # a second sensor on the joint: PyBullet warns on stdout
-            pybullet.enableJointForceTorqueSensor(self._body, self._index, on,
-                                                  physicsClientId=self._client)
+        users = _FEEDBACK_USERS.setdefault(self._physics, collections.Counter())
+        users[self._index] += 1 if on else -1
+        if users[self._index] == (1 if on else 0):
+            with quiet_native_output():  # a second sensor on the joint: PyBullet warns
+                pybullet.enableJointForceTorqueSensor(self._body, self._index, on,
+                                                      physicsClientId=self._client)
         self.enabled = on
 
     def read(self) -> Wrench:

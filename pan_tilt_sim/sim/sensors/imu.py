@@ -14,6 +14,9 @@ place (its ``<pose>`` on the link):
   acceleration that step applied.  The caller stores ``v_{k-1}`` one step
   before each sample (:meth:`Imu.remember`); :meth:`Imu.read` without it
   takes the point to be at rest, so callers check :meth:`Imu.has_previous`.
+  A velocity stored ``n`` steps before gives the mean acceleration over those
+  steps, ``(v_k - v_{k-n}) / (n dt)`` (a reader sampling at a lower rate
+  than the physics, as a ros2_control IMU read at the controller rate).
 """
 
 from __future__ import annotations
@@ -87,6 +90,10 @@ class Imu:
         """Whether the velocity of the step before ``step`` is stored."""
         return self._previous is not None and self._previous[0] == step - 1
 
+    def has_earlier(self, step: int) -> bool:
+        """Whether a velocity of any step before ``step`` is stored."""
+        return self._previous is not None and self._previous[0] < step
+
     def forget(self) -> None:
         """Drop the stored velocity (the simulation was reset)."""
         self._previous = None
@@ -96,8 +103,8 @@ class Imu:
         pose, state = self._pose_now()
         velocity = state.point_velocity(numpy.array(pose.translation))
         previous = self._previous
-        if previous is not None and previous[0] == step - 1:
-            acceleration = (velocity - previous[1]) / self._time_step
+        if previous is not None and previous[0] < step:
+            acceleration = (velocity - previous[1]) / ((step - previous[0]) * self._time_step)
         else:
             acceleration = numpy.zeros(3)
         self._previous = (step, velocity)
