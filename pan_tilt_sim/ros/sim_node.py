@@ -30,6 +30,7 @@ from pan_tilt_sim.model.controller_config import (
 )
 from pan_tilt_sim.model.description import RobotDescription, load_description
 from pan_tilt_sim.ros import (
+    command_reader,
     optional_interfaces,
     parameters,
     services,
@@ -143,10 +144,15 @@ class SimNode(Node):
         self.gain_parameters = GainParameters(self)
         topic_mode = self._topic_settings is not None
         # With a physics thread, callbacks take turns with it; commands have a reader of
-        # their own.
+        # their own where this rclpy allows one (else the executor reads them).
         self.turns: Turns | None = Turns() if physics_thread else None
         if self.turns is not None:
-            self._command_reader = CommandReader(self.context, self.turns)
+            if command_reader.available(self.context):
+                self._command_reader = CommandReader(self.context, self.turns)
+            else:
+                self.get_logger().info(
+                    "command topics are read by the executor: this rclpy's private wait set "
+                    'is not the one pan_tilt_sim.ros.command_reader knows')
         self.controllers = ControllerBindings(
             self, self.simulation,
             topic_hardware.topics(self._topic_settings, self.topic) if topic_mode
@@ -196,7 +202,8 @@ class SimNode(Node):
             f"'{self.robot_namespace or '/'}', time_step {self.settings.time_step} s, "
             f'real_time_factor {self._pacer.real_time_factor}')
         if self._physics_thread is not None:
-            self._command_reader.start()
+            if self._command_reader is not None:
+                self._command_reader.start()
             self._physics_thread.start()  # last: nothing may fail after it runs
 
     def create_publisher(self, *args, **kwargs):

@@ -14,6 +14,7 @@ from std_msgs.msg import Float64
 from std_srvs.srv import Empty
 from waiting import BUDGET_S, wait_for
 
+from pan_tilt_sim.ros import command_reader
 from pan_tilt_sim.ros.command_reader import ReaderGroup
 from pan_tilt_sim.ros.physics_thread import PhysicsThread, Turns, TurnTakingExecutor, Wakeup
 from pan_tilt_sim.ros.ros_interfaces import SERVICE_QOS
@@ -389,3 +390,27 @@ def test_with_its_thread_commands_come_by_their_own_reader_also_after_a_reconfig
     assert wait_for(lambda: controller.setpoints()['pan_joint'] > 0.0)
     assert node.commands_received[name] == 1
 
+
+@pytest.fixture
+def without_private_wait_set(monkeypatch):
+    """An rclpy whose private wait set is not the one the command reader knows."""
+    monkeypatch.setattr(command_reader, '_rclpy', None)
+
+
+def test_without_rclpys_private_wait_set_the_executor_reads_commands_in_their_turn(
+        without_private_wait_set, threaded):
+    node, probe = threaded
+    name = 'joint1_position_controller'
+    commands = [s for s in node.subscriptions if s.topic_name.endswith('/command')]
+    assert commands and not any(isinstance(s.callback_group, ReaderGroup) for s in commands)
+    in_turn = []
+    for subscription in commands:
+        callback = subscription.callback
+        subscription.callback = lambda message, callback=callback: (
+            in_turn.append(node.turns._lock.locked()), callback(message))
+    publisher = probe.create_publisher(Float64, f'/ex_urdf_pan_tilt/{name}/command', 10)
+    assert wait_for(lambda: publisher.get_subscription_count() > 0)
+    publisher.publish(Float64(data=0.4))
+    controller = node.simulation.controller(name)
+    assert wait_for(lambda: controller.setpoints()['pan_joint'] > 0.0)
+    assert node.commands_received[name] == 1 and in_turn == [True]
