@@ -16,6 +16,13 @@ sees them as any other) in a callback group that no executor executes
 (:class:`ReaderGroup`), so the executor leaves them out of its wait set.
 A callback that raises stops the reader and is handed to the executor,
 which raises it, as it would its own callback's exception.
+
+rclpy has no public wait set: :func:`wait_and_take` is the one place that
+uses its private one (``WaitSet`` and the subscription handles'
+``take_message``).  :func:`available` tries it out; where it does not work
+(another rclpy), sim_node makes no reader and its executor reads the command
+topics like any other, in their turn: the same behaviour, at more CPU per
+message.
 """
 
 from __future__ import annotations
@@ -28,12 +35,73 @@ from rclpy.callback_groups import CallbackGroup
 from rclpy.context import Context
 from rclpy.exceptions import InvalidHandle
 from rclpy.guard_condition import GuardCondition
-from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.subscription import Subscription
+
+try:
+    from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+except ImportError:  # moved or gone: available() says no
+    _rclpy = None
 
 from pan_tilt_sim.ros.physics_thread import JOIN_TIMEOUT_S, Turns
 
 WAIT_FOREVER = -1  # ns, for the wait set
+DONT_WAIT = 0  # ns
+# What wait_and_take uses of rclpy's private subscription handle.
+_HANDLE_API = ('take_message', 'pointer')
+
+
+def wait_and_take(subscriptions: list[Subscription], guard: GuardCondition, context: Context,
+                  timeout_ns: int = WAIT_FOREVER) -> list[tuple[Subscription, Any]]:
+    """Wait for a message on ``subscriptions`` or a trigger of ``guard``; take every message.
+
+    Returns (subscription, message) pairs, in the order of ``subscriptions``
+    and, for each, of arrival; subscriptions destroyed meanwhile are skipped.
+    ``timeout_ns`` < 0 waits without end.  Built on rclpy's private API
+    (see the module's docstring): AttributeError or TypeError where rclpy
+    changed it.
+    """
+    with contextlib.ExitStack() as held:
+        usable = []
+        for subscription in subscriptions:
+            try:
+                held.enter_context(subscription.handle)
+            except InvalidHandle:  # destroyed meanwhile
+                continue
+            usable.append(subscription)
+        held.enter_context(guard.handle)
+        wait_set = _rclpy.WaitSet(len(usable), 1, 0, 0, 0, 0, context.handle)
+        wait_set.clear_entities()
+        for subscription in usable:
+            wait_set.add_subscription(subscription.handle)
+        wait_set.add_guard_condition(guard.handle)
+        wait_set.wait(timeout_ns)
+        ready = wait_set.get_ready_entities('subscription')
+        taken = []
+        for subscription in usable:
+            if subscription.handle.pointer not in ready:
+                continue
+            while (message := subscription.handle.take_message(
+                    subscription.msg_type, subscription.raw)) is not None:
+                taken.append((subscription, message[0]))
+        return taken
+
+
+def available(context: Context) -> bool:
+    """Whether :func:`wait_and_take` works with the rclpy installed.
+
+    It waits for a guard condition triggered beforehand, which must end the
+    wait at once, and checks that subscription handles have what it uses.
+    """
+    guard = GuardCondition(None, None, context=context)
+    try:
+        guard.trigger()
+        taken = wait_and_take([], guard, context, DONT_WAIT)
+        subscription_type = getattr(_rclpy, 'Subscription', None)
+        return taken == [] and all(hasattr(subscription_type, name) for name in _HANDLE_API)
+    except (AttributeError, TypeError):
+        return False
+    finally:
+        guard.destroy()
 
 
 class ReaderGroup(CallbackGroup):
@@ -108,7 +176,7 @@ class CommandReader:
                     if self._stopping:
                         return
                     subscriptions = list(self._subscriptions)
-                taken = self._wait_and_take(subscriptions)
+                taken = wait_and_take(subscriptions, self._guard, self._context)
                 if taken:
                     self._hand_over(taken)
         except BaseException as error:
@@ -117,34 +185,6 @@ class CommandReader:
             if stopping or not self._context.ok():  # the program is ending anyway
                 return
             self._turns.fail(error)
-
-    def _wait_and_take(self, subscriptions: list[Subscription]
-                       ) -> list[tuple[Subscription, Any]]:
-        """Wait until a message or a change comes; take every message there is."""
-        with contextlib.ExitStack() as held:
-            usable = []
-            for subscription in subscriptions:
-                try:
-                    held.enter_context(subscription.handle)
-                except InvalidHandle:  # destroyed meanwhile
-                    continue
-                usable.append(subscription)
-            held.enter_context(self._guard.handle)
-            wait_set = _rclpy.WaitSet(len(usable), 1, 0, 0, 0, 0, self._context.handle)
-            wait_set.clear_entities()
-            for subscription in usable:
-                wait_set.add_subscription(subscription.handle)
-            wait_set.add_guard_condition(self._guard.handle)
-            wait_set.wait(WAIT_FOREVER)
-            ready = wait_set.get_ready_entities('subscription')
-            taken = []
-            for subscription in usable:
-                if subscription.handle.pointer not in ready:
-                    continue
-                while (message := subscription.handle.take_message(
-                        subscription.msg_type, subscription.raw)) is not None:
-                    taken.append((subscription, message[0]))
-            return taken
 
     def _hand_over(self, taken: list[tuple[Subscription, Any]]) -> None:
         """Run the callbacks of the messages taken, in order, in one turn."""

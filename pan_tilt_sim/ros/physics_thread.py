@@ -27,6 +27,7 @@ import contextlib
 import threading
 import time
 from collections.abc import Callable, Iterator
+from typing import TYPE_CHECKING
 
 from rclpy.context import Context
 from rclpy.executors import (
@@ -35,7 +36,10 @@ from rclpy.executors import (
     SingleThreadedExecutor,
     TimeoutException,
 )
-from rclpy.task import Task
+
+if TYPE_CHECKING:
+    from rclpy.executors import TimeoutObject
+    from rclpy.task import Future, Task
 
 JOIN_TIMEOUT_S = 5.0
 # Wall seconds of callbacks one turn may run when more are ready, before the physics
@@ -98,7 +102,12 @@ class Turns:
 
 
 class TurnTakingExecutor(SingleThreadedExecutor):
-    """rclpy's SingleThreadedExecutor, running each callback in its turn (see :class:`Turns`)."""
+    """rclpy's SingleThreadedExecutor, running each callback in its turn (see :class:`Turns`).
+
+    Whichever way it is spun -- ``spin``, ``spin_once``, ``spin_until_future_complete``,
+    ``spin_once_until_future_complete``, or rclpy's functions of those names
+    -- no callback runs during a batch of steps.
+    """
 
     def __init__(self, turns: Turns, *, context: Context | None = None) -> None:
         super().__init__(context=context)
@@ -120,7 +129,24 @@ class TurnTakingExecutor(SingleThreadedExecutor):
         :data:`CALLBACK_TURN_S` of wall time: a queue of requests is served
         between two batches of steps, not one request per batch.
         """
-        handler = self._next_ready(timeout_sec)
+        self._take_turn(timeout_sec, self._physics_failed)
+
+    def spin_once_until_future_complete(
+            self, future: Future, timeout_sec: float | TimeoutObject | None = None) -> None:
+        """As :meth:`spin_once`, but the wait also ends when ``future`` is done.
+
+        rclpy's ``spin_until_future_complete`` (the executor's and
+        ``rclpy.spin_until_future_complete``) loops over this method, and
+        ``spin`` over :meth:`spin_once`: every way to spin this executor runs
+        its callbacks in their turn.
+        """
+        future.add_done_callback(lambda _future: self.wake())
+        self._take_turn(timeout_sec, lambda: self._physics_failed() or future.done())
+
+    def _take_turn(self, timeout_sec: float | TimeoutObject | None,
+                   condition: Callable[[], bool]) -> None:
+        """Run the next ready callback, and those ready with it, in one turn."""
+        handler = self._next_ready(timeout_sec, condition)
         if handler is None:
             return
         with self._turns.callback():
@@ -130,19 +156,27 @@ class TurnTakingExecutor(SingleThreadedExecutor):
                 if handler.exception() is not None:
                     raise handler.exception()
                 handler.result()
-                handler = self._next_ready(0.0) if time.perf_counter() < deadline else None
+                handler = (self._next_ready(0.0, condition) if time.perf_counter() < deadline
+                           else None)
 
-    def _next_ready(self, timeout_sec: float | None) -> Task | None:
-        """Return the next ready callback, waiting up to ``timeout_sec`` (None: not in time)."""
+    def _next_ready(self, timeout_sec: float | TimeoutObject | None,
+                    condition: Callable[[], bool]) -> Task | None:
+        """Return the next ready callback, waiting up to ``timeout_sec``.
+
+        None when none came in time or ``condition()`` ended the wait; the
+        physics' failure, if it failed, is raised instead.
+        """
         if self._turns.failure is not None:
             raise self._turns.failure
         try:
             handler, _entity, _node = self.wait_for_ready_callbacks(
-                timeout_sec, condition=self._physics_failed)
+                timeout_sec, condition=condition)
         except (ShutdownException, TimeoutException):
             return None
-        except ConditionReachedException:  # the physics failed and woke the wait
-            raise self._turns.failure from None
+        except ConditionReachedException:  # the physics failed, or the future is done
+            if self._turns.failure is not None:
+                raise self._turns.failure from None
+            return None
         return handler
 
 

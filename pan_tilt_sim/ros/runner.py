@@ -189,22 +189,44 @@ def _captured_native_stderr() -> Iterator[list[str]]:
 
 
 def _rcl_reason(err: Exception, log: str) -> str:
-    """One line from rclpy.init's exception and the lines rcl logged about it."""
-    if type(err).__name__ == 'UnknownROSArgsError':
-        try:
-            unknown = ast.literal_eval(str(err))
-        except (SyntaxError, ValueError):
-            unknown = [str(err)]
+    """One line from rclpy.init's exception and the lines rcl logged about it.
+
+    rcl reports a bad argument only as text (rclpy raises its private
+    RCLError or UnknownROSArgsError), so this is the one place that reads
+    that text: it drops rcl's prefix, source locations, lexer detail and
+    generic last word.  Text of another shape (another rcl) is kept as it is,
+    folded into the line, so nothing rcl said is lost.
+    """
+    unknown = _unknown_ros_arguments(err)
+    if unknown is not None:
         return 'unknown ROS argument ' + ', '.join(f"'{arg}'" for arg in unknown)
     reason = str(err).removeprefix(_RCL_PREFIX)
     reason = _RCL_SOURCE_LOCATION.sub('', reason)
     reason = _RCL_LEXER_DETAIL.sub('', reason).rstrip('.').replace('. Error: ', ': ')
-    details = [match['text'] for match in map(_RCL_LOG_LINE.match, log.splitlines())
-               if match and _RCL_GENERIC_ERROR not in match['text']]
+    details = []
+    for line in filter(str.strip, log.splitlines()):
+        match = _RCL_LOG_LINE.match(line)
+        if match is None:
+            details.append(line.strip())
+        elif _RCL_GENERIC_ERROR not in match['text']:
+            details.append(match['text'])
     if details:
         reason += ' (' + '; '.join(details) + ')'
     reason = one_line(reason)
     return reason[:1].lower() + reason[1:]
+
+
+def _unknown_ros_arguments(err: Exception) -> list[str] | None:
+    """Return the arguments an UnknownROSArgsError names (its text is a list's repr), or None."""
+    if type(err).__name__ != 'UnknownROSArgsError':
+        return None
+    try:
+        unknown = ast.literal_eval(str(err))
+    except (SyntaxError, ValueError):
+        return None
+    if isinstance(unknown, list) and unknown and all(isinstance(arg, str) for arg in unknown):
+        return unknown
+    return None
 
 
 def init_ros(args: list[str] | None, *, debug: bool = False) -> None:

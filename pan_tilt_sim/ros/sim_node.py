@@ -32,6 +32,7 @@ from pan_tilt_sim.model.controller_config import (
 from pan_tilt_sim.model.description import RobotDescription, load_description
 from pan_tilt_sim.model.ros_arguments import parse_ros_arguments
 from pan_tilt_sim.ros import (
+    command_reader,
     drop_in,
     optional_interfaces,
     parameters,
@@ -192,9 +193,15 @@ class SimNode(Node):
         self._clock_throttle = Throttle(CLOCK_MIN_WALL_PERIOD_S, CLOCK_BURST)
         self.gain_parameters = GainParameters(self)
         topic_mode = self._topic_settings is not None
-        # With a physics thread, commands have a reader of their own.
+        # With a physics thread, commands have a reader of their own where this rclpy allows
+        # one (else the executor reads them, in their turn).
         if self.turns is not None:
-            self._command_reader = CommandReader(self.context, self.turns)
+            if command_reader.available(self.context):
+                self._command_reader = CommandReader(self.context, self.turns)
+            else:
+                self.get_logger().info(
+                    "command topics are read by the executor: this rclpy's private wait set "
+                    'is not the one pan_tilt_sim.ros.command_reader knows')
         self.controllers = ControllerBindings(
             self, self.simulation,
             topic_hardware.topics(self._topic_settings, self.topic) if topic_mode
@@ -251,7 +258,8 @@ class SimNode(Node):
                 f"recording to '{self.recorder.folder}' (rosbag2, MCAP storage"
                 f"{', sensors included' if self.settings.record_sensors else ''})")
         if self._physics_thread is not None:
-            self._command_reader.start()
+            if self._command_reader is not None:
+                self._command_reader.start()
             self._physics_thread.start()  # last: nothing may fail after it runs
 
     def set_parameters(self, parameter_list: list[Parameter]) -> list[SetParametersResult]:

@@ -7,11 +7,14 @@ import time
 
 import pytest
 import rclpy
+from rclpy.executors import Executor
 from rclpy.parameter import Parameter
+from rclpy.task import Future
 from std_msgs.msg import Float64
 from std_srvs.srv import Empty
 from waiting import BUDGET_S, wait_for
 
+from pan_tilt_sim.ros import command_reader
 from pan_tilt_sim.ros.command_reader import ReaderGroup
 from pan_tilt_sim.ros.physics_thread import PhysicsThread, Turns, TurnTakingExecutor, Wakeup
 from pan_tilt_sim.ros.ros_interfaces import SERVICE_QOS
@@ -202,6 +205,112 @@ def test_requests_ready_together_are_served_in_one_turn_not_one_per_batch(contex
     assert len(set(served_in)) <= 5, f'served between batches {sorted(set(served_in))}'
 
 
+class FinishedError(Exception):
+    """Raised by the test's callback: it ends every way of spinning, spin() included."""
+
+
+SPIN_PATHS = {
+    'spin': lambda executor, node, future: executor.spin(),
+    'spin_once': lambda executor, node, future: executor.spin_once(),
+    'spin_until_future_complete': lambda executor, node, future: (
+        executor.spin_until_future_complete(future)),
+    'spin_until_future_complete with a timeout': lambda executor, node, future: (
+        executor.spin_until_future_complete(future, timeout_sec=BUDGET_S)),
+    'spin_once_until_future_complete': lambda executor, node, future: (
+        executor.spin_once_until_future_complete(future, timeout_sec=BUDGET_S)),
+    'rclpy.spin': lambda executor, node, future: rclpy.spin(node, executor=executor),
+    'rclpy.spin_once': lambda executor, node, future: rclpy.spin_once(node, executor=executor),
+    'rclpy.spin_until_future_complete': lambda executor, node, future: (
+        rclpy.spin_until_future_complete(node, future, executor=executor)),
+}
+
+
+def test_every_way_rclpy_offers_to_spin_an_executor_is_checked_below():
+    # A way to spin that rclpy adds may bypass spin_once and run callbacks out of turn.
+    spin_methods = {name for name in dir(Executor) if name.startswith('spin')}
+    checked = {name for name in SPIN_PATHS if not name.startswith('rclpy.')}
+    assert spin_methods <= checked, (
+        f'rclpy has ways to spin an executor not known to take turns: '
+        f'{sorted(spin_methods - checked)}')
+
+
+@pytest.mark.parametrize('way', SPIN_PATHS)
+def test_every_way_to_spin_runs_a_callback_only_in_its_turn(context, way):
+    turns, ran, finished = Turns(), [], []
+    node = rclpy.create_node('turn_taker', context=context)
+    executor = TurnTakingExecutor(turns, context=context)
+    future = Future(executor=executor)
+
+    def on_trigger():
+        ran.append(threading.current_thread().name)
+        raise FinishedError
+
+    node.create_guard_condition(on_trigger).trigger()
+    executor.add_node(node)
+
+    def spin():
+        try:
+            SPIN_PATHS[way](executor, node, future)
+        except FinishedError:
+            finished.append(way)
+
+    spinner = threading.Thread(target=spin, name='spinner', daemon=True)
+    try:
+        with turns.physics():  # a batch of steps in progress
+            spinner.start()
+            assert wait_for(lambda: turns._callbacks_waiting == 1), 'it did not wait its turn'
+            assert ran == []
+        spinner.join(BUDGET_S)
+        assert not spinner.is_alive() and ran == ['spinner'] and finished == [way]
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+
+
+def test_spin_until_future_complete_returns_when_another_thread_completes_the_future(context):
+    # A future of no executor's calls its done callbacks (the wake-up) in the thread that
+    # completes it; nothing else ends the executor's wait, which has no timeout.
+    executor = TurnTakingExecutor(Turns(), context=context)
+    future, returned = Future(), threading.Event()
+
+    def spin():
+        executor.spin_until_future_complete(future)
+        returned.set()
+
+    spinner = threading.Thread(target=spin, daemon=True)
+    spinner.start()
+    try:
+        assert not returned.wait(0.05)
+        future.set_result('done')
+        assert returned.wait(BUDGET_S), 'the executor slept through the completed future'
+    finally:
+        if returned.is_set():
+            executor.shutdown()
+
+
+def test_spin_until_future_complete_raises_the_physics_failure(context):
+    turns, waiting = Turns(), threading.Event()
+
+    class Observed(TurnTakingExecutor):
+        def wait_for_ready_callbacks(self, *args, **kwargs):
+            waiting.set()
+            return super().wait_for_ready_callbacks(*args, **kwargs)
+
+    def tick():
+        assert waiting.wait(BUDGET_S)
+        raise RuntimeError('the physics broke')
+
+    executor = Observed(turns, context=context)
+    thread = PhysicsThread(tick, lambda: 0.0, turns)
+    thread.start()
+    try:
+        with pytest.raises(RuntimeError, match='the physics broke'):
+            executor.spin_until_future_complete(Future(executor=executor), timeout_sec=BUDGET_S)
+    finally:
+        thread.stop()
+        executor.shutdown()
+
+
 # --- sim_node with its physics thread -------------------------------------------------
 
 @pytest.fixture
@@ -280,3 +389,28 @@ def test_with_its_thread_commands_come_by_their_own_reader_also_after_a_reconfig
     publisher.publish(Float64(data=0.4))
     assert wait_for(lambda: controller.setpoints()['pan_joint'] > 0.0)
     assert node.commands_received[name] == 1
+
+
+@pytest.fixture
+def without_private_wait_set(monkeypatch):
+    """An rclpy whose private wait set is not the one the command reader knows."""
+    monkeypatch.setattr(command_reader, '_rclpy', None)
+
+
+def test_without_rclpys_private_wait_set_the_executor_reads_commands_in_their_turn(
+        without_private_wait_set, threaded):
+    node, probe = threaded
+    name = 'joint1_position_controller'
+    commands = [s for s in node.subscriptions if s.topic_name.endswith('/command')]
+    assert commands and not any(isinstance(s.callback_group, ReaderGroup) for s in commands)
+    in_turn = []
+    for subscription in commands:
+        callback = subscription.callback
+        subscription.callback = lambda message, callback=callback: (
+            in_turn.append(node.turns._lock.locked()), callback(message))
+    publisher = probe.create_publisher(Float64, f'/ex_urdf_pan_tilt/{name}/command', 10)
+    assert wait_for(lambda: publisher.get_subscription_count() > 0)
+    publisher.publish(Float64(data=0.4))
+    controller = node.simulation.controller(name)
+    assert wait_for(lambda: controller.setpoints()['pan_joint'] > 0.0)
+    assert node.commands_received[name] == 1 and in_turn == [True]

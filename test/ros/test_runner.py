@@ -17,6 +17,7 @@ import pytest
 import sim_process
 
 from pan_tilt_sim.errors import ArgumentError, ConfigurationError
+from pan_tilt_sim.ros import runner
 from pan_tilt_sim.ros.runner import (
     StopRequested,
     StopSignals,
@@ -66,6 +67,46 @@ def test_malformed_ros_arguments_raise_one_clean_line(args, expected, capfd, def
     assert str(raised.value) == expected
     # rcl's own log lines were folded into the message, not printed.
     assert capfd.readouterr().err == ''
+
+
+def _rcl_failure(args):
+    """rclpy.init's exception for ``args`` and what rcl logged meanwhile, untouched."""
+    import rclpy
+
+    with runner._captured_native_stderr() as captured:
+        with pytest.raises(Exception) as raised:  # noqa: PT011 -- rclpy's private RCLError
+            rclpy.init(args=args)
+    return raised.value, ''.join(captured)
+
+
+def test_rcl_still_words_a_bad_argument_as_the_runner_tidies_it(default_context):
+    # Fails when rcl or rclpy reword it: update runner._rcl_reason's patterns (until
+    # then it passes the new text on whole, see the next test).
+    err, log = _rcl_failure(['sim_node', '--ros-args', '-p', 'time_step'])
+    text = str(err)
+    assert text.startswith(runner._RCL_PREFIX), f'rcl no longer begins with the prefix: {text}'
+    assert runner._RCL_SOURCE_LOCATION.search(text), f'no source location to drop: {text}'
+    assert runner._RCL_LEXER_DETAIL.search(text), f'no lexer detail to drop: {text}'
+    lines = [runner._RCL_LOG_LINE.match(line) for line in log.splitlines() if line.strip()]
+    assert lines and all(lines), f'rcl logs lines of another shape: {log!r}'
+    assert any(runner._RCL_GENERIC_ERROR in line['text'] for line in lines), log
+
+
+def test_rclpy_still_names_unknown_ros_arguments_as_the_runner_reads_them(default_context):
+    err, _ = _rcl_failure(['sim_node', '--ros-args', '--no-such-flag', '--nor-this'])
+    assert runner._unknown_ros_arguments(err) == ['--no-such-flag', '--nor-this'], (
+        f'rclpy reports unknown ROS arguments differently: {type(err).__name__}: {err}')
+
+
+def test_rcl_text_of_another_shape_is_passed_on_whole_in_one_line():
+    class UnknownROSArgsError(Exception):
+        pass
+
+    assert runner._rcl_reason(RuntimeError('Something new:\n  at line 3'),
+                              'a log line of another shape\n\n') == (
+        'something new: at line 3 (a log line of another shape)')
+    assert runner._rcl_reason(UnknownROSArgsError('--flag is unknown'), '') == (
+        '--flag is unknown')
 
 
 def test_the_first_signal_interrupts_only_an_interruptible_block():
