@@ -231,30 +231,32 @@ class ControllerBindings:
         controller.node_namespace = self._topic()
         for endpoint in controller.ros_surface():
             if isinstance(endpoint, CommandTopic):
-                if self._command_topics and COMMAND_MESSAGES.get(
-                        endpoint.message, (None,))[0] is not None:
+                if COMMAND_MESSAGES.get(endpoint.message, (None,))[0] is None:
+                    self._missing(controller, endpoint.name, endpoint.message)
+                elif self._command_topics:
                     entities.append(self._subscribe(controller, endpoint))
             elif isinstance(endpoint, StateTopic):
                 if STATE_SINKS.get(endpoint.message, (None,))[0] is not None:
                     entities.append(self._publish(controller, endpoint))
-                else:  # its interface package is missing
+                else:  # the controller takes no samples for it
                     endpoint.connect(None)
-                    self._logger.info(
-                        f'{name}: no {self._name(controller, endpoint.name)} '
-                        f'({endpoint.message}): its interface package is not installed '
-                        f'({optional_interfaces.BUILD_HINT})')
+                    self._missing(controller, endpoint.name, endpoint.message)
             elif isinstance(endpoint, Service):
                 if SERVICES.get(endpoint.service, (None,))[0] is not None:
                     entities.append(self._provide(controller, endpoint))
-                else:  # its interface package is missing
-                    self._logger.info(
-                        f'{name}: no {self._name(controller, endpoint.name)} '
-                        f'({endpoint.service}): its interface package is not installed '
-                        f'({optional_interfaces.BUILD_HINT})')
+                else:
+                    self._missing(controller, endpoint.name, endpoint.service)
             elif isinstance(endpoint, ActionServer):
                 self._serve(controller, endpoint)
         self._noticing.append(controller)
         self._gains.add(controller)
+
+    def _missing(self, controller: Controller, name: str, interface: str) -> None:
+        """Say that ``controller`` has no ``name``: ``interface``'s package is not installed."""
+        package = interface.split('/')[0]
+        self._logger.warning(
+            f'{controller.name}: no topic {self._name(controller, name)} ({interface}): '
+            f'{package} is not installed ({optional_interfaces.BUILD_HINT})')
 
     def _name(self, controller: Controller, topic: str) -> str:
         """Resolve a declared name: ``~/x`` the controller's, ``/x`` as is, else the robot's.

@@ -36,17 +36,23 @@ def test_publishes_the_pose_and_the_transform_to_the_pose_name():
     controller, topics, _source, poses, transforms = broadcaster()
     assert {name: topic.message for name, topic in topics.items()} == {
         '~/pose': 'geometry_msgs/msg/PoseStamped', '/tf': 'tf2_msgs/msg/TFMessage'}
-    assert topics['/tf'].fields == {'frame_id': 'world', 'child_frame_id': 'tool_pose'}
     controller.update(0.0, DT)
     expected = (0.0, [0.1, 0.2, 0.75], [0.0, 0.0, HALF_TURN, HALF_TURN])
-    assert poses == [expected] and transforms == [expected]
+    assert poses == [expected]
+    ((time, frames),) = transforms
+    ((parent, child, transform),) = frames
+    assert (time, parent, child) == (0.0, 'world', 'tool_pose')
+    assert transform.translation == pytest.approx((0.1, 0.2, 0.75))
+    assert transform.rotation == pytest.approx((0.0, 0.0, HALF_TURN, HALF_TURN))
 
 
 def test_tf_disabled_no_tf_topic_and_a_child_frame_can_be_named():
     _controller, topics, *_ = broadcaster(tf={'enable': False})
     assert set(topics) == {'~/pose'}
-    _controller, topics, *_ = broadcaster(tf={'child_frame_id': 'tcp'})
-    assert topics['/tf'].fields['child_frame_id'] == 'tcp'
+    controller, topics, _source, _poses, transforms = broadcaster(tf={'child_frame_id': 'tcp'})
+    controller.update(0.0, DT)
+    ((_time, ((parent, child, _transform),)),) = transforms
+    assert (parent, child) == ('world', 'tcp')
 
 
 @pytest.mark.parametrize('bad', [
