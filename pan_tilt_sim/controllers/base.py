@@ -249,6 +249,7 @@ class CommandKind(enum.Enum):
     JOINT_TRAJECTORY = 'trajectory_msgs/msg/JointTrajectory'
     MULTI_DOF_COMMAND = 'control_msgs/msg/MultiDOFCommand'
     TWIST_STAMPED = 'geometry_msgs/msg/TwistStamped'
+    TWIST = 'geometry_msgs/msg/Twist'  # Gazebo's drive plugins: taken as an unstamped one
 
 
 class CommandResult(enum.Enum):

@@ -18,6 +18,7 @@ import functools
 import math
 from collections.abc import Mapping
 
+from pan_tilt_sim.model.drive_plugins import DiffDrivePlugin
 from pan_tilt_sim.model.sensors import SensorSpec
 from pan_tilt_sim.model.surfaces import Surface
 from pan_tilt_sim.model.transforms import (
@@ -279,6 +280,8 @@ class RobotModel:
     sensor_warnings: tuple[str, ...] = ()
     # Contact surfaces from <gazebo reference="LINK"> (mu1, mu2, kp, kd), for links that give any.
     surfaces: tuple[Surface, ...] = ()
+    # Gazebo drive plugins (<gazebo><plugin> libgazebo_ros_diff_drive.so): they drive the base.
+    drive_plugins: tuple[DiffDrivePlugin, ...] = ()
 
     @property
     def link_frictions(self) -> dict[str, Surface]:

@@ -70,6 +70,7 @@ from pan_tilt_sim.model.robot import (
     RobotModel,
     Shape,
 )
+from pan_tilt_sim.model.drive_plugins import read_drive_plugins
 from pan_tilt_sim.model.sensors import (
     CHILD,
     CHILD_TO_PARENT,
@@ -171,9 +172,11 @@ def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
                     'not a joint of this robot')
     _check_position_gain(plugins, systems, source)
     sensors, sensor_warnings = _SensorReader(source, links, joints).read(root)
+    drive_plugins = read_drive_plugins(root, source, {joint.name: joint for joint in joints})
     return RobotModel(name=name, links=links, joints=joints,
                       ros2_control=systems, control_plugins=plugins,
                       sensors=sensors, sensor_warnings=sensor_warnings,
+                      drive_plugins=drive_plugins,
                       surfaces=read_surfaces(root, source, link_names))
 
 
