@@ -11,7 +11,8 @@ a ``diff_drive_controller/DiffDriveController`` named ``base_controller``.
 :func:`plugin_rover_urdf` is the same rover driven by a
 ``libgazebo_ros_diff_drive.so`` plugin instead (no ros2_control, no
 controllers file), with a planar lidar (``<sensor type="ray">`` on a
-``lidar_link`` above the base) publishing a LaserScan on ``/scan``.
+``lidar_link`` above the base) publishing a LaserScan on ``/scan`` and a
+``libgazebo_ros_p3d.so`` publishing the base's true pose on ``/ground_truth``.
 """
 
 from __future__ import annotations
@@ -68,6 +69,12 @@ ROS1_DIFF_DRIVE = f'''
     <odometryFrame>odom</odometryFrame><robotBaseFrame>base_link</robotBaseFrame>
     <odometrySource>encoder</odometrySource>
   </plugin>'''
+P3D = '''
+  <plugin name="ground_truth" filename="libgazebo_ros_p3d.so">
+    <ros><remapping>odom:=ground_truth</remapping></ros>
+    <body_name>base_link</body_name><frame_name>world</frame_name>
+    <update_rate>50</update_rate>
+  </plugin>'''
 LIDAR = '''
   <joint name="lidar_joint" type="fixed">
     <parent link="base_link"/><child link="lidar_link"/><origin xyz="0.1 0 0.05"/>
@@ -90,10 +97,14 @@ LIDAR = '''
   </gazebo>'''
 
 
-def plugin_rover_urdf(plugin: str = ROS2_DIFF_DRIVE, name: str = 'rover') -> str:
-    """Return the rover driven by a Gazebo diff drive ``plugin`` (no ros2_control), with a lidar."""
+def plugin_rover_urdf(plugin: str = ROS2_DIFF_DRIVE, name: str = 'rover', *,
+                      ground_truth: str = P3D) -> str:
+    """Return the rover driven by a Gazebo diff drive ``plugin`` (no ros2_control), a lidar.
+
+    ``ground_truth`` (a p3d plugin on ``/ground_truth`` by default) goes beside the drive.
+    """
     return rover_urdf(name, ros2_control=False,
-                      extra=f'<gazebo>{plugin}</gazebo>{LIDAR}')
+                      extra=f'<gazebo>{plugin}{ground_truth}</gazebo>{LIDAR}')
 
 
 def rover_urdf(name: str = 'rover', *, world_joint: bool = False,

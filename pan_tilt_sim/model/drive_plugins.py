@@ -32,6 +32,13 @@ covariance (x, y, yaw)      ``covariance_x``,         fixed: 1e-5, 1e-5, 1e-3
                             ``covariance_yaw`` 1e-3
 ==========================  ========================  ===============================
 
+``libgazebo_ros_p3d.so`` publishes a link's true pose and twist as
+``nav_msgs/Odometry`` (ground truth): ROS 2 ``body_name`` (required),
+``frame_name`` (world), ``xyz_offsets``, ``rpy_offsets`` (0 0 0),
+``gaussian_noise`` (0), ``update_rate`` (0: every step), topic ``odom`` of
+its node; ROS 1 ``bodyName``, ``frameName``, ``xyzOffsets``, ``rpyOffsets``,
+``gaussianNoise``, ``updateRate``, ``topicName`` in ``robotNamespace``.
+
 Topic names resolve as each generation resolves them: ROS 2 in a node named
 after the plugin in ``<ros><namespace>`` with its ``<remapping>``s; ROS 1
 in ``robotNamespace`` (see :mod:`pan_tilt_sim.model.sensors`).  A wheel
@@ -46,13 +53,17 @@ from __future__ import annotations
 import dataclasses
 import math
 import pathlib
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from xml.etree import ElementTree
 
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.sensors import ROS1, ROS2, Ros2Names, plugin_stem, ros1_resolve
 
 DIFF_DRIVE = 'gazebo_ros_diff_drive'
+P3D = 'gazebo_ros_p3d'
+WORLD_FRAMES = ('world', '/world', 'map', '/map')  # p3d: poses in the world
+ROS1_P3D_KEYS = {'bodyName', 'frameName', 'topicName', 'xyzOffsets', 'rpyOffsets',
+                 'gaussianNoise', 'updateRate', 'robotNamespace'}
 ENCODER, WORLD = 'encoder', 'world'
 ROS2_SOURCES = {0: ENCODER, 1: WORLD}  # gazebo_ros's odometry_source numbers
 # Elements only one generation's diff drive reads: they tell which one a plugin is.
@@ -123,12 +134,47 @@ class DiffDrivePlugin:
         return self.pose_covariance if self.convention == ROS2 else (0.0,) * 6
 
 
+@dataclasses.dataclass(frozen=True)
+class P3dPlugin:
+    """One ``gazebo_ros_p3d`` plugin: which link, in which frame, offsets, noise, rate, topic.
+
+    ``frame_name`` a link of the robot: the pose and twist relative to that
+    link; ``world``/``map``: in the world.  Offsets: m and rad (roll, pitch,
+    yaw); ``gaussian_noise``: the standard deviation added to each twist
+    component.  ``update_rate`` 0: every physics step.
+    """
+
+    name: str
+    convention: str
+    body_name: str
+    frame_name: str = 'world'
+    xyz_offsets: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy_offsets: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    gaussian_noise: float = 0.0
+    update_rate: float = 0.0
+    topic: str = 'odom'
+    namespace: str = ''
+    remappings: tuple[tuple[str, str], ...] = ()
+
+    @property
+    def in_world(self) -> bool:
+        """Whether poses are in the world (not relative to a link)."""
+        return self.frame_name in WORLD_FRAMES
+
+    def topics(self, override: str = '') -> str:
+        """Return the odometry topic (absolute), ``override`` as the namespace."""
+        namespace = override or self.namespace
+        if self.convention == ROS1:
+            return ros1_resolve(namespace, self.topic)
+        return Ros2Names(self.name, namespace, self.remappings).topic(self.topic)
+
+
 class _PluginReader:
     """Reads one ``<plugin>`` element's children; bad values name the plugin and the element."""
 
     def __init__(self, element: ElementTree.Element, source: pathlib.Path | str) -> None:
         self.element = element
-        self.name = element.get('name', '') or DIFF_DRIVE
+        self.name = element.get('name', '') or plugin_stem(element.get('filename', ''))
         self.filename = element.get('filename', '')
         self.source = source
         self.texts: dict[str, list[str]] = {}
@@ -166,6 +212,16 @@ class _PluginReader:
             raise self.error(key, f'must be >= 0, got {value:g}')
         return value
 
+    def vector(self, key: str) -> tuple[float, float, float]:
+        text = self.text(key, '')
+        if not text:
+            return (0.0, 0.0, 0.0)
+        words = text.split()
+        if len(words) != 3:
+            raise self.error(key, f"'{text}' is not three numbers")
+        x, y, z = (self.check(key, word, 0.0) for word in words)
+        return (x, y, z)
+
     def flag(self, key: str, default: bool) -> bool:
         text = self.text(key, '').lower()
         if not text:
@@ -190,9 +246,49 @@ class _PluginReader:
         return (ros.findtext('namespace') or '').strip(), tuple(rules)
 
 
+def read_p3d_plugins(root: ElementTree.Element, source: pathlib.Path | str,
+                     links: Collection[str]) -> tuple[P3dPlugin, ...]:
+    """Return the ``gazebo_ros_p3d`` plugins of the robot's ``<gazebo>`` tags (see the module).
+
+    ``links`` are the robot's links: a ``body_name`` outside them ends start-up.
+    """
+    plugins = []
+    for gazebo in root.findall('gazebo'):
+        if gazebo.get('reference') is not None:
+            continue
+        for element in gazebo.findall('plugin'):
+            if plugin_stem(element.get('filename', '')) != P3D:
+                continue
+            reader = _PluginReader(element, source)
+            ros1 = bool(set(reader.texts) & ROS1_P3D_KEYS) and 'ros' not in reader.texts
+            names = ('bodyName', 'frameName', 'xyzOffsets', 'rpyOffsets', 'gaussianNoise',
+                     'updateRate') if ros1 else ('body_name', 'frame_name', 'xyz_offsets',
+                                                 'rpy_offsets', 'gaussian_noise', 'update_rate')
+            body, frame, xyz, rpy, noise, rate = names
+            link = reader.text(body, '')
+            if link not in links:
+                raise reader.error(body, f"'{link}' is not a link of this robot" if link
+                                   else 'is missing (the plugin needs the link to track)')
+            frame_name = reader.text(frame, 'world')
+            if frame_name not in WORLD_FRAMES and frame_name not in links:
+                raise reader.error(frame, f"'{frame_name}' is neither world, map nor a link of "
+                                   'this robot')
+            namespace, remappings = ('', ()) if ros1 else reader.ros()
+            plugins.append(P3dPlugin(
+                name=reader.name, convention=ROS1 if ros1 else ROS2, body_name=link,
+                frame_name=frame_name, xyz_offsets=reader.vector(xyz),
+                rpy_offsets=reader.vector(rpy),
+                gaussian_noise=reader.number(noise, 0.0, non_negative=True),
+                update_rate=reader.number(rate, 0.0, non_negative=True),
+                topic=reader.text('topicName', 'odom') if ros1 else 'odom',
+                namespace=reader.text('robotNamespace', '') if ros1 else namespace,
+                remappings=remappings))
+    return tuple(plugins)
+
+
 def read_drive_plugins(root: ElementTree.Element, source: pathlib.Path | str,
                        joints: Mapping[str, object]) -> tuple[DiffDrivePlugin, ...]:
-    """Return the drive plugins of the robot's ``<gazebo><plugin>`` tags (see the module).
+    """Return the diff drive plugins of the robot's ``<gazebo><plugin>`` tags (see the module).
 
     ``joints`` are the robot's joints by name: a wheel outside them ends start-up.
     """

@@ -18,7 +18,7 @@ import functools
 import math
 from collections.abc import Mapping
 
-from pan_tilt_sim.model.drive_plugins import DiffDrivePlugin
+from pan_tilt_sim.model.drive_plugins import DiffDrivePlugin, P3dPlugin
 from pan_tilt_sim.model.sensors import SensorSpec
 from pan_tilt_sim.model.surfaces import Surface
 from pan_tilt_sim.model.transforms import (
@@ -282,6 +282,8 @@ class RobotModel:
     surfaces: tuple[Surface, ...] = ()
     # Gazebo drive plugins (<gazebo><plugin> libgazebo_ros_diff_drive.so): they drive the base.
     drive_plugins: tuple[DiffDrivePlugin, ...] = ()
+    # Gazebo ground-truth plugins (libgazebo_ros_p3d.so): a link's true pose on a topic.
+    p3d_plugins: tuple[P3dPlugin, ...] = ()
 
     @property
     def link_frictions(self) -> dict[str, Surface]:

@@ -70,7 +70,7 @@ from pan_tilt_sim.model.robot import (
     RobotModel,
     Shape,
 )
-from pan_tilt_sim.model.drive_plugins import read_drive_plugins
+from pan_tilt_sim.model.drive_plugins import read_drive_plugins, read_p3d_plugins
 from pan_tilt_sim.model.sensors import (
     CHILD,
     CHILD_TO_PARENT,
@@ -173,10 +173,11 @@ def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
     _check_position_gain(plugins, systems, source)
     sensors, sensor_warnings = _SensorReader(source, links, joints).read(root)
     drive_plugins = read_drive_plugins(root, source, {joint.name: joint for joint in joints})
+    p3d_plugins = read_p3d_plugins(root, source, link_names)
     return RobotModel(name=name, links=links, joints=joints,
                       ros2_control=systems, control_plugins=plugins,
                       sensors=sensors, sensor_warnings=sensor_warnings,
-                      drive_plugins=drive_plugins,
+                      drive_plugins=drive_plugins, p3d_plugins=p3d_plugins,
                       surfaces=read_surfaces(root, source, link_names))
 
 

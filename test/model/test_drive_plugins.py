@@ -97,3 +97,52 @@ def test_a_bad_plugin_element_ends_start_up_naming_the_plugin_and_the_element(
     message = str(raised.value)
     assert 'libgazebo_ros_diff_drive.so' in message and element in message
     assert problem in message and '\n' not in message
+
+
+def p3d(text: str):
+    return parse_urdf(plugin_rover_urdf(ground_truth=text), SOURCE).p3d_plugins
+
+
+def test_ros2_p3d_reads_its_elements_and_topic():
+    (plugin,) = parse_urdf(plugin_rover_urdf(), SOURCE).p3d_plugins
+    assert plugin.convention == ROS2 and plugin.body_name == 'base_link'
+    assert plugin.in_world and plugin.update_rate == 50.0
+    assert plugin.topics() == '/ground_truth'
+
+
+def test_ros2_p3d_defaults_are_the_plugins():
+    (plugin,) = p3d('<plugin name="truth" filename="libgazebo_ros_p3d.so">'
+                    '<body_name>base_link</body_name></plugin>')
+    assert plugin.frame_name == 'world' and plugin.update_rate == 0.0
+    assert plugin.gaussian_noise == 0.0 and plugin.xyz_offsets == (0.0, 0.0, 0.0)
+    assert plugin.topics() == '/odom'
+
+
+def test_ros1_p3d_reads_the_ros1_names():
+    (plugin,) = p3d('<plugin name="truth" filename="libgazebo_ros_p3d.so">'
+                    '<bodyName>base_link</bodyName><topicName>truth</topicName>'
+                    '<frameName>left_wheel</frameName><xyzOffsets>1 2 3</xyzOffsets>'
+                    '<gaussianNoise>0.01</gaussianNoise><updateRate>20</updateRate></plugin>')
+    assert plugin.convention == ROS1 and plugin.frame_name == 'left_wheel'
+    assert not plugin.in_world and plugin.xyz_offsets == (1.0, 2.0, 3.0)
+    assert (plugin.gaussian_noise, plugin.update_rate) == (0.01, 20.0)
+    assert plugin.topics() == '/truth' and plugin.topics('robot1') == '/robot1/truth'
+
+
+@pytest.mark.parametrize(('plugin', 'element', 'problem'), [
+    ('<body_name>chassis</body_name>', '<body_name>', "'chassis' is not a link"),
+    ('<frame_name>base_link</frame_name>', '<body_name>', 'is missing'),
+    ('<body_name>base_link</body_name><frame_name>odom</frame_name>', '<frame_name>',
+     "'odom' is neither world"),
+    ('<body_name>base_link</body_name><xyz_offsets>1 2</xyz_offsets>', '<xyz_offsets>',
+     'not three numbers'),
+    ('<body_name>base_link</body_name><gaussian_noise>-1</gaussian_noise>', '<gaussian_noise>',
+     'must be >= 0'),
+])
+def test_a_bad_p3d_element_ends_start_up_naming_the_plugin_and_the_element(
+        plugin, element, problem):
+    with pytest.raises(DescriptionError) as raised:
+        p3d(f'<plugin name="truth" filename="libgazebo_ros_p3d.so">{plugin}</plugin>')
+    message = str(raised.value)
+    assert "plugin 'truth' (libgazebo_ros_p3d.so)" in message and element in message
+    assert problem in message
