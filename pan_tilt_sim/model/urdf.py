@@ -53,6 +53,7 @@ import xml.etree.ElementTree as ElementTree
 
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model import naming
+from pan_tilt_sim.model.drive_plugins import read_drive_plugins, read_p3d_plugins
 from pan_tilt_sim.model.robot import (
     DEFAULT_AXIS,
     INITIAL_VALUE,
@@ -70,7 +71,6 @@ from pan_tilt_sim.model.robot import (
     RobotModel,
     Shape,
 )
-from pan_tilt_sim.model.drive_plugins import read_drive_plugins, read_p3d_plugins
 from pan_tilt_sim.model.sensors import (
     CHILD,
     CHILD_TO_PARENT,

@@ -6,7 +6,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from builtin_interfaces.msg import Duration, Time
-from geometry_msgs.msg import TwistStamped
+from geometry_msgs.msg import Twist, TwistStamped
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
@@ -57,6 +57,12 @@ def stamped_twist(message: TwistStamped) -> StampedTwist:
                         (angular.x, angular.y, angular.z))
 
 
+def twist(message: Twist) -> StampedTwist:
+    """Return a ``geometry_msgs/Twist`` as an unstamped :class:`StampedTwist` (stamp 0)."""
+    linear, angular = message.linear, message.angular
+    return StampedTwist(0.0, (linear.x, linear.y, linear.z), (angular.x, angular.y, angular.z))
+
+
 # Each command message type (by its ROS name), and how to get the command value out of it.
 # The class is None where its interface package is not installed (no such topics then).
 COMMAND_MESSAGES: dict[str, tuple[type | None, Callable[[Any], Any]]] = {
@@ -67,6 +73,7 @@ COMMAND_MESSAGES: dict[str, tuple[type | None, Callable[[Any], Any]]] = {
     CommandKind.MULTI_DOF_COMMAND.value: (MultiDOFCommand, lambda msg: (
         list(msg.dof_names), list(msg.values), list(msg.values_dot))),
     CommandKind.TWIST_STAMPED.value: (TwistStamped, stamped_twist),
+    CommandKind.TWIST.value: (Twist, twist),
 }
 
 
