@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import textwrap
 from collections.abc import Iterator
 
 import pytest
@@ -170,3 +171,40 @@ def test_p3d_publishes_the_true_pose_of_its_link(tmp_path):
         assert 2.0 * math.atan2(last.pose.pose.orientation.z,
                                 last.pose.pose.orientation.w) == pytest.approx(yaw, abs=1e-3)
 
+
+WALL_FACE = 0.8  # m: the near face of the wall ahead, on the x axis
+FRONT = 0.15  # m: the rover's front (its base box) ahead of its base frame
+LIDAR_X = 0.1  # m: the lidar ahead of the base frame
+
+
+def test_driving_at_a_wall_the_scan_sees_it_approach_and_the_contact_stops_the_robot(tmp_path):
+    world = tmp_path / 'wall.yaml'
+    world.write_text(textwrap.dedent(f'''\
+        entities:
+          - name: wall
+            shape: box
+            size: [0.1, 2.0, 0.5]
+            pose: {{position: [{WALL_FACE + 0.05}, 0.0, 0.25]}}
+        '''), encoding='utf-8')
+    with running(tmp_path, ROS2_DIFF_DRIVE, world=str(world)) as rover:
+        scans = rover.sim.collect(LaserScan, '/scan')
+        rover.sim.wait_for_subscribers('/scan')
+        rover.period()
+        rover.command(0.2, 0.0)
+        ahead = []  # (true x, range straight ahead) at each scan
+        for _ in range(60):  # 6 s: 1.2 m at 0.2 m/s, were there no wall
+            for _ in range(10):
+                rover.period()
+            assert rover.sim.spin_until(lambda: scans), 'no scan came'
+            rover.sim.drain()
+            middle = len(scans[-1].ranges) // 2
+            ahead.append((rover.true_pose()[0][0], min(scans[-1].ranges[middle - 1:middle + 1])))
+        first_x, first_range = ahead[0]
+        assert first_range == pytest.approx(WALL_FACE - LIDAR_X - first_x, abs=0.02)
+        ranges = [measured for _, measured in ahead]
+        assert all(later <= earlier + 0.005
+                   for earlier, later in zip(ranges, ranges[1:], strict=False))
+        last_x, last_range = ahead[-1]
+        assert last_x == pytest.approx(WALL_FACE - FRONT, abs=0.02)  # at the wall, not through
+        assert ahead[-10][0] == pytest.approx(last_x, abs=0.005)  # and stopped there
+        assert last_range == pytest.approx(WALL_FACE - LIDAR_X - last_x, abs=0.02)
