@@ -41,7 +41,9 @@ its node; ROS 1 ``bodyName``, ``frameName``, ``xyzOffsets``, ``rpyOffsets``,
 
 Topic names resolve as each generation resolves them: ROS 2 in a node named
 after the plugin in ``<ros><namespace>`` with its ``<remapping>``s; ROS 1
-in ``robotNamespace`` (see :mod:`pan_tilt_sim.model.sensors`).  A wheel
+in ``robotNamespace`` -- absent: the root (as spawn_model sets it), given
+empty: the robot's name, as gazebo_plugins' GazeboRos takes it (see
+:mod:`pan_tilt_sim.model.sensors`).  A wheel
 the robot does not have, a number that is not one, or a separation,
 diameter, torque or rate that is not positive ends start-up
 (:class:`~pan_tilt_sim.errors.DescriptionError` naming the plugin and the
@@ -172,11 +174,13 @@ class P3dPlugin:
 class _PluginReader:
     """Reads one ``<plugin>`` element's children; bad values name the plugin and the element."""
 
-    def __init__(self, element: ElementTree.Element, source: pathlib.Path | str) -> None:
+    def __init__(self, element: ElementTree.Element, source: pathlib.Path | str,
+                 robot_name: str) -> None:
         self.element = element
         self.name = element.get('name', '') or plugin_stem(element.get('filename', ''))
         self.filename = element.get('filename', '')
         self.source = source
+        self.robot_name = robot_name
         self.texts: dict[str, list[str]] = {}
         for child in element:
             self.texts.setdefault(child.tag, []).append((child.text or '').strip())
@@ -232,6 +236,12 @@ class _PluginReader:
             return False
         raise self.error(key, f"'{text}' is not a boolean (true/false)")
 
+    def ros1_namespace(self) -> str:
+        values = self.texts.get('robotNamespace')
+        if values is None:
+            return ''
+        return values[0] or self.robot_name
+
     def ros(self) -> tuple[str, tuple[tuple[str, str], ...]]:
         ros = self.element.find('ros')
         if ros is None:
@@ -259,7 +269,7 @@ def read_p3d_plugins(root: ElementTree.Element, source: pathlib.Path | str,
         for element in gazebo.findall('plugin'):
             if plugin_stem(element.get('filename', '')) != P3D:
                 continue
-            reader = _PluginReader(element, source)
+            reader = _PluginReader(element, source, root.get('name', ''))
             ros1 = bool(set(reader.texts) & ROS1_P3D_KEYS) and 'ros' not in reader.texts
             names = ('bodyName', 'frameName', 'xyzOffsets', 'rpyOffsets', 'gaussianNoise',
                      'updateRate') if ros1 else ('body_name', 'frame_name', 'xyz_offsets',
@@ -281,7 +291,7 @@ def read_p3d_plugins(root: ElementTree.Element, source: pathlib.Path | str,
                 gaussian_noise=reader.number(noise, 0.0, non_negative=True),
                 update_rate=reader.number(rate, 0.0, non_negative=True),
                 topic=reader.text('topicName', 'odom') if ros1 else 'odom',
-                namespace=reader.text('robotNamespace', '') if ros1 else namespace,
+                namespace=reader.ros1_namespace() if ros1 else namespace,
                 remappings=remappings))
     return tuple(plugins)
 
@@ -298,7 +308,7 @@ def read_drive_plugins(root: ElementTree.Element, source: pathlib.Path | str,
             continue
         for element in gazebo.findall('plugin'):
             if plugin_stem(element.get('filename', '')) == DIFF_DRIVE:
-                reader = _PluginReader(element, source)
+                reader = _PluginReader(element, source, root.get('name', ''))
                 ros1 = bool(set(reader.texts) & ROS1_DIFF_DRIVE_KEYS) and 'ros' not in \
                     reader.texts
                 plugin = _ros1_diff_drive(reader) if ros1 else _ros2_diff_drive(reader)
@@ -366,4 +376,4 @@ def _ros1_diff_drive(reader: _PluginReader) -> DiffDrivePlugin:
         covariance=(1e-5, 1e-5, 1e-3),
         command_topic=reader.text('commandTopic', 'cmd_vel'),
         odometry_topic=reader.text('odometryTopic', 'odom'),
-        namespace=reader.text('robotNamespace', ''))
+        namespace=reader.ros1_namespace())

@@ -129,6 +129,12 @@ def test_ros1_p3d_reads_the_ros1_names():
     assert plugin.topics() == '/truth' and plugin.topics('robot1') == '/robot1/truth'
 
 
+def test_ros1_an_empty_robot_namespace_is_the_robots_name():
+    (plugin,) = plugins(ROS1_DIFF_DRIVE.replace('<commandTopic>',
+                                                '<robotNamespace></robotNamespace><commandTopic>'))
+    assert plugin.topics() == ('/rover/cmd_vel', '/rover/odom')
+
+
 @pytest.mark.parametrize(('plugin', 'element', 'problem'), [
     ('<body_name>chassis</body_name>', '<body_name>', "'chassis' is not a link"),
     ('<frame_name>base_link</frame_name>', '<body_name>', 'is missing'),
