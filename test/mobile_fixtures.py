@@ -12,7 +12,8 @@ a ``diff_drive_controller/DiffDriveController`` named ``base_controller``.
 ``libgazebo_ros_diff_drive.so`` plugin instead (no ros2_control, no
 controllers file), with a planar lidar (``<sensor type="ray">`` on a
 ``lidar_link`` above the base) publishing a LaserScan on ``/scan`` and a
-``libgazebo_ros_p3d.so`` publishing the base's true pose on ``/ground_truth``.
+``libgazebo_ros_p3d.so`` publishing the base's true pose on ``/ground_truth``
+and a ``libgazebo_ros_joint_state_publisher.so`` of the wheels.
 """
 
 from __future__ import annotations
@@ -75,6 +76,11 @@ P3D = '''
     <body_name>base_link</body_name><frame_name>world</frame_name>
     <update_rate>50</update_rate>
   </plugin>'''
+JOINT_STATES = '''
+  <plugin name="joint_states" filename="libgazebo_ros_joint_state_publisher.so">
+    <joint_name>left_wheel_joint</joint_name><joint_name>right_wheel_joint</joint_name>
+    <update_rate>50</update_rate>
+  </plugin>'''
 LIDAR = '''
   <joint name="lidar_joint" type="fixed">
     <parent link="base_link"/><child link="lidar_link"/><origin xyz="0.1 0 0.05"/>
@@ -98,13 +104,15 @@ LIDAR = '''
 
 
 def plugin_rover_urdf(plugin: str = ROS2_DIFF_DRIVE, name: str = 'rover', *,
-                      ground_truth: str = P3D) -> str:
+                      ground_truth: str = P3D, joint_states: str = JOINT_STATES) -> str:
     """Return the rover driven by a Gazebo diff drive ``plugin`` (no ros2_control), a lidar.
 
-    ``ground_truth`` (a p3d plugin on ``/ground_truth`` by default) goes beside the drive.
+    ``ground_truth`` (a p3d plugin on ``/ground_truth`` by default) and
+    ``joint_states`` (a joint state publisher of both wheels on ``/joint_states``)
+    go beside the drive.
     """
     return rover_urdf(name, ros2_control=False,
-                      extra=f'<gazebo>{plugin}{ground_truth}</gazebo>{LIDAR}')
+                      extra=f'<gazebo>{plugin}{ground_truth}{joint_states}</gazebo>{LIDAR}')
 
 
 def rover_urdf(name: str = 'rover', *, world_joint: bool = False,

@@ -39,6 +39,12 @@ covariance (x, y, yaw)      ``covariance_x``,         fixed: 1e-5, 1e-5, 1e-3
 its node; ROS 1 ``bodyName``, ``frameName``, ``xyzOffsets``, ``rpyOffsets``,
 ``gaussianNoise``, ``updateRate``, ``topicName`` in ``robotNamespace``.
 
+``libgazebo_ros_joint_state_publisher.so`` publishes the named joints'
+``sensor_msgs/JointState``: ROS 2 ``joint_name`` (one element per joint,
+required), ``update_rate`` (100 Hz), topic ``joint_states`` of its node;
+ROS 1 ``jointName`` (comma-separated), ``updateRate`` (100 Hz) in
+``robotNamespace``.
+
 Topic names resolve as each generation resolves them: ROS 2 in a node named
 after the plugin in ``<ros><namespace>`` with its ``<remapping>``s; ROS 1
 in ``robotNamespace`` -- absent: the root (as spawn_model sets it), given
@@ -63,6 +69,7 @@ from pan_tilt_sim.model.sensors import ROS1, ROS2, Ros2Names, plugin_stem, ros1_
 
 DIFF_DRIVE = 'gazebo_ros_diff_drive'
 P3D = 'gazebo_ros_p3d'
+JOINT_STATE_PUBLISHER = 'gazebo_ros_joint_state_publisher'
 WORLD_FRAMES = ('world', '/world', 'map', '/map')  # p3d: poses in the world
 ROS1_P3D_KEYS = {'bodyName', 'frameName', 'topicName', 'xyzOffsets', 'rpyOffsets',
                  'gaussianNoise', 'updateRate', 'robotNamespace'}
@@ -169,6 +176,59 @@ class P3dPlugin:
         if self.convention == ROS1:
             return ros1_resolve(namespace, self.topic)
         return Ros2Names(self.name, namespace, self.remappings).topic(self.topic)
+
+
+@dataclasses.dataclass(frozen=True)
+class JointStatePlugin:
+    """One ``gazebo_ros_joint_state_publisher``: which joints, how often (Hz; 0: every step)."""
+
+    name: str
+    convention: str
+    joints: tuple[str, ...]
+    update_rate: float = 100.0
+    namespace: str = ''
+    remappings: tuple[tuple[str, str], ...] = ()
+
+    def topics(self, override: str = '') -> str:
+        """Return the joint states topic (absolute), ``override`` as the namespace."""
+        namespace = override or self.namespace
+        if self.convention == ROS1:
+            return ros1_resolve(namespace, 'joint_states')
+        return Ros2Names(self.name, namespace, self.remappings).topic('joint_states')
+
+
+def read_joint_state_plugins(root: ElementTree.Element, source: pathlib.Path | str,
+                             joints: Collection[str]) -> tuple[JointStatePlugin, ...]:
+    """Return the robot's ``gazebo_ros_joint_state_publisher`` plugins (see the module).
+
+    ``joints`` are the robot's movable joints: a name outside them, or none, ends start-up.
+    """
+    plugins = []
+    for gazebo in root.findall('gazebo'):
+        if gazebo.get('reference') is not None:
+            continue
+        for element in gazebo.findall('plugin'):
+            if plugin_stem(element.get('filename', '')) != JOINT_STATE_PUBLISHER:
+                continue
+            reader = _PluginReader(element, source, root.get('name', ''))
+            ros1 = 'jointName' in reader.texts or 'updateRate' in reader.texts or \
+                'robotNamespace' in reader.texts
+            key = 'jointName' if ros1 else 'joint_name'
+            names = [name.strip() for text in reader.all(key) for name in (
+                text.split(',') if ros1 else [text]) if name.strip()]
+            if not names:
+                raise reader.error(key, 'is missing: name the joints to publish')
+            for name in names:
+                if name not in joints:
+                    raise reader.error(key, f"'{name}' is not a movable joint of this robot")
+            namespace, remappings = ('', ()) if ros1 else reader.ros()
+            plugins.append(JointStatePlugin(
+                name=reader.name, convention=ROS1 if ros1 else ROS2, joints=tuple(names),
+                update_rate=reader.number('updateRate' if ros1 else 'update_rate', 100.0,
+                                          non_negative=True),
+                namespace=reader.ros1_namespace() if ros1 else namespace,
+                remappings=remappings))
+    return tuple(plugins)
 
 
 class _PluginReader:

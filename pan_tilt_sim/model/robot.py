@@ -18,7 +18,7 @@ import functools
 import math
 from collections.abc import Mapping
 
-from pan_tilt_sim.model.drive_plugins import DiffDrivePlugin, P3dPlugin
+from pan_tilt_sim.model.drive_plugins import DiffDrivePlugin, JointStatePlugin, P3dPlugin
 from pan_tilt_sim.model.sensors import SensorSpec
 from pan_tilt_sim.model.surfaces import Surface
 from pan_tilt_sim.model.transforms import (
@@ -284,6 +284,8 @@ class RobotModel:
     drive_plugins: tuple[DiffDrivePlugin, ...] = ()
     # Gazebo ground-truth plugins (libgazebo_ros_p3d.so): a link's true pose on a topic.
     p3d_plugins: tuple[P3dPlugin, ...] = ()
+    # Gazebo joint state publishers (libgazebo_ros_joint_state_publisher.so).
+    joint_state_plugins: tuple[JointStatePlugin, ...] = ()
 
     @property
     def link_frictions(self) -> dict[str, Surface]:

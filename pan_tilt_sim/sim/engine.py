@@ -43,6 +43,7 @@ from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
 from pan_tilt_sim.controllers.base import Drive, idle_actuator
 from pan_tilt_sim.controllers.gains import plugin_gains
 from pan_tilt_sim.controllers.gazebo_diff_drive import GazeboDiffDrive
+from pan_tilt_sim.controllers.gazebo_joint_state_publisher import GazeboJointStatePublisher
 from pan_tilt_sim.controllers.gazebo_p3d import GazeboP3d
 from pan_tilt_sim.controllers.manager import ControllerManager
 from pan_tilt_sim.controllers.registry import drives_base
@@ -159,8 +160,8 @@ class Simulation:
             self.manager = ControllerManager(controllers, self.handles, description.model,
                                              active=active_controllers,
                                              autostart=autostart_controllers)
-            # The URDF's Gazebo plugins (drive, ground truth): always active, updated before
-            # the controllers; no controller_manager knows them.
+            # The URDF's Gazebo plugins (drive, joint states, ground truth): always active,
+            # updated before the controllers; no controller_manager knows them.
             self.plugins: list[Controller] = []
             self._link_readers: dict[str, LinkReader] = {}
             for drive_plugin in description.model.drive_plugins:
@@ -168,6 +169,10 @@ class Simulation:
                 drive.configure(self.handles)
                 drive.set_base_state(self.base_state)
                 self.plugins.append(drive)
+            for states_plugin in description.model.joint_state_plugins:
+                states = GazeboJointStatePublisher(states_plugin, controllers.label)
+                states.configure(self.handles)
+                self.plugins.append(states)
             for p3d_plugin in description.model.p3d_plugins:
                 p3d = GazeboP3d(p3d_plugin, controllers.label)
                 p3d.set_link_state(self.link_state)

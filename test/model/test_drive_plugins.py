@@ -152,3 +152,41 @@ def test_a_bad_p3d_element_ends_start_up_naming_the_plugin_and_the_element(
     message = str(raised.value)
     assert "plugin 'truth' (libgazebo_ros_p3d.so)" in message and element in message
     assert problem in message
+
+
+def joint_states(text: str):
+    return parse_urdf(plugin_rover_urdf(joint_states=text), SOURCE).joint_state_plugins
+
+
+def test_ros2_joint_state_publisher_reads_its_joints_rate_and_topic():
+    (plugin,) = parse_urdf(plugin_rover_urdf(), SOURCE).joint_state_plugins
+    assert plugin.convention == ROS2
+    assert plugin.joints == ('left_wheel_joint', 'right_wheel_joint')
+    assert plugin.update_rate == 50.0 and plugin.topics() == '/joint_states'
+    (default,) = joint_states('<plugin name="js" filename="libgazebo_ros_joint_state_publisher.so">'
+                              '<joint_name>left_wheel_joint</joint_name></plugin>')
+    assert default.update_rate == 100.0
+
+
+def test_ros1_joint_state_publisher_reads_comma_separated_joints():
+    (plugin,) = joint_states(
+        '<plugin name="js" filename="libgazebo_ros_joint_state_publisher.so">'
+        '<robotNamespace>/rover</robotNamespace>'
+        '<jointName>left_wheel_joint, right_wheel_joint</jointName>'
+        '<updateRate>20</updateRate></plugin>')
+    assert plugin.convention == ROS1 and plugin.update_rate == 20.0
+    assert plugin.joints == ('left_wheel_joint', 'right_wheel_joint')
+    assert plugin.topics() == '/rover/joint_states'
+
+
+@pytest.mark.parametrize(('elements', 'problem'), [
+    ('', '<joint_name> is missing'),
+    ('<joint_name>caster_joint</joint_name>', "'caster_joint' is not a movable joint"),
+    ('<joint_name>left_wheel_joint</joint_name><update_rate>fast</update_rate>',
+     "<update_rate> 'fast' is not a number"),
+])
+def test_a_bad_joint_state_publisher_element_ends_start_up(elements, problem):
+    with pytest.raises(DescriptionError, match=problem) as raised:
+        joint_states('<plugin name="js" filename="libgazebo_ros_joint_state_publisher.so">'
+                     f'{elements}</plugin>')
+    assert "plugin 'js' (libgazebo_ros_joint_state_publisher.so)" in str(raised.value)

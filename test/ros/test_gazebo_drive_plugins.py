@@ -20,7 +20,7 @@ from geometry_msgs.msg import Twist
 from mobile_fixtures import REST_HEIGHT, ROS1_DIFF_DRIVE, ROS2_DIFF_DRIVE, plugin_rover_urdf
 from nav_msgs.msg import Odometry
 from node_harness import sim_node
-from sensor_msgs.msg import LaserScan
+from sensor_msgs.msg import JointState, LaserScan
 from sim_interfaces_client import SimInterfaces, position
 from tf2_msgs.msg import TFMessage
 
@@ -208,3 +208,21 @@ def test_driving_at_a_wall_the_scan_sees_it_approach_and_the_contact_stops_the_r
         assert last_x == pytest.approx(WALL_FACE - FRONT, abs=0.02)  # at the wall, not through
         assert ahead[-10][0] == pytest.approx(last_x, abs=0.005)  # and stopped there
         assert last_range == pytest.approx(WALL_FACE - LIDAR_X - last_x, abs=0.02)
+
+
+def test_the_joint_state_publisher_publishes_the_wheels(tmp_path):
+    with running(tmp_path, ROS2_DIFF_DRIVE) as rover:
+        states = rover.sim.collect(JointState, '/joint_states')
+        rover.sim.wait_for_subscribers('/joint_states')
+        rover.period()
+        rover.command(0.2, 0.0)
+        for _ in range(50):  # 0.5 s
+            rover.period()
+        assert rover.sim.spin_until(lambda: states), 'no joint states came'
+        rover.sim.drain()
+        last = states[-1]
+        assert list(last.name) == ['left_wheel_joint', 'right_wheel_joint']
+        positions = rover.node.simulation.joint_positions()
+        assert last.position[0] == pytest.approx(positions['left_wheel_joint'], abs=0.1)
+        assert last.position[0] > 0.5  # the wheels turned: 0.2 m/s for most of 0.5 s
+        assert len(states) == pytest.approx(0.5 * 50, abs=2)  # at the plugin's 50 Hz
