@@ -312,7 +312,8 @@ class Simulation:
         (:meth:`Physics.law_runner`), the steps between two broadcaster
         samples run in C, at least :data:`MIN_COMPILED_STEPS` at a time; a
         step at which a scheduled controller is due runs in Python.  Either
-        way the results are the same to the last bit.
+        way the results are the same to the last bit.  A robot with Gazebo
+        plugins (:attr:`plugins`) runs in Python: they have no compiled law.
         """
         scheduled = self.manager.scheduled_updates
         dt = self._time_step
@@ -448,9 +449,9 @@ class Simulation:
 
         Controllers are reset as after a start (commands and trajectories,
         timed on the old clock, are dropped; position controllers hold the
-        present position).
+        present position), and so are the Gazebo plugins (their rates start again).
         """
-        for controller in self.controllers:
+        for controller in [*self.plugins, *self.controllers]:
             controller.reset()
         self._steps = 0
 
