@@ -103,6 +103,8 @@ class Actuator:
     # For a velocity motor: whether the controller sets its force limit every step
     # (``JointHandle.force_limit``: a gripper's max_effort); else it is the effort limit.
     force_from_controller: bool = False
+    # What limits the motor's force, when not the URDF's effort limit (a Gazebo plugin's torque).
+    force_text: str = ''
 
     @property
     def drive(self) -> Drive:
@@ -127,6 +129,8 @@ class Actuator:
                         "(gz_ros2_control's hold_joints)")
             if self.kind is ActuatorKind.IDEAL_ACCELERATION:
                 return f'{self.kind.label}{owner}, a velocity motor with {limit}'
+            if self.force_text:
+                return f'{self.kind.label}{owner}, a velocity motor with {self.force_text}'
             if self.force_from_controller:
                 return (f'{self.kind.label}{owner}, a velocity motor with {limit}, or less as '
                         "the controller asks (a goal's max_effort)")

@@ -81,8 +81,12 @@ class GazeboDiffDrive(CommandController):
 
     def actuators(self) -> dict[str, Actuator]:
         """Return the ideal velocity actuator, its force limit the wheel torque, per wheel."""
+        plugin = self.plugin
+        element = 'wheelTorque' if plugin.convention == 'ros1' else 'max_wheel_torque'
+        text = f"at most {plugin.max_wheel_torque:g} N*m (the plugin's {element})"
         return {wheel: Actuator(ActuatorKind.IDEAL_VELOCITY, self.name,
-                                force_from_controller=True) for wheel in self.joint_names}
+                                force_from_controller=True, force_text=text)
+                for wheel in self.joint_names}
 
     def set_base_state(self, source: Callable[[], BaseState]) -> None:
         """Where the ``world`` odometry reads the base's true pose and twist."""

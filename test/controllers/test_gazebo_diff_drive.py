@@ -138,3 +138,10 @@ def test_a_reset_drops_the_command_and_the_odometry():
     assert drive.odometry.x == 0.0
     run(drive, handles, 0.05)
     assert all(handle.velocity_target == 0.0 for handle in handles.values())
+
+
+def test_the_start_up_line_names_the_plugins_torque():
+    drive, _ = unit(ROS1_DIFF_DRIVE)
+    spec = JointSpec('left_wheel_joint', JointKind.CONTINUOUS, effort_limit=2.0)
+    line = drive.actuators()['left_wheel_joint'].describe(spec)
+    assert "at most 20 N*m (the plugin's wheelTorque)" in line
