@@ -8,6 +8,12 @@ caster's lowest points are ``REST_HEIGHT`` below the base frame: resting on
 the ground, the base frame is at z = ``REST_HEIGHT``.  :func:`rover_controllers`
 is a ros2_control-style controllers file with a joint_state_broadcaster and
 a ``diff_drive_controller/DiffDriveController`` named ``base_controller``.
+:func:`plugin_rover_urdf` is the same rover driven by a
+``libgazebo_ros_diff_drive.so`` plugin instead (no ros2_control, no
+controllers file), with a planar lidar (``<sensor type="ray">`` on a
+``lidar_link`` above the base) publishing a LaserScan on ``/scan`` and a
+``libgazebo_ros_p3d.so`` publishing the base's true pose on ``/ground_truth``
+and a ``libgazebo_ros_joint_state_publisher.so`` of the wheels.
 """
 
 from __future__ import annotations
@@ -43,13 +49,80 @@ def _wheel(side: str, y: float) -> str:
       </link>'''
 
 
+ROS2_DIFF_DRIVE = f'''
+  <plugin name="diff_drive" filename="libgazebo_ros_diff_drive.so">
+    <left_joint>left_wheel_joint</left_joint><right_joint>right_wheel_joint</right_joint>
+    <wheel_separation>{WHEEL_SEPARATION}</wheel_separation>
+    <wheel_diameter>{2 * WHEEL_RADIUS}</wheel_diameter>
+    <max_wheel_torque>20</max_wheel_torque>
+    <max_wheel_acceleration>1.0</max_wheel_acceleration>
+    <publish_odom>true</publish_odom><publish_odom_tf>true</publish_odom_tf>
+    <odometry_frame>odom</odometry_frame><robot_base_frame>base_link</robot_base_frame>
+    <odometry_source>0</odometry_source>
+  </plugin>'''
+ROS1_DIFF_DRIVE = f'''
+  <plugin name="differential_drive_controller" filename="libgazebo_ros_diff_drive.so">
+    <leftJoint>left_wheel_joint</leftJoint><rightJoint>right_wheel_joint</rightJoint>
+    <wheelSeparation>{WHEEL_SEPARATION}</wheelSeparation>
+    <wheelDiameter>{2 * WHEEL_RADIUS}</wheelDiameter>
+    <wheelTorque>20</wheelTorque>
+    <commandTopic>cmd_vel</commandTopic><odometryTopic>odom</odometryTopic>
+    <odometryFrame>odom</odometryFrame><robotBaseFrame>base_link</robotBaseFrame>
+    <odometrySource>encoder</odometrySource>
+  </plugin>'''
+P3D = '''
+  <plugin name="ground_truth" filename="libgazebo_ros_p3d.so">
+    <ros><remapping>odom:=ground_truth</remapping></ros>
+    <body_name>base_link</body_name><frame_name>world</frame_name>
+    <update_rate>50</update_rate>
+  </plugin>'''
+JOINT_STATES = '''
+  <plugin name="joint_states" filename="libgazebo_ros_joint_state_publisher.so">
+    <joint_name>left_wheel_joint</joint_name><joint_name>right_wheel_joint</joint_name>
+    <update_rate>50</update_rate>
+  </plugin>'''
+LIDAR = '''
+  <joint name="lidar_joint" type="fixed">
+    <parent link="base_link"/><child link="lidar_link"/><origin xyz="0.1 0 0.05"/>
+  </joint>
+  <link name="lidar_link">
+    <inertial><mass value="0.05"/>
+      <inertia ixx="0.00001" ixy="0" ixz="0" iyy="0.00001" iyz="0" izz="0.00001"/></inertial>
+  </link>
+  <gazebo reference="lidar_link">
+    <sensor type="ray" name="lidar">
+      <update_rate>10</update_rate>
+      <ray><scan><horizontal><samples>90</samples><resolution>1</resolution>
+        <min_angle>-1.5708</min_angle><max_angle>1.5708</max_angle></horizontal></scan>
+        <range><min>0.05</min><max>8.0</max></range></ray>
+      <plugin name="scan" filename="libgazebo_ros_ray_sensor.so">
+        <ros><remapping>~/out:=scan</remapping></ros>
+        <output_type>sensor_msgs/LaserScan</output_type>
+      </plugin>
+    </sensor>
+  </gazebo>'''
+
+
+def plugin_rover_urdf(plugin: str = ROS2_DIFF_DRIVE, name: str = 'rover', *,
+                      ground_truth: str = P3D, joint_states: str = JOINT_STATES) -> str:
+    """Return the rover driven by a Gazebo diff drive ``plugin`` (no ros2_control), a lidar.
+
+    ``ground_truth`` (a p3d plugin on ``/ground_truth`` by default) and
+    ``joint_states`` (a joint state publisher of both wheels on ``/joint_states``)
+    go beside the drive.
+    """
+    return rover_urdf(name, ros2_control=False,
+                      extra=f'<gazebo>{plugin}{ground_truth}{joint_states}</gazebo>{LIDAR}')
+
+
 def rover_urdf(name: str = 'rover', *, world_joint: bool = False,
-               footprint: bool = False) -> str:
+               footprint: bool = False, ros2_control: bool = True, extra: str = '') -> str:
     """Return the rover's URDF.
 
     ``world_joint`` hangs it on a ``world`` link by a fixed joint; ``footprint``
     on a massless ``base_footprint`` root on the ground, ``REST_HEIGHT`` below
-    ``base_link``.
+    ``base_link``.  ``ros2_control`` False leaves out the ``<ros2_control>``
+    block; ``extra`` is inserted before the end of the robot.
     """
     world = ('<link name="world"/><joint name="world_joint" type="fixed">'
              '<parent link="world"/><child link="base_link"/></joint>') if world_joint else ''
@@ -81,15 +154,19 @@ def rover_urdf(name: str = 'rover', *, world_joint: bool = False,
           </link>
           <gazebo reference="caster"><mu1>0.0</mu1><mu2>0.0</mu2></gazebo>
           <gazebo reference="left_wheel"><mu1>1.0</mu1><mu2>1.0</mu2></gazebo>
-          <ros2_control name="rover" type="system">
+          {_ROS2_CONTROL if ros2_control else ''}
+          {extra}
+        </robot>
+        ''').lstrip()
+
+
+_ROS2_CONTROL = '''<ros2_control name="rover" type="system">
             <hardware><plugin>gz_ros2_control/GazeboSimSystem</plugin></hardware>
             <joint name="left_wheel_joint"><command_interface name="velocity"/>
               <state_interface name="position"/><state_interface name="velocity"/></joint>
             <joint name="right_wheel_joint"><command_interface name="velocity"/>
               <state_interface name="position"/><state_interface name="velocity"/></joint>
-          </ros2_control>
-        </robot>
-        ''').lstrip()
+          </ros2_control>'''
 
 
 def drive_parameters(**overrides: Any) -> dict[str, Any]:

@@ -109,6 +109,8 @@ class Actuator:
     # For a velocity motor: whether the controller sets its force limit every step
     # (``JointHandle.force_limit``: a gripper's max_effort); else it is the effort limit.
     force_from_controller: bool = False
+    # What limits the motor's force, when not the URDF's effort limit (a Gazebo plugin's torque).
+    force_text: str = ''
 
     @property
     def drive(self) -> Drive:
@@ -133,6 +135,8 @@ class Actuator:
                         "(gz_ros2_control's hold_joints)")
             if self.kind is ActuatorKind.IDEAL_ACCELERATION:
                 return f'{self.kind.label}{owner}, a velocity motor with {limit}'
+            if self.force_text:
+                return f'{self.kind.label}{owner}, a velocity motor with {self.force_text}'
             if self.force_from_controller:
                 return (f'{self.kind.label}{owner}, a velocity motor with {limit}, or less as '
                         "the controller asks (a goal's max_effort)")
@@ -255,6 +259,7 @@ class CommandKind(enum.Enum):
     JOINT_TRAJECTORY = 'trajectory_msgs/msg/JointTrajectory'
     MULTI_DOF_COMMAND = 'control_msgs/msg/MultiDOFCommand'
     TWIST_STAMPED = 'geometry_msgs/msg/TwistStamped'
+    TWIST = 'geometry_msgs/msg/Twist'  # Gazebo's drive plugins: taken as an unstamped one
 
 
 class CommandResult(enum.Enum):

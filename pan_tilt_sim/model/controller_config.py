@@ -222,6 +222,9 @@ def controllers_files_for(given: str, description: RobotDescription, *,
     a relative path is taken from the description's folder, or from the
     current directory -- where Gazebo would look -- if only there it
     exists).  Else, for the shipped pan/tilt model, its shipped controllers.
+    Else, for a URDF whose Gazebo plugins run it (a diff drive, p3d or
+    joint state publisher plugin, :mod:`pan_tilt_sim.model.drive_plugins`), none: it runs without
+    controllers, as in Gazebo.
     """
     if given:
         try:
@@ -233,6 +236,9 @@ def controllers_files_for(given: str, description: RobotDescription, *,
         return named
     if description.name == DEFAULT_ROBOT_NAME:
         return (package_share() / DEFAULT_CONTROLLERS,)
+    model = description.model
+    if model.drive_plugins or model.p3d_plugins or model.joint_state_plugins:
+        return ()
     raise ControllerConfigError(
         f'{description.source}: no controllers file: {given_as} is not set and the URDF names '
         'none (no gz_ros2_control, ign_ros2_control or gazebo_ros2_control plugin with '
@@ -294,17 +300,24 @@ def read_yaml(path: pathlib.Path) -> Any:
     return parse_yaml(read_text(path), path)
 
 
+NO_CONTROLLERS_FILE = pathlib.Path('(no controllers file)')
+
+
 def load_controllers_config(paths: pathlib.Path | str | Sequence[pathlib.Path | str],
                             args: Mapping[str, str] | None = None, *,
                             args_name: str = f"the parameter '{CONTROLLERS_ARGS}'"
                             ) -> ControllersConfig:
     """Read the controllers file(s) at ``paths`` (several: read in order, later ones win).
 
+    No paths: no controllers (a robot its Gazebo plugins run).
+
     ``args`` are the values of ``$(var name)`` substitutions; ``args_name``
     says in errors where they come from.
     """
     if isinstance(paths, str | os.PathLike):
         paths = [paths]
+    if not paths:  # a robot its Gazebo plugins run (see controllers_files_for)
+        return ControllersConfig((), NO_CONTROLLERS_FILE)
     paths = [pathlib.Path(path).expanduser().resolve() for path in paths]
     documents = [(path, _read_document(path, args or {}, args_name)) for path in paths]
     label = ' + '.join(str(path) for path in paths)

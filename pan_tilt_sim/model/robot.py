@@ -18,6 +18,7 @@ import functools
 import math
 from collections.abc import Mapping
 
+from pan_tilt_sim.model.drive_plugins import DiffDrivePlugin, JointStatePlugin, P3dPlugin
 from pan_tilt_sim.model.sensors import SensorSpec
 from pan_tilt_sim.model.surfaces import Surface
 from pan_tilt_sim.model.transforms import (
@@ -318,6 +319,12 @@ class RobotModel:
     sensor_warnings: tuple[str, ...] = ()
     # Contact surfaces from <gazebo reference="LINK"> (mu1, mu2, kp, kd), for links that give any.
     surfaces: tuple[Surface, ...] = ()
+    # Gazebo drive plugins (<gazebo><plugin> libgazebo_ros_diff_drive.so): they drive the base.
+    drive_plugins: tuple[DiffDrivePlugin, ...] = ()
+    # Gazebo ground-truth plugins (libgazebo_ros_p3d.so): a link's true pose on a topic.
+    p3d_plugins: tuple[P3dPlugin, ...] = ()
+    # Gazebo joint state publishers (libgazebo_ros_joint_state_publisher.so).
+    joint_state_plugins: tuple[JointStatePlugin, ...] = ()
 
     @property
     def link_frictions(self) -> dict[str, Surface]:

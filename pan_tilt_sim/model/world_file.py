@@ -16,6 +16,16 @@ give::
           orientation: [0, 0, 0, 1]         # quaternion x y z w, or rpy: [r, p, y] (rad)
         description: a box to push          # optional, for GetEntityInfo
         tags: [pushable]                    # optional, for GetEntities' tag filter
+      - name: north_wall       # a simple shape instead of a URDF
+        shape: box             # box | cylinder | sphere
+        size: [0.1, 4.0, 0.5]  # m: box [x, y, z]; cylinder [radius, length]; sphere [radius]
+        colour: [0.8, 0.8, 0.8, 1.0]        # rgba (or rgb), each 0..1 (default grey)
+        static: true           # fixed where it is (default); false: free, of ``mass`` kg (1)
+        pose: {position: [2.0, 0.0, 0.25]}  # its centre
+
+A shape becomes a one-link URDF (:func:`shape_urdf`), its collision and
+visual the same shape, a cylinder's axis along z; cameras and lidars see
+it, robots touch it.
 
 Every problem ends start-up with one line naming the file and the field
 (:class:`WorldFileError`), or the parameter when its value names nothing
@@ -48,7 +58,12 @@ TARGETS = 'targets'
 SCENERIES = (EMPTY, GROUND, TARGETS)
 DEFAULT_FILE_SCENERY = GROUND
 WORLD_KEYS = ('scenery', 'entities')
-ENTITY_KEYS = ('name', 'uri', 'resource_string', 'pose', 'description', 'tags')
+ENTITY_KEYS = ('name', 'uri', 'resource_string', 'pose', 'description', 'tags', 'shape', 'size',
+               'colour', 'static', 'mass')
+SHAPE_KEYS = ('shape', 'size', 'colour', 'static', 'mass')
+SHAPE_SIZES = {'box': ('x', 'y', 'z'), 'cylinder': ('radius', 'length'), 'sphere': ('radius',)}
+DEFAULT_COLOUR = (0.7, 0.7, 0.7, 1.0)
+DEFAULT_SHAPE_MASS = 1.0  # kg, for a shape that is not static
 POSE_KEYS = ('position', 'orientation', 'rpy')
 NORM_TOLERANCE = 1e-6  # a quaternion whose norm is this close to 0 is no rotation
 
@@ -135,13 +150,89 @@ def _entity(entry: Any, path: pathlib.Path, where: str) -> EntitySpec:
         if not isinstance(value, str):
             raise WorldFileError(f'{path}: {where}.{key}: must be a string, got {_kind(value)}')
         texts[key] = value
+    if 'shape' in entry:
+        if texts['uri'] or texts['resource_string']:
+            raise WorldFileError(f'{path}: {where}: give a shape, a uri or a resource_string, '
+                                 'only one')
+        index = ''.join(character for character in where if character.isdigit())
+        texts['resource_string'] = _shape(entry, path, where,
+                                          texts['name'] or f"{entry['shape']}_{index}")
+    else:
+        extra = [key for key in SHAPE_KEYS if key in entry]
+        if extra:
+            raise WorldFileError(f"{path}: {where}.{extra[0]}: only a shape takes it (no "
+                                 "'shape' given)")
     if not texts['uri'] and not texts['resource_string']:
-        raise WorldFileError(f'{path}: {where}: give a uri or a resource_string')
+        raise WorldFileError(f'{path}: {where}: give a uri, a resource_string or a shape')
     tags = entry.get('tags', [])
     if not isinstance(tags, list) or not all(isinstance(tag, str) for tag in tags):
         raise WorldFileError(f'{path}: {where}.tags: must be a list of strings')
     position, orientation = _pose(entry.get('pose', {}), path, f'{where}.pose')
     return EntitySpec(position=position, orientation=orientation, tags=tuple(tags), **texts)
+
+
+def _shape(entry: Mapping[str, Any], path: pathlib.Path, where: str, name: str) -> str:
+    """Check a shape entry; return its URDF."""
+    shape = entry['shape']
+    if shape not in SHAPE_SIZES:
+        raise WorldFileError(f"{path}: {where}.shape: must be one of {', '.join(SHAPE_SIZES)}, "
+                             f'got {shape!r}')
+    names = SHAPE_SIZES[shape]
+    if 'size' not in entry:
+        raise WorldFileError(f"{path}: {where}.size: a {shape} needs its size "
+                             f"[{', '.join(names)}] (m)")
+    size = _numbers(entry['size'], len(names), path, f'{where}.size')
+    if not all(value > 0.0 for value in size):
+        raise WorldFileError(f"{path}: {where}.size: [{', '.join(names)}] must all be > 0, "
+                             f'got {list(size)!r}')
+    colour = entry.get('colour', list(DEFAULT_COLOUR))
+    if isinstance(colour, list) and len(colour) == 3:
+        colour = [*colour, 1.0]
+    rgba = _numbers(colour, 4, path, f'{where}.colour')
+    if not all(0.0 <= value <= 1.0 for value in rgba):
+        raise WorldFileError(f'{path}: {where}.colour: each of r, g, b, a must be in 0..1, '
+                             f'got {colour!r}')
+    static = entry.get('static', True)
+    if not isinstance(static, bool):
+        raise WorldFileError(f'{path}: {where}.static: must be true or false, got {static!r}')
+    mass = entry.get('mass', DEFAULT_SHAPE_MASS)
+    if isinstance(mass, bool) or not isinstance(mass, int | float) or not (
+            math.isfinite(mass) and mass > 0.0):
+        raise WorldFileError(f'{path}: {where}.mass: must be a number > 0 (kg), got {mass!r}')
+    return shape_urdf(name, shape, size, rgba, static=static, mass=float(mass))
+
+
+def shape_urdf(name: str, shape: str, size: tuple[float, ...], rgba: tuple[float, ...], *,
+               static: bool = True, mass: float = DEFAULT_SHAPE_MASS) -> str:
+    """Return a one-link URDF of a box, cylinder or sphere (m, kg), centred on its frame.
+
+    ``size``: a box's [x, y, z], a cylinder's [radius, length] (axis z), a
+    sphere's [radius].  ``static``: ``<gazebo><static>`` (fixed where it is put).
+    """
+    if shape == 'box':
+        x, y, z = size
+        geometry = f'<box size="{x!r} {y!r} {z!r}"/>'
+        inertia = (mass * (y * y + z * z) / 12, mass * (x * x + z * z) / 12,
+                   mass * (x * x + y * y) / 12)
+    elif shape == 'cylinder':
+        radius, length = size
+        geometry = f'<cylinder radius="{radius!r}" length="{length!r}"/>'
+        side = mass * (3 * radius * radius + length * length) / 12
+        inertia = (side, side, mass * radius * radius / 2)
+    else:
+        (radius,) = size
+        geometry = f'<sphere radius="{radius!r}"/>'
+        inertia = (2 * mass * radius * radius / 5,) * 3
+    ixx, iyy, izz = inertia
+    colour = ' '.join(repr(value) for value in rgba)
+    static_tag = '<gazebo><static>true</static></gazebo>' if static else ''
+    return (f'<robot name="{name}"><link name="{name}_link">'
+            f'<inertial><mass value="{mass!r}"/><inertia ixx="{ixx!r}" ixy="0" ixz="0" '
+            f'iyy="{iyy!r}" iyz="0" izz="{izz!r}"/></inertial>'
+            f'<visual><geometry>{geometry}</geometry><material name="{name}_colour">'
+            f'<color rgba="{colour}"/></material></visual>'
+            f'<collision><geometry>{geometry}</geometry></collision></link>'
+            f'{static_tag}</robot>')
 
 
 def _pose(pose: Any, path: pathlib.Path, where: str) -> tuple[Vector, Quaternion]:

@@ -40,7 +40,9 @@ start-up, and :meth:`~ControllerBindings.load`,
 :meth:`~ControllerBindings.unload` and :meth:`~ControllerBindings.switch`
 change the simulation's controllers (the controller_manager services call
 these, and nothing else touches the simulation's controllers) and keep the
-entities in step.  Each is one short call, made between physics steps.
+entities in step.  The URDF's Gazebo drive plugins
+(:attr:`~pan_tilt_sim.sim.engine.Simulation.plugins`) get their entities the
+same way, once, and always take commands.  Each is one short call, made between physics steps.
 """
 
 from __future__ import annotations
@@ -132,7 +134,9 @@ class ControllerBindings:
         self.actions: dict[str, Any] = {}
         # Wakes the executor when a goal ended or feedback is due (see after_steps).
         self._attention = node.create_guard_condition(self.serve_actions)
-        for controller in self._manager.configured:
+        # The URDF's Gazebo drive plugins: bound once, always active (no manager knows them).
+        self._plugins = {unit.name for unit in simulation.plugins}
+        for controller in [*simulation.plugins, *self._manager.configured]:
             self._bind(controller)
 
     # --- the run-time changes (controller_manager's services) ----------------------------------
@@ -352,7 +356,11 @@ class ControllerBindings:
         name = controller.name
         logger = self._logger
         counts = self.commands_received
-        is_active = self._manager.is_active
+        manager_active = self._manager.is_active
+        plugins = self._plugins
+
+        def is_active(name: str) -> bool:
+            return name in plugins or manager_active(name)
         accept, problem = endpoint.accept, endpoint.problem
         while_chained = endpoint.while_chained
 
@@ -562,6 +570,32 @@ class TrajectoryStateSink(_HeldSink):
         message.output.positions, message.output.effort = output
 
 
+class SpatialOdometrySink(OdometrySink):
+    """Odometry samples in 3-D: ``sink(time, pose, linear, angular)``.
+
+    ``pose`` a Transform (m, quaternion), ``linear`` and ``angular`` the
+    twist's (x, y, z) in m/s and rad/s.  The fields are the planar sink's.
+    """
+
+    def __call__(self, time: float, pose: Any, linear: Sequence[float],
+                 angular: Sequence[float]) -> None:
+        """Take a sample."""
+        message = self._take()
+        stamp(time, message.header.stamp)
+        position, orientation = message.pose.pose.position, message.pose.pose.orientation
+        position.x, position.y, position.z = pose.translation
+        orientation.x, orientation.y, orientation.z, orientation.w = pose.rotation
+        twist = message.twist.twist
+        twist.linear.x, twist.linear.y, twist.linear.z = linear
+        twist.angular.x, twist.angular.y, twist.angular.z = angular
+
+
+def odometry_sink(publisher: Any, fields: Mapping[str, Any]) -> OdometrySink:
+    """Return the odometry sink ``fields`` ask for: planar, or 3-D with ``spatial``."""
+    kind = SpatialOdometrySink if fields.get('spatial') else OdometrySink
+    return kind(publisher, fields)
+
+
 class TfSink(_HeldSink):
     """Transforms as ``tf2_msgs/msg/TFMessage``: ``sink(time, [(parent, child, transform)])``."""
 
@@ -600,7 +634,7 @@ STATE_SINKS: dict[str, tuple[type | None, Callable[[Any, Mapping[str, Any]], Any
     'control_msgs/msg/MultiDOFStateStamped': (MultiDOFStateStamped, DofStateSink),
     'control_msgs/msg/JointTrajectoryControllerState': (
         JointTrajectoryControllerState, TrajectoryStateSink),
-    'nav_msgs/msg/Odometry': (Odometry, OdometrySink),
+    'nav_msgs/msg/Odometry': (Odometry, odometry_sink),
     'geometry_msgs/msg/TwistStamped': (TwistStamped, TwistSink),
     'geometry_msgs/msg/WrenchStamped': (WrenchStamped, WrenchSink),
     'sensor_msgs/msg/Imu': (Imu, ImuSink),

@@ -7,7 +7,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from builtin_interfaces.msg import Duration, Time
-from geometry_msgs.msg import TwistStamped
+from geometry_msgs.msg import Twist, TwistStamped
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
@@ -58,6 +58,12 @@ def stamped_twist(message: TwistStamped) -> StampedTwist:
                         (angular.x, angular.y, angular.z))
 
 
+def twist(message: Twist) -> StampedTwist:
+    """Return a ``geometry_msgs/Twist`` as an unstamped :class:`StampedTwist` (stamp 0)."""
+    linear, angular = message.linear, message.angular
+    return StampedTwist(0.0, (linear.x, linear.y, linear.z), (angular.x, angular.y, angular.z))
+
+
 def group_values(message: Any) -> tuple[list[str], list[tuple[list[str], list[float]]]]:
     """Return a ``control_msgs/DynamicInterfaceGroupValues`` as plain lists.
 
@@ -89,6 +95,7 @@ COMMAND_MESSAGES: dict[str, tuple[type | None, Callable[[Any], Any]]] = {
     CommandKind.MULTI_DOF_COMMAND.value: (MultiDOFCommand, lambda msg: (
         list(msg.dof_names), list(msg.values), list(msg.values_dot))),
     CommandKind.TWIST_STAMPED.value: (TwistStamped, stamped_twist),
+    CommandKind.TWIST.value: (Twist, twist),
 }
 if (_group_values := optional_message(GROUP_VALUES)) is not None:
     COMMAND_MESSAGES[GROUP_VALUES] = (_group_values, group_values)

@@ -593,12 +593,14 @@ class SimNode(Node):
         broadcasters = [c for c in every if not c.params['use_local_topics']]
         topic = self.topic('joint_states')
         if not broadcasters:
-            local = [c.name for c in every]
-            where = (f' publishes on {topic} (use_local_topics: {", ".join(local)})' if local
-                     else '')
-            logger.warning(
-                f'no joint_state_broadcaster in {controllers.label}{where}: nothing will '
-                f'be published on {topic}')
+            # A Gazebo joint state publisher in the URDF publishes them instead.
+            if not self.simulation.description.model.joint_state_plugins:
+                local = [c.name for c in every]
+                where = (f' publishes on {topic} (use_local_topics: {", ".join(local)})'
+                         if local else '')
+                logger.warning(
+                    f'no joint_state_broadcaster in {controllers.label}{where}: nothing will '
+                    f'be published on {topic}')
         elif not any(manager.is_active(c.name) for c in broadcasters):
             logger.warning(
                 f"{', '.join(c.name for c in broadcasters)}: inactive (not in "

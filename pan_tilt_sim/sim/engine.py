@@ -36,16 +36,22 @@ import time as wall_time
 from collections.abc import Mapping, Sequence
 from typing import Protocol
 
+import numpy
+
 from pan_tilt_sim.controllers import CommandController, Controller, JointHandle
 from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
 from pan_tilt_sim.controllers.base import Drive, idle_actuator
 from pan_tilt_sim.controllers.gains import plugin_gains
+from pan_tilt_sim.controllers.gazebo_diff_drive import GazeboDiffDrive
+from pan_tilt_sim.controllers.gazebo_joint_state_publisher import GazeboJointStatePublisher
+from pan_tilt_sim.controllers.gazebo_p3d import GazeboP3d
 from pan_tilt_sim.controllers.manager import ControllerManager
 from pan_tilt_sim.controllers.registry import drives_base
 from pan_tilt_sim.model.base_pose import FIXED_BASE, ORIGIN, BasePose
 from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.initial_positions import FROM_DEFAULT, StartPosition, start_positions
+from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.schedule import DUE_EPSILON
 from pan_tilt_sim.sim.hardware import SimulatedHardware
 from pan_tilt_sim.sim.physics import (
@@ -56,6 +62,7 @@ from pan_tilt_sim.sim.physics import (
     Physics,
     health_problem,
 )
+from pan_tilt_sim.sim.sensors.mount import LinkReader
 from pan_tilt_sim.sim.stability import check_startup_stability, pid_stability_warnings
 
 LOGGER_NAME = 'pan_tilt_sim'
@@ -86,13 +93,18 @@ def base_is_fixed(fixed_base: bool | None, description: RobotDescription,
     ``fixed_base`` True or False is the answer, None is ``auto``: free if a
     controller that drives the base will be active -- with ``autostart``,
     one of ``active`` (None: every controller of the file); waiting for
-    spawners, any the file declares.  A robot hung on a ``world`` link by a
+    spawners, any the file declares -- or if the URDF has a Gazebo drive
+    plugin (:mod:`pan_tilt_sim.model.drive_plugins`).  A robot hung on a ``world`` link by a
     fixed joint is welded whatever ``fixed_base`` says, as in Gazebo.
     """
     if description.model.welded_to_world:
         return True, "its root link 'world' holds it by a fixed joint, as in Gazebo"
     if fixed_base is not None:
         return fixed_base, f'{FIXED_BASE} is {str(fixed_base).lower()}'
+    plugins = description.model.drive_plugins
+    if plugins:
+        return False, (f"{FIXED_BASE} is auto and Gazebo plugin '{plugins[0].name}' "
+                       f'(libgazebo_ros_diff_drive.so) drives the base')
     candidates = [spec for spec in controllers.controllers
                   if not autostart or active is None or spec.name in active]
     drivers = [spec for spec in candidates if drives_base(spec.type)]
@@ -155,6 +167,23 @@ class Simulation:
                                              active=active_controllers,
                                              autostart=autostart_controllers,
                                              hardware=self.hardware.interfaces)
+            # The URDF's Gazebo plugins (drive, joint states, ground truth): always active,
+            # updated before the controllers; no controller_manager knows them.
+            self.plugins: list[Controller] = []
+            self._link_readers: dict[str, LinkReader] = {}
+            for drive_plugin in description.model.drive_plugins:
+                drive = GazeboDiffDrive(drive_plugin, controllers.label)
+                drive.configure(self.handles)
+                drive.set_base_state(self.base_state)
+                self.plugins.append(drive)
+            for states_plugin in description.model.joint_state_plugins:
+                states = GazeboJointStatePublisher(states_plugin, controllers.label)
+                states.configure(self.handles)
+                self.plugins.append(states)
+            for p3d_plugin in description.model.p3d_plugins:
+                p3d = GazeboP3d(p3d_plugin, controllers.label)
+                p3d.set_link_state(self.link_state)
+                self.plugins.append(p3d)
         except BaseException:
             self.physics.close()
             raise
@@ -178,6 +207,8 @@ class Simulation:
         has driven yet is held instead (see ``autostart_controllers``).
         """
         actuators = {}
+        for plugin in self.plugins:
+            actuators.update(plugin.actuators())
         for controller in self.manager.active:
             actuators.update(controller.actuators())
         self._driven.update(actuators)
@@ -287,12 +318,13 @@ class Simulation:
         (:meth:`Physics.law_runner`), the steps between two broadcaster
         samples run in C, at least :data:`MIN_COMPILED_STEPS` at a time; a
         step at which a scheduled controller is due runs in Python.  Either
-        way the results are the same to the last bit.
+        way the results are the same to the last bit.  A robot with Gazebo
+        plugins (:attr:`plugins`) runs in Python: they have no compiled law.
         """
         scheduled = self.manager.scheduled_updates
         dt = self._time_step
         shortest = min((schedule.period for schedule, _ in scheduled), default=math.inf)
-        if self._run_laws is None or shortest < MIN_COMPILED_STEPS * dt:
+        if self._run_laws is None or self.plugins or shortest < MIN_COMPILED_STEPS * dt:
             # A broadcaster due (nearly) every step leaves no stretch worth the hand-over.
             self._advance_python(steps)
             return
@@ -351,7 +383,7 @@ class Simulation:
         # and scheduled ones (the broadcasters) only when due.  This loop's
         # Python is what the compiled laws save (docs/performance.md).
         handles = self._handle_list
-        updates = self.manager.updates
+        updates = [unit.update for unit in self.plugins] + self.manager.updates
         scheduled = self.manager.scheduled_updates
         effort_handles, efforts = self._effort_handles, self._efforts
         velocity_handles, targets = self._velocity_handles, self._targets
@@ -410,7 +442,7 @@ class Simulation:
         self.physics.reset_base()
         self.physics.reset_joints([handle.position for handle in self._handle_list])
         self._states = self.physics.read_states()
-        for controller in self.manager.configured:
+        for controller in [*self.plugins, *self.manager.configured]:
             controller.reset()
         if self._hold_undriven:  # undriven joints are held again, as at start
             self._driven.clear()
@@ -424,14 +456,42 @@ class Simulation:
 
         Controllers are reset as after a start (commands and trajectories,
         timed on the old clock, are dropped; position controllers hold the
-        present position).
+        present position), and so are the Gazebo plugins (their rates start again).
         """
-        for controller in self.controllers:
+        for controller in [*self.plugins, *self.controllers]:
             controller.reset()
         self._steps = 0
         for sensor in self.hardware.interfaces.sensors.values():  # their readings' past is gone
             if sensor.source is not None:
                 sensor.source.reset()
+
+    def base_state(self) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+        """Return the base's planar pose and twist: (x, y, heading), (forward, left, yaw rate).
+
+        The pose of the root link frame in the world (m, rad); the velocity of
+        its centre of mass in its own heading's axes (m/s) and the yaw rate (rad/s).
+        """
+        frame = self.physics.base_frame()
+        x, y, _ = frame.translation
+        qx, qy, qz, qw = frame.rotation
+        heading = math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+        (vx, vy, _), (_, _, yaw_rate) = self.physics.base_velocity()
+        cos, sin = math.cos(heading), math.sin(heading)
+        return (x, y, heading), (cos * vx + sin * vy, cos * vy - sin * vx, yaw_rate)
+
+    def link_state(self, link: str) -> tuple[Transform, tuple[float, float, float],
+                                              tuple[float, float, float]]:
+        """Return ``link``'s frame in the world and its origin's linear and angular velocity.
+
+        Velocities in world axes (m/s, rad/s).
+        """
+        reader = self._link_readers.get(link)
+        if reader is None:
+            reader = self._link_readers[link] = LinkReader(self.physics, link)
+        state = reader.state()
+        frame = state.frame
+        linear = state.point_velocity(numpy.array(frame.translation))
+        return frame, tuple(linear), tuple(state.angular_velocity)  # type: ignore[return-value]
 
     def joint_positions(self) -> dict[str, float]:
         """Return the measured position of every movable joint, by name."""

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 import textwrap
 
 import pytest
@@ -65,8 +66,25 @@ def test_a_world_file_by_file_uri_and_its_default_scenery(tmp_path):
     ('scenery: moon\n', r"scenery: must be one of empty, ground, targets, got 'moon'"),
     ('entities: {a: 1}\n', 'entities: must be a list, got a mapping'),
     ('entities: [3]\n', r'entities\[0\]: must be a mapping, got a number'),
-    ('entities: [{name: a}]\n', r'entities\[0\]: give a uri or a resource_string'),
-    ('entities: [{uri: a, colour: red}]\n', r"entities\[0\]: unknown key 'colour'"),
+    ('entities: [{name: a}]\n', r'entities\[0\]: give a uri, a resource_string or a shape'),
+    ('entities: [{uri: a, texture: red}]\n', r"entities\[0\]: unknown key 'texture'"),
+    ('entities: [{uri: a, colour: [1, 0, 0]}]\n',
+     r"entities\[0\].colour: only a shape takes it \(no 'shape' given\)"),
+    ('entities: [{uri: a, shape: box, size: [1, 1, 1]}]\n',
+     r'entities\[0\]: give a shape, a uri or a resource_string, only one'),
+    ('entities: [{shape: cone, size: [1]}]\n',
+     r"entities\[0\].shape: must be one of box, cylinder, sphere, got 'cone'"),
+    ('entities: [{shape: box}]\n', r'entities\[0\].size: a box needs its size \[x, y, z\]'),
+    ('entities: [{shape: cylinder, size: [1]}]\n',
+     r'entities\[0\].size: must be 2 finite numbers'),
+    ('entities: [{shape: sphere, size: [0]}]\n',
+     r'entities\[0\].size: \[radius\] must all be > 0'),
+    ('entities: [{shape: sphere, size: [1], colour: [2, 0, 0]}]\n',
+     r'entities\[0\].colour: each of r, g, b, a must be in 0..1'),
+    ('entities: [{shape: sphere, size: [1], static: maybe}]\n',
+     r'entities\[0\].static: must be true or false'),
+    ('entities: [{shape: sphere, size: [1], static: false, mass: 0}]\n',
+     r'entities\[0\].mass: must be a number > 0'),
     ('entities: [{uri: a, name: 3}]\n', r'entities\[0\].name: must be a string'),
     ('entities: [{uri: a, pose: {position: [1, 2]}}]\n',
      r'entities\[0\].pose.position: must be 3 finite numbers'),
@@ -119,3 +137,34 @@ def test_a_device_given_as_the_world_is_not_a_regular_file(device):
 def test_the_shipped_world_file_reads(repo_root):
     world = read_world_file(repo_root / 'config' / 'worlds' / 'tabletop.yaml')
     assert [entity.name for entity in world.entities] == ['table', 'box', 'can']
+
+
+def test_a_shape_becomes_a_one_link_urdf_of_its_size_colour_and_staticness(tmp_path):
+    world = read_world_file(_world(tmp_path, """\
+        entities:
+          - name: wall
+            shape: box
+            size: [0.1, 4, 0.5]
+            colour: [1, 0, 0]
+            pose: {position: [2, 0, 0.25]}
+          - shape: sphere
+            size: [0.2]
+            static: false
+            mass: 2
+        """))
+    wall, ball = world.entities
+    assert wall.name == 'wall' and wall.position == (2.0, 0.0, 0.25)
+    assert '<box size="0.1 4.0 0.5"/>' in wall.resource_string
+    assert '<color rgba="1.0 0.0 0.0 1.0"/>' in wall.resource_string
+    assert '<static>true</static>' in wall.resource_string
+    assert '<robot name="sphere_1">' in ball.resource_string
+    assert '<static>' not in ball.resource_string
+    assert '<mass value="2.0"/>' in ball.resource_string
+    ixx = float(re.search(r'ixx="([^"]+)"', ball.resource_string).group(1))
+    assert ixx == pytest.approx(2 / 5 * 2.0 * 0.2 ** 2)
+
+
+def test_the_shipped_room_reads(repo_root):
+    world = read_world_file(repo_root / 'config' / 'worlds' / 'room.yaml')
+    assert [entity.name for entity in world.entities] == [
+        'wall_east', 'wall_west', 'wall_north', 'wall_south', 'crate', 'pillar', 'ball']

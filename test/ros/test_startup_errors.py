@@ -16,6 +16,7 @@ import pathlib
 import pytest
 import rclpy
 import sim_process
+from mobile_fixtures import P3D, ROS2_DIFF_DRIVE, plugin_rover_urdf
 from rclpy.parameter import Parameter
 
 from pan_tilt_sim.errors import (
@@ -82,6 +83,9 @@ FILES = {
     <robotNamespace>/my robot</robotNamespace></plugin></gazebo>
 </robot>
 ''',
+    'bad_diff_drive.urdf': plugin_rover_urdf(
+        ROS2_DIFF_DRIVE.replace('<wheel_separation>0.3<', '<wheel_separation>wide<')),
+    'bad_p3d.urdf': plugin_rover_urdf(ground_truth=P3D.replace('>base_link<', '>chassis<')),
     'weld.yaml': 'weld_controller: {type: effort_controllers/JointEffortController, '
                  'joint: weld}\n',
     'yaml_syntax.yaml': 'a:\n  type: [unclosed\n  joint: pan_joint\n',
@@ -150,6 +154,14 @@ def _case(case_id, overrides, error, *expected):
 
 # (overrides, error class, substrings of the message); '{dir}' is the files' folder.
 CASES = [
+    # Gazebo's drive plugins in the description.
+    _case('diff drive plugin element not a number',
+          {'robot_description_file': '{dir}/bad_diff_drive.urdf'}, DescriptionError,
+          "{dir}/bad_diff_drive.urdf: plugin 'diff_drive' (libgazebo_ros_diff_drive.so): "
+          "<wheel_separation> 'wide' is not a number"),
+    _case('p3d plugin of a link the robot lacks',
+          {'robot_description_file': '{dir}/bad_p3d.urdf'}, DescriptionError,
+          "plugin 'ground_truth' (libgazebo_ros_p3d.so): <body_name> 'chassis' is not a link"),
     # The description file.
     _case('description missing', {'robot_description_file': '{dir}/missing.urdf'},
           DescriptionError, '{dir}/missing.urdf', 'no such file'),
@@ -411,6 +423,9 @@ def _assert_one_line_exit_2(result, *expected: str) -> str:
     pytest.param(['-p', 'robot_description_file:={dir}/fixed.urdf',
                   '-p', 'controllers_file:={dir}/weld.yaml'], ["'weld'", 'fixed joint'],
                  id='fixed joint (after PyBullet loaded the robot)'),
+    pytest.param(['-p', 'robot_description_file:={dir}/bad_diff_drive.urdf'],
+                 ["plugin 'diff_drive' (libgazebo_ros_diff_drive.so): <wheel_separation>"],
+                 id='diff drive plugin element not a number'),
     pytest.param(['-p', 'controllers_file:={dir}/bad_controller_name.yaml'],
                  ["'pan controller'"], id='controller name not a ROS name'),
     pytest.param(['-p', 'controllers_file:={dir}/laughs.yaml'],
