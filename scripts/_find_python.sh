@@ -80,12 +80,15 @@ pts_choose_python() {
     PTS_PYTHON_VERSION=
     if [[ -n ${PAN_TILT_SIM_PYTHON:-} ]]; then
         version=$(pts_python_version "$PAN_TILT_SIM_PYTHON") || {
-            echo "PAN_TILT_SIM_PYTHON=$PAN_TILT_SIM_PYTHON does not run" >&2
+            # Its own words say why (not found; a pyenv shim for a version
+            # pyenv has not made active: its full path works).
+            echo "PAN_TILT_SIM_PYTHON=$PAN_TILT_SIM_PYTHON does not run:" \
+                 "$({ "$PAN_TILT_SIM_PYTHON" --version 2>&1 || true; } | head -n 1)" >&2
             return 1
         }
         pts_is_supported "$version" || {
             echo "PAN_TILT_SIM_PYTHON=$PAN_TILT_SIM_PYTHON is Python $version; the ROS 2" \
-                 "Jazzy wheels this project uses need ${PTS_SUPPORTED_VERSIONS[*]}" >&2
+                 "Jazzy wheels this project uses need 3.12 or 3.11" >&2
             return 1
         }
         PTS_PYTHON=$PAN_TILT_SIM_PYTHON
