@@ -96,12 +96,16 @@ _pts_requirement() {
 # before; where there is none for this Python, build it from the sdist once,
 # into $_PTS_WHEELS, saying so first and showing that it goes on.
 _pts_pybullet() {
-    local spec version lock_fd errors build_deps=() tmp log pid started missing elapsed
+    local spec version lock_fd errors build_deps=() tmp log heartbeat status=0 started missing
+    local elapsed
     spec=$(_pts_requirement pybullet) || return 0
     mkdir -p -- "$_PTS_WHEELS"
     # One build at a time per wheel folder (two venvs being made at once).
     exec {lock_fd}>"$_PTS_WHEELS/.lock"
-    flock "$lock_fd" 2>/dev/null || true
+    if command -v flock >/dev/null && ! flock -n "$lock_fd"; then
+        _pts_say "waiting for another install to finish with $_PTS_WHEELS"
+        flock "$lock_fd"
+    fi
     if errors=$("$VENV/bin/python" -m pip install --quiet --disable-pip-version-check \
             --no-deps --only-binary=:all: --find-links "$_PTS_WHEELS" "$spec" 2>&1); then
         exec {lock_fd}>&-
@@ -132,24 +136,30 @@ _pts_pybullet() {
     mkdir -- "$tmp/tmp" "$tmp/wheel"
     log=$VENV/pybullet-build.log
     started=$SECONDS
-    # Its own TMPDIR: the heartbeat counts the object files compiled there.
-    TMPDIR=$tmp/tmp "$VENV/bin/python" -m pip wheel --verbose --disable-pip-version-check \
-        --no-deps --no-build-isolation --no-binary=pybullet --wheel-dir "$tmp/wheel" "$spec" \
-        >"$log" 2>&1 &
-    pid=$!
-    # A heartbeat every 30 s: time so far and how many source files are compiled.
-    while kill -0 "$pid" 2>/dev/null; do
-        for _ in {1..30}; do
-            kill -0 "$pid" 2>/dev/null || break
-            sleep 1
+    # A heartbeat every 30 s, from the background (pip stays in the
+    # foreground, where Ctrl-C reaches it): the time so far and how many
+    # source files are compiled. It ends with the build or with this script.
+    (
+        while kill -0 "$$" 2>/dev/null; do
+            for _ in {1..30}; do
+                sleep 1
+                kill -0 "$$" 2>/dev/null || exit 0
+            done
+            elapsed=$((SECONDS - started))
+            _pts_say "building PyBullet: $((elapsed / 60)) min $((elapsed % 60)) s," \
+                "$(find "$tmp/tmp" -name '*.o' 2>/dev/null | wc -l) source files compiled" \
+                "(pip's output: $log)"
         done
-        kill -0 "$pid" 2>/dev/null || break
-        elapsed=$((SECONDS - started))
-        _pts_say "building PyBullet: $((elapsed / 60)) min $((elapsed % 60)) s," \
-            "$(find "$tmp/tmp" -name '*.o' 2>/dev/null | wc -l) source files compiled" \
-            "(pip's output: $log)"
-    done
-    if ! wait "$pid"; then
+    ) &
+    heartbeat=$!
+    # Its own TMPDIR: the heartbeat counts the object files compiled there.
+    # --no-cache-dir: a wheel pip built and cached before may lack NumPy.
+    TMPDIR=$tmp/tmp "$VENV/bin/python" -m pip wheel --verbose --disable-pip-version-check \
+        --no-cache-dir --no-deps --no-build-isolation --no-binary=pybullet \
+        --wheel-dir "$tmp/wheel" "$spec" >"$log" 2>&1 || status=$?
+    kill "$heartbeat" 2>/dev/null || true
+    wait "$heartbeat" 2>/dev/null || true
+    if (( status != 0 )); then
         tail -n 20 "$log" >&2
         rm -rf -- "$tmp"
         missing=$(_pts_missing_build_packages)
