@@ -122,7 +122,7 @@ _pts_pybullet() {
         "from source needs a C++ compiler and Python's headers; on Debian/Ubuntu:" \
         "sudo apt-get install $missing"
     _pts_say "$spec has no wheel for Python $version: building one from source now." \
-        "This takes several minutes (about 7 on 2 cores) and happens once: the wheel is" \
+        "This takes several minutes (about 7 on 2 idle cores) and happens once: the wheel is" \
         "kept in $_PTS_WHEELS and later venvs install it in seconds."
     # PyBullet compiles its NumPy support (getCameraImage returning arrays, as
     # PyPI's wheels do) only when numpy imports at build time, so the build
