@@ -3,7 +3,14 @@
 #
 #   prepare_venv runtime|test
 #
-# * creates $VENV (default <repo>/.venv) with python3.11 on first use;
+# * creates $VENV (default <repo>/.venv) on first use with the machine's
+#   default Python, 3.12 or else 3.11 (see _find_python.sh), or with
+#   PAN_TILT_SIM_PYTHON; an existing venv on a supported version is kept
+#   unless PAN_TILT_SIM_PYTHON names another version;
+# * PyBullet has no wheel on PyPI for some supported versions (3.12): the
+#   first install builds one from its source (several minutes, once) into
+#   PAN_TILT_SIM_WHEELS (default ~/.cache/pan_tilt_sim/wheels), which every
+#   later install, in any venv or clone, takes it from;
 # * pip-installs requirements.txt (runtime) or requirements-test.txt (test)
 #   only when those files changed since the last install (hash in a stamp);
 # * installs this package (not editable) from a throw-away copy of the
@@ -19,10 +26,12 @@
 #   package that a ROS install (or anything else) already provides and
 #   rebuilds only the packages whose definitions changed;
 # * leaves REPO and VENV set, PYTHONPATH unset (a sourced ROS install's
-#   Python 3.12 packages must not shadow the venv's).
+#   packages, built for the system's Python and libraries, must not shadow
+#   the venv's).
 #
 # Environment: PAN_TILT_SIM_VENV (venv path), PAN_TILT_SIM_PYTHON
-# (interpreter to create it with, default python3.11),
+# (interpreter to create it with, default: the machine's default Python),
+# PAN_TILT_SIM_WHEELS (where wheels built from source are kept),
 # PAN_TILT_SIM_INTERFACES: auto (default: `test` builds the interface
 # packages, `runtime` uses whatever is built), build (`runtime` builds them
 # too, installing requirements-build.txt) or skip (never build);
@@ -30,23 +39,142 @@
 
 REPO=$(cd -- "$(dirname -- "${BASH_SOURCE[0]}")/.." && pwd)
 VENV=${PAN_TILT_SIM_VENV:-$REPO/.venv}
-_PTS_PYTHON=${PAN_TILT_SIM_PYTHON:-python3.11}
+_PTS_WHEELS=${PAN_TILT_SIM_WHEELS:-${XDG_CACHE_HOME:-${HOME:-$REPO}/.cache}/pan_tilt_sim/wheels}
 # What setup.py installs from; a change to any of these reinstalls.
 _PTS_SOURCES=(setup.py setup.cfg package.xml resource pan_tilt_sim urdf config launch)
-_PTS_PY311='import sys; sys.exit(sys.version_info[:2] != (3, 11))'
+
+# shellcheck source=scripts/_find_python.sh
+source "$REPO/scripts/_find_python.sh"
 
 _pts_say() { echo "[pan_tilt_sim] $*" >&2; }
 _pts_die() { _pts_say "error: $*"; exit 1; }
 
-_pts_create_venv() {
-    command -v "$_PTS_PYTHON" >/dev/null \
-        || _pts_die "$_PTS_PYTHON not found; this project needs Python 3.11"
-    "$_PTS_PYTHON" -c "$_PTS_PY311" \
-        || _pts_die "$_PTS_PYTHON is not Python 3.11 (the ROS Jazzy wheels are built for 3.11)"
-    _pts_say "creating $VENV with $_PTS_PYTHON"
+# Make $VENV with the chosen Python unless it already runs a supported one
+# (and PAN_TILT_SIM_PYTHON, when set, names that same version).
+_pts_ensure_venv() {
+    local have=
+    if [[ -x $VENV/bin/python && -x $VENV/bin/pip ]]; then
+        have=$(pts_python_version "$VENV/bin/python") || have=
+    fi
+    if [[ -n $have ]] && pts_is_supported "$have" && [[ -z ${PAN_TILT_SIM_PYTHON:-} ]]; then
+        return 0
+    fi
+    pts_choose_python || _pts_die 'no Python to create the venv with (see above)'
+    [[ $have == "$PTS_PYTHON_VERSION" ]] && return 0
+    if [[ -n $have ]]; then
+        _pts_say "$VENV runs Python $have; recreating it with $PTS_PYTHON (Python $PTS_PYTHON_VERSION)"
+    else
+        _pts_say "creating $VENV with $PTS_PYTHON (Python $PTS_PYTHON_VERSION)"
+    fi
     # --clear: a half-made venv (e.g. ensurepip was missing) is redone.
-    "$_PTS_PYTHON" -m venv --clear "$VENV" \
-        || _pts_die "cannot create a venv; on Debian/Ubuntu: sudo apt-get install python3.11-venv"
+    "$PTS_PYTHON" -m venv --clear "$VENV" \
+        || _pts_die "cannot create a venv; on Debian/Ubuntu: sudo apt-get install python$PTS_PYTHON_VERSION-venv"
+}
+
+# What building C/C++ extensions for the venv's Python lacks: the Debian/Ubuntu
+# packages to install, on one line (empty when nothing is missing).
+_pts_missing_build_packages() {
+    local version missing=()
+    version=$(pts_python_version "$VENV/bin/python")
+    command -v g++ >/dev/null || command -v c++ >/dev/null || missing+=(g++)
+    "$VENV/bin/python" -c 'import os, sys, sysconfig
+sys.exit(not os.path.exists(os.path.join(sysconfig.get_paths()["include"], "Python.h")))' \
+        || missing+=("python$version-dev")
+    echo "${missing[*]}"
+}
+
+# The requirement line for a package in requirements.txt, comment and spaces
+# stripped (none: fail).
+_pts_requirement() {
+    local line
+    line=$(grep -E -m1 "^[[:space:]]*$1([^[:alnum:]_.-]|\$)" "$REPO/requirements.txt") || return 1
+    line=${line%%#*}
+    echo "${line//[[:space:]]/}"
+}
+
+# Install requirements.txt's PyBullet from a wheel: PyPI's, or one built here
+# before; where there is none for this Python, build it from the sdist once,
+# into $_PTS_WHEELS, saying so first and showing that it goes on.
+_pts_pybullet() {
+    local spec version lock_fd errors build_deps=() tmp log heartbeat status=0 started missing
+    local elapsed
+    spec=$(_pts_requirement pybullet) || return 0
+    mkdir -p -- "$_PTS_WHEELS"
+    # One build at a time per wheel folder (two venvs being made at once).
+    exec {lock_fd}>"$_PTS_WHEELS/.lock"
+    if command -v flock >/dev/null && ! flock -n "$lock_fd"; then
+        _pts_say "waiting for another install to finish with $_PTS_WHEELS"
+        flock "$lock_fd"
+    fi
+    if errors=$("$VENV/bin/python" -m pip install --quiet --disable-pip-version-check \
+            --no-deps --only-binary=:all: --find-links "$_PTS_WHEELS" "$spec" 2>&1); then
+        exec {lock_fd}>&-
+        return 0
+    fi
+    # Anything but "no wheel" (no network, say) is not fixed by building.
+    if ! grep -q 'No matching distribution' <<<"$errors"; then
+        echo "$errors" >&2
+        _pts_die "installing $spec failed"
+    fi
+    version=$(pts_python_version "$VENV/bin/python")
+    missing=$(_pts_missing_build_packages)
+    [[ -z $missing ]] || _pts_die "$spec has no wheel for Python $version and building it" \
+        "from source needs a C++ compiler and Python's headers; on Debian/Ubuntu:" \
+        "sudo apt-get install $missing"
+    _pts_say "$spec has no wheel for Python $version: building one from source now." \
+        "This takes several minutes (about 7 on 2 idle cores) and happens once: the wheel is" \
+        "kept in $_PTS_WHEELS and later venvs install it in seconds."
+    # PyBullet compiles its NumPy support (getCameraImage returning arrays, as
+    # PyPI's wheels do) only when numpy imports at build time, so the build
+    # runs in the venv, with requirements.txt's numpy and setuptools.
+    build_deps+=("$(_pts_requirement numpy || echo numpy)")
+    build_deps+=("$(_pts_requirement setuptools || echo setuptools)")
+    "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check "${build_deps[@]}" \
+        || _pts_die "installing PyBullet's build requirements (${build_deps[*]}) failed"
+    rm -rf -- "$_PTS_WHEELS"/.build.*  # what an interrupted build left
+    tmp=$(mktemp -d "$_PTS_WHEELS/.build.XXXXXX")
+    mkdir -- "$tmp/tmp" "$tmp/wheel"
+    log=$VENV/pybullet-build.log
+    started=$SECONDS
+    # A heartbeat every 30 s, from the background (pip stays in the
+    # foreground, where Ctrl-C reaches it): the time so far and how many
+    # source files are compiled. It ends with the build or with this script.
+    (
+        while kill -0 "$$" 2>/dev/null; do
+            for _ in {1..30}; do
+                sleep 1
+                kill -0 "$$" 2>/dev/null || exit 0
+            done
+            elapsed=$((SECONDS - started))
+            _pts_say "building PyBullet: $((elapsed / 60)) min $((elapsed % 60)) s," \
+                "$(find "$tmp/tmp" -name '*.o' 2>/dev/null | wc -l) source files compiled" \
+                "(pip's output: $log)"
+        done
+    ) &
+    heartbeat=$!
+    # Its own TMPDIR: the heartbeat counts the object files compiled there.
+    # --no-cache-dir: a wheel pip built and cached before may lack NumPy.
+    TMPDIR=$tmp/tmp "$VENV/bin/python" -m pip wheel --verbose --disable-pip-version-check \
+        --no-cache-dir --no-deps --no-build-isolation --no-binary=pybullet \
+        --wheel-dir "$tmp/wheel" "$spec" >"$log" 2>&1 || status=$?
+    kill "$heartbeat" 2>/dev/null || true
+    wait "$heartbeat" 2>/dev/null || true
+    if (( status != 0 )); then
+        tail -n 20 "$log" >&2
+        rm -rf -- "$tmp"
+        missing=$(_pts_missing_build_packages)
+        _pts_die "building $spec from source failed (pip's output: $log)${missing:+; missing:" \
+            "sudo apt-get install $missing}"
+    fi
+    mv -f -- "$tmp"/wheel/*.whl "$_PTS_WHEELS"/ || _pts_die "pip wheel left no wheel in $tmp"
+    rm -rf -- "$tmp"
+    elapsed=$((SECONDS - started))
+    _pts_say "built PyBullet in $((elapsed / 60)) min $((elapsed % 60)) s;" \
+        "kept in $_PTS_WHEELS"
+    "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --no-deps \
+            --only-binary=:all: --find-links "$_PTS_WHEELS" "$spec" \
+        || _pts_die "installing the PyBullet wheel built in $_PTS_WHEELS failed"
+    exec {lock_fd}>&-
 }
 
 _pts_hash() { sha256sum | cut -d' ' -f1; }
@@ -131,10 +259,7 @@ prepare_venv() {
         flock "$_PTS_LOCK_FD"
     fi
 
-    if ! { [[ -x $VENV/bin/python && -x $VENV/bin/pip ]] \
-            && "$VENV/bin/python" -c "$_PTS_PY311" 2>/dev/null; }; then
-        _pts_create_venv
-    fi
+    _pts_ensure_venv
 
     # The test set includes the runtime set, so a current test stamp is
     # enough for runtime use too.
@@ -143,8 +268,10 @@ prepare_venv() {
     deps_stamp=$VENV/.pan_tilt_sim-deps-$mode
     if [[ "$(cat "$deps_stamp" 2>/dev/null)" != "$deps_hash" \
             && "$(cat "$VENV/.pan_tilt_sim-deps-test" 2>/dev/null)" != "$deps_hash" ]]; then
+        _pts_pybullet
         _pts_say "installing dependencies from ${reqs#"$REPO"/} (first run: about a minute)"
-        "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check -r "$reqs" \
+        "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check \
+                --find-links "$_PTS_WHEELS" -r "$reqs" \
             || _pts_die "installing dependencies failed"
         echo "$deps_hash" >"$deps_stamp"
     fi

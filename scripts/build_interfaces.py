@@ -190,7 +190,7 @@ def build_environment(prefix: pathlib.Path) -> dict:
     """Return the environment CMake runs in: the venv's packages only."""
     env = dict(os.environ)
     # Only the venv's ament packages and CMake configs: a sourced ROS install
-    # (Python 3.12, other ABI) must not mix in.
+    # (built for the system's Python and libraries) must not mix in.
     env['AMENT_PREFIX_PATH'] = str(prefix)
     env['CMAKE_PREFIX_PATH'] = str(prefix)
     env['PATH'] = os.pathsep.join([str(prefix / 'bin'), env.get('PATH', '')])
@@ -210,9 +210,11 @@ def check_tools() -> None:
     if not any(shutil.which(compiler) for compiler in ('c++', 'g++', 'clang++')):
         missing.append('a C/C++ compiler')
     if missing:
+        version = f'{sys.version_info.major}.{sys.version_info.minor}'
         raise SystemExit(
             f'building the interface packages needs {" and ".join(missing)}; on Debian/Ubuntu: '
-            'sudo apt-get install cmake g++ python3.11-dev (or set PAN_TILT_SIM_INTERFACES=skip)')
+            f'sudo apt-get install cmake g++ python{version}-dev '
+            '(or set PAN_TILT_SIM_INTERFACES=skip)')
 
 
 def build(package: Package, prefix: pathlib.Path, generators: str, jobs: int) -> pathlib.Path:

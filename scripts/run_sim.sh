@@ -2,7 +2,8 @@
 # Run the simulator: scripts/run_sim.sh [sim_node arguments...]
 #   e.g. scripts/run_sim.sh --ros-args -p real_time_factor:=0
 #
-# First use creates .venv (python3.11) and installs the dependencies and this
+# First use creates .venv (Python 3.12 where the machine has it, else 3.11;
+# PAN_TILT_SIM_PYTHON chooses) and installs the dependencies and this
 # package; later runs reinstall only what changed. Then it starts sim_node the
 # way `ros2 run pan_tilt_sim sim_node` does: looks the package up in the ament
 # index and execs <prefix>/lib/pan_tilt_sim/sim_node, so sim_node gets this

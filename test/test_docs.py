@@ -547,6 +547,14 @@ def check(command: Command, setup: Setup, tmp_path: pathlib.Path) -> Setup:
         return setup
     if head == 'ros2':
         return check_ros2(command, setup, rest, tmp_path)
+    if words[:3] == ('sudo', 'apt-get', 'install'):
+        # The system packages the scripts themselves ask for (or install, in CI).
+        named = ''.join((REPO / path).read_text(encoding='utf-8') for path in (
+            '.ci/run', 'scripts/_find_python.sh', 'scripts/_prepare_venv.sh'))
+        for package in words[3:]:
+            assert re.search(rf'(?<![\w.-]){re.escape(package)}(?![\w.-])', named), \
+                f'{command.where}: the scripts never name the package {package}'
+        return setup
     if head == 'colcon':
         assert f'<name>{PACKAGE}</name>' in (REPO / 'package.xml').read_text(encoding='utf-8')
         assert rest[rest.index('--packages-select') + 1] == PACKAGE, command.where
