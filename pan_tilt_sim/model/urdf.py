@@ -19,6 +19,7 @@ from pan_tilt_sim.model.robot import (
     DEFAULT_AXIS,
     INITIAL_VALUE,
     POSITION_PROPORTIONAL_GAIN,
+    UNIT_SCALE,
     ControlInterface,
     ControlJoint,
     ControlPlugin,
@@ -29,6 +30,7 @@ from pan_tilt_sim.model.robot import (
     JointSpec,
     Link,
     Mimic,
+    Rgba,
     RobotModel,
     Shape,
 )
@@ -64,6 +66,8 @@ GAZEBO_ROS_CONTROL_PLUGINS = ('libgazebo_ros_control.so', 'libgazebo_ros2_contro
 POSITION = 'position'
 INERTIA_FIELDS = ('ixx', 'ixy', 'ixz', 'iyy', 'iyz', 'izz')
 SHAPE_ROLES = ('visual', 'collision')
+VISUAL = 'visual'
+RGBA_LENGTH = 4
 
 
 def parse_xml(urdf_xml: str, source: pathlib.Path) -> ElementTree.Element:
@@ -82,6 +86,7 @@ def parse_xml(urdf_xml: str, source: pathlib.Path) -> ElementTree.Element:
 def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
     """Build the robot model from a parsed ``<robot>`` element."""
     reader = _Reader(source)
+    reader.materials = reader.robot_materials(root)
     links = tuple(reader.link(element) for element in root.findall('link'))
     joints = tuple(reader.joint(element) for element in root.findall('joint'))
     link_names = {link.name for link in links}
@@ -153,9 +158,42 @@ class _Reader:
 
     def __init__(self, source: pathlib.Path) -> None:
         self.source = source
+        self.materials: dict[str, Rgba] = {}  # the robot-level <material>s with a colour
 
     def error(self, owner: str, problem: str) -> DescriptionError:
         return DescriptionError(f'{self.source}: {owner}: {problem}')
+
+    def robot_materials(self, root: ElementTree.Element) -> dict[str, Rgba]:
+        """Return the colour of every named ``<robot><material>`` that has a ``<color>``."""
+        found = {}
+        for element in root.findall('material'):
+            name = element.get('name', '')
+            rgba = self.colour(element, f"material '{name}'")
+            if name and rgba is not None:
+                found[name] = rgba
+        return found
+
+    def colour(self, material: ElementTree.Element, owner: str) -> Rgba | None:
+        """Return a ``<material>``'s own ``<color rgba>``, or None if it has none."""
+        colour = material.find('color')
+        if colour is None or colour.get('rgba') is None:
+            return None
+        text = colour.get('rgba', '')
+        try:
+            values = tuple(float(value) for value in text.split())
+        except ValueError:
+            values = ()
+        if len(values) != RGBA_LENGTH or not all(0.0 <= value <= 1.0 for value in values):
+            raise self.error(owner, f'<color rgba="{text}"> is not four numbers from 0 to 1')
+        return values  # type: ignore[return-value]
+
+    def visual_colour(self, element: ElementTree.Element, owner: str) -> Rgba | None:
+        """Return a ``<visual>``'s colour: its material's own, else the robot-level one's."""
+        material = element.find('material')
+        if material is None:
+            return None
+        own = self.colour(material, owner)
+        return own if own is not None else self.materials.get(material.get('name', ''))
 
     def number(self, element: ElementTree.Element, attribute: str, default: float,
                owner: str) -> float:
@@ -217,16 +255,20 @@ class _Reader:
             return None
         shape = geometry[0]
         origin = self.origin(element.find('origin'), owner)
+        rgba = self.visual_colour(element, owner) if element.tag == VISUAL else None
         if shape.tag == 'box':
             return Shape(origin, Geometry('box', size=self.vector(shape, 'size', ZERO_VECTOR,
-                                                                   owner)))
+                                                                   owner)), rgba)
         if shape.tag in ('cylinder', 'sphere'):
             return Shape(origin, Geometry(shape.tag,
                                           radius=self.number(shape, 'radius', 0.0, owner),
-                                          length=self.number(shape, 'length', 0.0, owner)))
+                                          length=self.number(shape, 'length', 0.0, owner)),
+                         rgba)
         if shape.tag == 'mesh':
-            return Shape(origin, Geometry('mesh', filename=shape.get('filename', '')))
-        return Shape(origin, Geometry(shape.tag))
+            return Shape(origin, Geometry('mesh', filename=shape.get('filename', ''),
+                                          scale=self.vector(shape, 'scale', UNIT_SCALE, owner)),
+                         rgba)
+        return Shape(origin, Geometry(shape.tag), rgba)
 
     def control_system(self, element: ElementTree.Element) -> ControlSystem:
         name = element.get('name', '')

@@ -35,6 +35,7 @@ from pan_tilt_sim.ros import (
     services,
     simulation_services,
     topic_hardware,
+    view_feed,
 )
 from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.controller_bindings import ControllerBindings
@@ -98,6 +99,7 @@ class SimNode(Node):
         self._physics_thread: PhysicsThread | None = None
         self._command_reader: CommandReader | None = None
         self._timer = None
+        self.viewer = None  # the browser view (viewer:=true), a pan_tilt_sim.ros.viewer.Viewer
         super().__init__(NODE_NAME, **kwargs)
         try:
             self._build(physics_thread)
@@ -108,6 +110,11 @@ class SimNode(Node):
     def _build(self, physics_thread: bool) -> None:
         """Everything sim_node is, from its parameters; the last step starts the physics."""
         self.settings = parameters.declare_parameters(self)
+        # The view's address is checked first: a port in use ends start-up before anything
+        # is loaded.
+        viewer_settings = view_feed.declare_viewer(self)
+        if viewer_settings.enabled:
+            view_feed.check_viewer(viewer_settings)
         description = load_description(
             self.settings.robot_description_file, self.settings.xacro_args)
         # Topic-based hardware (topic_based_ros2_control): no YAML controllers run here.
@@ -194,9 +201,21 @@ class SimNode(Node):
             f"{controllers.label}; topics under "
             f"'{self.robot_namespace or '/'}', time_step {self.settings.time_step} s, "
             f'real_time_factor {self._pacer.real_time_factor}')
+        if viewer_settings.enabled:
+            self._start_viewer(viewer_settings)
         if self._physics_thread is not None:
             self._command_reader.start()
             self._physics_thread.start()  # last: nothing may fail after it runs
+
+    def _start_viewer(self, settings: view_feed.ViewerSettings) -> None:
+        """Serve the browser view (its port was checked at the start of start-up)."""
+        from pan_tilt_sim.ros.viewer import Viewer  # viser is imported only with the view
+
+        camera = self.features.camera
+        self.viewer = Viewer(self, settings, turns=self.turns,
+                             extra_frames=tuple(self.features.robot_state.static_frames),
+                             camera_image_topic=camera.image_topic if camera else None)
+        self.get_logger().info(f'viewer: open {self.viewer.url} in a browser')
 
     def create_publisher(self, *args, **kwargs):
         """Create a publisher without rclpy's default QoS-event handler (see below)."""
@@ -344,7 +363,9 @@ class SimNode(Node):
         self.features.after_steps()
 
     def destroy_node(self) -> None:
-        """Stop ticking, destroy the controller_manager node and release PyBullet."""
+        """Stop the view and the ticking, destroy the controller_manager node, release PyBullet."""
+        if self.viewer is not None:
+            self.viewer.close()
         if self._physics_thread is not None:
             self._physics_thread.stop()
         if self._command_reader is not None:
