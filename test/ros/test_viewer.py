@@ -20,6 +20,7 @@ from websockets.sync.client import connect
 from pan_tilt_sim.ros.runner import EXIT_CONFIGURATION_ERROR
 from pan_tilt_sim.ros.view_feed import FLOAT64
 
+NS = '/ex_urdf_pan_tilt'
 PAN = 'joint1_position_controller'
 BUDGET_S = 30.0
 
@@ -98,6 +99,21 @@ def test_a_connected_browser_is_fed_and_after_it_leaves_nothing_more_is_computed
     assert (viewer.frames, viewer.access.calls) == (frames, calls)
 
 
+def test_the_camera_is_subscribed_only_while_a_browser_shows_it(viewed):
+    viewer = viewed.node.viewer
+    image = f'{NS}/camera/image_raw'
+    assert [entry.topic for entry in viewer.taps.topics] == [image]
+    assert viewed.node.count_subscribers(image) == 0
+    browser = FakeBrowser(viewer.settings.port)
+    try:
+        assert viewed.spin_until(lambda: viewer.taps.watching and image in viewer.taps.latest,
+                                 BUDGET_S)
+    finally:
+        browser.close()
+    assert viewed.spin_until(lambda: not viewer.taps.watching, BUDGET_S)
+    assert viewed.spin_until(lambda: viewed.node.count_subscribers(image) == 0, BUDGET_S)
+
+
 def test_a_slider_publishes_on_the_controllers_command_topic_as_a_user_would(viewed):
     viewer = viewed.node.viewer
     browser = FakeBrowser(viewer.settings.port)
@@ -105,7 +121,7 @@ def test_a_slider_publishes_on_the_controllers_command_topic_as_a_user_would(vie
         assert viewed.spin_until(lambda: len(viewer.sliders) == 2, BUDGET_S)
         pan = next(spec for spec in viewer.sliders if spec.joint == 'pan_joint')
         assert (pan.channel.topic, pan.channel.message) == (
-            f'/ex_urdf_pan_tilt/{PAN}/command', FLOAT64)
+            f'{NS}/{PAN}/command', FLOAT64)
         counts = viewed.node.commands_received
         before = counts[PAN]
         taken = viewed.simulation.controller(PAN)
