@@ -264,7 +264,7 @@ prepare_venv() {
     # The test set includes the runtime set, so a current test stamp is
     # enough for runtime use too.
     deps_hash=$(cat "$REPO/requirements.txt" "$REPO/requirements-test.txt" \
-        "$REPO/requirements-build.txt" | _pts_hash)
+        "$REPO/requirements-build.txt" "$REPO/requirements-viewer.txt" | _pts_hash)
     deps_stamp=$VENV/.pan_tilt_sim-deps-$mode
     if [[ "$(cat "$deps_stamp" 2>/dev/null)" != "$deps_hash" \
             && "$(cat "$VENV/.pan_tilt_sim-deps-test" 2>/dev/null)" != "$deps_hash" ]]; then

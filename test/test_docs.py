@@ -520,8 +520,14 @@ def check(command: Command, setup: Setup, tmp_path: pathlib.Path) -> Setup:
         return setup
     if head == 'scripts/run_sim.sh':
         assert os.access(REPO / head, os.X_OK), f'{command.where}: {head} is not executable'
+        viewer = rest[:1] == ('--viewer',)
+        if viewer:  # run_sim.sh's own option: the view's package, and viewer:=true
+            assert 'viewer:=true' in (REPO / head).read_text(encoding='utf-8'), command.where
+            rest = rest[1:]
         new = ros_parameters(command, rest)
-        check_setup(command, new)
+        # The view on any free port: the docs' 8080 may be taken where the tests run.
+        check_setup(command, Setup(new.parameters + (('viewer', 'true'), ('viewer.port', '0')))
+                    if viewer else new)
         return new
     if head == 'scripts/run_tests.sh':
         assert os.access(REPO / head, os.X_OK), f'{command.where}: {head} is not executable'

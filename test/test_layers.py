@@ -1,9 +1,10 @@
 """The package's layers: data flows one way, PyBullet and rclpy stay in their layer, no cycles.
 
 model -> controllers -> sim -> ros -> tools; ``errors``, ``schedule`` and
-``share`` are shared by all.  Read from the installed package's source with
-``ast`` (every import, also those inside functions), and checked once more by
-importing: loading model/ and controllers/ pulls in neither rclpy nor PyBullet.
+``share`` are shared by all; viser (the browser view) only in ``ros/viewer.py``.
+Read from the installed package's source with ``ast`` (every import, also
+those inside functions), and checked once more by importing: loading model/
+and controllers/ pulls in neither rclpy nor PyBullet.
 """
 
 import ast
@@ -28,6 +29,7 @@ ALLOWED = {
 }
 ROS_PACKAGE_SUFFIXES = ('_msgs', '_srvs', '_interfaces')
 ROS_PACKAGES = {'rclpy', 'builtin_interfaces'}
+VIEWER_MODULE = 'pan_tilt_sim.ros.viewer'  # the browser view: an optional dependency's adapter
 
 
 def modules() -> dict[str, pathlib.Path]:
@@ -69,6 +71,12 @@ def test_the_package_has_the_layer_folders():
 def test_pybullet_is_imported_only_in_the_sim_layer(module):
     uses_pybullet = any(name.split('.')[0] == 'pybullet' for name in imports(MODULES[module]))
     assert not uses_pybullet or layer(module) == 'sim', module
+
+
+@pytest.mark.parametrize('module', sorted(MODULES))
+def test_viser_is_imported_only_by_the_browser_view(module):
+    uses_viser = any(name.split('.')[0] == 'viser' for name in imports(MODULES[module]))
+    assert not uses_viser or module == VIEWER_MODULE, module
 
 
 @pytest.mark.parametrize('module', sorted(MODULES))

@@ -267,6 +267,65 @@ def _loadable_mesh(path: pathlib.Path, cache_dir: pathlib.Path) -> pathlib.Path:
     return target
 
 
+def read_mesh_triangles(path: pathlib.Path) -> np.ndarray:
+    """Return the triangles (N x 3 x 3, in the file's units) of an STL, OBJ or DAE file.
+
+    For drawing a mesh: STL (binary or ASCII) and DAE as :func:`localize_meshes`
+    reads them, OBJ faces fanned into triangles (materials and textures are
+    not read).  Raises :class:`DescriptionError` naming the file and the problem.
+    """
+    try:
+        data = path.read_bytes()
+        if not data:
+            raise _UnusableError('file is empty')
+        suffix = path.suffix.lower()
+        if suffix == STL_SUFFIX:
+            _is_loadable_binary_stl(data)  # raises for what is no STL
+            return _stl_triangles(data)
+        if suffix == OBJ_SUFFIX:
+            return read_obj(data)
+        if suffix == DAE_SUFFIX:
+            return read_collada(data)
+        raise _UnusableError(f"unsupported mesh format '{path.suffix}' "
+                             f"(supported: {', '.join(SUPPORTED_MESH_SUFFIXES)})")
+    except OSError as exc:
+        raise DescriptionError(one_line(f'mesh {path}: cannot read file: {exc.strerror}')) \
+            from None
+    except _UnusableError as exc:
+        raise DescriptionError(one_line(f'mesh {path}: {exc}')) from None
+
+
+def read_obj(data: bytes) -> np.ndarray:
+    """Return the triangles (N x 3 x 3) of a Wavefront OBJ: each face fanned from its first corner.
+
+    Faces are checked as :func:`check_obj` does; a negative (relative) index
+    counts back from the vertices read so far, as the format says.
+    """
+    check_obj(data)
+    vertices: list[list[float]] = []
+    triangles: list[list[int]] = []
+    for line in data.splitlines():
+        fields = line.split()
+        if not fields:
+            continue
+        if fields[0] == b'v' and len(fields) >= 1 + VECTOR3_LENGTH:
+            try:
+                vertices.append([float(value) for value in fields[1:1 + VECTOR3_LENGTH]])
+            except ValueError:
+                raise _UnusableError('OBJ with a non-numeric vertex') from None
+        elif fields[0] == b'f':
+            corners = [int(corner.split(b'/')[0]) for corner in fields[1:]]
+            corners = [index - 1 if index > 0 else len(vertices) + index for index in corners]
+            triangles.extend([corners[0], corners[i], corners[i + 1]]
+                             for i in range(1, len(corners) - 1))
+    points = np.array(vertices, dtype=float).reshape(-1, VECTOR3_LENGTH)
+    indices = np.array(triangles, dtype=np.int64).reshape(-1, TRIANGLE_CORNERS)
+    if indices.size and (indices.min() < 0 or indices.max() >= len(points)):
+        raise _UnusableError('a face names a vertex the file does not define')
+    _check_finite(points)
+    return points[indices]
+
+
 def _is_loadable_binary_stl(data: bytes) -> bool:
     """Tell whether PyBullet reads this STL as it is; raise if it is no STL at all.
 

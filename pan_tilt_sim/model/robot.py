@@ -30,6 +30,8 @@ from pan_tilt_sim.model.transforms import (
 
 DEFAULT_AXIS: Vector = (1.0, 0.0, 0.0)  # URDF's default joint axis
 WORLD_LINK = 'world'  # a root link of this name, joined by a fixed joint, welds the robot
+UNIT_SCALE: Vector = (1.0, 1.0, 1.0)  # a <mesh> without a scale attribute
+Rgba = tuple[float, float, float, float]  # red, green, blue, alpha, each 0..1
 POSITION_PROPORTIONAL_GAIN = 'position_proportional_gain'
 INITIAL_VALUE = 'initial_value'  # the <param> of a ros2_control interface that sets its start
 
@@ -80,13 +82,18 @@ class Inertial:
 
 @dataclasses.dataclass(frozen=True)
 class Geometry:
-    """A ``<geometry>``: a box (``size``), cylinder (``radius``, ``length``), sphere or mesh."""
+    """A ``<geometry>``: a box (``size``), cylinder (``radius``, ``length``), sphere or mesh.
+
+    A mesh keeps its ``filename`` as written (``package://...``) and its
+    ``scale`` (per axis, applied to the file's own units).
+    """
 
     kind: str
     size: Vector = (0.0, 0.0, 0.0)
     radius: float = 0.0
     length: float = 0.0
     filename: str = ''
+    scale: Vector = UNIT_SCALE
 
     def half_extents(self) -> Vector | None:
         """Half-size of the shape's bounding box in its own frame; None for meshes."""
@@ -102,10 +109,16 @@ class Geometry:
 
 @dataclasses.dataclass(frozen=True)
 class Shape:
-    """A ``<visual>`` or ``<collision>``: geometry placed by ``origin`` in the link frame."""
+    """A ``<visual>`` or ``<collision>``: geometry placed by ``origin`` in the link frame.
+
+    ``rgba`` is a visual's ``<material>`` colour: its own ``<color>``, else
+    that of the robot-level ``<material>`` of the same name; None when the
+    description gives it none (a collision never has one).
+    """
 
     origin: Transform
     geometry: Geometry
+    rgba: Rgba | None = None
 
 
 @dataclasses.dataclass(frozen=True)

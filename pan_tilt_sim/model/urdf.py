@@ -63,6 +63,7 @@ from pan_tilt_sim.model.robot import (
     INITIAL_VALUE,
     POSITION_PROPORTIONAL_GAIN,
     ControlGpio,
+    UNIT_SCALE,
     ControlInterface,
     ControlJoint,
     ControlPlugin,
@@ -74,6 +75,7 @@ from pan_tilt_sim.model.robot import (
     JointSpec,
     Link,
     Mimic,
+    Rgba,
     RobotModel,
     Shape,
 )
@@ -125,6 +127,8 @@ UNSIMULATED_KINDS = {
     JointKind.FLOATING: 'PyBullet would silently make it fixed (declare it fixed if that is '
                         'what it is; a free body is an object of its own)',
 }
+VISUAL = 'visual'
+RGBA_LENGTH = 4
 
 
 def parse_xml(urdf_xml: str, source: pathlib.Path) -> ElementTree.Element:
@@ -145,6 +149,7 @@ def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
     reader = _Reader(source)
     name = root.get('name', '')
     _check_name_length(name, f'<robot name="{shown(name)}">', source)
+    reader.materials = reader.robot_materials(root)
     links = tuple(reader.link(element) for element in root.findall('link'))
     joints = tuple(reader.joint(element) for element in root.findall('joint'))
     _check_unique('link', [link.name for link in links], source)
@@ -325,9 +330,42 @@ class _Reader:
 
     def __init__(self, source: pathlib.Path) -> None:
         self.source = source
+        self.materials: dict[str, Rgba] = {}  # the robot-level <material>s with a colour
 
     def error(self, owner: str, problem: str) -> DescriptionError:
         return DescriptionError(f'{self.source}: {owner}: {problem}')
+
+    def robot_materials(self, root: ElementTree.Element) -> dict[str, Rgba]:
+        """Return the colour of every named ``<robot><material>`` that has a ``<color>``."""
+        found = {}
+        for element in root.findall('material'):
+            name = element.get('name', '')
+            rgba = self.colour(element, f"material '{name}'")
+            if name and rgba is not None:
+                found[name] = rgba
+        return found
+
+    def colour(self, material: ElementTree.Element, owner: str) -> Rgba | None:
+        """Return a ``<material>``'s own ``<color rgba>``, or None if it has none."""
+        colour = material.find('color')
+        if colour is None or colour.get('rgba') is None:
+            return None
+        text = colour.get('rgba', '')
+        try:
+            values = tuple(float(value) for value in text.split())
+        except ValueError:
+            values = ()
+        if len(values) != RGBA_LENGTH or not all(0.0 <= value <= 1.0 for value in values):
+            raise self.error(owner, f'<color rgba="{text}"> is not four numbers from 0 to 1')
+        return values  # type: ignore[return-value]
+
+    def visual_colour(self, element: ElementTree.Element, owner: str) -> Rgba | None:
+        """Return a ``<visual>``'s colour: its material's own, else the robot-level one's."""
+        material = element.find('material')
+        if material is None:
+            return None
+        own = self.colour(material, owner)
+        return own if own is not None else self.materials.get(material.get('name', ''))
 
     def number(self, element: ElementTree.Element, attribute: str, default: float,
                owner: str) -> float:
@@ -403,16 +441,20 @@ class _Reader:
             return None
         shape = geometry[0]
         origin = self.origin(element.find('origin'), owner)
+        rgba = self.visual_colour(element, owner) if element.tag == VISUAL else None
         if shape.tag == 'box':
             return Shape(origin, Geometry('box', size=self.vector(shape, 'size', ZERO_VECTOR,
-                                                                   owner)))
+                                                                   owner)), rgba)
         if shape.tag in ('cylinder', 'sphere'):
             return Shape(origin, Geometry(shape.tag,
                                           radius=self.number(shape, 'radius', 0.0, owner),
-                                          length=self.number(shape, 'length', 0.0, owner)))
+                                          length=self.number(shape, 'length', 0.0, owner)),
+                         rgba)
         if shape.tag == 'mesh':
-            return Shape(origin, Geometry('mesh', filename=shape.get('filename', '')))
-        return Shape(origin, Geometry(shape.tag))
+            return Shape(origin, Geometry('mesh', filename=shape.get('filename', ''),
+                                          scale=self.vector(shape, 'scale', UNIT_SCALE, owner)),
+                         rgba)
+        return Shape(origin, Geometry(shape.tag), rgba)
 
     def control_system(self, element: ElementTree.Element) -> ControlSystem:
         name = element.get('name', '')

@@ -141,6 +141,11 @@ class CameraPublisher:
         self._frames = 0
 
     @property
+    def image_topic(self) -> str:
+        """The image topic's full name."""
+        return self._image_publisher.topic_name
+
+    @property
     def mount(self) -> Transform:
         """Pose of the optical frame in the camera link's frame."""
         return self._renderer.mount

@@ -39,6 +39,7 @@ from pan_tilt_sim.ros import (
     services,
     simulation_services,
     topic_hardware,
+    view_feed,
 )
 from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.controller_bindings import ControllerBindings
@@ -117,6 +118,7 @@ class SimNode(Node):
         # With record:=<folder>, every publisher and subscription made from then on is
         # teed into the bag (see create_publisher, create_subscription).
         self.recorder: Recorder | None = None
+        self.viewer = None  # the browser view (viewer:=true), a pan_tilt_sim.ros.viewer.Viewer
         super().__init__(NODE_NAME, **kwargs)
         # Named controller_manager (launch's name='controller_manager'), sim_node stands
         # in for ros2_control_node: see the module pan_tilt_sim.ros.drop_in.
@@ -139,6 +141,11 @@ class SimNode(Node):
         self._manager_settings = (
             drop_in.declare_manager_parameters(self, self._arguments, overrides)
             if self.is_controller_manager else None)
+        # The view's address is checked first: a port in use ends start-up before anything
+        # is loaded.
+        self._viewer_settings = view_feed.declare_viewer(self)
+        if self._viewer_settings.enabled:
+            view_feed.check_viewer(self._viewer_settings)
         # With a physics thread, callbacks take turns with it (the executor needs them now).
         self.turns: Turns | None = Turns() if physics_thread else None
         if self.settings.robot_description_file:
@@ -257,6 +264,8 @@ class SimNode(Node):
             self.get_logger().info(
                 f"recording to '{self.recorder.folder}' (rosbag2, MCAP storage"
                 f"{', sensors included' if self.settings.record_sensors else ''})")
+        if self._viewer_settings.enabled:
+            self._start_viewer(self._viewer_settings)
         if self._physics_thread is not None:
             if self._command_reader is not None:
                 self._command_reader.start()
@@ -273,6 +282,16 @@ class SimNode(Node):
         if self.is_controller_manager:
             drop_in.declare_controller_fields(self, parameter_list)
         return super().set_parameters_atomically(parameter_list)
+
+    def _start_viewer(self, settings: view_feed.ViewerSettings) -> None:
+        """Serve the browser view (its port was checked at the start of start-up)."""
+        from pan_tilt_sim.ros.viewer import Viewer  # viser is imported only with the view
+
+        camera = self.features.camera
+        self.viewer = Viewer(self, settings, turns=self.turns,
+                             extra_frames=tuple(self.features.robot_state.static_frames),
+                             camera_image_topic=camera.image_topic if camera else None)
+        self.get_logger().info(f'viewer: open {self.viewer.url} in a browser')
 
     def create_publisher(self, *args, **kwargs):
         """Create a publisher without rclpy's default QoS-event handler (see below).
@@ -434,7 +453,9 @@ class SimNode(Node):
         self.features.after_steps()
 
     def destroy_node(self) -> None:
-        """Stop ticking, destroy the controller_manager node and release PyBullet."""
+        """Stop the view and the ticking, destroy the controller_manager node, release PyBullet."""
+        if self.viewer is not None:
+            self.viewer.close()
         if self._physics_thread is not None:
             self._physics_thread.stop()
         if self._command_reader is not None:

@@ -180,6 +180,10 @@ class Entity:
     inertial: Transform = Transform()
     initial_joints: tuple[float, ...] = ()
     initial_info: EntityInfo = None  # type: ignore[assignment]  # a copy of info by default
+    # An object's description (None for the robot and the scenery) and its joints in
+    # PyBullet's order: what a view of the world draws.
+    description: RobotDescription | None = None
+    joint_names: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.initial_info is None:
@@ -261,6 +265,16 @@ class Entities:
         # The root link frame's origin moves with v_com + w x (p_link - p_com).
         offset = _minus(pose.translation, com_position)
         return EntityState(pose, _plus(linear, _cross(angular, offset)), tuple(angular))
+
+    def joint_positions(self, name: str) -> dict[str, float]:
+        """Return the position of every joint of an object, by name (none for the robot)."""
+        entity = self._entities[name]
+        if not entity.joint_names:
+            return {}
+        states = pybullet.getJointStates(entity.body, list(range(len(entity.joint_names))),
+                                         physicsClientId=self._client)
+        return {joint: state[STATE_POSITION]
+                for joint, state in zip(entity.joint_names, states, strict=True)}
 
     def world_bounds(self, name: str) -> tuple[Vector, Vector]:
         """Return the world-axis-aligned box around every link of the entity (min, max)."""
@@ -478,10 +492,10 @@ class Entities:
             pybullet.changeDynamics(body, index, frictionAnchor=1, physicsClientId=client)
         apply_surface_friction(body, links, resource.model.link_frictions, client)
         joints = pybullet.getNumJoints(body, physicsClientId=client)
+        names = [pybullet.getJointInfo(body, index, physicsClientId=client)[1].decode()
+                 for index in range(joints)]
         if joints:
             friction = {joint.name: joint.friction for joint in resource.joints}
-            names = [pybullet.getJointInfo(body, index, physicsClientId=client)[1].decode()
-                     for index in range(joints)]
             pybullet.setJointMotorControlArray(
                 body, list(range(joints)), pybullet.VELOCITY_CONTROL,
                 targetVelocities=[0.0] * joints,
@@ -489,7 +503,10 @@ class Entities:
         static = fixed or pybullet.getDynamicsInfo(
             body, BASE_LINK_INDEX, physicsClientId=client)[DYNAMICS_MASS] == 0.0
         category = Category.STATIC_OBJECT if static else Category.DYNAMIC_OBJECT
-        return self._record(name, body, origin, static=static, info=EntityInfo(category))
+        entity = self._record(name, body, origin, static=static, info=EntityInfo(category))
+        entity.description = resource
+        entity.joint_names = tuple(names)
+        return entity
 
     def _record(self, name: str, body: int, origin: Origin, *, static: bool,
                 info: EntityInfo) -> Entity:
