@@ -94,8 +94,8 @@ def test_a_bad_world_file_ends_the_program_with_one_line_and_exit_code_2(tmp_pat
     result = sim_process.run('-p', f'world:={world}')
     assert result.returncode == 2
     lines = result.stderr.strip().splitlines()
-    assert lines[-1] == (f'sim_node: error: {world}: entities[0]: give a uri or a '
-                         'resource_string')
+    assert lines[-1] == (f'sim_node: error: {world}: entities[0]: give a uri, a '
+                         'resource_string or a shape')
     assert 'Traceback' not in result.stderr
 
 
