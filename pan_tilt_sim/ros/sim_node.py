@@ -463,8 +463,13 @@ class SimNode(Node):
         if self._timer is not None:
             self._timer.cancel()
         if self.controllers is not None:
-            # Samples a batch took before the physics stopped still leave (and reach a bag).
-            self.controllers.flush_joint_states()
+            # Samples a batch took before the physics stopped still leave (and reach a bag) --
+            # unless a signal already shut the context down: then nothing can leave.
+            if self.context.ok():
+                try:
+                    self.controllers.flush_joint_states()
+                except RuntimeError:  # rclpy's RCLError: the context went in the meantime
+                    pass
             self.controllers.destroy()
         self._destroy_companions()
         if self.simulation_interfaces is not None:
