@@ -42,7 +42,7 @@ from pan_tilt_sim.controllers.gripper_action_controller import (
     GripperRequest,
     GripperResult,
 )
-from pan_tilt_sim.controllers.trajectory_goal import GoalStatus
+from pan_tilt_sim.ros.goal_handles import cancel_running, end_handle
 
 ACTION = 'gripper_cmd'
 
@@ -111,21 +111,12 @@ class GripperActionServer(abc.ABC):
             await running[1]
         if goal.reason:
             self._logger.warning(f'{self._label}: goal aborted: {goal.reason}')
-        if goal.status is GoalStatus.SUCCEEDED:
-            goal_handle.succeed()
-        elif goal.status is GoalStatus.CANCELED:
-            goal_handle.canceled()
-        else:
-            goal_handle.abort()
+        end_handle(goal_handle, goal.status)
         return self.result_message(goal.result)
 
     def _on_cancel(self, goal_handle: ServerGoalHandle) -> CancelResponse:
-        for goal, (handle, _future) in self._running.items():
-            if handle is goal_handle:
-                self._controller.cancel_goal(goal)
-                self.poll()
-                return CancelResponse.ACCEPT
-        return CancelResponse.REJECT  # it has ended already: its result stands
+        return cancel_running(self._running, goal_handle, self._controller.cancel_goal,
+                              self.poll)
 
     # --- called by the node ---------------------------------------------------------------------
 

@@ -48,6 +48,7 @@ from pan_tilt_sim.controllers.trajectory_goal import (
     TrajectoryGoal,
     goal_tolerances,
 )
+from pan_tilt_sim.ros.goal_handles import cancel_running, end_handle
 from pan_tilt_sim.ros.ros_interfaces import joint_trajectory, seconds, stamp
 
 ACTION = 'follow_joint_trajectory'
@@ -119,21 +120,12 @@ class TrajectoryActionServer:
         if running is not None:
             await running[1]
         result = self._type.Result(error_code=goal.error_code, error_string=goal.error_string)
-        if goal.status is GoalStatus.SUCCEEDED:
-            goal_handle.succeed()
-        elif goal.status is GoalStatus.CANCELED:
-            goal_handle.canceled()
-        else:
-            goal_handle.abort()
+        end_handle(goal_handle, goal.status)
         return result
 
     def _on_cancel(self, goal_handle: ServerGoalHandle) -> CancelResponse:
-        for goal, (handle, _future) in self._running.items():
-            if handle is goal_handle:
-                self._controller.cancel_goal(goal)
-                self.poll()
-                return CancelResponse.ACCEPT
-        return CancelResponse.REJECT  # it has ended already: its result stands
+        return cancel_running(self._running, goal_handle, self._controller.cancel_goal,
+                              self.poll)
 
     # --- called by the node ---------------------------------------------------------------------
 
