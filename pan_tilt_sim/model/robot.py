@@ -34,6 +34,8 @@ UNIT_SCALE: Vector = (1.0, 1.0, 1.0)  # a <mesh> without a scale attribute
 Rgba = tuple[float, float, float, float]  # red, green, blue, alpha, each 0..1
 POSITION_PROPORTIONAL_GAIN = 'position_proportional_gain'
 INITIAL_VALUE = 'initial_value'  # the <param> of a ros2_control interface that sets its start
+# How far above the robot's lowest point a wheel's lowest point may be and still touch (m).
+WHEEL_CONTACT_TOLERANCE = 1e-3
 
 
 class JointKind(enum.Enum):
@@ -380,6 +382,41 @@ class RobotModel:
         return self.root == WORLD_LINK and any(
             joint.parent == WORLD_LINK and joint.kind is JointKind.FIXED for joint in self.joints)
 
+    @functools.cached_property
+    def ground_wheels(self) -> tuple[str, ...]:
+        """The continuous joints whose wheels are the robot's lowest points, at zero positions.
+
+        A wheel is a cylinder or sphere collision of a continuous joint's child
+        link; it touches the ground when its lowest point lies within
+        ``WHEEL_CONTACT_TOLERANCE`` (m) of the lowest point of every box,
+        cylinder and sphere collision of the robot (meshes, whose size is not
+        known here, do not count).  A robot that stands on such wheels is one
+        that drives, whichever controller will turn them.
+        """
+        poses = self.link_poses({})
+        lowest: dict[str, float] = {}
+        for link in self.links:
+            if link.name not in poses:
+                continue
+            heights = [_lowest_point(poses[link.name].then(shape.origin), shape.geometry)
+                       for shape in link.collisions]
+            heights = [height for height in heights if height is not None]
+            if heights:
+                lowest[link.name] = min(heights)
+        if not lowest:
+            return ()
+        ground = min(lowest.values())
+        parents = {joint.child: joint for joint in self.joints}
+        wheels = []
+        for link in self.links:
+            joint = parents.get(link.name)
+            if (joint is None or joint.kind is not JointKind.CONTINUOUS
+                    or lowest.get(link.name, math.inf) > ground + WHEEL_CONTACT_TOLERANCE):
+                continue
+            if any(shape.geometry.kind in ('cylinder', 'sphere') for shape in link.collisions):
+                wheels.append(joint.name)
+        return tuple(wheels)
+
     @property
     def plugin_namespace(self) -> str | None:
         """The namespace the first control plugin gives the robot's topics, if any."""
@@ -510,3 +547,19 @@ class RobotModel:
             poses[joint.child] = poses[joint.parent].then(
                 joint.transform(self.joint_position(positions, joint.name)))
         return poses
+
+
+def _lowest_point(pose: Transform, geometry: Geometry) -> float | None:
+    """Height of a shape's lowest point in the frame ``pose`` is given in; None for a mesh."""
+    height = pose.translation[2]
+    row = rotation_matrix(pose.rotation)[2]  # the z components of the shape's own axes
+    if geometry.kind == 'sphere':
+        return height - geometry.radius
+    if geometry.kind == 'cylinder':  # its axis along the shape's z
+        axis_z = abs(row[2])
+        return height - (geometry.length / 2.0 * axis_z
+                         + geometry.radius * math.sqrt(max(0.0, 1.0 - axis_z * axis_z)))
+    half = geometry.half_extents()
+    if half is None:
+        return None
+    return height - sum(abs(r) * h for r, h in zip(row, half, strict=True))

@@ -94,8 +94,11 @@ def base_is_fixed(fixed_base: bool | None, description: RobotDescription,
     controller that drives the base will be active -- with ``autostart``,
     one of ``active`` (None: every controller of the file); waiting for
     spawners, any the file declares -- or if the URDF has a Gazebo drive
-    plugin (:mod:`pan_tilt_sim.model.drive_plugins`).  A robot hung on a ``world`` link by a
-    fixed joint is welded whatever ``fixed_base`` says, as in Gazebo.
+    plugin (:mod:`pan_tilt_sim.model.drive_plugins`).  Waiting for spawners,
+    whose controllers are not known yet (a robot's own launch file), a robot
+    that stands on wheels (``RobotModel.ground_wheels``) is free too.  A
+    robot hung on a ``world`` link by a fixed joint is welded whatever
+    ``fixed_base`` says, as in Gazebo.
     """
     if description.model.welded_to_world:
         return True, "its root link 'world' holds it by a fixed joint, as in Gazebo"
@@ -111,6 +114,10 @@ def base_is_fixed(fixed_base: bool | None, description: RobotDescription,
     if drivers:
         return False, (f"{FIXED_BASE} is auto and controller '{drivers[0].name}' "
                        f'({drivers[0].type}) drives the base')
+    wheels = description.model.ground_wheels
+    if not autostart and wheels:
+        return False, (f'{FIXED_BASE} is auto, the spawners choose its controllers and it '
+                       f"stands on wheels ({', '.join(wheels)}): it drives, as in Gazebo")
     return True, f'{FIXED_BASE} is auto and no controller drives the base'
 
 

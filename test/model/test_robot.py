@@ -224,3 +224,34 @@ def test_the_parent_joint_of_a_link_is_the_joint_whose_child_it_is():
     model = parse_urdf(CONTROLLED, pathlib.Path('c.urdf'))
     assert model.parent_joint('f').name == 'g'
     assert model.parent_joint('a') is None
+
+
+def _wheeled(axle_z: float, wheel: str = 'cylinder radius="0.05" length="0.03"',
+             kind: str = 'continuous') -> str:
+    """A box body 0.04 m tall at the origin, one wheel on an axle ``axle_z`` below it."""
+    return f'''<robot name="cart">
+      <link name="body"><collision><geometry><box size="0.3 0.2 0.04"/></geometry></collision>
+      </link>
+      <joint name="wheel_joint" type="{kind}"><parent link="body"/><child link="wheel"/>
+        <origin xyz="0 0 {axle_z}"/><axis xyz="0 1 0"/>
+        {'<limit lower="-1" upper="1" effort="1" velocity="1"/>' if kind == 'revolute' else ''}
+      </joint>
+      <link name="wheel"><collision><origin rpy="1.5707963267948966 0 0"/>
+        <geometry><{wheel}/></geometry></collision></link>
+    </robot>'''
+
+
+@pytest.mark.parametrize('urdf, wheels', [
+    (_wheeled(-0.06), ('wheel_joint',)),  # a wheel below the body: it stands on it
+    (_wheeled(-0.06, 'sphere radius="0.05"'), ('wheel_joint',)),
+    (_wheeled(0.05), ()),  # the wheel's bottom 0.02 m above the body's
+    (_wheeled(-0.06, kind='revolute'), ()),  # a joint that does not turn round is no wheel
+    (_wheeled(-0.06, 'box size="0.1 0.1 0.1"'), ()),  # a box is no wheel
+])
+def test_the_ground_wheels_are_continuous_joints_whose_round_links_are_lowest(urdf, wheels):
+    assert parse_urdf(urdf, pathlib.Path('cart.urdf')).ground_wheels == wheels
+
+
+def test_an_arm_and_the_pan_tilt_example_stand_on_no_wheels():
+    assert arm_model().ground_wheels == ()
+    assert pan_tilt_model().ground_wheels == ()

@@ -192,3 +192,22 @@ def test_a_drive_controller_left_inactive_leaves_the_base_welded(tmp_path):
     drive_params = drive_parameters()
     with rover(tmp_path, drive_params, active=['joint_state_broadcaster']) as simulation:
         assert simulation.physics.fixed_base
+
+
+def test_waiting_for_spawners_a_robot_on_wheels_stands_free_and_an_arm_stays_welded(tmp_path):
+    # A robot's own launch file: no controller declared, the spawners bring them later.
+    log = Log()
+    description, _ = write_rover(tmp_path)
+    broadcaster = write_text(tmp_path, 'broadcaster.yaml', ros2_control_yaml({
+        'joint_state_broadcaster': ('joint_state_broadcaster/JointStateBroadcaster', {})}))
+    with make_simulation(str(description), str(broadcaster), TIME_STEP, fixed_base=None,
+                         autostart_controllers=False, logger=log) as simulation:
+        assert not simulation.physics.fixed_base
+        assert simulation.physics.base_frame().translation == pytest.approx(
+            (0.0, 0.0, REST_HEIGHT), abs=1e-9)
+    assert any('stands on wheels (left_wheel_joint, right_wheel_joint)' in line
+               for line in log.infos)
+    arm = write_star_robot(tmp_path, [JointDef('joint1')])
+    with make_simulation(str(arm), str(broadcaster), TIME_STEP, fixed_base=None,
+                         autostart_controllers=False) as simulation:
+        assert simulation.physics.fixed_base
