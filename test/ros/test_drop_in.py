@@ -12,6 +12,7 @@ from __future__ import annotations
 import importlib.util
 
 import pytest
+import yaml
 from drop_in_fixtures import (
     FORWARD,
     FORWARD_PARAMETERS_YAML,
@@ -23,6 +24,9 @@ from drop_in_fixtures import (
     drop_in_node,
     write_yaml,
 )
+from geometry_msgs.msg import TwistStamped
+from mobile_fixtures import drive_parameters, rover_urdf
+from nav_msgs.msg import Odometry
 from node_harness import NodeHarness, SimUnderTest
 from rclpy.parameter import Parameter
 from robot_state_publisher_stand_in import RobotStatePublisherStandIn
@@ -250,3 +254,34 @@ def test_named_sim_node_an_empty_description_file_also_means_the_topic(tmp_path)
         assert Spawner(sim).controllers()[JSB].state == 'active'
     finally:
         harness.close()
+
+
+def test_a_diffbot_launch_drives_from_cmd_vel_with_its_spawned_drive_controller(tmp_path):
+    # Example 2's shape: the drive controller exists only in the spawner's --param-file, its
+    # ~/cmd_vel remapped to /cmd_vel; the robot stands on its wheels, free, from the start.
+    drive = {'type': 'diff_drive_controller/DiffDriveController', 'cmd_vel_timeout': 0.0,
+             **drive_parameters()}
+    controllers = write_yaml(tmp_path, 'diffbot_controllers.yaml', yaml.safe_dump({
+        JSB: {'ros__parameters': {'type': 'joint_state_broadcaster/JointStateBroadcaster'}},
+        'diffbot_base_controller': {'ros__parameters': drive}}))
+    with drop_in_node() as (harness, node):
+        publish_description(harness, rover_urdf())
+        sim = wait_built(harness, node)
+        assert not sim.simulation.physics.fixed_base
+        assert spawner_main(sim, [JSB, 'diffbot_base_controller', '--param-file', controllers,
+                                  '--controller-ros-args', '-r ~/cmd_vel:=/cmd_vel']) == 0
+        odometry = sim.collect(Odometry, '/diffbot_base_controller/odom')
+        publisher = sim.probe.create_publisher(TwistStamped, '/cmd_vel', 10)
+        assert sim.spin_until(lambda: publisher.get_subscription_count() > 0)
+        forward = TwistStamped()
+        forward.twist.linear.x = 0.2
+        publisher.publish(forward)
+        base = sim.simulation.physics.base_frame
+        assert sim.spin_until(lambda: base().translation[0] > 0.3, BUILD_BUDGET_S), (
+            'the base did not drive 0.3 m')
+        publisher.publish(TwistStamped())
+        assert sim.spin_until(lambda: odometry and abs(odometry[-1].twist.twist.linear.x) < 1e-3
+                              and odometry[-1].pose.pose.position.x > 0.3, BUILD_BUDGET_S)
+        sim.run_for(0.2)
+        assert odometry[-1].pose.pose.position.x == pytest.approx(base().translation[0],
+                                                                  rel=0.02)
