@@ -4,7 +4,8 @@
 file's ``generate_launch_description()`` against stand-in modules that record
 what it asks for (Node, RegisterEventHandler + OnProcessExit, Command,
 PathJoinSubstitution, PathSubstitution, FindPackageShare, LaunchConfiguration,
-DeclareLaunchArgument, IfCondition, ParameterFile), and
+DeclareLaunchArgument, IfCondition, UnlessCondition, ParameterFile; IncludeLaunchDescription
+is recorded and refused when it would run), and
 :class:`StandInLaunch` carries the nodes out, as launch_ros would start them:
 
 * ``pan_tilt_sim``'s ``sim_node`` as a process, ``--ros-args -r
@@ -36,8 +37,9 @@ from spawner_client import spawner_main
 
 HERE = pathlib.Path(__file__).resolve().parent
 STAND_IN_MODULES = ('launch', 'launch.actions', 'launch.conditions', 'launch.event_handlers',
-                    'launch.substitutions', 'launch_ros', 'launch_ros.actions',
-                    'launch_ros.parameter_descriptions', 'launch_ros.substitutions')
+                    'launch.launch_description_sources', 'launch.substitutions', 'launch_ros',
+                    'launch_ros.actions', 'launch_ros.parameter_descriptions',
+                    'launch_ros.substitutions')
 SUBSTITUTION = re.compile(r'\$\(var ([A-Za-z0-9_]+)\)')
 
 
@@ -83,6 +85,22 @@ class IfCondition(Recorded):
     """launch.conditions.IfCondition: true when its text is 'true' (any case) or '1'."""
 
 
+class UnlessCondition(Recorded):
+    """launch.conditions.UnlessCondition: false when its text is 'true' (any case) or '1'."""
+
+
+class IncludeLaunchDescription(Recorded):
+    """launch.actions.IncludeLaunchDescription: another package's launch file (Gazebo's).
+
+    The stand-in does not run other packages' launch files; :class:`StandInLaunch`
+    refuses one that is left in (its condition holding).
+    """
+
+
+class PythonLaunchDescriptionSource(Recorded):
+    """launch.launch_description_sources.PythonLaunchDescriptionSource."""
+
+
 class ParameterFile(Recorded):
     """launch_ros ParameterFile: a file; with allow_substs its $(var name) are filled in."""
 
@@ -102,6 +120,10 @@ def modules() -> dict[str, types.ModuleType]:
     made['launch.actions'].RegisterEventHandler = RegisterEventHandler
     made['launch.actions'].DeclareLaunchArgument = DeclareLaunchArgument
     made['launch.conditions'].IfCondition = IfCondition
+    made['launch.conditions'].UnlessCondition = UnlessCondition
+    made['launch.actions'].IncludeLaunchDescription = IncludeLaunchDescription
+    made['launch.launch_description_sources'].PythonLaunchDescriptionSource = (
+        PythonLaunchDescriptionSource)
     made['launch.substitutions'].PathSubstitution = PathSubstitution
     made['launch_ros.parameter_descriptions'].ParameterFile = ParameterFile
     made['launch.event_handlers'].OnProcessExit = OnProcessExit
@@ -135,6 +157,8 @@ def perform(value: Any, arguments: dict[str, str]) -> Any:
         return perform(value.args[0], arguments)
     if isinstance(value, IfCondition):
         return perform(value.args[0], arguments).strip().lower() in ('true', '1')
+    if isinstance(value, UnlessCondition):
+        return perform(value.args[0], arguments).strip().lower() not in ('true', '1')
     if isinstance(value, LaunchConfiguration):
         return arguments[value.args[0]]
     if isinstance(value, Command):
@@ -168,7 +192,16 @@ class StandInLaunch:
             action.kwargs.get('condition', True), self.arguments))
 
     def start_processes(self) -> None:
-        """Start every node that runs as a process (all but the spawners)."""
+        """Start every node that runs as a process (all but the spawners).
+
+        An included launch file whose condition holds is refused (ValueError):
+        the stand-in runs only this file's nodes.
+        """
+        for action in self.actions:
+            if isinstance(action, IncludeLaunchDescription) and perform(
+                    action.kwargs.get('condition', True), self.arguments):
+                raise ValueError(f'IncludeLaunchDescription({action.args[0].args[0]!r}) is '
+                                 'not carried out by the launch stand-in')
         for node in self.nodes():
             package, executable = node.kwargs['package'], node.kwargs['executable']
             if (package, executable) == ('pan_tilt_sim', 'sim_node'):

@@ -113,8 +113,9 @@ def _specs(controller_manager: bool = False) -> tuple[_Spec, ...]:
               '<ros2_control> initial_value, and the reset services return to them.'),
         _Spec(FIXED_BASE, BOOL_OR_STRING, AUTO,
               "Weld the robot's root link to the world: auto (welded unless a controller "
-              'that drives the base, such as diff_drive_controller, will be active), true or '
-              "false. A robot hung on a 'world' link by a fixed joint is always welded."),
+              'that drives the base, such as diff_drive_controller, will be active or, '
+              'waiting for spawners, the robot stands on wheels), true or false. A robot '
+              "hung on a 'world' link by a fixed joint is always welded."),
         _Spec(INITIAL_POSE, ParameterType.PARAMETER_DOUBLE_ARRAY, None,
               '[x, y, z, yaw] (m, m, m, rad) of the base: a free base rests on the ground, '
               'its lowest collision point z above it; a welded one has its root link frame '
