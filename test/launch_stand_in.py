@@ -3,10 +3,13 @@
 ``launch`` and ``launch_ros`` are not on PyPI.  :func:`load` runs a launch
 file's ``generate_launch_description()`` against stand-in modules that record
 what it asks for (Node, RegisterEventHandler + OnProcessExit, Command,
-PathJoinSubstitution, PathSubstitution, FindPackageShare, LaunchConfiguration,
-DeclareLaunchArgument, IfCondition, UnlessCondition, ParameterFile; IncludeLaunchDescription
-is recorded and refused when it would run), and
-:class:`StandInLaunch` carries the nodes out, as launch_ros would start them:
+PathJoinSubstitution, PathSubstitution, FindPackageShare, FindExecutable, LaunchConfiguration,
+IfElseSubstitution, DeclareLaunchArgument with its choices, IfCondition, UnlessCondition,
+OpaqueFunction, ParameterFile; IncludeLaunchDescription is recorded and refused when it would
+run), and :class:`StandInLaunch` carries it out as launch would: the arguments declared (a
+default performed, a value outside ``choices`` refused) and each OpaqueFunction's function
+called with a context of the arguments so far, its actions carried out in its place; then
+the nodes, as launch_ros would start them:
 
 * ``pan_tilt_sim``'s ``sim_node`` as a process, ``--ros-args -r
   __node:=<name>`` and its parameters as ``--params-file`` arguments (a dict
@@ -28,7 +31,7 @@ import shutil
 import subprocess
 import sys
 import types
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from typing import Any
 
 import sim_process
@@ -41,6 +44,8 @@ STAND_IN_MODULES = ('launch', 'launch.actions', 'launch.conditions', 'launch.eve
                     'launch_ros.actions', 'launch_ros.parameter_descriptions',
                     'launch_ros.substitutions')
 SUBSTITUTION = re.compile(r'\$\(var ([A-Za-z0-9_]+)\)')
+# The texts launch reads as a true or false condition (any case); any other is an error.
+TRUE_TEXTS, FALSE_TEXTS = ('true', '1'), ('false', '0')
 
 
 class Recorded:
@@ -48,6 +53,21 @@ class Recorded:
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         self.args, self.kwargs = args, kwargs
+
+
+class Substitution(Recorded):
+    """A substitution: ``perform(context)`` gives its text, as launch's substitutions do."""
+
+    def perform(self, context: LaunchContext) -> str:
+        """Return the text this stands for with the context's launch configurations."""
+        return text(self, context.launch_configurations)
+
+
+class LaunchContext:
+    """launch.LaunchContext: what an OpaqueFunction's function is called with."""
+
+    def __init__(self, launch_configurations: dict[str, str]) -> None:
+        self.launch_configurations = launch_configurations
 
 
 class Node(Recorded):
@@ -62,15 +82,15 @@ class OnProcessExit(Recorded):
     """launch.event_handlers.OnProcessExit."""
 
 
-class Command(Recorded):
+class Command(Substitution):
     """launch.substitutions.Command: the words, run; its stdout."""
 
 
-class PathJoinSubstitution(Recorded):
+class PathJoinSubstitution(Substitution):
     """launch.substitutions.PathJoinSubstitution."""
 
 
-class PathSubstitution(Recorded):
+class PathSubstitution(Substitution):
     """launch.substitutions.PathSubstitution: ``/`` joins a part on."""
 
     def __truediv__(self, part: Any) -> PathSubstitution:
@@ -78,23 +98,64 @@ class PathSubstitution(Recorded):
 
 
 class DeclareLaunchArgument(Recorded):
-    """launch.actions.DeclareLaunchArgument: a name and its default_value."""
+    """launch.actions.DeclareLaunchArgument: a name, its default_value and its choices."""
+
+    def declare(self, arguments: dict[str, str]) -> None:
+        """Set the default (performed) unless given; refuse a value outside ``choices``."""
+        name = self.args[0]
+        if name not in arguments:
+            arguments[name] = text(self.kwargs.get('default_value', ''), arguments)
+        choices = self.kwargs.get('choices')
+        if choices is not None and arguments[name] not in choices:
+            raise ValueError(f'Argument "{name}" provided value "{arguments[name]}" is not '
+                             f'valid. Valid options are: {choices}')
+
+
+class OpaqueFunction(Recorded):
+    """launch.actions.OpaqueFunction: ``function(context, *args, **kwargs)`` gives actions."""
+
+    def run(self, arguments: dict[str, str]) -> list:
+        """Call the function with a context of ``arguments``; return its actions."""
+        function = self.kwargs['function']
+        return function(LaunchContext(arguments), *self.kwargs.get('args') or [],
+                        **self.kwargs.get('kwargs') or {}) or []
+
+
+class FindExecutable(Substitution):
+    """launch.substitutions.FindExecutable: the program's path (this environment's bin first)."""
+
+
+class IfElseSubstitution(Substitution):
+    """launch.substitutions.IfElseSubstitution: if_value when the condition holds, else_value."""
+
+    def __init__(self, condition: Any, if_value: Any = '', else_value: Any = '') -> None:
+        if if_value == else_value == '':
+            raise ValueError('One of if_value and else_value must be specified')
+        super().__init__(condition, if_value=if_value, else_value=else_value)
 
 
 class IfCondition(Recorded):
-    """launch.conditions.IfCondition: true when its text is 'true' (any case) or '1'."""
+    """launch.conditions.IfCondition: holds when its text is true (see :func:`truth`)."""
 
 
 class UnlessCondition(Recorded):
-    """launch.conditions.UnlessCondition: false when its text is 'true' (any case) or '1'."""
+    """launch.conditions.UnlessCondition: holds when its text is false (see :func:`truth`)."""
 
 
 class IncludeLaunchDescription(Recorded):
     """launch.actions.IncludeLaunchDescription: another package's launch file (Gazebo's).
 
     The stand-in does not run other packages' launch files; :class:`StandInLaunch`
-    refuses one that is left in (its condition holding).
+    refuses one that is left in (its condition holding), naming the file and its
+    ``launch_arguments`` (name-value pairs, or a dict's items).
     """
+
+    def describe(self, arguments: dict[str, str]) -> str:
+        """Return the included file's name and its launch arguments, performed."""
+        names = [part for part in _strings(self.args[0].args[0]) if part.strip('/')]
+        given = ', '.join(f'{text(name, arguments)}={text(value, arguments)!r}'
+                          for name, value in self.kwargs.get('launch_arguments', []))
+        return f'{os.path.basename(names[-1])}({given})'
 
 
 class PythonLaunchDescriptionSource(Recorded):
@@ -105,11 +166,11 @@ class ParameterFile(Recorded):
     """launch_ros ParameterFile: a file; with allow_substs its $(var name) are filled in."""
 
 
-class FindPackageShare(Recorded):
+class FindPackageShare(Substitution):
     """launch_ros.substitutions.FindPackageShare."""
 
 
-class LaunchConfiguration(Recorded):
+class LaunchConfiguration(Substitution):
     """launch.substitutions.LaunchConfiguration."""
 
 
@@ -119,6 +180,7 @@ def modules() -> dict[str, types.ModuleType]:
     made['launch'].LaunchDescription = list
     made['launch.actions'].RegisterEventHandler = RegisterEventHandler
     made['launch.actions'].DeclareLaunchArgument = DeclareLaunchArgument
+    made['launch.actions'].OpaqueFunction = OpaqueFunction
     made['launch.conditions'].IfCondition = IfCondition
     made['launch.conditions'].UnlessCondition = UnlessCondition
     made['launch.actions'].IncludeLaunchDescription = IncludeLaunchDescription
@@ -130,6 +192,8 @@ def modules() -> dict[str, types.ModuleType]:
     made['launch.substitutions'].Command = Command
     made['launch.substitutions'].PathJoinSubstitution = PathJoinSubstitution
     made['launch.substitutions'].LaunchConfiguration = LaunchConfiguration
+    made['launch.substitutions'].FindExecutable = FindExecutable
+    made['launch.substitutions'].IfElseSubstitution = IfElseSubstitution
     made['launch_ros.actions'].Node = Node
     made['launch_ros.substitutions'].FindPackageShare = FindPackageShare
     return made
@@ -156,13 +220,23 @@ def perform(value: Any, arguments: dict[str, str]) -> Any:
     if isinstance(value, PathSubstitution):
         return perform(value.args[0], arguments)
     if isinstance(value, IfCondition):
-        return perform(value.args[0], arguments).strip().lower() in ('true', '1')
+        return truth(text(value.args[0], arguments))
     if isinstance(value, UnlessCondition):
-        return perform(value.args[0], arguments).strip().lower() not in ('true', '1')
+        return not truth(text(value.args[0], arguments))
+    if isinstance(value, IfElseSubstitution):
+        holds = truth(text(value.args[0], arguments))
+        return text(value.kwargs['if_value' if holds else 'else_value'], arguments)
     if isinstance(value, LaunchConfiguration):
         return arguments[value.args[0]]
+    if isinstance(value, FindExecutable):
+        name = text(value.kwargs['name'], arguments)
+        found = (shutil.which(name, path=os.path.dirname(sys.executable))
+                 or shutil.which(name))
+        if found is None:
+            raise ValueError(f"executable '{name}' not found on the PATH")
+        return found
     if isinstance(value, Command):
-        words = shlex.split(''.join(perform(part, arguments) for part in value.args[0]))
+        words = shlex.split(text(value.args[0], arguments))
         words[0] = shutil.which(words[0], path=os.path.dirname(sys.executable)) or words[0]
         return subprocess.run(words, capture_output=True, text=True, check=True).stdout
     if isinstance(value, list | tuple):
@@ -172,24 +246,54 @@ def perform(value: Any, arguments: dict[str, str]) -> Any:
     return value
 
 
+def text(value: Any, arguments: dict[str, str]) -> str:
+    """Return the text of a substitution or a list of them (joined, as launch joins them)."""
+    performed = perform(value, arguments)
+    return ''.join(performed) if isinstance(performed, list) else performed
+
+
+def truth(condition: str) -> bool:
+    """Return what a condition's text means to launch: 'true'/'1' or 'false'/'0', any case."""
+    if condition.strip().lower() in TRUE_TEXTS:
+        return True
+    if condition.strip().lower() in FALSE_TEXTS:
+        return False
+    raise ValueError(f'{condition!r} is not a condition: expected true, false, 1 or 0')
+
+
+def _strings(value: Any) -> Iterator[str]:
+    """The plain texts inside a substitution or a list of them, in order."""
+    if isinstance(value, str):
+        yield value
+    elif isinstance(value, list | tuple):
+        for item in value:
+            yield from _strings(item)
+    elif isinstance(value, Recorded):
+        yield from _strings(list(value.args))
+
+
 class StandInLaunch:
-    """Carries out a launch description's nodes; :meth:`close` stops the processes."""
+    """Carries out a launch description's nodes; :meth:`close` stops the processes.
+
+    ``arguments`` are the launch arguments given (``name:=value``); the
+    declarations and OpaqueFunctions are carried out here, in order, so
+    :attr:`actions` holds what they left: the file's own actions with each
+    OpaqueFunction replaced by the actions it returned.
+    """
 
     def __init__(self, actions: list, folder: pathlib.Path,
                  arguments: dict[str, str] | None = None) -> None:
-        self.actions = actions
         self.folder = folder
-        self.arguments = {action.args[0]: action.kwargs.get('default_value', '')
-                          for action in actions if isinstance(action, DeclareLaunchArgument)}
-        self.arguments.update(arguments or {})
+        self.arguments = dict(arguments or {})
+        self.actions = self._carry_out(actions)
         self.processes: dict[str, subprocess.Popen] = {}
         self.spawner_exits: list[tuple[list[str], int]] = []
         self._files = 0
 
     def nodes(self) -> Iterator[Node]:
         """The Node actions started at once (not those an event waits for) whose condition holds."""
-        return (action for action in self.actions if isinstance(action, Node) and perform(
-            action.kwargs.get('condition', True), self.arguments))
+        return (action for action in self.actions
+                if isinstance(action, Node) and self._holds(action))
 
     def start_processes(self) -> None:
         """Start every node that runs as a process (all but the spawners).
@@ -198,10 +302,9 @@ class StandInLaunch:
         the stand-in runs only this file's nodes.
         """
         for action in self.actions:
-            if isinstance(action, IncludeLaunchDescription) and perform(
-                    action.kwargs.get('condition', True), self.arguments):
-                raise ValueError(f'IncludeLaunchDescription({action.args[0].args[0]!r}) is '
-                                 'not carried out by the launch stand-in')
+            if isinstance(action, IncludeLaunchDescription) and self._holds(action):
+                raise ValueError(f'IncludeLaunchDescription of {action.describe(self.arguments)} '
+                                 'is not carried out by the launch stand-in')
         for node in self.nodes():
             package, executable = node.kwargs['package'], node.kwargs['executable']
             if (package, executable) == ('pan_tilt_sim', 'sim_node'):
@@ -214,11 +317,19 @@ class StandInLaunch:
                     stderr=subprocess.PIPE, text=True)
 
     def run_spawners(self, harness) -> list[int]:
-        """Run the spawners in order, each OnProcessExit's actions after its target; exits."""
-        handlers = {id(action.args[0].kwargs['target_action']): action.args[0].kwargs['on_exit']
-                    for action in self.actions if isinstance(action, RegisterEventHandler)}
+        """Run the spawners in order, each OnProcessExit's spawners after its target; exits.
+
+        A RegisterEventHandler whose condition does not hold registers nothing.
+        """
+        handlers = {}
+        for action in self.actions:
+            if isinstance(action, RegisterEventHandler) and self._holds(action):
+                handler = action.kwargs.get('event_handler') or action.args[0]
+                on_exit = handler.kwargs['on_exit']
+                handlers[id(handler.kwargs['target_action'])] = (
+                    on_exit if isinstance(on_exit, list | tuple) else [on_exit])
         codes = []
-        queue = [node for node in self.nodes() if node.kwargs['executable'] == 'spawner']
+        queue = self._spawners(self.nodes())
         while queue:
             spawner = queue.pop(0)
             arguments = [str(item) for item in perform(spawner.kwargs.get('arguments', []),
@@ -229,7 +340,7 @@ class StandInLaunch:
             code = spawner_main(harness, arguments, spawner.kwargs.get('namespace') or '/')
             codes.append(code)
             self.spawner_exits.append((arguments, code))
-            queue.extend(handlers.get(id(spawner), []))
+            queue.extend(self._spawners(handlers.get(id(spawner), [])))
         return codes
 
     def close(self) -> dict[str, str]:
@@ -238,6 +349,27 @@ class StandInLaunch:
         for name, process in self.processes.items():
             _ended, errors[name] = sim_process.stop(process, 10.0)
         return errors
+
+    def _carry_out(self, actions: list) -> list:
+        """Declare the arguments and run the OpaqueFunctions in order; return the actions left."""
+        left = []
+        for action in actions:
+            if isinstance(action, DeclareLaunchArgument):
+                action.declare(self.arguments)
+            if isinstance(action, OpaqueFunction):
+                left += self._carry_out(action.run(self.arguments))
+            else:
+                left.append(action)
+        return left
+
+    def _holds(self, action: Recorded) -> bool:
+        """Whether the action's condition (if any) holds."""
+        return perform(action.kwargs.get('condition', True), self.arguments)
+
+    def _spawners(self, actions: Iterable) -> list[Node]:
+        """The spawner nodes among ``actions`` whose condition holds (others are not run here)."""
+        return [action for action in actions if isinstance(action, Node)
+                and action.kwargs['executable'] == 'spawner' and self._holds(action)]
 
     def _ros_args(self, node: Node) -> list[str]:
         args = []

@@ -5,8 +5,10 @@ shape (control node with the controllers YAML, robot_state_publisher with
 the xacro output, spawners with ``--param-file`` and ``--controller-ros-args``
 chained by OnProcessExit); a stand-in of the launch API carries it out
 (test/launch_stand_in.py: sim_node and a stand-in robot_state_publisher as
-processes, spawners in-process as jazzy's spawner calls).  With nobody
-publishing robot_description, the program says so once and waits idle.
+processes, spawners in-process as jazzy's spawner calls).
+test/data/gz_shaped/arm_sim_control.launch.py is a Gazebo launch in UR's shape
+(its nodes made by an OpaqueFunction) with the spawn step swapped for sim_node.
+With nobody publishing robot_description, the program says so once and waits idle.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import pytest
 import sim_process
 from builtin_interfaces.msg import Duration
 from node_harness import PROBE_QUEUE, NodeHarness
+from rcl_interfaces.srv import GetParameters
 from sensor_msgs.msg import JointState
 from spawner_client import Spawner
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
@@ -31,6 +34,7 @@ pytestmark = pytest.mark.skipif(
     reason='controller_manager_msgs is not installed')
 
 LAUNCH_FILE = ('examples', 'launch', 'arm_ros2_control.launch.py')
+GZ_SHAPED_LAUNCH_FILE = ('test', 'data', 'gz_shaped', 'arm_sim_control.launch.py')
 ARM_JOINTS = ['shoulder_joint', 'extend_joint', 'wrist_joint']
 TARGET = [0.5, 0.1, 0.3]
 REACHED_RAD = 0.02
@@ -66,26 +70,63 @@ def test_the_launch_file_starts_the_simulation_spawns_and_the_arm_follows_its_co
         listed = {name: c.state for name, c in Spawner(harness).controllers().items()}
         assert listed == {'joint_state_broadcaster': 'active', 'arm_controller': 'active'}
         # --controller-ros-args "-r ~/joint_trajectory:=/arm/joint_trajectory"
-        publisher = harness.probe.create_publisher(JointTrajectory, '/arm/joint_trajectory', 10)
-        assert harness.spin_until(lambda: publisher.get_subscription_count() > 0)
-        publisher.publish(JointTrajectory(joint_names=ARM_JOINTS, points=[JointTrajectoryPoint(
-            positions=TARGET, time_from_start=Duration(sec=1))]))
-
-        def reached() -> bool:
-            if not states:
-                return False
-            positions = dict(zip(states[-1].name, states[-1].position, strict=True))
-            return all(abs(positions[joint] - target) < REACHED_RAD
-                       for joint, target in zip(ARM_JOINTS, TARGET, strict=True))
-
-        assert harness.spin_until(reached, MOVE_BUDGET_S), (
-            f'the arm did not reach {TARGET}: last {states[-1] if states else None}')
+        _assert_the_arm_follows(harness, states, '/arm/joint_trajectory')
     finally:
         harness.close()
         errors = launch.close()
     log = errors['sim_node']
     assert log.count(WAITING) <= 1, log
     assert "Received robot description from topic '/robot_description'" in log
+
+
+def _assert_the_arm_follows(harness: NodeHarness, states: list[JointState], topic: str) -> None:
+    """Send TARGET as a JointTrajectory on ``topic``; wait until /joint_states is there."""
+    publisher = harness.probe.create_publisher(JointTrajectory, topic, 10)
+    assert harness.spin_until(lambda: publisher.get_subscription_count() > 0)
+    publisher.publish(JointTrajectory(joint_names=ARM_JOINTS, points=[JointTrajectoryPoint(
+        positions=TARGET, time_from_start=Duration(sec=1))]))
+
+    def reached() -> bool:
+        if not states:
+            return False
+        positions = dict(zip(states[-1].name, states[-1].position, strict=True))
+        return all(abs(positions[joint] - target) < REACHED_RAD
+                   for joint, target in zip(ARM_JOINTS, TARGET, strict=True))
+
+    assert harness.spin_until(reached, MOVE_BUDGET_S), (
+        f'the arm did not reach {TARGET}: last {states[-1] if states else None}')
+
+
+def test_a_gz_shaped_launch_built_in_an_opaque_function_spawns_and_the_arm_follows(
+        repo_root, monkeypatch, tmp_path):
+    actions = launch_stand_in.load(repo_root.joinpath(*GZ_SHAPED_LAUNCH_FILE), monkeypatch)
+    launch = launch_stand_in.StandInLaunch(actions, tmp_path,
+                                           {'with_gripper': 'false', 'scenery': 'false'})
+    harness = NodeHarness()
+    states: list[JointState] = []
+    harness.probe.create_subscription(JointState, '/joint_states', states.append, PROBE_QUEUE)
+    try:
+        launch.start_processes()
+        # No spawner for the gripper: its event handler's condition does not hold.
+        assert launch.run_spawners(harness) == [0, 0]
+        # Their types and the arm's effort interfaces come from the controllers file the
+        # URDF's gazebo_ros2_control plugin names: the launch file gives sim_node no other.
+        listed = {name: (c.state, c.type, sorted(c.claimed_interfaces))
+                  for name, c in Spawner(harness).controllers().items()}
+        assert listed == {
+            'joint_state_broadcaster': ('active', 'joint_state_broadcaster/JointStateBroadcaster',
+                                        []),
+            'arm_controller': ('active', 'joint_trajectory_controller/JointTrajectoryController',
+                               sorted(f'{joint}/effort' for joint in ARM_JOINTS))}
+        # IfElseSubstitution's else_value, scenery:=false.
+        world = harness.call(GetParameters, '/controller_manager/get_parameters',
+                             GetParameters.Request(names=['world']))
+        assert [value.string_value for value in world.values] == ['empty']
+        _assert_the_arm_follows(harness, states, '/arm_controller/joint_trajectory')
+    finally:
+        harness.close()
+        errors = launch.close()
+    assert "Received robot description from topic '/robot_description'" in errors['sim_node']
 
 
 def _cpu_seconds(pid: int) -> float:

@@ -1,0 +1,156 @@
+"""test/launch_stand_in.py carries out a launch file as ROS 2's launch would.
+
+test/data/gz_shaped/arm_sim_control.launch.py is written in the shape of
+Universal Robots' gz simulation launch (an OpaqueFunction building the nodes,
+FindExecutable, choices, conditions on spawners and on a RegisterEventHandler,
+IfElseSubstitution); here it is only loaded and carried out up to the nodes,
+with the spawners recorded instead of run.  test/end_to_end/test_drop_in_launch.py
+runs it against sim_node.
+"""
+
+from __future__ import annotations
+
+import os
+import pathlib
+import sys
+
+import launch_stand_in
+import pytest
+from launch_stand_in import (
+    FindExecutable,
+    IfElseSubstitution,
+    LaunchConfiguration,
+    LaunchContext,
+    StandInLaunch,
+    perform,
+)
+
+FIXTURE = pathlib.Path(__file__).resolve().parent / 'data' / 'gz_shaped' / (
+    'arm_sim_control.launch.py')
+INCLUDING = '''
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument, IncludeLaunchDescription
+from launch.launch_description_sources import PythonLaunchDescriptionSource
+from launch.substitutions import IfElseSubstitution, LaunchConfiguration
+from launch_ros.substitutions import FindPackageShare
+
+
+def generate_launch_description():
+    return LaunchDescription([
+        DeclareLaunchArgument('gazebo_gui', default_value='true'),
+        IncludeLaunchDescription(
+            PythonLaunchDescriptionSource(
+                [FindPackageShare('ros_gz_sim'), '/launch/gz_sim.launch.py']),
+            launch_arguments={
+                'gz_args': IfElseSubstitution(LaunchConfiguration('gazebo_gui'),
+                                              if_value=[' -r -v 4 ', 'empty.sdf'],
+                                              else_value=[' -s -r -v 4 ', 'empty.sdf'])
+            }.items(),
+        ),
+    ])
+'''
+
+
+def _launch(monkeypatch, tmp_path, **arguments) -> StandInLaunch:
+    return StandInLaunch(launch_stand_in.load(FIXTURE, monkeypatch), tmp_path, arguments)
+
+
+def _node(launch: StandInLaunch, executable: str):
+    (node,) = [node for node in launch.nodes() if node.kwargs['executable'] == executable]
+    return node
+
+
+def test_the_opaque_functions_nodes_take_its_place_made_from_the_arguments(
+        monkeypatch, tmp_path):
+    launch = _launch(monkeypatch, tmp_path, activate_joint_controller='false')
+    assert [node.kwargs['executable'] for node in launch.nodes()] == [
+        'robot_state_publisher', 'spawner', 'spawner', 'sim_node']
+    # The UnlessCondition's spawner, its controller a text the file performed itself.
+    spawner = list(launch.nodes())[2]
+    assert spawner.kwargs['arguments'] == ['arm_controller', '-c', '/controller_manager',
+                                           '--inactive']
+    assert not any(isinstance(action, launch_stand_in.OpaqueFunction)
+                   for action in launch.actions)
+
+
+def test_a_default_is_performed_and_a_given_argument_wins(monkeypatch, tmp_path):
+    launch = _launch(monkeypatch, tmp_path, world='ground')
+    from ament_index_python.packages import get_package_share_directory
+
+    assert launch.arguments['description_file'] == os.path.join(
+        get_package_share_directory('pan_tilt_sim'), 'urdf', 'three_joint_arm.xacro')
+    assert launch.arguments['world'] == 'ground'
+
+
+def test_a_value_outside_the_choices_is_refused_as_launch_refuses_it(monkeypatch, tmp_path):
+    with pytest.raises(ValueError) as refused:
+        _launch(monkeypatch, tmp_path, initial_joint_controller='elbow_controller')
+    assert str(refused.value) == (
+        'Argument "initial_joint_controller" provided value "elbow_controller" is not valid. '
+        "Valid options are: ['arm_controller', 'gripper_controller']")
+
+
+def test_if_else_substitution_gives_the_if_value_when_its_condition_holds(
+        monkeypatch, tmp_path):
+    scenery = _launch(monkeypatch, tmp_path, world='ground')
+    assert perform(_node(scenery, 'sim_node').kwargs['parameters'], scenery.arguments) == [
+        {'world': 'ground'}]
+    bare = _launch(monkeypatch, tmp_path, scenery='False', world='ground')
+    assert perform(_node(bare, 'sim_node').kwargs['parameters'], bare.arguments) == [
+        {'world': 'empty'}]
+
+
+def test_a_condition_text_launch_would_not_read_is_refused():
+    choice = IfElseSubstitution(LaunchConfiguration('gui'), if_value='a', else_value='b')
+    assert perform(choice, {'gui': '1'}) == 'a'
+    assert perform(choice, {'gui': '0'}) == 'b'
+    with pytest.raises(ValueError, match="'yes' is not a condition"):
+        perform(choice, {'gui': 'yes'})
+
+
+def test_a_substitution_performs_with_the_contexts_launch_configurations():
+    context = LaunchContext({'ur_type': 'ur5e'})
+    assert LaunchConfiguration('ur_type').perform(context) == 'ur5e'
+
+
+def test_find_executable_finds_xacro_in_this_environments_bin():
+    assert perform(FindExecutable(name='xacro'), {}) == os.path.join(
+        os.path.dirname(sys.executable), 'xacro')
+    with pytest.raises(ValueError, match="executable 'no-such-program' not found"):
+        perform(FindExecutable(name='no-such-program'), {})
+
+
+def _spawned(monkeypatch, launch: StandInLaunch) -> list[str]:
+    """Run the launch's spawners, recorded instead of run; return their controllers."""
+    ran = []
+    monkeypatch.setattr(launch_stand_in, 'spawner_main',
+                        lambda harness, arguments, namespace: ran.append(arguments[0]) or 0)
+    assert set(launch.run_spawners(None)) == {0}
+    return ran
+
+
+def test_an_event_handler_whose_condition_holds_runs_its_spawner_after_the_target(
+        monkeypatch, tmp_path):
+    launch = _launch(monkeypatch, tmp_path)
+    assert _spawned(monkeypatch, launch) == [
+        'joint_state_broadcaster', 'arm_controller', 'gripper_controller']
+
+
+def test_an_event_handler_whose_condition_does_not_hold_registers_nothing(
+        monkeypatch, tmp_path):
+    launch = _launch(monkeypatch, tmp_path, with_gripper='false')
+    assert _spawned(monkeypatch, launch) == ['joint_state_broadcaster', 'arm_controller']
+
+
+def test_an_include_left_in_is_refused_naming_the_file_and_its_launch_arguments(
+        monkeypatch, tmp_path):
+    path = tmp_path / 'gz.launch.py'
+    path.write_text(INCLUDING)
+    launch = StandInLaunch(launch_stand_in.load(path, monkeypatch), tmp_path,
+                           {'gazebo_gui': 'false'})
+    with pytest.raises(ValueError) as refused:
+        launch.start_processes()
+    assert str(refused.value) == (
+        "IncludeLaunchDescription of gz_sim.launch.py(gz_args=' -s -r -v 4 empty.sdf') is not "
+        'carried out by the launch stand-in')
+    assert launch.processes == {}
