@@ -337,7 +337,10 @@ class StandInLaunch:
             # Its own parameter files are --param-files to jazzy's spawner too.
             for parameters in perform(spawner.kwargs.get('parameters', []), self.arguments):
                 arguments += ['--param-file', str(self._parameter_file(parameters))]
-            code = spawner_main(harness, arguments, spawner.kwargs.get('namespace') or '/')
+            try:
+                code = spawner_main(harness, arguments, spawner.kwargs.get('namespace') or '/')
+            except SystemExit as refused:  # its arguments refused, as the program exits
+                code = refused.code
             codes.append(code)
             self.spawner_exits.append((arguments, code))
             queue.extend(self._spawners(handlers.get(id(spawner), [])))

@@ -51,6 +51,17 @@ def generate_launch_description():
 '''
 
 
+STOPPED = '''
+from launch import LaunchDescription
+from launch_ros.actions import Node
+
+
+def generate_launch_description():
+    return LaunchDescription([Node(package='controller_manager', executable='spawner',
+                                   arguments=['arm_controller', '--stopped'])])
+'''
+
+
 def _launch(monkeypatch, tmp_path, **arguments) -> StandInLaunch:
     return StandInLaunch(launch_stand_in.load(FIXTURE, monkeypatch), tmp_path, arguments)
 
@@ -154,3 +165,12 @@ def test_an_include_left_in_is_refused_naming_the_file_and_its_launch_arguments(
         "IncludeLaunchDescription of gz_sim.launch.py(gz_args=' -s -r -v 4 empty.sdf') is not "
         'carried out by the launch stand-in')
     assert launch.processes == {}
+
+
+def test_a_spawner_refusing_its_arguments_exits_2_as_the_program_would(
+        monkeypatch, tmp_path, capsys):
+    path = tmp_path / 'stopped.launch.py'
+    path.write_text(STOPPED)  # humble's --stopped, gone from jazzy's spawner
+    launch = StandInLaunch(launch_stand_in.load(path, monkeypatch), tmp_path)
+    assert launch.run_spawners(None) == [2]
+    assert 'unrecognized arguments: --stopped' in capsys.readouterr().err
