@@ -144,7 +144,8 @@ def manager_controllers(node: Node, settings: ManagerSettings, arguments: RosArg
     controllers = controller_manager_config(
         fields, lambda name: shared_parameters(node, arguments, name),
         update_rate=float(rate),
-        source=f'the parameters of {node.get_fully_qualified_name()}')
+        source=' + '.join([*(str(path) for path in plugin_files),
+                           f'the parameters of {node.get_fully_qualified_name()}']))
     return controllers, arguments
 
 

@@ -147,7 +147,8 @@ def test_controllers_given_as_node_parameters_in_the_managers_layout_need_no_par
     assert f'{FORWARD}.real_time_factor: unknown parameter' not in capfd.readouterr().err
 
 
-def test_a_gazebo_robots_plugin_file_gives_the_controller_manager_its_controllers(tmp_path):
+def test_a_gazebo_robots_plugin_file_gives_the_controller_manager_its_controllers(
+        tmp_path, capfd):
     from ros2_control_fixtures import write_arm
 
     from pan_tilt_sim.model.description import load_description
@@ -165,6 +166,9 @@ def test_a_gazebo_robots_plugin_file_gives_the_controller_manager_its_controller
         listed = spawner.controllers()
         assert listed[FORWARD].update_rate == 50  # the plugin file's controller_manager's
         assert listed[FORWARD].claimed_interfaces == ['joint1/position', 'joint2/position']
+    # The start-up line names the file the controllers came from.
+    assert f'(declared in {plugin_file} + the parameters of /controller_manager: ' in (
+        capfd.readouterr().err)
 
 
 def test_a_params_file_given_to_the_controller_manager_is_loaded(tmp_path):
