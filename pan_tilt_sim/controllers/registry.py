@@ -29,6 +29,7 @@ from pan_tilt_sim.controllers.joint_position_controller import JointPositionCont
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
 from pan_tilt_sim.controllers.joint_trajectory_controller import JointTrajectoryController
 from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
+from pan_tilt_sim.controllers.mecanum_drive_controller import MecanumDriveController
 from pan_tilt_sim.controllers.parallel_gripper_action_controller import (
     ParallelGripperActionController,
 )
@@ -49,6 +50,7 @@ CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
     JointTrajectoryController,
     PidController,
     DiffDriveController,
+    MecanumDriveController,
     GripperActionController,
     EffortGripperActionController,
     ParallelGripperActionController,
