@@ -1,0 +1,98 @@
+"""Wheels with free rollers on the ground: the base moves by contact forces, as the rollers allow.
+
+The mecanum base of test/roller_fixtures.py stands free on its four wheels;
+its controller's wheel speeds are the only thing driving it, and the roller
+friction (pan_tilt_sim/sim/roller_wheels.py) is the only grip the wheels
+have.  Each drive is closed loop on the controller's odometry, as a
+navigation stack would drive it; the true pose is PyBullet's.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from roller_fixtures import CONTROLLER, REST_HEIGHT, mecanum_joints, write_mecanum
+
+from pan_tilt_sim.controllers.surface import StampedTwist
+from pan_tilt_sim.sim.bullet import pybullet
+from pan_tilt_sim.sim.engine import make_simulation
+
+TIME_STEP = 0.001
+UPDATE_STEPS = 10  # one controller update at 100 Hz
+FRICTION = 1  # index of the lateral friction in pybullet.getDynamicsInfo
+
+
+def mecanum(tmp_path):
+    """Return a Simulation of the mecanum base, free on the ground."""
+    description, controllers = write_mecanum(tmp_path)
+    return make_simulation(str(description), str(controllers), TIME_STEP, fixed_base=None)
+
+
+def drive_until(simulation, velocity: tuple[float, float, float], done) -> None:
+    """Command ``velocity`` (vx, vy, wz) until ``done(odometry)``, then stop and settle."""
+    controller = simulation.controller(CONTROLLER)
+    vx, vy, wz = velocity
+    for _ in range(20000):
+        if done(controller.odometry):
+            break
+        controller.set_command(StampedTwist(0.0, (vx, vy, 0.0), (0.0, 0.0, wz)))
+        simulation.advance(UPDATE_STEPS)
+    else:
+        pytest.fail('the odometry never got there')
+    for _ in range(100):
+        controller.set_command(StampedTwist(0.0, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)))
+        simulation.advance(UPDATE_STEPS)
+
+
+def yaw(rotation) -> float:
+    """Return the heading of a quaternion that turns about z only."""
+    return 2.0 * math.atan2(rotation[2], rotation[3])
+
+
+def test_one_metre_forward_the_odometry_agrees_with_the_true_pose(tmp_path):
+    with mecanum(tmp_path) as simulation:
+        drive_until(simulation, (0.2, 0.0, 0.0), lambda odometry: odometry.x >= 1.0)
+        (x, y, z), odometry = simulation.physics.base_frame().translation, simulation.controller(
+            CONTROLLER).odometry
+        assert x == pytest.approx(1.0, rel=0.02)
+        assert odometry.x == pytest.approx(x, rel=0.02)
+        assert abs(y) < 0.02 and abs(odometry.y) < 0.02
+        assert z == pytest.approx(REST_HEIGHT, abs=2e-3)  # upright, on its wheels
+
+
+def test_one_metre_sideways_the_rollers_let_it_strafe_and_the_odometry_agrees(tmp_path):
+    with mecanum(tmp_path) as simulation:
+        drive_until(simulation, (0.0, 0.2, 0.0), lambda odometry: odometry.y >= 1.0)
+        frame, odometry = simulation.physics.base_frame(), simulation.controller(
+            CONTROLLER).odometry
+        x, y, _ = frame.translation
+        assert y == pytest.approx(1.0, rel=0.02)
+        assert odometry.y == pytest.approx(y, rel=0.02)
+        assert abs(x) < 0.02 and abs(yaw(frame.rotation)) < 0.02
+
+
+def test_a_quarter_turn_on_the_spot_the_odometry_agrees_with_the_true_heading(tmp_path):
+    with mecanum(tmp_path) as simulation:
+        drive_until(simulation, (0.0, 0.0, 0.5),
+                    lambda odometry: odometry.heading >= math.pi / 2)
+        frame = simulation.physics.base_frame()
+        heading = yaw(frame.rotation)
+        assert heading == pytest.approx(math.pi / 2, rel=0.02)
+        assert simulation.controller(CONTROLLER).odometry.heading == pytest.approx(
+            heading, rel=0.02)
+        assert math.hypot(*frame.translation[:2]) < 0.02
+
+
+def test_the_roller_wheels_have_no_pybullet_friction_while_their_controller_is_active(tmp_path):
+    with mecanum(tmp_path) as simulation:
+        physics = simulation.physics
+
+        def friction(joint: str) -> float:
+            return pybullet.getDynamicsInfo(physics.body_id, physics.joint_index(joint),
+                                            physicsClientId=physics.client_id)[FRICTION]
+
+        assert [friction(joint) for joint in mecanum_joints()] == [0.0] * 4
+        simulation.manager.switch(deactivate=[CONTROLLER])
+        assert [friction(joint) for joint in mecanum_joints()] == [1.0] * 4
+
