@@ -153,9 +153,10 @@ def yaw_transform(x: float, y: float, heading: float) -> Transform:
 
 def _wheel_params(position: str) -> tuple[Param, Param]:
     text = position.replace('_', ' ')
+    example = f'joint{WHEELS.index(position) + 1}'
     return (Param(f'{position}_wheel_command_joint_name', STRING, REQUIRED,
                   f'The joint commanding the {text} wheel.', (not_empty(),), read_only=True,
-                  example=f'{position}_wheel_joint'),
+                  example=example),
             Param(f'{position}_wheel_state_joint_name', STRING, '',
                   f'The joint the {text} wheel is read by; empty: the command joint.',
                   read_only=True))
@@ -225,11 +226,11 @@ class MecanumDriveController(CommandController):
               read_only=True),
         Param('kinematics.base_frame_offset.theta', DOUBLE, 0.0, 'Rotation about z (rad).',
               read_only=True),
-        Param('kinematics.wheels_radius', DOUBLE, REQUIRED, "The wheels' radius (m).",
+        Param('kinematics.wheels_radius', DOUBLE, 0.0, "The wheels' radius (m).",
               (gt(0.0),), read_only=True, example=0.05),
-        Param('kinematics.sum_of_robot_center_projection_on_X_Y_axis', DOUBLE, REQUIRED,
+        Param('kinematics.sum_of_robot_center_projection_on_X_Y_axis', DOUBLE, 0.0,
               "lx + ly: the wheels' distances from the centre along x plus along y (m); "
-              'upstream defaults to 0, which its odometry divides by.', (gt(0.0),),
+              'upstream accepts 0, which its odometry divides by.', (gt(0.0),),
               read_only=True, example=0.3),
         Param('tf_frame_prefix_enable', BOOL, True, 'Prefix the frame ids with tf_frame_prefix.'),
         Param('tf_frame_prefix', STRING, '', "The frame ids' prefix; empty: the controller's "
@@ -272,6 +273,9 @@ class MecanumDriveController(CommandController):
         self._references = {reference: Reference(reference) for reference in names}
         self._reference_list = tuple(self._references.values())
         kinematics = params['kinematics']
+        for field in ('wheels_radius', 'sum_of_robot_center_projection_on_X_Y_axis'):
+            if not kinematics[field] > 0.0:  # the default 0 too: upstream validates it so
+                raise self.error(f'kinematics.{field}', f'{kinematics[field]!r} must be > 0')
         offset = kinematics['base_frame_offset']
         self._offset = (offset['x'], offset['y'], offset['theta'])
         self._radius = kinematics['wheels_radius']

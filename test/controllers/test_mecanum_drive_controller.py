@@ -206,7 +206,7 @@ def test_samples_leave_once_per_update_with_the_measured_wheels_and_the_referenc
                      'sum_of_robot_center_projection_on_X_Y_axis': 0.3}},
      'kinematics.wheels_radius', 'must be > 0'),
     ({'kinematics': {'wheels_radius': 0.05}},
-     'kinematics.sum_of_robot_center_projection_on_X_Y_axis', 'missing'),
+     'kinematics.sum_of_robot_center_projection_on_X_Y_axis', '0.0 must be > 0'),
     ({'front_left_wheel_command_joint_name': ''}, 'front_left_wheel_command_joint_name',
      'must not be empty'),
     ({'rear_left_wheel_command_joint_name': FL}, 'rear_left_wheel_command_joint_name',
