@@ -1,10 +1,11 @@
 """Wheels with free rollers on the ground: the base moves by contact forces, as the rollers allow.
 
-The mecanum base of test/roller_fixtures.py stands free on its four wheels;
-its controller's wheel speeds are the only thing driving it, and the roller
-friction (pan_tilt_sim/sim/roller_wheels.py) is the only grip the wheels
-have.  Each drive is closed loop on the controller's odometry, as a
-navigation stack would drive it; the true pose is PyBullet's.
+The mecanum base of test/roller_fixtures.py stands free on its four wheels,
+the omni base on its three; their controllers' wheel speeds are the only
+thing driving them, and the roller friction
+(pan_tilt_sim/sim/roller_wheels.py) is the only grip the wheels have.
+Each drive is closed loop on the controller's odometry, as a navigation
+stack would drive it; the true pose is PyBullet's.
 """
 
 from __future__ import annotations
@@ -12,7 +13,14 @@ from __future__ import annotations
 import math
 
 import pytest
-from roller_fixtures import CONTROLLER, REST_HEIGHT, mecanum_joints, write_mecanum
+from roller_fixtures import (
+    CONTROLLER,
+    REST_HEIGHT,
+    mecanum_joints,
+    omni_joints,
+    write_mecanum,
+    write_omni,
+)
 
 from pan_tilt_sim.controllers.surface import StampedTwist
 from pan_tilt_sim.sim.bullet import pybullet
@@ -26,6 +34,12 @@ FRICTION = 1  # index of the lateral friction in pybullet.getDynamicsInfo
 def mecanum(tmp_path):
     """Return a Simulation of the mecanum base, free on the ground."""
     description, controllers = write_mecanum(tmp_path)
+    return make_simulation(str(description), str(controllers), TIME_STEP, fixed_base=None)
+
+
+def omni(tmp_path):
+    """Return a Simulation of the omni base, free on the ground."""
+    description, controllers = write_omni(tmp_path)
     return make_simulation(str(description), str(controllers), TIME_STEP, fixed_base=None)
 
 
@@ -96,3 +110,38 @@ def test_the_roller_wheels_have_no_pybullet_friction_while_their_controller_is_a
         simulation.manager.switch(deactivate=[CONTROLLER])
         assert [friction(joint) for joint in mecanum_joints()] == [1.0] * 4
 
+
+
+@pytest.mark.parametrize('velocity, axis', [((0.2, 0.0, 0.0), 0), ((0.0, 0.2, 0.0), 1)])
+def test_the_omni_base_drives_one_metre_forward_or_sideways_and_the_odometry_agrees(
+        tmp_path, velocity, axis):
+    with omni(tmp_path) as simulation:
+        drive_until(simulation, velocity,
+                    lambda odometry: (odometry.x, odometry.y)[axis] >= 1.0)
+        frame, odometry = simulation.physics.base_frame(), simulation.controller(
+            CONTROLLER).odometry
+        travelled = frame.translation[axis]
+        assert travelled == pytest.approx(1.0, rel=0.02)
+        assert (odometry.x, odometry.y)[axis] == pytest.approx(travelled, rel=0.02)
+        assert abs(frame.translation[1 - axis]) < 0.02 and abs(yaw(frame.rotation)) < 0.02
+
+
+def test_the_omni_base_turns_a_quarter_on_the_spot_and_the_odometry_agrees(tmp_path):
+    with omni(tmp_path) as simulation:
+        drive_until(simulation, (0.0, 0.0, 0.5),
+                    lambda odometry: odometry.heading >= math.pi / 2)
+        frame = simulation.physics.base_frame()
+        heading = yaw(frame.rotation)
+        assert heading == pytest.approx(math.pi / 2, rel=0.02)
+        assert simulation.controller(CONTROLLER).odometry.heading == pytest.approx(
+            heading, rel=0.02)
+        assert math.hypot(*frame.translation[:2]) < 0.02
+
+
+def test_the_omni_wheels_have_no_pybullet_friction_while_their_controller_is_active(tmp_path):
+    with omni(tmp_path) as simulation:
+        physics = simulation.physics
+        frictions = [pybullet.getDynamicsInfo(physics.body_id, physics.joint_index(joint),
+                                              physicsClientId=physics.client_id)[FRICTION]
+                     for joint in omni_joints()]
+        assert frictions == [0.0] * 3
