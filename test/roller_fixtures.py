@@ -57,7 +57,7 @@ def _ros2_control(joints: list[str]) -> str:
             '</ros2_control>')
 
 
-def _robot(name: str, body: str, wheels: str, joints: list[str]) -> str:
+def _robot(name: str, body: str, wheels: str, joints: list[str], extra: str = '') -> str:
     return textwrap.dedent(f'''\
         <?xml version="1.0"?>
         <robot name="{name}">
@@ -68,6 +68,7 @@ def _robot(name: str, body: str, wheels: str, joints: list[str]) -> str:
           </link>
           {wheels}
           {_ros2_control(joints)}
+          {extra}
         </robot>
         ''').lstrip()
 
@@ -77,12 +78,18 @@ def mecanum_joints() -> list[str]:
     return [f'{wheel}_wheel_joint' for wheel in MECANUM_WHEELS]
 
 
-def mecanum_urdf(name: str = 'mecanum') -> str:
-    """Return the four-wheel mecanum base (every axis along the base's y)."""
+def mecanum_urdf(name: str = 'mecanum', friction: float | None = None) -> str:
+    """Return the four-wheel mecanum base (every axis along the base's y).
+
+    ``friction``: the wheels' ``<mu1>``/``<mu2>`` (None: none given, Gazebo's 1).
+    """
     places = {'front_left': (MECANUM_LX, MECANUM_LY), 'front_right': (MECANUM_LX, -MECANUM_LY),
               'rear_right': (-MECANUM_LX, -MECANUM_LY), 'rear_left': (-MECANUM_LX, MECANUM_LY)}
     wheels = ''.join(_wheel(f'{wheel}_wheel', x, y, 0.0) for wheel, (x, y) in places.items())
-    return _robot(name, '<box size="0.4 0.3 0.04"/>', wheels, mecanum_joints())
+    surfaces = '' if friction is None else ''.join(
+        f'<gazebo reference="{wheel}_wheel"><mu1>{friction}</mu1><mu2>{friction}</mu2></gazebo>'
+        for wheel in MECANUM_WHEELS)
+    return _robot(name, '<box size="0.4 0.3 0.04"/>', wheels, mecanum_joints(), surfaces)
 
 
 def mecanum_parameters(**overrides: Any) -> dict[str, Any]:
@@ -132,11 +139,11 @@ def controllers_file(kind: str, drive: Mapping[str, Any], update_rate: int = 100
     })
 
 
-def write_mecanum(directory: pathlib.Path,
-                  drive: Mapping[str, Any] | None = None) -> tuple[pathlib.Path, pathlib.Path]:
+def write_mecanum(directory: pathlib.Path, drive: Mapping[str, Any] | None = None,
+                  friction: float | None = None) -> tuple[pathlib.Path, pathlib.Path]:
     """Write the mecanum base's URDF and controllers file into ``directory``; return both."""
     description = directory / 'mecanum.urdf'
-    description.write_text(mecanum_urdf(), encoding='utf-8')
+    description.write_text(mecanum_urdf(friction=friction), encoding='utf-8')
     controllers = directory / 'mecanum_controllers.yaml'
     controllers.write_text(controllers_file(
         MECANUM, drive if drive is not None else mecanum_parameters()), encoding='utf-8')

@@ -31,9 +31,9 @@ UPDATE_STEPS = 10  # one controller update at 100 Hz
 FRICTION = 1  # index of the lateral friction in pybullet.getDynamicsInfo
 
 
-def mecanum(tmp_path):
-    """Return a Simulation of the mecanum base, free on the ground."""
-    description, controllers = write_mecanum(tmp_path)
+def mecanum(tmp_path, friction=None):
+    """Return a Simulation of the mecanum base, free on the ground (wheels' ``friction``)."""
+    description, controllers = write_mecanum(tmp_path, friction=friction)
     return make_simulation(str(description), str(controllers), TIME_STEP, fixed_base=None)
 
 
@@ -96,6 +96,20 @@ def test_a_quarter_turn_on_the_spot_the_odometry_agrees_with_the_true_heading(tm
         assert simulation.controller(CONTROLLER).odometry.heading == pytest.approx(
             heading, rel=0.02)
         assert math.hypot(*frame.translation[:2]) < 0.02
+
+
+def test_the_grip_across_the_rollers_is_bounded_by_the_wheels_friction(tmp_path):
+    # Each wheel pushes along its traction direction, 45 degrees off x, with at most mu N:
+    # together at most mu g / sqrt(2) of forward acceleration, however fast the wheels spin.
+    mu = 0.1
+    with mecanum(tmp_path, friction=mu) as simulation:
+        controller = simulation.controller(CONTROLLER)
+        for _ in range(20):  # 0.2 s asking for 2 m/s at once
+            controller.set_command(StampedTwist(0.0, (2.0, 0.0, 0.0), (0.0, 0.0, 0.0)))
+            simulation.advance(UPDATE_STEPS)
+        (speed, _, _), _ = simulation.physics.base_velocity()
+        most = mu * 9.81 / math.sqrt(2.0) * 0.2
+        assert 0.8 * most < speed < 1.05 * most
 
 
 def test_the_roller_wheels_have_no_pybullet_friction_while_their_controller_is_active(tmp_path):
