@@ -16,13 +16,16 @@ As ros2_controllers' (jazzy), parameters by their names there:
   applied before the inverse kinematics.
 * **Wheels**: ``front_left_wheel_command_joint_name`` ... (four), driven
   through their ``velocity`` command interface by the ideal velocity
-  actuator: with ``l`` = ``kinematics.sum_of_robot_center_projection_on_X_Y_axis``
-  and ``r`` = ``kinematics.wheels_radius``, front left ``(vx - vy - l w) / r``,
+  actuator -- or a following controller's references
+  (``<controller>/<joint>``, its ``velocity`` reference), as upstream.
+  With ``l`` = ``kinematics.sum_of_robot_center_projection_on_X_Y_axis``
+  and ``r`` = ``kinematics.wheels_radius``: front left ``(vx - vy - l w) / r``,
   front right ``(vx + vy + l w) / r``, rear right ``(vx - vy + l w) / r``,
   rear left ``(vx + vy - l w) / r`` rad/s, the twist first moved from the
   base frame to the wheels' centre by ``kinematics.base_frame_offset``.
   The ``*_wheel_state_joint_name`` (default: the command joint) are read
-  through their ``velocity`` state interface.
+  through their ``velocity`` state interface; they name the wheels when a
+  following controller takes the commands.
 * **Odometry**: the forward kinematics of the measured wheel velocities,
   integrated at every update (Euler, heading first), twist raw (no rolling
   mean), as upstream.  ``~/odometry`` (``nav_msgs/msg/Odometry``,
@@ -282,7 +285,9 @@ class MecanumDriveController(CommandController):
         self._projection_sum = kinematics['sum_of_robot_center_projection_on_X_Y_axis']
         self._odometry = MecanumOdometry(self._radius, self._projection_sum, self._offset)
         self._schedule = PeriodicSchedule(update_period(params))
-        self._commands: list[JointHandle] = []
+        # Each wheel's command: a joint's handle, or a following controller's reference.
+        self._commands: list[JointHandle | Reference] = []
+        self._command_handles: list[JointHandle] = []
         self._states: list[JointHandle] = []
         self._odometry_sink: OdometrySink | None = None
         self._tf_sink: TfSink | None = None
@@ -306,18 +311,22 @@ class MecanumDriveController(CommandController):
         return {joint: (VELOCITY,) for joint in self._state_names}
 
     def actuators(self) -> dict[str, Actuator]:
-        """Return the ideal velocity actuator for every command joint."""
-        return {joint: Actuator(ActuatorKind.IDEAL_VELOCITY, self.name)
-                for joint in self._command_names}
+        """Return the ideal velocity actuator for every command joint (not references)."""
+        return {handle.name: Actuator(ActuatorKind.IDEAL_VELOCITY, self.name)
+                for handle in self._command_handles}
 
     def reference_interfaces(self) -> Mapping[str, Reference]:
         """Return ``<name>/linear/x/velocity``, ``.../linear/y/...`` and ``.../angular/z/...``."""
         return self._references
 
     def roller_wheels(self) -> dict[str, float]:
-        """Return each command joint's roller angle (rad): 45 degrees, an X seen from above."""
+        """Return each wheel's roller angle (rad): 45 degrees, an X seen from above.
+
+        The wheels are the state joints: the command joints unless a
+        following controller drives them (then the state joints name them).
+        """
         return {joint: ROLLER_ANGLES[wheel]
-                for wheel, joint in zip(WHEELS, self._command_names, strict=True)}
+                for wheel, joint in zip(WHEELS, self._state_names, strict=True)}
 
     def schedule(self) -> PeriodicSchedule:
         """Return the update schedule: every ``1 / update_rate`` s of sim time."""
@@ -365,8 +374,11 @@ class MecanumDriveController(CommandController):
 
     def configure(self, joints: Mapping[str, JointHandle]) -> None:
         """Bind the wheels (an unknown joint names its parameter), then reset."""
-        self._commands = [self.handle(joints, joint, f'{wheel}_wheel_command_joint_name')
+        self._commands = [self.command_target(joints, joint, VELOCITY,
+                                              f'{wheel}_wheel_command_joint_name')
                           for wheel, joint in zip(WHEELS, self._command_names, strict=True)]
+        self._command_handles = [target for target in self._commands
+                                 if isinstance(target, JointHandle)]
         self._states = [self.handle(joints, joint, f'{wheel}_wheel_state_joint_name'
                                     if self.params[f'{wheel}_wheel_state_joint_name']
                                     else f'{wheel}_wheel_command_joint_name', commanded=False)
@@ -385,13 +397,18 @@ class MecanumDriveController(CommandController):
         self._schedule.reset()
         self._odometry.reset()
         self._wheel_commands = [0.0] * len(WHEELS)
-        for handle in self._commands:
-            handle.velocity_target = 0.0
+        self._write(self._wheel_commands)
 
     def deactivate(self) -> None:
-        """Stop the wheels (upstream writes NaN, which a velocity interface cannot drive)."""
-        for handle in self._commands:
-            handle.velocity_target = 0.0
+        """Stop the wheels; following controllers' references get NaN, as upstream writes.
+
+        A joint's velocity interface cannot be driven at NaN: it gets 0.
+        """
+        for target in self._commands:
+            if isinstance(target, Reference):
+                target.value = math.nan
+            else:
+                target.velocity_target = 0.0
 
     # --- commands --------------------------------------------------------------------------
 
@@ -419,7 +436,7 @@ class MecanumDriveController(CommandController):
 
     def setpoints(self) -> dict[str, float]:
         """Return each command joint's commanded velocity (rad/s)."""
-        return {handle.name: handle.velocity_target for handle in self._commands}
+        return {handle.name: handle.velocity_target for handle in self._command_handles}
 
     @property
     def odometry(self) -> MecanumOdometry:
@@ -464,11 +481,18 @@ class MecanumDriveController(CommandController):
                                            self._history[0][index], interval))
             self._history = [self._history[1], tuple(limited)]
             self._wheel_commands = list(self.wheel_velocities(*limited))
-        for handle, command in zip(self._commands, self._wheel_commands, strict=False):
-            handle.velocity_target = command
+        self._write(self._wheel_commands)
         self._publish(time, measured, references)
         for reference in self._reference_list:
             reference.value = math.nan
+
+    def _write(self, velocities: Sequence[float]) -> None:
+        """Command the wheels' velocities (rad/s): to their joints or following references."""
+        for target, velocity in zip(self._commands, velocities, strict=False):
+            if isinstance(target, Reference):
+                target.value = velocity
+            else:
+                target.velocity_target = velocity
 
     def _update_references(self, time: float) -> None:
         """Write the reference while it is fresh; zeros once, then nothing, when it is stale."""

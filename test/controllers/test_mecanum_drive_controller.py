@@ -14,7 +14,7 @@ import pytest
 from roller_fixtures import MECANUM_LX, MECANUM_LY, WHEEL_RADIUS, mecanum_joints, mecanum_parameters
 
 from pan_tilt_sim.controllers import JointHandle, registry
-from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult
+from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult, Reference
 from pan_tilt_sim.controllers.mecanum_drive_controller import MecanumDriveController
 from pan_tilt_sim.controllers.surface import CommandTopic, StampedTwist, StateTopic
 from pan_tilt_sim.errors import ControllerConfigError
@@ -111,6 +111,31 @@ def test_separate_state_joints_are_read_instead_of_the_command_joints():
         front_left_wheel_state_joint_name='other_joint'), 'mecanum.yaml')
     assert drive.state_interfaces()['other_joint'] == ('velocity',)
     assert FL not in drive.state_interfaces()
+
+
+def test_a_following_controllers_references_take_the_commands_and_the_state_joints_the_wheels():
+    follower = {f'pid/{joint}/velocity': Reference(f'pid/{joint}/velocity')
+                for joint in mecanum_joints()}
+    params = mecanum_parameters()
+    for wheel, joint in zip(('front_left', 'front_right', 'rear_right', 'rear_left'),
+                            mecanum_joints(), strict=True):
+        params[f'{wheel}_wheel_command_joint_name'] = f'pid/{joint}'
+        params[f'{wheel}_wheel_state_joint_name'] = joint
+    drive = MecanumDriveController(NAME, params, 'mecanum.yaml')
+    drive.set_available_references(follower)
+    handles = {name: JointHandle(JointSpec(name, JointKind.CONTINUOUS))
+               for name in mecanum_joints()}
+    drive.configure(handles)
+    assert drive.command_interfaces() == {f'pid/{joint}': ('velocity',)
+                                          for joint in mecanum_joints()}
+    assert drive.actuators() == {}
+    assert set(drive.roller_wheels()) == set(mecanum_joints())
+    drive.set_command(twist(0.2, 0.1, 0.5))
+    drive.update(0.0, DT)
+    assert [reference.value for reference in follower.values()] == pytest.approx(
+        [-1.2, 9.2, 5.2, 2.8])
+    drive.deactivate()
+    assert all(math.isnan(reference.value) for reference in follower.values())
 
 
 def test_a_reference_is_used_until_reference_timeout_then_the_wheels_stop():
