@@ -71,6 +71,8 @@ UPSTREAM_HASHES = {
         'RIHS01_51acbcd62aa44097d3877c506eab1146856fa8768628ffbe102c1699152d2afa',
     'control_msgs/msg/GripperCommand':
         'RIHS01_57eb8f326c9889ca8bb34ead82cc94cc09bf6bc5c3b6c09546dca3a00b589890',
+    'control_msgs/msg/MecanumDriveControllerState':
+        'RIHS01_c560d21a4484fd5f2c05896a11de3315f4c33535a203d3e8d62af4b6a9cd3355',
     'control_msgs/msg/DynamicInterfaceGroupValues':
         'RIHS01_0ebef56c55cdde46b4622f7e0a4dbf26fefbf0296205463e955047252b434cbc',
     'controller_manager_msgs/srv/SwitchController':

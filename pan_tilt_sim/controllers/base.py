@@ -483,6 +483,16 @@ class Controller(abc.ABC):
         """Return what drives each of this controller's joints while it is active; none here."""
         return {}
 
+    def roller_wheels(self) -> dict[str, float]:
+        """Return the wheel joints that carry free rollers, each with its rollers' angle (rad).
+
+        The angle is between the wheel's rolling direction and the direction
+        its rollers roll freely at the ground, turned towards the wheel's
+        axis: pi / 2 for an omni wheel, +-pi / 4 for a mecanum wheel (see
+        :mod:`pan_tilt_sim.sim.roller_wheels`).  Ordinary wheels: none here.
+        """
+        return {}
+
     def error(self, field: str, problem: str) -> ControllerConfigError:
         """Return an error naming this controller's field in the controllers file."""
         where = f'{self._source}: ' if self._source else ''

@@ -29,6 +29,8 @@ from pan_tilt_sim.controllers.joint_position_controller import JointPositionCont
 from pan_tilt_sim.controllers.joint_state_controller import JointStateController
 from pan_tilt_sim.controllers.joint_trajectory_controller import JointTrajectoryController
 from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
+from pan_tilt_sim.controllers.mecanum_drive_controller import MecanumDriveController
+from pan_tilt_sim.controllers.omni_wheel_drive_controller import OmniWheelDriveController
 from pan_tilt_sim.controllers.parallel_gripper_action_controller import (
     ParallelGripperActionController,
 )
@@ -49,6 +51,8 @@ CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
     JointTrajectoryController,
     PidController,
     DiffDriveController,
+    MecanumDriveController,
+    OmniWheelDriveController,
     GripperActionController,
     EffortGripperActionController,
     ParallelGripperActionController,

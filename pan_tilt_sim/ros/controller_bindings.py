@@ -98,6 +98,10 @@ try:
 except ImportError:  # an optional interface package (see optional_interfaces)
     DynamicJointState = InterfaceValue = MultiDOFStateStamped = SingleDOFState = None
     JointTrajectoryControllerState = QueryTrajectoryState = None
+try:
+    from control_msgs.msg import MecanumDriveControllerState
+except ImportError:  # optional, and absent from control_msgs builds older than this project's
+    MecanumDriveControllerState = None
 
 QUEUE_DEPTH = 10
 WARNING_THROTTLE_S = 1.0
@@ -625,6 +629,29 @@ class TwistSink(_HeldSink):
         message.twist.angular.z = angular
 
 
+class MecanumStateSink(_HeldSink):
+    """A mecanum drive's state as ``control_msgs/msg/MecanumDriveControllerState``.
+
+    Field ``frame_id`` (the odometry frame, as upstream).  A sample is the
+    time, the measured wheel velocities (rad/s: front left, front right,
+    rear right, rear left) and the reference (vx m/s, vy m/s, wz rad/s).
+    """
+
+    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
+        message = MecanumDriveControllerState()
+        message.header.frame_id = fields['frame_id']
+        super().__init__(publisher, message)
+
+    def __call__(self, time: float, wheels: Sequence[float], reference: Sequence[float]) -> None:
+        """Take a sample (see the class)."""
+        message = self._take()
+        stamp(time, message.header.stamp)
+        (message.front_left_wheel_velocity, message.front_right_wheel_velocity,
+         message.back_right_wheel_velocity, message.back_left_wheel_velocity) = wheels
+        twist = message.reference_velocity
+        twist.linear.x, twist.linear.y, twist.angular.z = reference
+
+
 # Each state message type (by its ROS name): its class (None where its interface package is
 # not installed: no such topics then), and the sink that turns a controller's samples into
 # messages on a publisher.
@@ -641,6 +668,8 @@ STATE_SINKS: dict[str, tuple[type | None, Callable[[Any, Mapping[str, Any]], Any
     'sensor_msgs/msg/Range': (Range, RangeSink),
     'geometry_msgs/msg/PoseStamped': (PoseStamped, PoseSink),
     GROUP_VALUES: (optional_message(GROUP_VALUES), GroupValuesSink),
+    'control_msgs/msg/MecanumDriveControllerState': (MecanumDriveControllerState,
+                                                     MecanumStateSink),
 }
 def _success_and_message(answer: tuple[bool, str], response: Any) -> None:
     """Fill a response's ``success`` and ``message`` from ``(success, message)``."""

@@ -62,6 +62,7 @@ from pan_tilt_sim.sim.physics import (
     Physics,
     health_problem,
 )
+from pan_tilt_sim.sim.roller_wheels import RollerWheels
 from pan_tilt_sim.sim.sensors.mount import LinkReader
 from pan_tilt_sim.sim.stability import check_startup_stability, pid_stability_warnings
 
@@ -201,6 +202,9 @@ class Simulation:
         # gz_ros2_control's hold_joints holds it; once driven, it is passive when undriven.
         self._hold_undriven = not autostart_controllers
         self._driven: set[str] = set()
+        # The active controllers' wheels with free rollers (mecanum, omni), and their friction.
+        self._roller_angles: dict[str, float] = {}
+        self._rollers: RollerWheels | None = None
         self._apply_actuators()
         self.manager.add_switch_listener(self._apply_actuators)
         self._speed_limit = AT_CAP * self.physics.velocity_cap
@@ -244,9 +248,41 @@ class Simulation:
                         if handle.actuator.force_from_controller]
         self._physics_step = self.physics.stepper()
         self._run_laws = self.physics.law_runner()
+        self._apply_rollers()
         self._effort_slot = {handle.name: index
                              for index, handle in enumerate(self._effort_handles)}
         self._state_slot = {handle.name: index for index, handle in enumerate(self._handle_list)}
+
+    def _apply_rollers(self) -> None:
+        """Give the active controllers' roller wheels their friction (a free base only).
+
+        A controller says which of its wheels carry free rollers
+        (:meth:`~pan_tilt_sim.controllers.base.Controller.roller_wheels`);
+        while it is active they grip only across their rollers
+        (:mod:`pan_tilt_sim.sim.roller_wheels`), the force added before every
+        physics step, which therefore runs in Python.
+        """
+        angles: dict[str, float] = {}
+        for controller in self.manager.active:
+            angles.update(controller.roller_wheels())
+        if self.physics.fixed_base:
+            angles = {}
+        if angles != self._roller_angles:
+            if self._rollers is not None:
+                self._rollers.release()
+            self._rollers = RollerWheels(self.physics, angles) if angles else None
+            self._roller_angles = angles
+        if self._rollers is None:
+            return
+        apply, step = self._rollers.apply, self._physics_step
+
+        def rolling_step(efforts: Sequence[float], targets: Sequence[float] = (),
+                         forces: Sequence[float] | None = None) -> Sequence:
+            apply()
+            return step(efforts, targets, forces)
+
+        self._physics_step = rolling_step
+        self._run_laws = None
 
     def report_startup(self) -> None:
         """Log :attr:`startup_report` (info and warnings), once."""

@@ -23,11 +23,13 @@ from pan_tilt_sim.model.robot import JointKind, JointSpec
 
 DT = 0.001
 
+EXAMPLE_JOINTS = ('joint1', 'joint2', 'joint3', 'joint4')
+
 
 def small_robot():
-    """Return joint1 (every example's joint) and joint2 (a diff drive's other wheel)."""
+    """Return joint1 (every example's joint), joint2 to joint4 (a drive's other wheels)."""
     return {name: JointHandle(JointSpec(name, JointKind.REVOLUTE, -1.0, 1.0, effort_limit=10.0,
-                                        velocity_limit=2.0)) for name in ('joint1', 'joint2')}
+                                        velocity_limit=2.0)) for name in EXAMPLE_JOINTS}
 
 
 @pytest.mark.parametrize('type_name', sorted(CONTROLLER_TYPES))

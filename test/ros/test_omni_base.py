@@ -1,0 +1,158 @@
+"""An omni base on sim_node: ~/cmd_vel in; ~/odom and /tf out, the base free on the ground.
+
+The three-wheel omni base of test/roller_fixtures.py runs in-process,
+paused, at real_time_factor 0; each test drives it closed loop from the
+probe: it reads ``/base_controller/odom``, decides the next command and
+steps the physics one controller update (10 steps at 100 Hz) at a time.
+The true pose comes from simulation_interfaces' GetEntityState.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import time
+from collections.abc import Iterator
+
+import pytest
+import sim_process
+from geometry_msgs.msg import TwistStamped
+from nav_msgs.msg import Odometry
+from node_harness import PROBE_QUEUE, sim_node
+from rcl_interfaces.msg import Log
+from roller_fixtures import CONTROLLER, REST_HEIGHT, omni_parameters, write_omni
+from sim_interfaces_client import SimInterfaces, position
+from tf2_msgs.msg import TFMessage
+
+TIME_STEP = 0.001
+UPDATE_STEPS = 10  # one controller update at the controller_manager's 100 Hz
+ROBOT = 'omni'
+ODOM = f'/{CONTROLLER}/odom'
+EXIT_CONFIGURATION_ERROR = 2
+WARNING_THROTTLE_S = 1.0
+FLOOD_COUNT = 50
+
+
+class Base:
+    """The omni base on sim_node, driven from the probe one update at a time."""
+
+    def __init__(self, sim) -> None:
+        self.sim = sim
+        self.node = sim.node
+        self.odometry: list[Odometry] = sim.collect(Odometry, ODOM)
+        self.tf: list[TFMessage] = sim.collect(TFMessage, '/tf')
+        self.log: list[Log] = sim.collect(Log, '/rosout', PROBE_QUEUE)
+        self.interfaces = SimInterfaces(sim)
+        sim.wait_for_subscribers(ODOM)
+
+    def command(self, vx: float, vy: float, wz: float) -> None:
+        """Publish an unstamped twist; return once the controller took it."""
+        message = TwistStamped()
+        message.twist.linear.x, message.twist.linear.y, message.twist.angular.z = vx, vy, wz
+        self.sim.command(CONTROLLER, message)
+
+    def update(self) -> Odometry:
+        """Step one controller update; return the odometry it published."""
+        count = len(self.odometry)
+        self.node.step(UPDATE_STEPS)
+        assert self.sim.spin_until(lambda: len(self.odometry) > count), 'no odometry came'
+        return self.odometry[-1]
+
+    def true_pose(self) -> tuple[tuple[float, float, float], float]:
+        """Return the base's true position and heading (GetEntityState)."""
+        state = self.interfaces.entity_state(ROBOT)
+        q = state.pose.orientation
+        return position(state), 2.0 * math.atan2(q.z, q.w)
+
+
+@contextlib.contextmanager
+def running_base(folder, **drive) -> Iterator[Base]:
+    """Run the omni base on sim_node, its controller given ``drive`` parameters."""
+    description, controllers = write_omni(folder, omni_parameters(**drive))
+    with sim_node(paused=True, time_step=TIME_STEP, robot_description_file=str(description),
+                  controllers_file=str(controllers), world='ground') as sim:
+        yield Base(sim)
+
+
+@pytest.fixture
+def base(tmp_path):
+    """The base on sim_node, each command good for a second of sim time."""
+    with running_base(tmp_path, cmd_vel_timeout=1.0) as running:
+        yield running
+
+
+def test_the_base_is_free_and_the_topics_are_upstreams(base):
+    assert not base.node.simulation.physics.fixed_base
+    where, _ = base.true_pose()
+    assert where == pytest.approx((0.0, 0.0, REST_HEIGHT), abs=1e-6)
+    published, subscribed = base.sim.own_topics()
+    assert subscribed[f'/{CONTROLLER}/cmd_vel'] == 'geometry_msgs/msg/TwistStamped'
+    assert published[ODOM] == 'nav_msgs/msg/Odometry'
+    assert published['/tf'] == 'tf2_msgs/msg/TFMessage'
+
+
+def test_one_metre_sideways_the_odometry_agrees_with_the_true_pose(base):
+    base.command(0.0, 0.2, 0.0)
+    odometry = base.update()
+    while odometry.pose.pose.position.y < 1.0:
+        base.command(0.0, 0.2, 0.0)
+        odometry = base.update()
+    base.command(0.0, 0.0, 0.0)
+    for _ in range(50):
+        odometry = base.update()
+    where, yaw = base.true_pose()
+    assert where[1] == pytest.approx(1.0, rel=0.02)
+    assert odometry.pose.pose.position.y == pytest.approx(where[1], rel=0.02)
+    assert abs(odometry.pose.pose.position.x) < 0.02 and abs(yaw) < 0.02
+    assert odometry.header.frame_id == 'odom' and odometry.child_frame_id == 'base_link'
+    base.sim.drain()
+    transform = [message.transforms[0] for message in base.tf
+                 if message.transforms[0].header.frame_id == 'odom'][-1]
+    assert transform.child_frame_id == 'base_link'
+    assert transform.transform.translation.y == pytest.approx(odometry.pose.pose.position.y)
+
+
+def test_the_base_stops_once_cmd_vel_times_out(tmp_path):
+    with running_base(tmp_path, cmd_vel_timeout=0.2) as base:
+        base.command(0.2, 0.0, 0.0)
+        for _ in range(10):  # 0.1 s: within the timeout
+            base.update()
+        assert base.odometry[-1].twist.twist.linear.x == pytest.approx(0.2, rel=0.05)
+        for _ in range(60):
+            base.update()
+        assert base.odometry[-1].twist.twist.linear.x == pytest.approx(0.0, abs=1e-3)
+        where, _ = base.true_pose()
+        assert where[0] < 0.2 * 0.4
+
+
+def test_a_stream_of_non_finite_twists_is_ignored_with_a_throttled_warning(base):
+    base.command(0.2, 0.0, 0.0)
+    for _ in range(10):
+        base.update()
+    start = time.monotonic()
+    for index in range(FLOOD_COUNT):
+        bad = (math.nan, math.inf, -math.inf)[index % 3]
+        base.command(0.0, 0.0, bad)
+    elapsed = time.monotonic() - start
+    for _ in range(10):
+        base.update()
+    base.sim.drain()
+    assert base.odometry[-1].twist.twist.linear.x == pytest.approx(0.2, rel=0.05)
+    assert abs(base.odometry[-1].twist.twist.angular.z) < 0.01
+    warnings = [entry for entry in base.log if entry.level == Log.WARN
+                and CONTROLLER in entry.msg and 'not finite numbers' in entry.msg]
+    assert warnings, 'no warning at all'
+    assert len(warnings) <= 1 + int(elapsed / WARNING_THROTTLE_S)
+
+
+def test_a_wheel_joint_the_urdf_lacks_stops_start_up_with_one_line_naming_the_parameter(
+        tmp_path):
+    description, controllers = write_omni(tmp_path, omni_parameters(
+        wheel_names=['wheel_0_joint', 'wheel_1_joint', 'wheel_3_joint']))
+    result = sim_process.run('-p', f'robot_description_file:={description}',
+                             '-p', f'controllers_file:={controllers}')
+    assert result.returncode == EXIT_CONFIGURATION_ERROR, result.stderr
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith('sim_node: error: ')
+    assert f"{CONTROLLER}.wheel_names: joint 'wheel_3_joint' is not a movable joint" in lines[0]
