@@ -83,7 +83,7 @@ JOINT_STATES = '''
   </plugin>'''
 PLANAR_MOVE = '''
   <plugin name="planar_move" filename="libgazebo_ros_planar_move.so">
-    <update_rate>100</update_rate><publish_rate>50</publish_rate>
+    <update_rate>100</update_rate><publish_rate>100</publish_rate>
     <odometry_frame>odom</odometry_frame><robot_base_frame>base_link</robot_base_frame>
   </plugin>'''
 GZ_DIFF_DRIVE = f'''
