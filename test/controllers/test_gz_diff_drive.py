@@ -119,3 +119,14 @@ def test_a_reset_drops_the_command_and_the_odometry():
     assert drive.odometry.x == 0.0
     run(drive, handles, 0.1)
     assert handles['left_wheel_joint'].velocity_target == 0.0
+
+
+def test_turning_in_place_the_odometry_heading_follows_the_two_wheels():
+    drive, handles = unit(UNLIMITED)
+    samples: list = []
+    drive.set_odometry_sink(lambda *sample: samples.append(sample))
+    drive.set_command(twist(0.0, 1.0))
+    run(drive, handles, 1.0)
+    time, x, y, heading, linear, angular = samples[-1]
+    assert heading == pytest.approx(time, abs=0.01)  # 1 rad/s
+    assert angular == pytest.approx(1.0, abs=1e-6) and abs(x) < 1e-9
