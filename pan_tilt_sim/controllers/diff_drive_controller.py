@@ -222,6 +222,11 @@ class DiffDriveController(CommandController):
         self._problem = ''
         self.reset()
 
+    def error(self, field: str, problem: str) -> ControllerConfigError:
+        """Return a configuration error naming ``field``; in noetic's names for a ROS 1 file."""
+        err = super().error(field, problem)
+        return ControllerConfigError(ros1_diff_drive.ros1_message(str(err))) if self.ros1 else err
+
     def _limiter(self, group: str) -> RateLimiter:
         axis, direction = group.split('.')
         params = self.params[axis][direction]

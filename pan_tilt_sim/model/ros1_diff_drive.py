@@ -151,8 +151,8 @@ def ros1_message(message: str) -> str:
     A missing ``wheel_radius``/``wheel_separation`` also says where noetic
     would have found it.
     """
-    for jazzy, noetic in (('.left_wheel_names', f'.{LEFT}'), ('.right_wheel_names', f'.{RIGHT}'),
-                          ('.publish_limited_velocity', '.publish_cmd')):
+    for jazzy, noetic in (('left_wheel_names', LEFT), ('right_wheel_names', RIGHT),
+                          ('publish_limited_velocity', 'publish_cmd')):
         message = message.replace(jazzy, noetic)
     if '.wheel_radius:' in message or '.wheel_separation:' in message:
         message += (" (noetic reads it from the URDF when absent: the first left and right "

@@ -89,6 +89,9 @@ def test_the_controller_takes_an_unstamped_twist_in_the_ros1_layout():
      'base_controller.right_wheel:', 'missing'),
     ({'left_wheel': 'left_wheel_joint', 'right_wheel': 'right_wheel_joint',
       'wheel_separation': 0.3}, 'base_controller.wheel_radius:', 'noetic reads it from the URDF'),
+    ({'left_wheel': ['left_wheel_joint', 'caster_joint'], 'right_wheel': 'right_wheel_joint',
+      'wheel_separation': 0.3, 'wheel_radius': 0.05}, 'base_controller.right_wheel:',
+     '1 wheels, but left_wheel names 2'),
 ])
 def test_a_ros1_layout_error_names_the_ros1_field(params, field, problem):
     with pytest.raises(ControllerConfigError) as raised:
