@@ -372,3 +372,18 @@ def test_far_out_on_the_ground_plane_the_robot_keeps_driving_the_ground_is_infin
         rover.sim.drain()
         assert not (_base_warnings(log, 'tipped over') or _base_warnings(log, 'fell below')), (
             'a healthy robot far out got a warning')
+
+
+def test_gz_joint_state_publisher_publishes_every_step_on_its_topic(tmp_path):
+    with running(tmp_path, GZ_DIFF_DRIVE, ground_truth=GZ_ODOMETRY,
+                 joint_states=GZ_JOINT_STATES, **GZ_TOPICS) as rover:
+        states = rover.sim.collect(JointState, '/joint_states', PROBE_QUEUE)
+        rover.sim.wait_for_subscribers('/joint_states')
+        rover.period()
+        rover.command(0.2, 0.0)
+        for _ in range(5):
+            rover.period()
+        assert rover.sim.spin_until(lambda: len(states) >= 5 * PERIOD_STEPS), (
+            f'{len(states)} joint states for {5 * PERIOD_STEPS} steps')
+        assert list(states[-1].name) == ['left_wheel_joint', 'right_wheel_joint']
+        assert states[-1].velocity[0] > 0.0
