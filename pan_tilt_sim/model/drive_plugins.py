@@ -45,6 +45,20 @@ required), ``update_rate`` (100 Hz), topic ``joint_states`` of its node;
 ROS 1 ``jointName`` (comma-separated), ``updateRate`` (100 Hz) in
 ``robotNamespace``.
 
+``libgazebo_ros_planar_move.so`` sets the base's planar velocity from a
+``geometry_msgs/Twist``: ROS 2 ``update_rate`` (20 Hz), ``publish_rate``
+(20 Hz), ``publish_odom`` / ``publish_odom_tf`` (true), ``odometry_frame``,
+``robot_base_frame``, ``covariance_x|y|yaw``; ROS 1 ``commandTopic``,
+``odometryTopic``, ``odometryFrame``, ``robotBaseFrame``, ``odometryRate``
+(20 Hz), ``publishOdometryTf`` (true), ``cmdTimeout`` (-1: none).
+
+gz-sim's DiffDrive, OdometryPublisher and JointStatePublisher systems are
+known by their file (``gz-sim-*-system``, ``ignition-gazebo-*-system``, with
+or without ``lib``/``.so``) or name (``gz::sim::systems::*``,
+``ignition::gazebo::systems::*``), their elements and defaults as in their
+sources (:func:`read_gz_plugins`); their topics are gz-transport names, as
+ros_gz_bridge would carry them under the same name.
+
 Topic names resolve as each generation resolves them: ROS 2 in a node named
 after the plugin in ``<ros><namespace>`` with its ``<remapping>``s; ROS 1
 in ``robotNamespace`` -- absent: the root (as spawn_model sets it), given
