@@ -81,6 +81,31 @@ JOINT_STATES = '''
     <joint_name>left_wheel_joint</joint_name><joint_name>right_wheel_joint</joint_name>
     <update_rate>50</update_rate>
   </plugin>'''
+PLANAR_MOVE = '''
+  <plugin name="planar_move" filename="libgazebo_ros_planar_move.so">
+    <update_rate>100</update_rate><publish_rate>100</publish_rate>
+    <odometry_frame>odom</odometry_frame><robot_base_frame>base_link</robot_base_frame>
+  </plugin>'''
+GZ_DIFF_DRIVE = f'''
+  <plugin filename="gz-sim-diff-drive-system" name="gz::sim::systems::DiffDrive">
+    <left_joint>left_wheel_joint</left_joint><right_joint>right_wheel_joint</right_joint>
+    <wheel_separation>{WHEEL_SEPARATION}</wheel_separation>
+    <wheel_radius>{WHEEL_RADIUS}</wheel_radius>
+    <odom_publish_frequency>100</odom_publish_frequency>
+    <max_linear_acceleration>1.0</max_linear_acceleration>
+    <min_linear_acceleration>-1.0</min_linear_acceleration>
+  </plugin>'''
+GZ_ODOMETRY = '''
+  <plugin filename="gz-sim-odometry-publisher-system"
+          name="gz::sim::systems::OdometryPublisher">
+    <odom_frame>odom</odom_frame><robot_base_frame>base_link</robot_base_frame>
+    <odom_topic>ground_truth</odom_topic><odom_publish_frequency>50</odom_publish_frequency>
+  </plugin>'''
+GZ_JOINT_STATES = '''
+  <plugin filename="gz-sim-joint-state-publisher-system"
+          name="gz::sim::systems::JointStatePublisher">
+    <topic>joint_states</topic>
+  </plugin>'''
 LIDAR = '''
   <joint name="lidar_joint" type="fixed">
     <parent link="base_link"/><child link="lidar_link"/><origin xyz="0.1 0 0.05"/>

@@ -32,6 +32,11 @@ As ros2_controllers' (jazzy), parameters by their names there:
   ``<name>/angular/velocity``; in chained mode the preceding controller
   writes them and ``~/cmd_vel`` (and its timeout) is not used.
 
+A ROS 1 (gazebo_ros_control) YAML's controller -- ``left_wheel`` /
+``right_wheel`` instead of the ``*_names`` -- is read with noetic's names
+and defaults (:mod:`pan_tilt_sim.model.ros1_diff_drive`) and takes an
+unstamped ``geometry_msgs/msg/Twist`` on ``~/cmd_vel``.
+
 Its type frees the robot's base (``drives_base``): with sim_node's
 ``fixed_base:=auto`` a robot with one active stands on the ground.  A reset
 (activation, ``reset_simulation``) puts the odometry back at the origin;
@@ -73,6 +78,8 @@ from pan_tilt_sim.controllers.parameter_spec import (
 )
 from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError, RateLimiter, RateLimits
 from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
+from pan_tilt_sim.errors import ControllerConfigError
+from pan_tilt_sim.model import ros1_diff_drive
 from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.schedule import PeriodicSchedule
 
@@ -179,7 +186,17 @@ class DiffDriveController(CommandController):
     ])
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
-        super().__init__(name, params, source)
+        # ROS 1's layout (gazebo_ros_control YAML): its names and defaults, an unstamped Twist.
+        self.ros1 = isinstance(params, Mapping) and ros1_diff_drive.is_ros1_layout(params)
+        if self.ros1:
+            params = ros1_diff_drive.jazzy_params(params)
+            self.command_kind = CommandKind.TWIST
+        try:
+            super().__init__(name, params, source)
+        except ControllerConfigError as err:
+            if not self.ros1:
+                raise
+            raise ControllerConfigError(ros1_diff_drive.ros1_message(str(err))) from None
         left, right = list(self.params[LEFT]), list(self.params[RIGHT])
         if len(left) != len(right):
             raise self.error(RIGHT, f'{len(right)} wheels, but {LEFT} names {len(left)}: '
@@ -204,6 +221,11 @@ class DiffDriveController(CommandController):
         self._command: StampedTwist | None = None
         self._problem = ''
         self.reset()
+
+    def error(self, field: str, problem: str) -> ControllerConfigError:
+        """Return a configuration error naming ``field``; in noetic's names for a ROS 1 file."""
+        err = super().error(field, problem)
+        return ControllerConfigError(ros1_diff_drive.ros1_message(str(err))) if self.ros1 else err
 
     def _limiter(self, group: str) -> RateLimiter:
         axis, direction = group.split('.')

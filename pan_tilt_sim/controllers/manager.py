@@ -79,6 +79,7 @@ from pan_tilt_sim.controllers.registry import (
     supported_types,
 )
 from pan_tilt_sim.errors import ControllerConfigError, ControllerSwitchError
+from pan_tilt_sim.model import ros1_diff_drive
 from pan_tilt_sim.model.command_modes import (
     SWITCH_REJECTED,
     Claim,
@@ -501,6 +502,8 @@ class ControllerManager:
 
     def _create(self, name: str, type_name: Any, params: Mapping[str, Any],
                 source: str) -> Controller:
+        # A ROS 1 diff drive without wheel geometry reads it from the URDF, as noetic's does.
+        params = ros1_diff_drive.with_urdf_geometry(type_name, params, self._model)
         controller = create_controller(name, type_name, params, source)
         for joint in controller.joint_names:
             if joint in self._unmovable:

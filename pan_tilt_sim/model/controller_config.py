@@ -222,7 +222,7 @@ def controllers_files_for(given: str, description: RobotDescription, *,
     a relative path is taken from the description's folder, or from the
     current directory -- where Gazebo would look -- if only there it
     exists).  Else, for the shipped pan/tilt model, its shipped controllers.
-    Else, for a URDF whose Gazebo plugins run it (a diff drive, p3d or
+    Else, for a URDF whose Gazebo plugins run it (a diff drive, planar move, p3d, odometry or
     joint state publisher plugin, :mod:`pan_tilt_sim.model.drive_plugins`), none: it runs without
     controllers, as in Gazebo.
     """
@@ -237,7 +237,7 @@ def controllers_files_for(given: str, description: RobotDescription, *,
     if description.name == DEFAULT_ROBOT_NAME:
         return (package_share() / DEFAULT_CONTROLLERS,)
     model = description.model
-    if model.drive_plugins or model.p3d_plugins or model.joint_state_plugins:
+    if model.runs_by_plugins:
         return ()
     raise ControllerConfigError(
         f'{description.source}: no controllers file: {given_as} is not set and the URDF names '

@@ -45,6 +45,20 @@ required), ``update_rate`` (100 Hz), topic ``joint_states`` of its node;
 ROS 1 ``jointName`` (comma-separated), ``updateRate`` (100 Hz) in
 ``robotNamespace``.
 
+``libgazebo_ros_planar_move.so`` sets the base's planar velocity from a
+``geometry_msgs/Twist``: ROS 2 ``update_rate`` (20 Hz), ``publish_rate``
+(20 Hz), ``publish_odom`` / ``publish_odom_tf`` (true), ``odometry_frame``,
+``robot_base_frame``, ``covariance_x|y|yaw``; ROS 1 ``commandTopic``,
+``odometryTopic``, ``odometryFrame``, ``robotBaseFrame``, ``odometryRate``
+(20 Hz), ``publishOdometryTf`` (true), ``cmdTimeout`` (-1: none).
+
+gz-sim's DiffDrive, OdometryPublisher and JointStatePublisher systems are
+known by their file (``gz-sim-*-system``, ``ignition-gazebo-*-system``, with
+or without ``lib``/``.so``) or name (``gz::sim::systems::*``,
+``ignition::gazebo::systems::*``), their elements and defaults as in their
+sources (:func:`read_gz_plugins`); their topics are gz-transport names, as
+ros_gz_bridge would carry them under the same name.
+
 Topic names resolve as each generation resolves them: ROS 2 in a node named
 after the plugin in ``<ros><namespace>`` with its ``<remapping>``s; ROS 1
 in ``robotNamespace`` -- absent: the root (as spawn_model sets it), given
@@ -65,7 +79,14 @@ from collections.abc import Collection, Mapping
 from xml.etree import ElementTree
 
 from pan_tilt_sim.errors import DescriptionError
-from pan_tilt_sim.model.sensors import ROS1, ROS2, Ros2Names, plugin_stem, ros1_resolve
+from pan_tilt_sim.model.sensors import (
+    GZ_WORLD,
+    ROS1,
+    ROS2,
+    Ros2Names,
+    plugin_stem,
+    ros1_resolve,
+)
 
 DIFF_DRIVE = 'gazebo_ros_diff_drive'
 P3D = 'gazebo_ros_p3d'
@@ -74,6 +95,7 @@ WORLD_FRAMES = ('world', '/world', 'map', '/map')  # p3d: poses in the world
 ROS1_P3D_KEYS = {'bodyName', 'frameName', 'topicName', 'xyzOffsets', 'rpyOffsets',
                  'gaussianNoise', 'updateRate', 'robotNamespace'}
 ENCODER, WORLD = 'encoder', 'world'
+GZ = 'gz'  # gz-sim's systems: SDF element names, gz-transport topics
 ROS2_SOURCES = {0: ENCODER, 1: WORLD}  # gazebo_ros's odometry_source numbers
 # Elements only one generation's diff drive reads: they tell which one a plugin is.
 ROS1_DIFF_DRIVE_KEYS = {'leftJoint', 'rightJoint', 'wheelSeparation', 'wheelDiameter',
@@ -112,6 +134,8 @@ class DiffDrivePlugin:
     odometry_topic: str = 'odom'
     namespace: str = ''
     remappings: tuple[tuple[str, str], ...] = ()
+
+    filename = 'libgazebo_ros_diff_drive.so'
 
     @property
     def joint_names(self) -> tuple[str, ...]:
@@ -188,9 +212,12 @@ class JointStatePlugin:
     update_rate: float = 100.0
     namespace: str = ''
     remappings: tuple[tuple[str, str], ...] = ()
+    topic: str = ''  # gz-sim's: the topic as the bridge carries it (no namespace applies)
 
     def topics(self, override: str = '') -> str:
         """Return the joint states topic (absolute), ``override`` as the namespace."""
+        if self.convention == GZ:
+            return self.topic
         namespace = override or self.namespace
         if self.convention == ROS1:
             return ros1_resolve(namespace, 'joint_states')
@@ -437,3 +464,258 @@ def _ros1_diff_drive(reader: _PluginReader) -> DiffDrivePlugin:
         command_topic=reader.text('commandTopic', 'cmd_vel'),
         odometry_topic=reader.text('odometryTopic', 'odom'),
         namespace=reader.ros1_namespace())
+
+
+# --- libgazebo_ros_planar_move.so ------------------------------------------------------------
+
+PLANAR_MOVE = 'gazebo_ros_planar_move'
+ROS1_PLANAR_MOVE_KEYS = {'commandTopic', 'odometryTopic', 'odometryFrame', 'odometryRate',
+                         'robotBaseFrame', 'publishOdometryTf', 'cmdTimeout', 'robotNamespace'}
+
+
+@dataclasses.dataclass(frozen=True)
+class PlanarMovePlugin:
+    """One ``gazebo_ros_planar_move`` plugin: the base's planar velocity set from a Twist.
+
+    ``update_rate`` (Hz, 0: every step): how often the base's velocity is
+    set; ``publish_rate`` (Hz, 0: every step): odometry and TF.
+    ``command_timeout`` (s, negative: none; ROS 1's ``cmdTimeout``).
+    """
+
+    name: str
+    convention: str
+    update_rate: float = 20.0
+    publish_rate: float = 20.0
+    odometry_frame: str = 'odom'
+    robot_base_frame: str = 'base_footprint'
+    publish_odom: bool = True
+    publish_odom_tf: bool = True
+    covariance: tuple[float, float, float] = (1e-5, 1e-5, 1e-3)  # x, y, yaw
+    command_timeout: float = -1.0
+    command_topic: str = 'cmd_vel'
+    odometry_topic: str = 'odom'
+    namespace: str = ''
+    remappings: tuple[tuple[str, str], ...] = ()
+
+    filename = 'libgazebo_ros_planar_move.so'
+
+    def topics(self, override: str = '') -> tuple[str, str]:
+        """Return the command and odometry topics (absolute), ``override`` as the namespace."""
+        namespace = override or self.namespace
+        if self.convention == ROS1:
+            return (ros1_resolve(namespace, self.command_topic),
+                    ros1_resolve(namespace, self.odometry_topic))
+        names = Ros2Names(self.name, namespace, self.remappings)
+        return names.topic(self.command_topic), names.topic(self.odometry_topic)
+
+    @property
+    def pose_covariance(self) -> tuple[float, ...]:
+        """The odometry pose (and twist) covariance's diagonal (x, y, z, roll, pitch, yaw)."""
+        x, y, yaw = self.covariance
+        return (x, y, UNPLANAR_COVARIANCE, UNPLANAR_COVARIANCE, UNPLANAR_COVARIANCE, yaw)
+
+
+def read_planar_move_plugins(root: ElementTree.Element,
+                             source: pathlib.Path | str) -> tuple[PlanarMovePlugin, ...]:
+    """Return the robot's ``gazebo_ros_planar_move`` plugins (see the module)."""
+    plugins = []
+    for element in _model_plugins(root, {PLANAR_MOVE}):
+        reader = _PluginReader(element, source, root.get('name', ''))
+        ros1 = bool(set(reader.texts) & ROS1_PLANAR_MOVE_KEYS) and 'ros' not in reader.texts
+        if ros1:
+            rate = reader.number('odometryRate', 20.0, non_negative=True)
+            plugins.append(PlanarMovePlugin(
+                name=reader.name, convention=ROS1, update_rate=0.0, publish_rate=rate,
+                odometry_frame=reader.text('odometryFrame', 'odom'),
+                robot_base_frame=reader.text('robotBaseFrame', 'base_footprint'),
+                publish_odom=True, publish_odom_tf=reader.flag('publishOdometryTf', True),
+                command_timeout=reader.number('cmdTimeout', -1.0),
+                command_topic=reader.text('commandTopic', 'cmd_vel'),
+                odometry_topic=reader.text('odometryTopic', 'odom'),
+                namespace=reader.ros1_namespace()))
+            continue
+        namespace, remappings = reader.ros()
+        plugins.append(PlanarMovePlugin(
+            name=reader.name, convention=ROS2,
+            update_rate=reader.number('update_rate', 20.0, non_negative=True),
+            publish_rate=reader.number('publish_rate', 20.0, non_negative=True),
+            odometry_frame=reader.text('odometry_frame', 'odom'),
+            robot_base_frame=reader.text('robot_base_frame', 'base_footprint'),
+            publish_odom=reader.flag('publish_odom', True),
+            publish_odom_tf=reader.flag('publish_odom_tf', True),
+            covariance=(reader.number('covariance_x', 1e-5), reader.number('covariance_y', 1e-5),
+                        reader.number('covariance_yaw', 1e-3)),
+            namespace=namespace, remappings=remappings))
+    return tuple(plugins)
+
+
+def _model_plugins(root: ElementTree.Element, stems: Collection[str],
+                   names: Collection[str] = ()) -> list[ElementTree.Element]:
+    """Return the ``<gazebo><plugin>`` elements (no ``reference``) of these files or names."""
+    return [element for gazebo in root.findall('gazebo') if gazebo.get('reference') is None
+            for element in gazebo.findall('plugin')
+            if plugin_stem(element.get('filename', '')) in stems
+            or element.get('name', '').strip() in names]
+
+
+# --- gz-sim systems -----------------------------------------------------------------------------
+
+GZ_DIFF_DRIVE_FILES = {'gz-sim-diff-drive-system', 'ignition-gazebo-diff-drive-system'}
+GZ_DIFF_DRIVE_NAMES = {'gz::sim::systems::DiffDrive', 'ignition::gazebo::systems::DiffDrive'}
+GZ_ODOMETRY_FILES = {'gz-sim-odometry-publisher-system',
+                     'ignition-gazebo-odometry-publisher-system'}
+GZ_ODOMETRY_NAMES = {'gz::sim::systems::OdometryPublisher',
+                     'ignition::gazebo::systems::OdometryPublisher'}
+GZ_JOINT_STATE_FILES = {'gz-sim-joint-state-publisher-system',
+                        'ignition-gazebo-joint-state-publisher-system'}
+GZ_JOINT_STATE_NAMES = {'gz::sim::systems::JointStatePublisher',
+                        'ignition::gazebo::systems::JointStatePublisher'}
+# DiffDrive's limits: (SDF element, jazzy RateLimits field) per group; min_acceleration
+# bounds every change, so it is both the deceleration and the reverse acceleration.
+GZ_LIMIT_ELEMENTS = ('min_velocity', 'max_velocity', 'min_acceleration', 'max_acceleration',
+                     'min_jerk', 'max_jerk')
+
+
+def gz_topic(name: str) -> str:
+    """Return a gz-transport topic as ROS sees it through the bridge: absolute, one '/' each."""
+    parts = [part for part in name.strip().split('/') if part]
+    return '/' + '/'.join(parts)
+
+
+@dataclasses.dataclass(frozen=True)
+class GzDiffDrivePlugin:
+    """gz-sim's DiffDrive system: wheels, geometry, limits, topics, frames.
+
+    ``limits`` per group (``linear``, ``angular``): the SDF's
+    ``min_/max_velocity``, ``_acceleration``, ``_jerk`` (NaN: not given; a
+    group's own element overrides the shared one).  Topics are gz-transport
+    names, as ros_gz_bridge carries them under the same name.
+    """
+
+    name: str
+    left_joints: tuple[str, ...]
+    right_joints: tuple[str, ...]
+    wheel_separation: float = 1.0
+    wheel_radius: float = 0.2
+    odom_publish_frequency: float = 50.0
+    command_topic: str = ''
+    odometry_topic: str = ''
+    tf_topic: str = ''
+    frame_id: str = ''
+    child_frame_id: str = ''
+    linear_limits: tuple[float, ...] = (math.nan,) * 6
+    angular_limits: tuple[float, ...] = (math.nan,) * 6
+
+    convention = GZ
+    filename = 'gz-sim-diff-drive-system'
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Every wheel, left ones first."""
+        return self.left_joints + self.right_joints
+
+
+@dataclasses.dataclass(frozen=True)
+class GzOdometryPlugin:
+    """gz-sim's OdometryPublisher system: the model's true pose as odometry.
+
+    ``dimensions`` 2: x, y and yaw only (z, roll, pitch 0); 3: the full pose.
+    ``xyz_offset`` (m) and ``rpy_offset`` (rad) move the published pose,
+    ``gaussian_noise`` is the standard deviation added to pose and twist.
+    """
+
+    name: str
+    odom_frame: str
+    robot_base_frame: str
+    odom_publish_frequency: float = 50.0
+    odometry_topic: str = ''
+    tf_topic: str = ''
+    dimensions: int = 2
+    xyz_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    gaussian_noise: float = 0.0
+
+    convention = GZ
+
+
+def read_gz_plugins(root: ElementTree.Element, source: pathlib.Path | str,
+                    joints: Mapping[str, object], movable: Collection[str]
+                    ) -> tuple[tuple[GzDiffDrivePlugin, ...], tuple[GzOdometryPlugin, ...],
+                               tuple[JointStatePlugin, ...]]:
+    """Return the robot's gz-sim DiffDrive, OdometryPublisher and JointStatePublisher systems.
+
+    The model's name is the URDF robot's; the world's is ``default`` (sim_node's
+    world has no name of its own), as in the gz-sim sensors' topics
+    (:mod:`~pan_tilt_sim.model.sensors`).  A wheel or joint the robot does not
+    have, a number that is not one, a separation, radius or frequency that is
+    not positive, or a limit's min above its max ends start-up.
+    """
+    model = root.get('name', '')
+    drives = []
+    for element in _model_plugins(root, GZ_DIFF_DRIVE_FILES, GZ_DIFF_DRIVE_NAMES):
+        reader = _PluginReader(element, source, model)
+        left, right = tuple(reader.all('left_joint')), tuple(reader.all('right_joint'))
+        for key, wheels in (('left_joint', left), ('right_joint', right)):
+            if not wheels:
+                raise reader.error(key, 'is missing: the system needs at least one on each side')
+            for wheel in wheels:
+                if wheel not in joints:
+                    raise reader.error(key, f"'{wheel}' is not a joint of this robot")
+        limits = {}
+        for group in ('linear', 'angular'):
+            values = {}
+            for entry in GZ_LIMIT_ELEMENTS:
+                kind, what = entry.split('_')
+                own = f'{kind}_{group}_{what}'
+                values[own] = reader.number(own, reader.number(entry, math.nan))
+            for what in ('velocity', 'acceleration', 'jerk'):
+                low, high = values[f'min_{group}_{what}'], values[f'max_{group}_{what}']
+                if low > high:
+                    raise reader.error(f'min_{group}_{what}', f'{low:g} is above max_{group}_'
+                                       f'{what} {high:g}')
+            limits[group] = tuple(values.values())
+        drives.append(GzDiffDrivePlugin(
+            name=reader.name, left_joints=left, right_joints=right,
+            wheel_separation=reader.number('wheel_separation', 1.0, positive=True),
+            wheel_radius=reader.number('wheel_radius', 0.2, positive=True),
+            odom_publish_frequency=reader.number('odom_publish_frequency', 50.0, positive=True),
+            command_topic=gz_topic(reader.text('topic', f'/model/{model}/cmd_vel')),
+            odometry_topic=gz_topic(reader.text('odom_topic', f'/model/{model}/odometry')),
+            tf_topic=gz_topic(reader.text('tf_topic', f'/model/{model}/tf')),
+            frame_id=reader.text('frame_id', f'{model}/odom'),
+            child_frame_id=reader.text('child_frame_id', f'{model}/{_root_link(root)}'),
+            linear_limits=limits['linear'], angular_limits=limits['angular']))
+    odometries = []
+    for element in _model_plugins(root, GZ_ODOMETRY_FILES, GZ_ODOMETRY_NAMES):
+        reader = _PluginReader(element, source, model)
+        dimensions = reader.number('dimensions', 2.0)
+        if dimensions not in (2.0, 3.0):
+            raise reader.error('dimensions', f'must be 2 or 3, got {dimensions:g}')
+        odometries.append(GzOdometryPlugin(
+            name=reader.name, odom_frame=reader.text('odom_frame', f'{model}/odom'),
+            robot_base_frame=reader.text('robot_base_frame', f'{model}/base_footprint'),
+            odom_publish_frequency=reader.number('odom_publish_frequency', 50.0, positive=True),
+            odometry_topic=gz_topic(reader.text('odom_topic', f'/model/{model}/odometry')),
+            tf_topic=gz_topic(reader.text('tf_topic', f'/model/{model}/pose')),
+            dimensions=int(dimensions), xyz_offset=reader.vector('xyz_offset'),
+            rpy_offset=reader.vector('rpy_offset'),
+            gaussian_noise=reader.number('gaussian_noise', 0.0, non_negative=True)))
+    states = []
+    for element in _model_plugins(root, GZ_JOINT_STATE_FILES, GZ_JOINT_STATE_NAMES):
+        reader = _PluginReader(element, source, model)
+        names = reader.all('joint_name')
+        for name in names:
+            if name not in movable:
+                raise reader.error('joint_name', f"'{name}' is not a movable joint of this robot")
+        states.append(JointStatePlugin(
+            name=reader.name, convention=GZ, joints=tuple(names or movable), update_rate=0.0,
+            topic=gz_topic(reader.text('topic', f'/world/{GZ_WORLD}/model/{model}/joint_state'))))
+    return tuple(drives), tuple(odometries), tuple(states)
+
+
+def _root_link(root: ElementTree.Element) -> str:
+    """Return the URDF's root link (the canonical link gz-sim names frames after)."""
+    children = {joint.find('child').get('link', '') for joint in root.findall('joint')
+                if joint.find('child') is not None}
+    return next((link.get('name', '') for link in root.findall('link')
+                 if link.get('name', '') not in children), '')

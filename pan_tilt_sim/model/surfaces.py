@@ -10,7 +10,9 @@ A URDF gives a link's contact properties in Gazebo's extension tags::
 Gazebo's defaults, for a link without them: ``mu1 = mu2 = 1``, ``kp =
 1e12``, ``kd = 1`` -- a rigid contact.  Where two surfaces touch Gazebo
 takes the smaller coefficient of each direction; its default ground plane
-has 100 and 50, so on the ground a link's own values decide.  Plain values;
+has 100 and 50, so on the ground a link's own values decide.  As Gazebo's
+URDF parser, a ``value`` attribute (``<mu1 value="200.0"/>``, ROS 1 tutorials'
+form) is read before the element's text.  Plain values;
 the physics (:mod:`pan_tilt_sim.sim.physics`) turns them into PyBullet's.
 """
 
@@ -82,7 +84,8 @@ def read_surfaces(root: ElementTree.Element, source: pathlib.Path,
         for name, element in zip(SURFACE_TAGS, tags, strict=True):
             if element is None:
                 continue
-            text = (element.text or '').strip()
+            # Gazebo's URDF parser takes a value attribute before the text (<mu1 value="1"/>).
+            text = (element.get('value') or element.text or '').strip()
             try:
                 value = float(text)
             except ValueError:

@@ -45,6 +45,9 @@ from pan_tilt_sim.controllers.gains import plugin_gains
 from pan_tilt_sim.controllers.gazebo_diff_drive import GazeboDiffDrive
 from pan_tilt_sim.controllers.gazebo_joint_state_publisher import GazeboJointStatePublisher
 from pan_tilt_sim.controllers.gazebo_p3d import GazeboP3d
+from pan_tilt_sim.controllers.gazebo_planar_move import GazeboPlanarMove
+from pan_tilt_sim.controllers.gz_diff_drive import GzDiffDrive
+from pan_tilt_sim.controllers.gz_odometry_publisher import GzOdometryPublisher
 from pan_tilt_sim.controllers.manager import ControllerManager
 from pan_tilt_sim.controllers.registry import drives_base
 from pan_tilt_sim.model.base_pose import FIXED_BASE, ORIGIN, BasePose
@@ -70,6 +73,8 @@ LOGGER_NAME = 'pan_tilt_sim'
 # A joint this close to PyBullet's speed cap is riding it.
 AT_CAP = 0.99
 WARNING_THROTTLE_S = 1.0  # wall seconds between two warnings about one joint
+TIPPED_TILT = 60.0  # deg: a free base tilted more than this from upright has tipped over
+BELOW_GROUND = -1.0  # m: a free base frame this far below the ground plane fell off it
 # The fewest steps handed to the compiled laws at once: below it, collecting
 # the laws and taking their state back costs more than the steps save.
 MIN_COMPILED_STEPS = 4
@@ -105,10 +110,10 @@ def base_is_fixed(fixed_base: bool | None, description: RobotDescription,
         return True, "its root link 'world' holds it by a fixed joint, as in Gazebo"
     if fixed_base is not None:
         return fixed_base, f'{FIXED_BASE} is {str(fixed_base).lower()}'
-    plugins = description.model.drive_plugins
+    plugins = description.model.base_drivers
     if plugins:
         return False, (f"{FIXED_BASE} is auto and Gazebo plugin '{plugins[0].name}' "
-                       f'(libgazebo_ros_diff_drive.so) drives the base')
+                       f'({plugins[0].filename}) drives the base')
     candidates = [spec for spec in controllers.controllers
                   if not autostart or active is None or spec.name in active]
     drivers = [spec for spec in candidates if drives_base(spec.type)]
@@ -184,6 +189,17 @@ class Simulation:
                 drive.configure(self.handles)
                 drive.set_base_state(self.base_state)
                 self.plugins.append(drive)
+            # Planar move sets the base's velocity itself: the step applies what it computed.
+            self._base_movers: list[GazeboPlanarMove] = []
+            for planar_plugin in description.model.planar_move_plugins:
+                mover = GazeboPlanarMove(planar_plugin, controllers.label)
+                mover.set_base_motion(self.base_motion)
+                self._base_movers.append(mover)
+                self.plugins.append(mover)
+            for gz_drive_plugin in description.model.gz_drive_plugins:
+                gz_drive = GzDiffDrive(gz_drive_plugin, controllers.label)
+                gz_drive.configure(self.handles)
+                self.plugins.append(gz_drive)
             for states_plugin in description.model.joint_state_plugins:
                 states = GazeboJointStatePublisher(states_plugin, controllers.label)
                 states.configure(self.handles)
@@ -192,6 +208,10 @@ class Simulation:
                 p3d = GazeboP3d(p3d_plugin, controllers.label)
                 p3d.set_link_state(self.link_state)
                 self.plugins.append(p3d)
+            for gz_odometry_plugin in description.model.gz_odometry_plugins:
+                gz_odometry = GzOdometryPublisher(gz_odometry_plugin, controllers.label)
+                gz_odometry.set_base_motion(self.base_motion)
+                self.plugins.append(gz_odometry)
         except BaseException:
             self.physics.close()
             raise
@@ -435,6 +455,8 @@ class Simulation:
         motor_forces = forces if forced else None
         readback = list(zip(velocity_handles, self._velocity_slots, strict=True))
         physics_step = self._physics_step
+        movers = [mover.take_base_velocity for mover in self._base_movers]
+        set_base_velocity = self.physics.set_base_velocity
         dt = self._time_step
         states = self._states
         first = self._steps
@@ -458,13 +480,23 @@ class Simulation:
             for index, handle in forced:
                 force = handle.force_limit
                 forces[index] = force if force < UNLIMITED_FORCE else UNLIMITED_FORCE
+            for take in movers:
+                velocity = take()
+                if velocity is not None:
+                    set_base_velocity(*velocity)
             states = physics_step(efforts, targets, motor_forces)
         self._steps = first + steps
         self._states = states
         self._check_health(states)
 
     def _check_health(self, states: Sequence[Sequence[float]]) -> None:
-        """Warn about any joint at PyBullet's speed cap or with a non-finite state."""
+        """Warn about any joint at PyBullet's speed cap or with a non-finite state.
+
+        And about a free base that tipped over or fell below the ground plane
+        (:meth:`_check_base`): the simulation goes on either way.
+        """
+        if not self.physics.fixed_base:
+            self._check_base()
         limit = self._speed_limit
         for handle, state in zip(self._handle_list, states, strict=False):
             velocity = state[STATE_VELOCITY]
@@ -477,6 +509,32 @@ class Simulation:
             self._logger.warning(
                 f'at sim time {self.time:.3f} s: '
                 f'{health_problem(handle.name, state, self.physics.velocity_cap)}')
+
+    def _check_base(self) -> None:
+        """Warn (throttled) when the free base tipped over or fell below the ground plane.
+
+        Tipped over: tilted more than :data:`TIPPED_TILT` from upright; fallen:
+        its frame below :data:`BELOW_GROUND`.  Instability is never silent, and
+        it does not stop the run.
+        """
+        frame = self.physics.base_frame()
+        x, y, z = frame.translation
+        qx, qy, _qz, _qw = frame.rotation
+        tilt = math.degrees(math.acos(max(-1.0, min(1.0, 1.0 - 2.0 * (qx * qx + qy * qy)))))
+        problems = []
+        if tilt > TIPPED_TILT:
+            problems.append(('base tipped over',
+                             f'has tipped over: its base is tilted {tilt:.0f} deg from upright'))
+        if z < BELOW_GROUND:
+            problems.append(('base fell', 'fell below the ground plane'))
+        for key, problem in problems:
+            now = wall_time.monotonic()
+            if now - self._last_warning.get(key, -math.inf) < WARNING_THROTTLE_S:
+                continue
+            self._last_warning[key] = now
+            self._logger.warning(
+                f"at sim time {self.time:.3f} s: robot '{self.description.model.name}' {problem} "
+                f'(base at x {x:.2f} m, y {y:.2f} m, z {z:.2f} m); the simulation goes on')
 
     def reset(self, *, reset_time: bool = True) -> None:
         """Put base and joints back at their start, reset controllers; sim time to 0 if asked."""
@@ -521,6 +579,15 @@ class Simulation:
         (vx, vy, _), (_, _, yaw_rate) = self.physics.base_velocity()
         cos, sin = math.cos(heading), math.sin(heading)
         return (x, y, heading), (cos * vx + sin * vy, cos * vy - sin * vx, yaw_rate)
+
+    def base_motion(self) -> tuple[Transform, tuple[float, float, float],
+                                   tuple[float, float, float]]:
+        """Return the root link frame in the world and the base's velocities (world axes).
+
+        Linear: the root link's centre of mass (m/s); angular (rad/s).
+        """
+        linear, angular = self.physics.base_velocity()
+        return self.physics.base_frame(), linear, angular
 
     def link_state(self, link: str) -> tuple[Transform, tuple[float, float, float],
                                               tuple[float, float, float]]:

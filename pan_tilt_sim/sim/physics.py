@@ -299,6 +299,16 @@ class Physics:
         linear, angular = pybullet.getBaseVelocity(self._body, physicsClientId=self._client)
         return tuple(linear), tuple(angular)  # type: ignore[return-value]
 
+    def set_base_velocity(self, linear: Sequence[float], angular: Sequence[float]) -> None:
+        """Set the free base's velocity: ``linear`` (m/s) and ``angular`` (rad/s), world axes.
+
+        What Gazebo's Model::SetLinearVel and SetAngularVel do for a model
+        plugin (planar move); a welded base does not move.
+        """
+        if not self._fixed_base:
+            pybullet.resetBaseVelocity(self._body, tuple(linear), tuple(angular),
+                                       physicsClientId=self._client)
+
     def reset_base(self) -> None:
         """Put the base back where it started, at rest (a welded base only moves)."""
         self._set_base_frame(self._initial_base)

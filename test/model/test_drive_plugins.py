@@ -4,6 +4,10 @@ import pathlib
 
 import pytest
 from mobile_fixtures import (
+    GZ_DIFF_DRIVE,
+    GZ_JOINT_STATES,
+    GZ_ODOMETRY,
+    PLANAR_MOVE,
     ROS1_DIFF_DRIVE,
     ROS2_DIFF_DRIVE,
     WHEEL_RADIUS,
@@ -12,7 +16,7 @@ from mobile_fixtures import (
 )
 
 from pan_tilt_sim.errors import DescriptionError
-from pan_tilt_sim.model.drive_plugins import ENCODER, WORLD
+from pan_tilt_sim.model.drive_plugins import ENCODER, GZ, WORLD
 from pan_tilt_sim.model.sensors import ROS1, ROS2
 from pan_tilt_sim.model.urdf import parse_urdf
 
@@ -190,3 +194,165 @@ def test_a_bad_joint_state_publisher_element_ends_start_up(elements, problem):
         joint_states('<plugin name="js" filename="libgazebo_ros_joint_state_publisher.so">'
                      f'{elements}</plugin>')
     assert "plugin 'js' (libgazebo_ros_joint_state_publisher.so)" in str(raised.value)
+
+
+def model(plugin: str, **others: str):
+    return parse_urdf(plugin_rover_urdf(plugin, **others), SOURCE)
+
+
+def planar(text: str):
+    return model(text).planar_move_plugins
+
+
+def test_ros2_planar_move_reads_its_elements_and_defaults_are_the_plugins():
+    (plugin,) = planar(PLANAR_MOVE)
+    assert plugin.convention == ROS2 and plugin.name == 'planar_move'
+    assert (plugin.update_rate, plugin.publish_rate) == (100.0, 100.0)
+    assert plugin.robot_base_frame == 'base_link'
+    (bare,) = planar('<plugin name="move" filename="libgazebo_ros_planar_move.so"/>')
+    assert (bare.update_rate, bare.publish_rate) == (20.0, 20.0)
+    assert bare.publish_odom and bare.publish_odom_tf  # on by default, unlike diff drive
+    assert (bare.odometry_frame, bare.robot_base_frame) == ('odom', 'base_footprint')
+    assert bare.pose_covariance == (1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3)
+    assert bare.topics() == ('/cmd_vel', '/odom')
+    assert bare.command_timeout < 0.0
+
+
+def test_ros2_planar_move_topics_follow_the_namespace_and_remappings():
+    (plugin,) = planar('<plugin name="move" filename="libgazebo_ros_planar_move.so">'
+                       '<ros><namespace>/demo</namespace><remapping>odom:=odom_truth</remapping>'
+                       '</ros><publish_odom_tf>false</publish_odom_tf></plugin>')
+    assert plugin.topics() == ('/demo/cmd_vel', '/demo/odom_truth')
+    assert plugin.topics('robot1') == ('/robot1/cmd_vel', '/robot1/odom_truth')
+    assert not plugin.publish_odom_tf
+
+
+def test_ros1_planar_move_reads_the_ros1_names():
+    (plugin,) = planar('<plugin name="move" filename="libgazebo_ros_planar_move.so">'
+                       '<commandTopic>move</commandTopic><odometryTopic>odometry</odometryTopic>'
+                       '<odometryFrame>map</odometryFrame><odometryRate>10</odometryRate>'
+                       '<robotBaseFrame>base_link</robotBaseFrame><cmdTimeout>0.5</cmdTimeout>'
+                       '<publishOdometryTf>false</publishOdometryTf></plugin>')
+    assert plugin.convention == ROS1 and plugin.update_rate == 0.0  # every step
+    assert plugin.publish_rate == 10.0 and plugin.command_timeout == 0.5
+    assert (plugin.odometry_frame, plugin.robot_base_frame) == ('map', 'base_link')
+    assert plugin.publish_odom and not plugin.publish_odom_tf
+    assert plugin.topics() == ('/move', '/odometry')
+
+
+@pytest.mark.parametrize(('elements', 'problem'), [
+    ('<update_rate>often</update_rate>', "<update_rate> 'often' is not a number"),
+    ('<publish_rate>-5</publish_rate>', '<publish_rate> must be >= 0'),
+    ('<publish_odom>sometimes</publish_odom>', "<publish_odom> 'sometimes' is not a boolean"),
+    ('<odometryRate>-1</odometryRate>', '<odometryRate> must be >= 0'),
+])
+def test_a_bad_planar_move_element_ends_start_up_naming_it(elements, problem):
+    with pytest.raises(DescriptionError, match=problem) as raised:
+        planar(f'<plugin name="move" filename="libgazebo_ros_planar_move.so">{elements}</plugin>')
+    assert "plugin 'move' (libgazebo_ros_planar_move.so)" in str(raised.value)
+
+
+def test_a_planar_move_robot_needs_no_controllers_and_its_base_is_driven():
+    robot = model(PLANAR_MOVE)
+    assert robot.runs_by_plugins and robot.base_drivers == robot.planar_move_plugins
+
+
+def gz_bare(elements: str = '', filename: str = 'gz-sim-diff-drive-system',
+            name: str = 'gz::sim::systems::DiffDrive') -> str:
+    return (f'<plugin filename="{filename}" name="{name}">'
+            '<left_joint>left_wheel_joint</left_joint><right_joint>right_wheel_joint</right_joint>'
+            f'{elements}</plugin>')
+
+
+def test_gz_diff_drive_reads_its_elements():
+    (plugin,) = model(GZ_DIFF_DRIVE).gz_drive_plugins
+    assert plugin.convention == GZ
+    assert plugin.left_joints == ('left_wheel_joint',)
+    assert (plugin.wheel_separation, plugin.wheel_radius) == (WHEEL_SEPARATION, WHEEL_RADIUS)
+    assert plugin.odom_publish_frequency == 100.0
+    assert plugin.linear_limits[2:4] == (-1.0, 1.0)  # min/max acceleration
+
+
+def test_gz_diff_drive_defaults_are_the_systems_named_after_the_model():
+    (plugin,) = model(gz_bare()).gz_drive_plugins
+    assert (plugin.wheel_separation, plugin.wheel_radius) == (1.0, 0.2)
+    assert plugin.odom_publish_frequency == 50.0
+    assert plugin.command_topic == '/model/rover/cmd_vel'
+    assert plugin.odometry_topic == '/model/rover/odometry'
+    assert plugin.tf_topic == '/model/rover/tf'
+    assert (plugin.frame_id, plugin.child_frame_id) == ('rover/odom', 'rover/base_link')
+    assert all(value != value for value in plugin.linear_limits)  # NaN: none
+
+
+@pytest.mark.parametrize(('filename', 'name'), [
+    ('libgz-sim-diff-drive-system.so', 'anything'),
+    ('ignition-gazebo-diff-drive-system', 'ignition::gazebo::systems::DiffDrive'),
+    ('some-other-file', 'gz::sim::systems::DiffDrive'),
+])
+def test_gz_diff_drive_is_known_by_either_generations_file_or_name(filename, name):
+    (plugin,) = model(gz_bare(filename=filename, name=name)).gz_drive_plugins
+    assert plugin.joint_names == ('left_wheel_joint', 'right_wheel_joint')
+
+
+def test_gz_diff_drive_topics_are_absolute_and_a_groups_own_limit_overrides_the_shared_one():
+    (plugin,) = model(gz_bare('<topic>cmd_vel</topic><odom_topic>odom</odom_topic>'
+                              '<max_velocity>2</max_velocity>'
+                              '<max_angular_velocity>1</max_angular_velocity>')).gz_drive_plugins
+    assert (plugin.command_topic, plugin.odometry_topic) == ('/cmd_vel', '/odom')
+    assert plugin.linear_limits[1] == 2.0 and plugin.angular_limits[1] == 1.0
+
+
+@pytest.mark.parametrize(('plugin', 'problem'), [
+    ('<plugin filename="gz-sim-diff-drive-system" name="d">'
+     '<right_joint>right_wheel_joint</right_joint></plugin>', '<left_joint> is missing'),
+    (gz_bare().replace('<right_joint>right_wheel_joint', '<right_joint>rear_wheel'),
+     "<right_joint> 'rear_wheel' is not a joint of this robot"),
+    (gz_bare('<wheel_radius>0</wheel_radius>'), '<wheel_radius> must be > 0'),
+    (gz_bare('<wheel_separation>far</wheel_separation>'), "'far' is not a number"),
+    (gz_bare('<min_linear_velocity>1</min_linear_velocity>'
+             '<max_linear_velocity>0.5</max_linear_velocity>'),
+     '<min_linear_velocity> 1 is above max_linear_velocity 0.5'),
+])
+def test_a_bad_gz_diff_drive_element_ends_start_up_naming_it(plugin, problem):
+    with pytest.raises(DescriptionError, match=problem) as raised:
+        model(plugin)
+    assert '\n' not in str(raised.value)
+
+
+def test_gz_odometry_publisher_reads_its_elements_and_defaults():
+    (plugin,) = model(GZ_DIFF_DRIVE, ground_truth=GZ_ODOMETRY).gz_odometry_plugins
+    assert (plugin.odom_frame, plugin.robot_base_frame) == ('odom', 'base_link')
+    assert plugin.odometry_topic == '/ground_truth' and plugin.odom_publish_frequency == 50.0
+    (bare,) = model(GZ_DIFF_DRIVE, ground_truth=(
+        '<plugin filename="gz-sim-odometry-publisher-system" '
+        'name="gz::sim::systems::OdometryPublisher"/>')).gz_odometry_plugins
+    assert (bare.odom_frame, bare.robot_base_frame) == ('rover/odom', 'rover/base_footprint')
+    assert (bare.odometry_topic, bare.tf_topic) == ('/model/rover/odometry', '/model/rover/pose')
+    assert bare.dimensions == 2 and bare.odom_publish_frequency == 50.0
+
+
+def test_a_bad_gz_odometry_dimension_ends_start_up():
+    with pytest.raises(DescriptionError, match='<dimensions> must be 2 or 3, got 4'):
+        model(GZ_DIFF_DRIVE, ground_truth=(
+            '<plugin filename="gz-sim-odometry-publisher-system" name="odometry">'
+            '<dimensions>4</dimensions></plugin>'))
+
+
+def test_gz_joint_state_publisher_defaults_to_every_movable_joint_on_the_worlds_topic():
+    robot = model(GZ_DIFF_DRIVE, joint_states=(
+        '<plugin filename="gz-sim-joint-state-publisher-system" '
+        'name="gz::sim::systems::JointStatePublisher"/>'))
+    (plugin,) = robot.joint_state_plugins
+    assert plugin.convention == GZ and plugin.update_rate == 0.0  # every step
+    assert plugin.joints == ('left_wheel_joint', 'right_wheel_joint')
+    assert plugin.topics() == '/world/default/model/rover/joint_state'
+    assert plugin.topics('robot1') == '/world/default/model/rover/joint_state'
+    (given,) = model(GZ_DIFF_DRIVE, joint_states=GZ_JOINT_STATES).joint_state_plugins
+    assert given.topics() == '/joint_states'
+
+
+def test_a_gz_joint_state_publisher_naming_a_fixed_joint_ends_start_up():
+    with pytest.raises(DescriptionError, match="'caster_joint' is not a movable joint"):
+        model(GZ_DIFF_DRIVE, joint_states=(
+            '<plugin filename="gz-sim-joint-state-publisher-system" name="js">'
+            '<joint_name>caster_joint</joint_name></plugin>'))

@@ -35,6 +35,12 @@ def test_the_tags_of_a_link_are_read_and_several_blocks_add_up():
     assert surface.spring == (1e6, DEFAULT_KD)
 
 
+def test_a_value_attribute_is_read_as_gazebos_urdf_parser_reads_it():
+    surface = model('<gazebo reference="wheel"><mu1 value="200.0"/><mu2 value="100.0"/>'
+                    '<kp value="10000000.0"/><kd>1.0</kd></gazebo>').surface('wheel')
+    assert surface == Surface('wheel', mu1=200.0, mu2=100.0, kp=1e7, kd=1.0)
+
+
 def test_gazebo_blocks_without_surface_tags_or_for_no_link_are_not_surfaces():
     robot = model('<gazebo reference="axle"><mu1>0.3</mu1></gazebo>'
                   '<gazebo reference="wheel"><material>Gazebo/Black</material></gazebo>')

@@ -1,0 +1,192 @@
+"""``libgazebo_ros_planar_move.so`` as a unit of the simulation: the base moved by a Twist. No ROS.
+
+Not a ros2_control controller: the simulation creates one per plugin the
+URDF declares (:mod:`pan_tilt_sim.model.drive_plugins`) and updates it every
+physics step, before the controllers; it is always active.  As the plugin:
+
+* **Command**: ``geometry_msgs/Twist`` on its command topic; ``linear.x``,
+  ``linear.y`` (m/s, in the base's heading) and ``angular.z`` (rad/s)
+  count; the last one holds until the next (ROS 1: until ``cmdTimeout`` s
+  of sim time have passed, when that is not negative).  A twist with a NaN
+  or infinite value is refused (a throttled warning names it).
+* **Motion**: every ``1 / update_rate`` s of sim time (0, and ROS 1: every
+  step) the base's velocity is *set*: ``(x cos(yaw) - y sin(yaw),
+  y cos(yaw) + x sin(yaw), 0)`` m/s in the world and ``(0, 0, angular.z)``
+  rad/s.  No wheel turns: the plugin moves the model itself.  The unit
+  computes the velocity (:meth:`take_base_velocity`); the simulation sets
+  it on the base before the physics step.
+* **Odometry**: the base's true pose in the world (3-D) and its twist in
+  the base's heading axes, every ``1 / publish_rate`` s on the odometry
+  topic (``publish_odom``) and as ``odometry_frame -> robot_base_frame`` on
+  ``/tf`` (``publish_odom_tf``); covariance diagonals ``covariance_x``,
+  ``covariance_y``, 1e12 for z, roll, pitch, ``covariance_yaw``.
+
+A reset drops the command, as the plugin's Reset.  Pure Python: the
+simulation hands in the base's state (:meth:`set_base_motion`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from typing import Any, ClassVar
+
+from pan_tilt_sim.controllers.base import (
+    Actuator,
+    CommandController,
+    CommandKind,
+    CommandResult,
+    JointHandle,
+)
+from pan_tilt_sim.controllers.diff_drive_controller import TfSink
+from pan_tilt_sim.controllers.gazebo_p3d import SpatialOdometrySink
+from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
+from pan_tilt_sim.model.drive_plugins import ROS1, PlanarMovePlugin
+from pan_tilt_sim.model.transforms import Transform, Vector
+from pan_tilt_sim.schedule import DUE_EPSILON
+
+# The base's motion: its frame in the world, its linear velocity (m/s) and angular velocity
+# (rad/s), both in world axes.
+BaseMotion = tuple[Transform, Vector, Vector]
+
+
+def heading(frame: Transform) -> float:
+    """Return the yaw (rad) of ``frame``'s rotation."""
+    qx, qy, qz, qw = frame.rotation
+    return math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+
+
+class GazeboPlanarMove(CommandController):
+    """One ``gazebo_ros_planar_move`` plugin: a Twist sets the base's planar velocity."""
+
+    drives_base: ClassVar[bool] = True
+    command_kind = CommandKind.TWIST
+
+    def __init__(self, plugin: PlanarMovePlugin, source: str = '') -> None:
+        super().__init__(plugin.name, {}, source)
+        self.plugin = plugin
+        self._update_period = 1.0 / plugin.update_rate if plugin.update_rate > 0.0 else 0.0
+        self._publish_period = 1.0 / plugin.publish_rate if plugin.publish_rate > 0.0 else 0.0
+        self._odometry_sink: SpatialOdometrySink | None = None
+        self._tf_sink: TfSink | None = None
+        self._base_motion: Callable[[], BaseMotion] | None = None
+        self._problem = ''
+        self._time = 0.0
+        self.reset()
+
+    def actuators(self) -> dict[str, Actuator]:
+        """None: the plugin moves the model, not its joints."""
+        return {}
+
+    def set_base_motion(self, source: Callable[[], BaseMotion]) -> None:
+        """Where the unit reads the base's frame and velocities."""
+        self._base_motion = source
+
+    # --- ROS surface -----------------------------------------------------------------------
+
+    def ros_surface(self) -> tuple[Endpoint, ...]:
+        """Return the command topic in; odometry and ``/tf`` out, as the plugin publishes."""
+        plugin = self.plugin
+        command, odometry = plugin.topics(self.node_namespace.strip('/'))
+        endpoints: list[Endpoint] = [
+            CommandTopic(command, self.command_kind.value, self.set_command,
+                         self.command_problem)]
+        if plugin.publish_odom:
+            endpoints.append(StateTopic(odometry, 'nav_msgs/msg/Odometry', self.set_odometry_sink,
+                                        {'frame_id': plugin.odometry_frame,
+                                         'child_frame_id': plugin.robot_base_frame,
+                                         'pose_covariance_diagonal': plugin.pose_covariance,
+                                         'twist_covariance_diagonal': plugin.pose_covariance,
+                                         'spatial': True}))
+        if plugin.publish_odom_tf:
+            endpoints.append(StateTopic('/tf', 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
+        return tuple(endpoints)
+
+    def set_odometry_sink(self, sink: SpatialOdometrySink | None) -> None:
+        """Where odometry samples go: ``sink(time, pose, linear, angular)``."""
+        self._odometry_sink = sink
+
+    def set_tf_sink(self, sink: TfSink | None) -> None:
+        """Where the odom -> base transform goes: ``sink(time, [(parent, child, transform)])``."""
+        self._tf_sink = sink
+
+    # --- lifecycle -------------------------------------------------------------------------
+
+    def configure(self, joints: Mapping[str, JointHandle]) -> None:
+        """Nothing to bind: the plugin moves the model, not joints."""
+        self.reset()
+
+    def reset(self) -> None:
+        """No command; both rates start again from sim time 0."""
+        self._twist = (0.0, 0.0, 0.0)
+        self._received = 0.0
+        self._last_update = self._last_publish = 0.0
+        self._pending: tuple[Vector, Vector] | None = None
+
+    # --- commands --------------------------------------------------------------------------
+
+    def set_command(self, value: StampedTwist) -> CommandResult:
+        """Take a twist (from the subscription; cheap): refuse non-finite ones."""
+        x, y, angular = value.linear[0], value.linear[1], value.angular[2]
+        if not all(math.isfinite(number) for number in (x, y, angular)):
+            self._problem = (f'ignored cmd_vel (linear.x {x!r}, linear.y {y!r}, angular.z '
+                             f'{angular!r}): not finite numbers')
+            return CommandResult.REJECTED
+        self._twist = (x, y, angular)
+        self._received = self._time
+        return CommandResult.ACCEPTED
+
+    def command_problem(self, value: Any, result: CommandResult) -> str:
+        """Describe the last refused twist."""
+        return self._problem
+
+    def setpoints(self) -> dict[str, float]:
+        """None: no joint is commanded."""
+        return {}
+
+    @property
+    def command(self) -> tuple[float, float, float]:
+        """The twist in force: (linear.x, linear.y, angular.z)."""
+        return self._twist
+
+    # --- the step ---------------------------------------------------------------------------
+
+    def update(self, time: float, period: float) -> None:
+        """When due, compute the base's velocity (see :meth:`take_base_velocity`) and publish."""
+        self._time = time
+        plugin = self.plugin
+        timeout = plugin.command_timeout
+        if plugin.convention == ROS1 and timeout >= 0.0 and time - self._received > timeout:
+            self._twist = (0.0, 0.0, 0.0)
+        if self._base_motion is None:
+            return
+        if time - self._last_update + DUE_EPSILON >= self._update_period:
+            frame, _linear, _angular = self._base_motion()
+            yaw = heading(frame)
+            x, y, angular = self._twist
+            cos, sin = math.cos(yaw), math.sin(yaw)
+            self._pending = ((x * cos - y * sin, y * cos + x * sin, 0.0), (0.0, 0.0, angular))
+            self._last_update = time
+        if self._odometry_sink is None and self._tf_sink is None:
+            return
+        if time - self._last_publish + DUE_EPSILON < self._publish_period:
+            return
+        self._last_publish = time
+        self._publish(time)
+
+    def take_base_velocity(self) -> tuple[Vector, Vector] | None:
+        """Return the velocity to set on the base now (world linear, angular), once; or None."""
+        pending, self._pending = self._pending, None
+        return pending
+
+    def _publish(self, time: float) -> None:
+        frame, linear, angular = self._base_motion()
+        yaw = heading(frame)
+        cos, sin = math.cos(yaw), math.sin(yaw)
+        vx, vy = linear[0], linear[1]
+        twist = (cos * vx + sin * vy, cos * vy - sin * vx, 0.0)
+        if self._odometry_sink is not None:
+            self._odometry_sink(time, frame, twist, (0.0, 0.0, angular[2]))
+        if self._tf_sink is not None:
+            self._tf_sink(time, [(self.plugin.odometry_frame, self.plugin.robot_base_frame,
+                                  frame)])

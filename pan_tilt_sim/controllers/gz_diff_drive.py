@@ -1,0 +1,208 @@
+"""gz-sim's DiffDrive system as a unit of the simulation: a Twist in, wheels out, odometry back.
+
+Not a ros2_control controller: the simulation creates one per system the
+URDF declares (:mod:`pan_tilt_sim.model.drive_plugins`) and updates it every
+physics step, before the controllers; it is always active.  As the system:
+
+* **Command**: ``gz.msgs.Twist`` on ``topic`` -- here the
+  ``geometry_msgs/msg/Twist`` ros_gz_bridge would carry on the same name
+  (no bridge process needed); ``linear.x`` (m/s) and ``angular.z`` (rad/s)
+  count and the last one holds (the system has no timeout).  A twist with a
+  NaN or infinite value is refused (a throttled warning names it).
+* **Limits**: every step the linear and angular velocity go through the
+  system's speed limiter: jerk, acceleration, velocity, each bounded to
+  ``[min, max]`` (an absent ``min``/``max``: unbounded that way).
+* **Wheels**: every step each left wheel's velocity target is ``(v - w *
+  wheel_separation / 2) / wheel_radius`` rad/s and each right one's ``(v +
+  ...)``, reached by the ideal velocity actuator within the joint's effort
+  limit.
+* **Odometry**: from the first left and first right wheels' positions
+  (:class:`~.odometry.Odometry`, its twist a rolling mean of 10 updates, as
+  gz-math's DiffDriveOdometry), updated and published every ``1 /
+  odom_publish_frequency`` s of sim time: ``gz.msgs.Odometry`` on
+  ``odom_topic`` (``nav_msgs/msg/Odometry``, ``frame_id`` ->
+  ``child_frame_id``, no covariance) and the same transform as
+  ``gz.msgs.Pose_V`` on ``tf_topic`` (``tf2_msgs/msg/TFMessage``).
+
+A reset drops the command and puts the odometry back at the origin.  Pure Python.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any, ClassVar
+
+from pan_tilt_sim.controllers.base import (
+    Actuator,
+    ActuatorKind,
+    CommandController,
+    CommandKind,
+    CommandResult,
+    JointHandle,
+)
+from pan_tilt_sim.controllers.diff_drive_controller import OdometrySink, TfSink
+from pan_tilt_sim.controllers.odometry import Odometry
+from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError, RateLimiter, RateLimits
+from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
+from pan_tilt_sim.model.drive_plugins import GzDiffDrivePlugin
+from pan_tilt_sim.model.transforms import Transform
+from pan_tilt_sim.schedule import DUE_EPSILON
+
+ODOMETRY_WINDOW = 10  # updates in the odometry twist's rolling mean (gz-math's default)
+
+
+def gz_limiter(limits: tuple[float, ...], name: str, group: str) -> RateLimiter:
+    """Return a limiter for one group's (min/max velocity, acceleration, jerk; NaN: absent).
+
+    gz's speed limiter bounds each quantity to ``[min, max]`` whichever way
+    the robot moves, an absent bound being unbounded.
+    """
+    def pair(low: float, high: float) -> tuple[float, float]:
+        if math.isnan(low) and math.isnan(high):
+            return math.nan, math.nan
+        return (-math.inf if math.isnan(low) else low), (math.inf if math.isnan(high) else high)
+
+    min_v, max_v, min_a, max_a, min_j, max_j = limits
+    min_v, max_v = pair(min_v, max_v)
+    min_a, max_a = pair(min_a, max_a)
+    min_j, max_j = pair(min_j, max_j)
+    try:
+        return RateLimiter(RateLimits(
+            min_velocity=min_v, max_velocity=max_v, max_acceleration=max_a,
+            max_deceleration=min_a, max_acceleration_reverse=min_a,
+            max_deceleration_reverse=max_a, min_jerk=min_j, max_jerk=max_j))
+    except InvalidLimitsError as err:
+        raise ValueError(f"system '{name}': {group} limits: {err}") from None
+
+
+class GzDiffDrive(CommandController):
+    """One gz-sim DiffDrive system: a Twist in, wheel velocities out, odometry back."""
+
+    drives_base: ClassVar[bool] = True
+    command_kind = CommandKind.TWIST
+
+    def __init__(self, plugin: GzDiffDrivePlugin, source: str = '') -> None:
+        super().__init__(plugin.name, {}, source)
+        self.plugin = plugin
+        self._period = 1.0 / plugin.odom_publish_frequency
+        self._limiters = (gz_limiter(plugin.linear_limits, plugin.name, 'linear'),
+                          gz_limiter(plugin.angular_limits, plugin.name, 'angular'))
+        self._odometry = Odometry(plugin.wheel_separation, plugin.wheel_radius,
+                                  plugin.wheel_radius, ODOMETRY_WINDOW)
+        self._left: list[JointHandle] = []
+        self._right: list[JointHandle] = []
+        self._odometry_sink: OdometrySink | None = None
+        self._tf_sink: TfSink | None = None
+        self._problem = ''
+        self.reset()
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """The wheels, left then right."""
+        return self.plugin.joint_names
+
+    def actuators(self) -> dict[str, Actuator]:
+        """Return the ideal velocity actuator per wheel (within the joint's effort limit)."""
+        return {wheel: Actuator(ActuatorKind.IDEAL_VELOCITY, self.name)
+                for wheel in self.joint_names}
+
+    # --- ROS surface -----------------------------------------------------------------------
+
+    def ros_surface(self) -> tuple[Endpoint, ...]:
+        """Return the command topic in; odometry and its transform out, bridged names."""
+        plugin = self.plugin
+        return (
+            CommandTopic(plugin.command_topic, self.command_kind.value, self.set_command,
+                         self.command_problem),
+            StateTopic(plugin.odometry_topic, 'nav_msgs/msg/Odometry', self.set_odometry_sink,
+                       {'frame_id': plugin.frame_id, 'child_frame_id': plugin.child_frame_id,
+                        'pose_covariance_diagonal': (0.0,) * 6,
+                        'twist_covariance_diagonal': (0.0,) * 6}),
+            StateTopic(plugin.tf_topic, 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
+
+    def set_odometry_sink(self, sink: OdometrySink | None) -> None:
+        """Where odometry samples go: ``sink(time, x, y, heading, linear, angular)``."""
+        self._odometry_sink = sink
+
+    def set_tf_sink(self, sink: TfSink | None) -> None:
+        """Where the odometry transform goes: ``sink(time, [(parent, child, transform)])``."""
+        self._tf_sink = sink
+
+    # --- lifecycle -------------------------------------------------------------------------
+
+    def configure(self, joints: Mapping[str, JointHandle]) -> None:
+        """Bind the wheels' handles, then reset."""
+        self._left = [self.handle(joints, wheel, 'left_joint')
+                      for wheel in self.plugin.left_joints]
+        self._right = [self.handle(joints, wheel, 'right_joint')
+                       for wheel in self.plugin.right_joints]
+        self.reset()
+
+    def reset(self) -> None:
+        """No command, the odometry at the origin of the wheels' present positions."""
+        self._linear = self._angular = 0.0
+        self._last = [(0.0, 0.0), (0.0, 0.0)]  # the limited (linear, angular) of two steps
+        self._last_publish = 0.0
+        left = self._left[0].position if self._left else 0.0
+        right = self._right[0].position if self._right else 0.0
+        self._odometry.reset(0.0, left, right)
+        for handle in self._left + self._right:
+            handle.velocity_target = 0.0
+
+    # --- commands --------------------------------------------------------------------------
+
+    def set_command(self, value: StampedTwist) -> CommandResult:
+        """Take a twist (from the subscription; cheap): refuse non-finite ones."""
+        linear, angular = value.linear[0], value.angular[2]
+        if not (math.isfinite(linear) and math.isfinite(angular)):
+            self._problem = (f'ignored cmd_vel (linear.x {linear!r}, angular.z {angular!r}): '
+                             'not finite numbers')
+            return CommandResult.REJECTED
+        self._linear, self._angular = linear, angular
+        return CommandResult.ACCEPTED
+
+    def command_problem(self, value: Any, result: CommandResult) -> str:
+        """Describe the last refused twist."""
+        return self._problem
+
+    def setpoints(self) -> dict[str, float]:
+        """Return each wheel's velocity target (rad/s)."""
+        return {handle.name: handle.velocity_target for handle in self._left + self._right}
+
+    @property
+    def odometry(self) -> Odometry:
+        """The wheel odometry (pose and twist in ``frame_id``)."""
+        return self._odometry
+
+    # --- the step ---------------------------------------------------------------------------
+
+    def update(self, time: float, period: float) -> None:
+        """Limit the command and set the wheels; when due, update and publish the odometry."""
+        plugin = self.plugin
+        (previous_linear, previous_angular), (before_linear, before_angular) = self._last
+        linear_limiter, angular_limiter = self._limiters
+        linear, angular = self._linear, self._angular
+        if period > 0.0:
+            linear = linear_limiter.limit(linear, previous_linear, before_linear, period)
+            angular = angular_limiter.limit(angular, previous_angular, before_angular, period)
+        self._last = [(linear, angular), (previous_linear, previous_angular)]
+        half = angular * plugin.wheel_separation / 2.0
+        for handle in self._left:
+            handle.velocity_target = (linear - half) / plugin.wheel_radius
+        for handle in self._right:
+            handle.velocity_target = (linear + half) / plugin.wheel_radius
+        if time - self._last_publish + DUE_EPSILON < self._period:
+            return
+        self._last_publish = time
+        if self._left and self._right:
+            self._odometry.update(self._left[0].position, self._right[0].position, time)
+        odometry = self._odometry
+        if self._odometry_sink is not None:
+            self._odometry_sink(time, odometry.x, odometry.y, odometry.heading, odometry.linear,
+                                odometry.angular)
+        if self._tf_sink is not None:
+            pose = Transform((odometry.x, odometry.y, 0.0),
+                             (0.0, 0.0, math.sin(odometry.heading / 2.0),
+                              math.cos(odometry.heading / 2.0)))
+            self._tf_sink(time, [(plugin.frame_id, plugin.child_frame_id, pose)])

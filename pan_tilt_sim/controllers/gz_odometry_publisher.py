@@ -1,0 +1,126 @@
+"""gz-sim's OdometryPublisher system as a unit of the simulation: true-pose odometry. No ROS.
+
+Not a ros2_control controller: the simulation creates one per system the
+URDF declares (:mod:`pan_tilt_sim.model.drive_plugins`) and updates it every
+physics step; it is always active.  As the system, every ``1 /
+odom_publish_frequency`` s of sim time it publishes the model's pose in the
+world (its root link frame, moved by ``xyz_offset`` and turned by
+``rpy_offset``) and its twist in the base's own axes: ``gz.msgs.Odometry``
+on ``odom_topic`` (``nav_msgs/msg/Odometry`` through the bridge,
+``odom_frame`` -> ``robot_base_frame``) and the same transform as
+``gz.msgs.Pose_V`` on ``tf_topic`` (``tf2_msgs/msg/TFMessage``).  With
+``dimensions`` 2, z, roll and pitch are 0 and so are the twist's z, roll
+and pitch rates.  ``gaussian_noise``: the standard deviation added to
+the position and the twist.  Pure Python: the simulation hands in the
+base's state (:meth:`GzOdometryPublisher.set_base_motion`).
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from collections.abc import Callable, Mapping
+
+from pan_tilt_sim.controllers.base import Controller, JointHandle
+from pan_tilt_sim.controllers.diff_drive_controller import TfSink
+from pan_tilt_sim.controllers.gazebo_p3d import SpatialOdometrySink
+from pan_tilt_sim.controllers.gazebo_planar_move import BaseMotion, heading
+from pan_tilt_sim.controllers.surface import Endpoint, StateTopic
+from pan_tilt_sim.model.drive_plugins import GzOdometryPlugin
+from pan_tilt_sim.model.transforms import (
+    Transform,
+    Vector,
+    quaternion_from_rpy,
+    quaternion_multiply,
+    rotate,
+)
+from pan_tilt_sim.schedule import DUE_EPSILON
+
+
+class GzOdometryPublisher(Controller):
+    """One gz-sim OdometryPublisher system: the model's true pose and twist as odometry."""
+
+    def __init__(self, plugin: GzOdometryPlugin, source: str = '', *,
+                 rng: random.Random | None = None) -> None:
+        super().__init__(plugin.name, {}, source)
+        self.plugin = plugin
+        self._period = 1.0 / plugin.odom_publish_frequency
+        self._offset = quaternion_from_rpy(*plugin.rpy_offset)
+        self._rng = rng or random.Random()
+        self._odometry_sink: SpatialOdometrySink | None = None
+        self._tf_sink: TfSink | None = None
+        self._base_motion: Callable[[], BaseMotion] | None = None
+        self.reset()
+
+    def set_base_motion(self, source: Callable[[], BaseMotion]) -> None:
+        """Where the unit reads the base's frame and velocities (world axes)."""
+        self._base_motion = source
+
+    def ros_surface(self) -> tuple[Endpoint, ...]:
+        """Return the odometry and pose topics, by the names the bridge would give them."""
+        plugin = self.plugin
+        return (StateTopic(plugin.odometry_topic, 'nav_msgs/msg/Odometry',
+                           self.set_odometry_sink,
+                           {'frame_id': plugin.odom_frame,
+                            'child_frame_id': plugin.robot_base_frame,
+                            'pose_covariance_diagonal': (0.0,) * 6,
+                            'twist_covariance_diagonal': (0.0,) * 6, 'spatial': True}),
+                StateTopic(plugin.tf_topic, 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
+
+    def set_odometry_sink(self, sink: SpatialOdometrySink | None) -> None:
+        """Where odometry samples go (None: nobody listens)."""
+        self._odometry_sink = sink
+
+    def set_tf_sink(self, sink: TfSink | None) -> None:
+        """Where the transform goes (None: nobody listens)."""
+        self._tf_sink = sink
+
+    def configure(self, joints: Mapping[str, JointHandle]) -> None:
+        """Nothing to bind: the system reads the model's pose."""
+        self.reset()
+
+    def reset(self) -> None:
+        """Start the rate again from sim time 0."""
+        self._last = 0.0
+
+    def update(self, time: float, period: float) -> None:
+        """Publish when due and watched."""
+        if self._base_motion is None or (self._odometry_sink is None and self._tf_sink is None):
+            return
+        if time - self._last + DUE_EPSILON < self._period:
+            return
+        self._last = time
+        pose, linear, angular = self.measure()
+        if self._odometry_sink is not None:
+            self._odometry_sink(time, pose, linear, angular)
+        if self._tf_sink is not None:
+            self._tf_sink(time, [(self.plugin.odom_frame, self.plugin.robot_base_frame, pose)])
+
+    def measure(self) -> tuple[Transform, Vector, Vector]:
+        """Return the pose (world), linear and angular velocity (base axes) published now."""
+        plugin = self.plugin
+        frame, linear, angular = self._base_motion()
+        x, y, z = frame.translation
+        dx, dy, dz = rotate(frame.rotation, plugin.xyz_offset)
+        rotation = quaternion_multiply(frame.rotation, self._offset)
+        x, y, z = x + dx, y + dy, z + dz
+        qx, qy, qz, qw = rotation
+        conjugate = (-qx, -qy, -qz, qw)
+        body_linear = rotate(conjugate, linear)
+        body_angular = rotate(conjugate, angular)
+        if plugin.dimensions == 2:
+            yaw = heading(Transform((x, y, z), rotation))
+            z = 0.0
+            rotation = (0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0))
+            body_linear = (body_linear[0], body_linear[1], 0.0)
+            body_angular = (0.0, 0.0, body_angular[2])
+        noise = plugin.gaussian_noise
+        if noise > 0.0:
+            gauss = self._rng.gauss
+            x, y = x + gauss(0.0, noise), y + gauss(0.0, noise)
+            if plugin.dimensions == 3:
+                z += gauss(0.0, noise)
+            body_linear = tuple(value + gauss(0.0, noise) for value in body_linear)
+            body_angular = tuple(value + gauss(0.0, noise) for value in body_angular)
+        return (Transform((x, y, z), rotation), tuple(body_linear),  # type: ignore[return-value]
+                tuple(body_angular))
