@@ -73,6 +73,8 @@ UPSTREAM_HASHES = {
         'RIHS01_57eb8f326c9889ca8bb34ead82cc94cc09bf6bc5c3b6c09546dca3a00b589890',
     'control_msgs/msg/DynamicInterfaceGroupValues':
         'RIHS01_0ebef56c55cdde46b4622f7e0a4dbf26fefbf0296205463e955047252b434cbc',
+    'control_msgs/msg/SteeringControllerStatus':
+        'RIHS01_151ec2fabdfdf10cabe982ceab9fec8882c9efff0effc8d07ba7a1d404cf8143',
     'controller_manager_msgs/srv/SwitchController':
         'RIHS01_d4ad10aa5da7808bc522d55d4123d8ef79de73d049d165639d7663ac37cc9895',
     'controller_manager_msgs/srv/ListControllers':

@@ -5,7 +5,9 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from pan_tilt_sim.controllers.ackermann_steering_controller import AckermannSteeringController
 from pan_tilt_sim.controllers.base import Controller
+from pan_tilt_sim.controllers.bicycle_steering_controller import BicycleSteeringController
 from pan_tilt_sim.controllers.diff_drive_controller import DiffDriveController
 from pan_tilt_sim.controllers.effort_gripper_action_controller import (
     EffortGripperActionController,
@@ -35,6 +37,7 @@ from pan_tilt_sim.controllers.parallel_gripper_action_controller import (
 from pan_tilt_sim.controllers.pid_controller import PidController
 from pan_tilt_sim.controllers.pose_broadcaster import PoseBroadcaster
 from pan_tilt_sim.controllers.range_sensor_broadcaster import RangeSensorBroadcaster
+from pan_tilt_sim.controllers.tricycle_steering_controller import TricycleSteeringController
 from pan_tilt_sim.errors import ControllerConfigError
 
 CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
@@ -49,6 +52,9 @@ CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
     JointTrajectoryController,
     PidController,
     DiffDriveController,
+    AckermannSteeringController,
+    BicycleSteeringController,
+    TricycleSteeringController,
     GripperActionController,
     EffortGripperActionController,
     ParallelGripperActionController,

@@ -82,7 +82,14 @@ from pan_tilt_sim.ros.ros_interfaces import (
     seconds,
     stamp,
 )
-from pan_tilt_sim.ros.state_sinks import GroupValuesSink, ImuSink, PoseSink, RangeSink, WrenchSink
+from pan_tilt_sim.ros.state_sinks import (
+    GroupValuesSink,
+    ImuSink,
+    PoseSink,
+    RangeSink,
+    SteeringStatusSink,
+    WrenchSink,
+)
 from pan_tilt_sim.ros.trajectory_action import TrajectoryActionServer
 from pan_tilt_sim.sim.engine import Simulation
 
@@ -100,6 +107,7 @@ except ImportError:  # an optional interface package (see optional_interfaces)
     JointTrajectoryControllerState = QueryTrajectoryState = None
 
 QUEUE_DEPTH = 10
+STEERING_STATUS = 'control_msgs/msg/SteeringControllerStatus'
 WARNING_THROTTLE_S = 1.0
 
 
@@ -641,6 +649,7 @@ STATE_SINKS: dict[str, tuple[type | None, Callable[[Any, Mapping[str, Any]], Any
     'sensor_msgs/msg/Range': (Range, RangeSink),
     'geometry_msgs/msg/PoseStamped': (PoseStamped, PoseSink),
     GROUP_VALUES: (optional_message(GROUP_VALUES), GroupValuesSink),
+    STEERING_STATUS: (optional_message(STEERING_STATUS), SteeringStatusSink),
 }
 def _success_and_message(answer: tuple[bool, str], response: Any) -> None:
     """Fill a response's ``success`` and ``message`` from ``(success, message)``."""

@@ -1,7 +1,7 @@
 """registry: every YAML type string maps to a controller class that loads and runs.
 
 Each registered type is loaded through the manager with nothing but its
-spec's examples (everything else from the defaults), on a minimal two-joint
+spec's examples (everything else from the defaults), on a minimal four-joint
 robot with the example sensor and gpio; it configures, activates, runs,
 declares its ROS surface, and documents every parameter.
 """
@@ -25,9 +25,13 @@ DT = 0.001
 
 
 def small_robot():
-    """Return joint1 (every example's joint) and joint2 (a diff drive's other wheel)."""
+    """Return joint1 (every example's joint), joint2 (a diff drive's other wheel) and more.
+
+    joint3 and joint4: the second traction and steering joints of the steering types.
+    """
     return {name: JointHandle(JointSpec(name, JointKind.REVOLUTE, -1.0, 1.0, effort_limit=10.0,
-                                        velocity_limit=2.0)) for name in ('joint1', 'joint2')}
+                                        velocity_limit=2.0))
+            for name in ('joint1', 'joint2', 'joint3', 'joint4')}
 
 
 @pytest.mark.parametrize('type_name', sorted(CONTROLLER_TYPES))
