@@ -55,3 +55,14 @@ def test_without_a_track_width_it_refuses_to_start():
     with pytest.raises(ControllerConfigError, match=r'^car\.yaml: steering_controller\.'
                        r'traction_track_width: not set'):
         tricycle(traction_track_width=0.0)
+
+
+def test_the_odometry_takes_each_rear_wheel_along_its_own_arc():
+    controller, joints = tricycle(velocity_rolling_window_size=1)
+    joints['front_steering_joint'].position = math.atan(0.3)  # about a centre 1 m to the left
+    joints['rear_right_wheel_joint'].velocity = 4.5  # on 1.125 m of radius
+    joints['rear_left_wheel_joint'].velocity = 3.0  # on 0.875 m
+    controller.update(0.0, DT)
+    linear = (4.5 / 1.125 + 3.0 / 0.875) / 2.0 * 0.05
+    assert controller.odometry.linear == pytest.approx(linear)
+    assert controller.odometry.angular == pytest.approx(linear / 1.0)
