@@ -11,10 +11,12 @@ from __future__ import annotations
 
 import contextlib
 import math
+import re
 import time
 from collections.abc import Iterator
 
 import pytest
+import sim_process
 from control_msgs.msg import SteeringControllerStatus
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
@@ -40,6 +42,7 @@ PERIOD_STEPS = 10  # one controller update (100 Hz): one odometry message per pe
 ROBOT = 'car'
 ODOMETRY = f'/{CONTROLLER}/odometry'
 BAD_COUNT = 20
+EXIT_CONFIGURATION_ERROR = 2
 
 
 class Car:
@@ -200,8 +203,15 @@ def test_a_twist_that_is_not_finite_is_refused_with_a_throttled_warning(tmp_path
 def test_a_steering_joint_the_robot_lacks_stops_start_up_naming_the_parameter(tmp_path):
     description, controllers = write_steered(tmp_path, BICYCLE, steering_parameters(
         BICYCLE, steering_joints_names=['front_steer_joint']))
-    with pytest.raises(ControllerConfigError, match=r"steering_controller\.steering_joints_names"
-                       r": joint 'front_steer_joint' is not a movable joint of the robot"):
+    problem = (f"{controllers}: steering_controller.steering_joints_names: joint "
+               "'front_steer_joint' is not a movable joint of the robot")
+    with pytest.raises(ControllerConfigError, match=re.escape(problem)):
         with sim_node(robot_description_file=str(description),
                       controllers_file=str(controllers), world='ground'):
             pass
+    result = sim_process.run('-p', f'robot_description_file:={description}',
+                             '-p', f'controllers_file:={controllers}', '-p', 'world:=ground')
+    assert result.returncode == EXIT_CONFIGURATION_ERROR, result.stderr
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith('sim_node: error: '), result.stderr
+    assert problem in lines[0]
