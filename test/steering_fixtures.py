@@ -18,7 +18,9 @@ Every wheel is a cylinder of radius ``WHEEL_RADIUS`` touching the ground with
 Gazebo's default friction; resting, ``base_link`` is ``REST_HEIGHT`` above
 the ground.  The ``<ros2_control>`` block gives the steering joints a
 ``position`` command interface and the ``driven`` wheel joints ``velocity``;
-the other wheels roll freely.
+the other wheels roll freely.  :func:`write_tricycle` writes the tricycle
+whose single front wheel steers and drives (``tricycle_controller``'s robot),
+its rear wheels rolling freely.
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ ACKERMANN = 'ackermann_steering_controller/AckermannSteeringController'
 BICYCLE = 'bicycle_steering_controller/BicycleSteeringController'
 TRICYCLE = 'tricycle_steering_controller/TricycleSteeringController'
 TRICYCLE_CONTROLLER = 'tricycle_controller/TricycleController'
+TRICYCLE_NAME = 'tricycle_controller'
 INERTIA = '<inertia ixx="0.0002" ixy="0" ixz="0" iyy="0.0004" iyz="0" izz="0.0002"/>'
 
 
@@ -178,6 +181,32 @@ def steered_controllers(type_name: str, params: Mapping[str, Any],
             CONTROLLER: {'type': type_name}}},
         CONTROLLER: {'ros__parameters': dict(params)},
     })
+
+
+def tricycle_controllers(params: Mapping[str, Any] | None = None, update_rate: int = 100) -> str:
+    """Return a controllers file: broadcaster and a ``tricycle_controller/TricycleController``."""
+    given: dict[str, Any] = {'traction_joint_name': 'front_wheel_joint',
+                             'steering_joint_name': 'front_steering_joint',
+                             'wheelbase': WHEELBASE, 'wheel_radius': WHEEL_RADIUS}
+    given.update(params or {})
+    return yaml.safe_dump({
+        'controller_manager': {'ros__parameters': {
+            'update_rate': update_rate,
+            'joint_state_broadcaster': {'type': 'joint_state_broadcaster/JointStateBroadcaster'},
+            TRICYCLE_NAME: {'type': TRICYCLE_CONTROLLER}}},
+        TRICYCLE_NAME: {'ros__parameters': given},
+    })
+
+
+def write_tricycle(directory: pathlib.Path,
+                   params: Mapping[str, Any] | None = None) -> tuple[pathlib.Path, pathlib.Path]:
+    """Write the tricycle (its front wheel steers and drives) and a tricycle_controller file."""
+    description = directory / 'trike.urdf'
+    description.write_text(steered_urdf('single', 'pair', driven=['front_wheel_joint'],
+                                        name='trike'), encoding='utf-8')
+    controllers = directory / 'trike_controllers.yaml'
+    controllers.write_text(tricycle_controllers(params), encoding='utf-8')
+    return description, controllers
 
 
 def write_steered(directory: pathlib.Path, type_name: str = ACKERMANN,

@@ -37,6 +37,7 @@ from pan_tilt_sim.controllers.parallel_gripper_action_controller import (
 from pan_tilt_sim.controllers.pid_controller import PidController
 from pan_tilt_sim.controllers.pose_broadcaster import PoseBroadcaster
 from pan_tilt_sim.controllers.range_sensor_broadcaster import RangeSensorBroadcaster
+from pan_tilt_sim.controllers.tricycle_controller import TricycleController
 from pan_tilt_sim.controllers.tricycle_steering_controller import TricycleSteeringController
 from pan_tilt_sim.errors import ControllerConfigError
 
@@ -55,6 +56,7 @@ CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
     AckermannSteeringController,
     BicycleSteeringController,
     TricycleSteeringController,
+    TricycleController,
     GripperActionController,
     EffortGripperActionController,
     ParallelGripperActionController,

@@ -50,7 +50,7 @@ writes NaN to both).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.actuator import ARRIVED, SETPOINT_ACCELERATION, ramp
@@ -165,6 +165,52 @@ DEPRECATED_JOINTS = (
 )
 
 
+class SteeringJoints:
+    """Steering joints driven through their ``position`` command interface, tracked every step.
+
+    A command (rad) is clamped to the joint's limits and becomes a setpoint
+    that moves toward it within the joint's velocity limit and
+    :data:`~pan_tilt_sim.controllers.actuator.SETPOINT_ACCELERATION`; the
+    ideal position actuator's velocity target follows the setpoint (as a
+    position command interface under gz_ros2_control).  Until the first
+    command (NaN) each joint holds where it was.
+    """
+
+    def __init__(self, handles: Sequence[JointHandle] = ()) -> None:
+        self.handles = list(handles)
+        self._limits = [PositionLimits(handle.spec) for handle in self.handles]
+        self.hold()
+
+    def hold(self) -> None:
+        """Hold each joint where it is: setpoint there, at rest, no command."""
+        self.setpoints = [handle.position for handle in self.handles]
+        self._rates = [0.0] * len(self.handles)
+        self.commands = [math.nan] * len(self.handles)
+        for handle in self.handles:
+            handle.velocity_target = 0.0
+
+    def command(self, angles: Sequence[float]) -> None:
+        """Take one angle per joint (rad), clamped to the joint's limits."""
+        self.commands = [min(max(angle, limits.lower), limits.upper)
+                         for angle, limits in zip(angles, self._limits, strict=True)]
+
+    def track(self, period: float) -> None:
+        """Move each setpoint toward its command; set each joint's velocity target."""
+        for index, handle in enumerate(self.handles):
+            command = self.commands[index]
+            setpoint, rate = self.setpoints[index], self._rates[index]
+            limits = self._limits[index]
+            if not math.isnan(command) and (rate != 0.0 or not -ARRIVED < command - setpoint
+                                            < ARRIVED):
+                setpoint, rate = ramp(setpoint, rate, command, period, limits.max_velocity,
+                                      SETPOINT_ACCELERATION)
+                self.setpoints[index], self._rates[index] = setpoint, rate
+            target = rate + handle.tracking_gain / period * (setpoint - handle.position)
+            limit = limits.max_velocity
+            handle.velocity_target = limit if target > limit else (
+                -limit if target < -limit else target)
+
+
 class SteeringController(CommandController):
     """A steered base from a twist: steering angles and wheel speeds out, odometry back.
 
@@ -188,10 +234,9 @@ class SteeringController(CommandController):
         self._linear_reference, self._angular_reference = self._references.values()
         self._updates = PeriodicSchedule(update_period(self.params))
         self._traction: list[JointHandle] = []
-        self._steering: list[JointHandle] = []
+        self._steering = SteeringJoints()
         self._traction_state: list[JointHandle] = []
         self._steering_state: list[JointHandle] = []
-        self._steering_limits: list[PositionLimits] = []
         self._odometry_sink: OdometrySink | None = None
         self._tf_sink: TfSink | None = None
         self._status_sink: StatusSink | None = None
@@ -314,12 +359,12 @@ class SteeringController(CommandController):
         """Bind the joints' handles (an unknown joint names its parameter), then reset."""
         names = self._names
         self._traction = [self.handle(joints, joint, TRACTION) for joint in names[TRACTION]]
-        self._steering = [self.handle(joints, joint, STEERING) for joint in names[STEERING]]
+        self._steering = SteeringJoints([self.handle(joints, joint, STEERING)
+                                         for joint in names[STEERING]])
         self._traction_state = [self.handle(joints, joint, TRACTION_STATE, commanded=False)
                                 for joint in names[TRACTION_STATE]]
         self._steering_state = [self.handle(joints, joint, STEERING_STATE, commanded=False)
                                 for joint in names[STEERING_STATE]]
-        self._steering_limits = [PositionLimits(handle.spec) for handle in self._steering]
         self.reset()
 
     def reset(self) -> None:
@@ -335,21 +380,13 @@ class SteeringController(CommandController):
         self._kinematics.reset(self._traction_positions())
         for handle in self._traction:
             handle.velocity_target = 0.0
-        self._hold_steering()
-
-    def _hold_steering(self) -> None:
-        """Hold each steering joint where it is: setpoint there, at rest, no command."""
-        self._setpoints = [handle.position for handle in self._steering]
-        self._rates = [0.0] * len(self._steering)
-        self._steering_commands = [math.nan] * len(self._steering)
-        for handle in self._steering:
-            handle.velocity_target = 0.0
+        self._steering.hold()
 
     def deactivate(self) -> None:
         """Stop the traction wheels and hold the steering where it is."""
         for handle in self._traction:
             handle.velocity_target = 0.0
-        self._hold_steering()
+        self._steering.hold()
 
     # --- commands --------------------------------------------------------------------------
 
@@ -379,8 +416,10 @@ class SteeringController(CommandController):
     def setpoints(self) -> dict[str, float]:
         """Return each traction joint's velocity (rad/s) and steering joint's setpoint (rad)."""
         wanted = {handle.name: handle.velocity_target for handle in self._traction}
+        steering = self._steering
         wanted.update({handle.name: setpoint
-                       for handle, setpoint in zip(self._steering, self._setpoints, strict=True)})
+                       for handle, setpoint in zip(steering.handles, steering.setpoints,
+                                                   strict=True)})
         return wanted
 
     @property
@@ -391,7 +430,7 @@ class SteeringController(CommandController):
     @property
     def steering_commands(self) -> list[float]:
         """The steering angles last commanded (rad; NaN before the first command)."""
-        return list(self._steering_commands)
+        return list(self._steering.commands)
 
     # --- the step ---------------------------------------------------------------------------
 
@@ -402,7 +441,7 @@ class SteeringController(CommandController):
             last = self._last_update
             self._last_update = time
             self._control(time, self._updates.period if last is None else time - last)
-        self._track_steering(period)
+        self._steering.track(period)
 
     def _control(self, time: float, period: float) -> None:
         """One upstream update: take the reference, update odometry, command the joints."""
@@ -418,9 +457,7 @@ class SteeringController(CommandController):
                 slow_until_steered=self.params['reduce_wheel_speed_until_steering_reached'])
             for handle, velocity in zip(self._traction, traction, strict=True):
                 handle.velocity_target = velocity
-            self._steering_commands = [
-                min(max(angle, limits.lower), limits.upper)
-                for angle, limits in zip(steering, self._steering_limits, strict=True)]
+            self._steering.command(steering)
         else:
             for handle in self._traction:
                 handle.velocity_target = 0.0
@@ -463,22 +500,6 @@ class SteeringController(CommandController):
             kinematics.update_from_velocities(
                 [handle.velocity for handle in self._traction_state], steering, period)
 
-    def _track_steering(self, period: float) -> None:
-        """Move each steering setpoint toward its command; drive the joint to the setpoint."""
-        for index, handle in enumerate(self._steering):
-            command = self._steering_commands[index]
-            setpoint, rate = self._setpoints[index], self._rates[index]
-            limits = self._steering_limits[index]
-            if not math.isnan(command) and (rate != 0.0 or not -ARRIVED < command - setpoint
-                                            < ARRIVED):
-                setpoint, rate = ramp(setpoint, rate, command, period, limits.max_velocity,
-                                      SETPOINT_ACCELERATION)
-                self._setpoints[index], self._rates[index] = setpoint, rate
-            target = rate + handle.tracking_gain / period * (setpoint - handle.position)
-            limit = limits.max_velocity
-            handle.velocity_target = limit if target > limit else (
-                -limit if target < -limit else target)
-
     def _publish(self, time: float) -> None:
         kinematics = self._kinematics
         if self._odometry_sink is not None:
@@ -498,5 +519,5 @@ class SteeringController(CommandController):
             self._status_sink(time, positions, velocities,
                               [handle.velocity_target for handle in self._traction],
                               [handle.position for handle in self._steering_state],
-                              list(self._steering_commands))
+                              list(self._steering.commands))
 

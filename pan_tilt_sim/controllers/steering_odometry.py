@@ -116,6 +116,12 @@ class SteeringKinematics:
         self.linear = self._linear_mean.add(linear)
         self.angular = self._angular_mean.add(angular)
 
+    def update_from_twist(self, linear: float, angular: float, dt: float) -> None:
+        """Integrate a measured twist (m/s, rad/s) over ``dt``; add it to the rolling means."""
+        self._integrate(linear, angular, dt)
+        self.linear = self._linear_mean.add(linear)
+        self.angular = self._angular_mean.add(angular)
+
     def update_open_loop(self, linear: float, angular: float, dt: float) -> None:
         """Integrate the commanded twist (m/s, rad/s) over ``dt``."""
         self.linear, self.angular = linear, angular

@@ -56,7 +56,7 @@ from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rclpy.service import Service as ServiceEntity
 from sensor_msgs.msg import Imu, JointState, Range
-from std_srvs.srv import SetBool
+from std_srvs.srv import Empty, SetBool
 
 from pan_tilt_sim.controllers import CommandResult, Controller
 from pan_tilt_sim.controllers.surface import (
@@ -83,6 +83,7 @@ from pan_tilt_sim.ros.ros_interfaces import (
     stamp,
 )
 from pan_tilt_sim.ros.state_sinks import (
+    AckermannDriveSink,
     GroupValuesSink,
     ImuSink,
     PoseSink,
@@ -108,6 +109,7 @@ except ImportError:  # an optional interface package (see optional_interfaces)
 
 QUEUE_DEPTH = 10
 STEERING_STATUS = 'control_msgs/msg/SteeringControllerStatus'
+ACKERMANN_DRIVE = 'ackermann_msgs/msg/AckermannDrive'  # not in the venv: no such topic there
 WARNING_THROTTLE_S = 1.0
 
 
@@ -650,6 +652,7 @@ STATE_SINKS: dict[str, tuple[type | None, Callable[[Any, Mapping[str, Any]], Any
     'geometry_msgs/msg/PoseStamped': (PoseStamped, PoseSink),
     GROUP_VALUES: (optional_message(GROUP_VALUES), GroupValuesSink),
     STEERING_STATUS: (optional_message(STEERING_STATUS), SteeringStatusSink),
+    ACKERMANN_DRIVE: (optional_message(ACKERMANN_DRIVE), AckermannDriveSink),
 }
 def _success_and_message(answer: tuple[bool, str], response: Any) -> None:
     """Fill a response's ``success`` and ``message`` from ``(success, message)``."""
@@ -670,6 +673,7 @@ def _trajectory_state(answer: TrajectoryStateAnswer, response: Any) -> None:
 # fills the response.
 SERVICES: dict[str, tuple[type | None, Callable[[Any], Any], Callable[[Any, Any], None]]] = {
     'std_srvs/srv/SetBool': (SetBool, lambda request: request.data, _success_and_message),
+    'std_srvs/srv/Empty': (Empty, lambda request: None, lambda answer, response: None),
     'control_msgs/srv/QueryTrajectoryState': (
         QueryTrajectoryState, lambda request: seconds(request.time), _trajectory_state),
 }

@@ -172,3 +172,22 @@ class SteeringStatusSink(HeldSample):
             message.steer_positions = list(steering_positions)
             message.steering_angle_command = list(steering_commands)
         self.take(fill)
+
+
+class AckermannDriveSink(HeldSample):
+    """``ackermann_msgs/msg/AckermannDrive`` from ``sink(time, speed, steering angle)``.
+
+    The tricycle controller's limited command, as upstream fills it: ``speed``
+    is the wheel's (rad/s), ``steering_angle`` in rad.  ackermann_msgs is
+    optional: the sink imports it only when created.
+    """
+
+    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
+        super().__init__(publisher, importlib.import_module('ackermann_msgs.msg').AckermannDrive())
+
+    def __call__(self, time: float, speed: float, steering_angle: float) -> None:
+        """Take a sample (the message has no stamp)."""
+        def fill() -> None:
+            self.message.speed = speed
+            self.message.steering_angle = steering_angle
+        self.take(fill)
