@@ -52,17 +52,18 @@ controller is configured. *Not simulated*: accepted, but the simulator does not 
 
 
 def example_controller(cls: type[Controller]) -> Controller:
-    """Return ``cls`` built from its spec's examples and configured on a two-joint robot.
+    """Return ``cls`` built from its spec's examples and configured on a four-joint robot.
 
-    Every example names joint1 (a diff drive's other side is joint2); the
-    robot also has the example sensor and gpio the examples name.
+    Every example names joint1 (a diff drive's other side is joint2; the
+    steering types' second traction and steering joints are joint3 and
+    joint4); the robot also has the example sensor and gpio the examples name.
     """
     controller = cls('<name>', cls.parameters.example())
     controller.type_name = cls.type_names[0]
     controller.set_hardware(example_hardware())
     controller.configure({name: JointHandle(JointSpec(
         name, JointKind.REVOLUTE, -1.0, 1.0, effort_limit=1.0, velocity_limit=1.0))
-        for name in ('joint1', 'joint2')})
+        for name in ('joint1', 'joint2', 'joint3', 'joint4')})
     return controller
 
 
