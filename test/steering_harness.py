@@ -7,6 +7,7 @@ kinematics alone.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 from pan_tilt_sim.controllers import JointHandle
@@ -66,7 +67,7 @@ def run(controller: SteeringController, joints: dict[str, JointHandle], seconds:
             assert controller.set_command(command) is CommandResult.ACCEPTED
         controller.update(time, DT)
         for name, angle in zip(steering, controller.steering_commands, strict=True):
-            if angle == angle:  # not NaN: commanded
+            if not math.isnan(angle):  # commanded
                 joints[name].position = angle
         for handle in joints.values():
             if handle.spec.kind is JointKind.CONTINUOUS:
