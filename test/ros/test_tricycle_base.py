@@ -26,6 +26,7 @@ from pan_tilt_sim.ros import controller_bindings
 PERIOD_STEPS = 10  # one controller update at 100 Hz: one odometry message per period
 ROBOT = 'trike'
 ODOM = f'/{TRICYCLE_NAME}/odom'
+BAD_COUNT = 20
 
 
 class Trike:
@@ -128,6 +129,21 @@ def test_it_stops_once_cmd_vel_times_out(tmp_path):
         where, yaw = trike.true_pose()
         assert trike.odometry[-1].twist.twist.linear.x == pytest.approx(0.0, abs=1e-3)
         assert where[0] < 0.2 * 0.4
+
+
+def test_a_twist_that_is_not_finite_is_refused_with_a_throttled_warning(tmp_path, capfd):
+    with running(tmp_path) as trike:
+        trike.command(0.2, 0.0)
+        trike.period()
+        for _ in range(BAD_COUNT):
+            trike.command(math.nan, 0.0)
+        for _ in range(15):
+            trike.period()
+        assert trike.odometry[-1].twist.twist.linear.x == pytest.approx(0.2, rel=0.05)
+    lines = [line for line in capfd.readouterr().err.splitlines()
+             if f'{TRICYCLE_NAME}: ignored cmd_vel' in line]
+    assert lines and 'not finite numbers' in lines[0]
+    assert len(lines) < BAD_COUNT  # throttled
 
 
 def test_reset_odometry_puts_the_odometry_back_at_the_origin(tmp_path):
