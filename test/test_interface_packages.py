@@ -75,6 +75,8 @@ UPSTREAM_HASHES = {
         'RIHS01_c560d21a4484fd5f2c05896a11de3315f4c33535a203d3e8d62af4b6a9cd3355',
     'control_msgs/msg/DynamicInterfaceGroupValues':
         'RIHS01_0ebef56c55cdde46b4622f7e0a4dbf26fefbf0296205463e955047252b434cbc',
+    'control_msgs/msg/SteeringControllerStatus':
+        'RIHS01_151ec2fabdfdf10cabe982ceab9fec8882c9efff0effc8d07ba7a1d404cf8143',
     'controller_manager_msgs/srv/SwitchController':
         'RIHS01_d4ad10aa5da7808bc522d55d4123d8ef79de73d049d165639d7663ac37cc9895',
     'controller_manager_msgs/srv/ListControllers':

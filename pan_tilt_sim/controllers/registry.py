@@ -5,7 +5,9 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from pan_tilt_sim.controllers.ackermann_steering_controller import AckermannSteeringController
 from pan_tilt_sim.controllers.base import Controller
+from pan_tilt_sim.controllers.bicycle_steering_controller import BicycleSteeringController
 from pan_tilt_sim.controllers.diff_drive_controller import DiffDriveController
 from pan_tilt_sim.controllers.effort_gripper_action_controller import (
     EffortGripperActionController,
@@ -37,6 +39,8 @@ from pan_tilt_sim.controllers.parallel_gripper_action_controller import (
 from pan_tilt_sim.controllers.pid_controller import PidController
 from pan_tilt_sim.controllers.pose_broadcaster import PoseBroadcaster
 from pan_tilt_sim.controllers.range_sensor_broadcaster import RangeSensorBroadcaster
+from pan_tilt_sim.controllers.tricycle_controller import TricycleController
+from pan_tilt_sim.controllers.tricycle_steering_controller import TricycleSteeringController
 from pan_tilt_sim.errors import ControllerConfigError
 
 CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
@@ -53,6 +57,10 @@ CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
     DiffDriveController,
     MecanumDriveController,
     OmniWheelDriveController,
+    AckermannSteeringController,
+    BicycleSteeringController,
+    TricycleSteeringController,
+    TricycleController,
     GripperActionController,
     EffortGripperActionController,
     ParallelGripperActionController,

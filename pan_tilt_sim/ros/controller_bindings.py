@@ -56,7 +56,7 @@ from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rclpy.service import Service as ServiceEntity
 from sensor_msgs.msg import Imu, JointState, Range
-from std_srvs.srv import SetBool
+from std_srvs.srv import Empty, SetBool
 
 from pan_tilt_sim.controllers import CommandResult, Controller
 from pan_tilt_sim.controllers.surface import (
@@ -82,7 +82,15 @@ from pan_tilt_sim.ros.ros_interfaces import (
     seconds,
     stamp,
 )
-from pan_tilt_sim.ros.state_sinks import GroupValuesSink, ImuSink, PoseSink, RangeSink, WrenchSink
+from pan_tilt_sim.ros.state_sinks import (
+    AckermannDriveSink,
+    GroupValuesSink,
+    ImuSink,
+    PoseSink,
+    RangeSink,
+    SteeringStatusSink,
+    WrenchSink,
+)
 from pan_tilt_sim.ros.trajectory_action import TrajectoryActionServer
 from pan_tilt_sim.sim.engine import Simulation
 
@@ -104,6 +112,8 @@ except ImportError:  # optional, and absent from control_msgs builds older than 
     MecanumDriveControllerState = None
 
 QUEUE_DEPTH = 10
+STEERING_STATUS = 'control_msgs/msg/SteeringControllerStatus'
+ACKERMANN_DRIVE = 'ackermann_msgs/msg/AckermannDrive'  # not in the venv: no such topic there
 WARNING_THROTTLE_S = 1.0
 
 
@@ -670,6 +680,8 @@ STATE_SINKS: dict[str, tuple[type | None, Callable[[Any, Mapping[str, Any]], Any
     GROUP_VALUES: (optional_message(GROUP_VALUES), GroupValuesSink),
     'control_msgs/msg/MecanumDriveControllerState': (MecanumDriveControllerState,
                                                      MecanumStateSink),
+    STEERING_STATUS: (optional_message(STEERING_STATUS), SteeringStatusSink),
+    ACKERMANN_DRIVE: (optional_message(ACKERMANN_DRIVE), AckermannDriveSink),
 }
 def _success_and_message(answer: tuple[bool, str], response: Any) -> None:
     """Fill a response's ``success`` and ``message`` from ``(success, message)``."""
@@ -690,6 +702,7 @@ def _trajectory_state(answer: TrajectoryStateAnswer, response: Any) -> None:
 # fills the response.
 SERVICES: dict[str, tuple[type | None, Callable[[Any], Any], Callable[[Any, Any], None]]] = {
     'std_srvs/srv/SetBool': (SetBool, lambda request: request.data, _success_and_message),
+    'std_srvs/srv/Empty': (Empty, lambda request: None, lambda answer, response: None),
     'control_msgs/srv/QueryTrajectoryState': (
         QueryTrajectoryState, lambda request: seconds(request.time), _trajectory_state),
 }

@@ -143,3 +143,51 @@ class GroupValuesSink(HeldSample):
                 entry.values = row  # the message keeps a copy (an array of doubles)
         self.take(fill)
 
+
+
+class SteeringStatusSink(HeldSample):
+    """``control_msgs/msg/SteeringControllerStatus`` from a steering controller's samples.
+
+    Field ``frame_id`` (the odometry frame, as upstream's header); a sample is
+    ``sink(time, traction positions, traction velocities, traction commands,
+    steering positions, steering commands)`` in rad, rad/s, rad/s, rad, rad
+    (an empty list leaves its field empty).
+    """
+
+    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
+        message = importlib.import_module('control_msgs.msg').SteeringControllerStatus()
+        message.header.frame_id = fields['frame_id']
+        super().__init__(publisher, message)
+
+    def __call__(self, time: float, traction_positions: Sequence[float],
+                 traction_velocities: Sequence[float], traction_commands: Sequence[float],
+                 steering_positions: Sequence[float], steering_commands: Sequence[float]) -> None:
+        """Take a sample (see the class)."""
+        def fill() -> None:
+            message = self.message
+            stamp(time, message.header.stamp)
+            message.traction_wheels_position = list(traction_positions)
+            message.traction_wheels_velocity = list(traction_velocities)
+            message.linear_velocity_command = list(traction_commands)
+            message.steer_positions = list(steering_positions)
+            message.steering_angle_command = list(steering_commands)
+        self.take(fill)
+
+
+class AckermannDriveSink(HeldSample):
+    """``ackermann_msgs/msg/AckermannDrive`` from ``sink(time, speed, steering angle)``.
+
+    The tricycle controller's limited command, as upstream fills it: ``speed``
+    is the wheel's (rad/s), ``steering_angle`` in rad.  ackermann_msgs is
+    optional: the sink imports it only when created.
+    """
+
+    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
+        super().__init__(publisher, importlib.import_module('ackermann_msgs.msg').AckermannDrive())
+
+    def __call__(self, time: float, speed: float, steering_angle: float) -> None:
+        """Take a sample (the message has no stamp)."""
+        def fill() -> None:
+            self.message.speed = speed
+            self.message.steering_angle = steering_angle
+        self.take(fill)

@@ -54,7 +54,8 @@ controller is configured. *Not simulated*: accepted, but the simulator does not 
 def example_controller(cls: type[Controller]) -> Controller:
     """Return ``cls`` built from its spec's examples and configured on a four-joint robot.
 
-    Every example names joint1 (a drive's other wheels are joint2 to joint4); the
+    Every example names joint1 (a drive's other wheels are joint2 to joint4; the
+    steering types' second traction and steering joints are joint3 and joint4); the
     robot also has the example sensor and gpio the examples name.
     """
     controller = cls('<name>', cls.parameters.example())

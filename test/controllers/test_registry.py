@@ -1,7 +1,7 @@
 """registry: every YAML type string maps to a controller class that loads and runs.
 
 Each registered type is loaded through the manager with nothing but its
-spec's examples (everything else from the defaults), on a minimal two-joint
+spec's examples (everything else from the defaults), on a minimal four-joint
 robot with the example sensor and gpio; it configures, activates, runs,
 declares its ROS surface, and documents every parameter.
 """
@@ -27,7 +27,10 @@ EXAMPLE_JOINTS = ('joint1', 'joint2', 'joint3', 'joint4')
 
 
 def small_robot():
-    """Return joint1 (every example's joint), joint2 to joint4 (a drive's other wheels)."""
+    """Return joint1 (every example's joint), joint2 to joint4 (a drive's other wheels).
+
+    joint3 and joint4 are also the second traction and steering joints of the steering types.
+    """
     return {name: JointHandle(JointSpec(name, JointKind.REVOLUTE, -1.0, 1.0, effort_limit=10.0,
                                         velocity_limit=2.0)) for name in EXAMPLE_JOINTS}
 
