@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ElementTree
 
-from pan_tilt_sim.model.robot import RobotModel
+from pan_tilt_sim.model.robot import Inertial, RobotModel
 
 INERTIA_FIELDS = ('ixx', 'ixy', 'ixz', 'iyy', 'iyz', 'izz')
 # What a massless link that must still move gets: small enough to change no
@@ -80,12 +80,31 @@ def complete_inertials(root: ElementTree.Element, model: RobotModel) -> tuple[st
     warnings = []
     for joint, links in frozen_joints(model).items():
         child = links[0]
-        _set_inertial(elements[child], MOVABLE_MASS, MOVABLE_INERTIA)
+        mass, inertia, why = MOVABLE_MASS, MOVABLE_INERTIA, 'so that the joint can move'
+        followers = _follower_inertials(model, joint)
+        if followers:
+            # A virtual leader (ros2_control_demos' carlikebot) turns real wheels through the
+            # mimic gears: a 1e-6 kg leader against them leaves the gear solver unable to.
+            mass = max(inertial.mass for inertial in followers)
+            inertia = max(max(inertial.ixx, inertial.iyy, inertial.izz) for inertial in followers)
+            why = 'as its heaviest <mimic> follower, so that it can turn its followers'
+        _set_inertial(elements[child], mass, inertia)
         warnings.append(
             f"joint '{joint}' moves only massless links ({', '.join(links)}): "
-            f"'{child}' gets {MOVABLE_MASS:g} kg and {MOVABLE_INERTIA:g} kg*m^2 so that the "
-            'joint can move (Gazebo would drop it); give the link an <inertial> to silence this')
+            f"'{child}' gets {mass:g} kg and {inertia:g} kg*m^2 {why} (Gazebo would drop "
+            'the joint); give the link an <inertial> to silence this')
     return tuple(warnings)
+
+
+def _follower_inertials(model: RobotModel, leader: str) -> list[Inertial]:
+    """Return the inertials of the child links of the joints that mimic ``leader``."""
+    inertials = []
+    for joint in model.joints:
+        if joint.mimic is not None and joint.mimic.joint == leader:
+            inertial = model.link(joint.child).inertial
+            if inertial is not None and inertial.mass > 0.0:
+                inertials.append(inertial)
+    return inertials
 
 
 def _set_inertial(link: ElementTree.Element, mass: float, inertia: float) -> None:

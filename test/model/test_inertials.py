@@ -61,6 +61,24 @@ def test_a_joint_that_moves_only_massless_links_gets_a_negligible_mass_and_a_war
     assert "'camera' gets 1e-06 kg" in warning
 
 
+def test_a_massless_virtual_leader_weighs_as_its_heaviest_mimic_follower(tmp_path):
+    # ros2_control_demos' carlikebot: a massless virtual wheel the controller turns, real
+    # wheels following it by <mimic>; a 1e-6 kg leader cannot turn them through the gears.
+    body = ARM + ('<link name="virtual_wheel"/>'
+                  '<joint name="virtual_joint" type="continuous"><parent link="upper"/>'
+                  '<child link="virtual_wheel"/></joint>'
+                  f'<link name="wheel_a">{INERTIAL.format(m=0.5)}</link>'
+                  f'<link name="wheel_b">{INERTIAL.format(m=0.3)}</link>'
+                  + ''.join(f'<joint name="{wheel}_joint" type="continuous"><parent link="upper"/>'
+                            f'<child link="{wheel}"/><mimic joint="virtual_joint"/></joint>'
+                            for wheel in ('wheel_a', 'wheel_b')))
+    description = robot(tmp_path, body)
+    assert physics_inertials(description)['virtual_wheel'] == (0.5, 0.1)
+    warning, = description.warnings
+    assert "'virtual_wheel' gets 0.5 kg and 0.1 kg*m^2 as its heaviest <mimic> follower" in (
+        warning)
+
+
 def test_a_massless_subtree_with_mass_zero_written_out_counts_as_massless(tmp_path):
     body = ARM + (f'<link name="pad">{INERTIAL.format(m=0)}</link>'
                   '<joint name="slide" type="prismatic"><parent link="upper"/><child link="pad"/>'
