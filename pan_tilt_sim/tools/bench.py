@@ -44,6 +44,17 @@ than wall time):
 * ``scaling``: serial chains of 2, 8 and 32 revolute joints, each with a
   position controller, at real_time_factor 0 with no subscriber:
   ``steps_per_s`` and ``node_cpu_us_per_step`` (keys are the joint counts).
+* ``scenes``: two scenes with contacts (:mod:`pan_tilt_sim.tools.bench_scenes`),
+  each in two cases that differ in what touches: ``driving_base``
+  (``on_ground``: the rover driving a circle in the room on its wheels and
+  caster, its lidar unwatched; ``base_fixed``: the same with
+  ``fixed_base:=true``, its wheels touching nothing) and ``grasp``
+  (``holding``: the fingers squeezing a box the lift holds up; ``open``: the
+  fingers open, the box on the ground).  Per case, at real_time_factor 0
+  with no subscriber: ``steps_per_s``, ``node_cpu_us_per_step``,
+  ``real_time_multiple`` (sim seconds per wall second), ``contact_points``
+  (PyBullet's per step, the case run in this process) and, for the grasp,
+  ``box_height_m`` (the box's centre, which says whether it is held).
 * ``service_round_trip``: sim_node at real_time_factor 1 (the default) answering
   ``SERVICE_CALLERS`` callers of its simulation_interfaces services
   (``get_entity_state`` and ``get_simulation_state``, half each) from one process
