@@ -30,7 +30,14 @@ As ros2_controllers' (jazzy), parameters by their names there:
   leading slash) when ``tf_frame_prefix_enable``.
 * **Chaining**: it exports ``<name>/linear/velocity`` and
   ``<name>/angular/velocity``; in chained mode the preceding controller
-  writes them and ``~/cmd_vel`` (and its timeout) is not used.
+  writes them and ``~/cmd_vel`` (and its timeout) is not used.  A wheel
+  name ``<controller>/<dof>`` (ros2_control_demos' example 16:
+  ``pid_controller_left_wheel_joint/left_wheel_joint``) is that chainable
+  controller's reference ``<controller>/<dof>/velocity``: the wheel velocity
+  (rad/s) is written there instead of to a joint.  Its feedback is the state
+  that controller exports for ``<dof>``, which for a pid_controller reading
+  its joint is the joint's own state: so ``<dof>`` must be a joint of the
+  robot unless ``open_loop`` needs no feedback.
 
 A ROS 1 (gazebo_ros_control) YAML's controller -- ``left_wheel`` /
 ``right_wheel`` instead of the ``*_names`` -- is read with noetic's names
@@ -213,6 +220,10 @@ class DiffDriveController(CommandController):
         self._publishing = PeriodicSchedule(1.0 / self.params['publish_rate'])
         self._limited_publishing = PeriodicSchedule(
             1.0 / (self.params.get('update_rate') or self.params['publish_rate']))
+        # What each wheel's velocity is written to: its joint, or a reference (chained).
+        self._left_outputs: list[JointHandle | Reference] = []
+        self._right_outputs: list[JointHandle | Reference] = []
+        # Where each wheel's feedback is read (empty in open loop for chained wheels).
         self._left: list[JointHandle] = []
         self._right: list[JointHandle] = []
         self._odometry_sink: OdometrySink | None = None
@@ -273,9 +284,10 @@ class DiffDriveController(CommandController):
         return {wheel: (feedback,) for wheel in self.joint_names}
 
     def actuators(self) -> dict[str, Actuator]:
-        """Return the ideal velocity actuator for every wheel."""
-        return {wheel: Actuator(ActuatorKind.IDEAL_VELOCITY, self.name)
-                for wheel in self.joint_names}
+        """Return the ideal velocity actuator for every wheel that is a joint (not a reference)."""
+        return {output.name: Actuator(ActuatorKind.IDEAL_VELOCITY, self.name)
+                for output in self._left_outputs + self._right_outputs
+                if isinstance(output, JointHandle)}
 
     def reference_interfaces(self) -> Mapping[str, Reference]:
         """Return ``<name>/linear/velocity`` and ``<name>/angular/velocity``."""
@@ -326,13 +338,34 @@ class DiffDriveController(CommandController):
     # --- lifecycle -------------------------------------------------------------------------
 
     def configure(self, joints: Mapping[str, JointHandle]) -> None:
-        """Bind the wheels' handles (an unknown wheel names its parameter), then reset."""
-        self._left = [self.handle(joints, wheel, LEFT) for wheel in self._left_names]
-        self._right = [self.handle(joints, wheel, RIGHT) for wheel in self._right_names]
+        """Bind each wheel's joint or reference and its feedback, then reset.
+
+        An unknown wheel names its parameter and what exists.
+        """
+        sides = []
+        for names, field in ((self._left_names, LEFT), (self._right_names, RIGHT)):
+            outputs = [self.command_target(joints, wheel, VELOCITY, field) for wheel in names]
+            feedback = [self._feedback(joints, wheel, output, field)
+                        for wheel, output in zip(names, outputs, strict=True)]
+            sides.append((outputs, [handle for handle in feedback if handle is not None]))
+        (self._left_outputs, self._left), (self._right_outputs, self._right) = sides
         self.reset()
 
+    def _feedback(self, joints: Mapping[str, JointHandle], wheel: str,
+                  output: JointHandle | Reference, field: str) -> JointHandle | None:
+        """Return the handle a wheel's feedback is read from (None: chained, in open loop)."""
+        if isinstance(output, JointHandle):
+            return output
+        dof = wheel.partition('/')[2]
+        handle = joints.get(dof)
+        if handle is None and not self.params['open_loop']:
+            raise self.error(field, f"'{wheel}' is a reference interface, and '{dof}' is not a "
+                             'joint of the robot whose state could be its feedback: set '
+                             'open_loop to true')
+        return None if self.params['open_loop'] else handle
+
     def reset(self) -> None:
-        """No command, references NaN, odometry at the origin, the wheels asked to stand."""
+        """No command, references NaN, odometry at the origin, wheel joints asked to stand."""
         self._command = None
         self._timed_out = False
         self._time = 0.0
@@ -344,13 +377,24 @@ class DiffDriveController(CommandController):
         self._limited_publishing.reset()
         self._linear_command = self._angular_command = 0.0
         self._odometry.reset(0.0, *self._side_positions())
-        for handle in self._left + self._right:
-            handle.velocity_target = 0.0
+        # The joints are asked to stand; a reference is written only while active (a
+        # configured, inactive controller must not touch an active chained controller's).
+        for output in self._left_outputs + self._right_outputs:
+            if isinstance(output, JointHandle):
+                output.velocity_target = 0.0
 
     def deactivate(self) -> None:
         """Stop the wheels (upstream's halt)."""
-        for handle in self._left + self._right:
-            handle.velocity_target = 0.0
+        self._drive(0.0, 0.0)
+
+    def _drive(self, left: float, right: float) -> None:
+        """Command each side's wheels ``left`` and ``right`` rad/s (joints or references)."""
+        for outputs, velocity in ((self._left_outputs, left), (self._right_outputs, right)):
+            for output in outputs:
+                if isinstance(output, Reference):
+                    output.value = velocity
+                else:
+                    output.velocity_target = velocity
 
     # --- commands --------------------------------------------------------------------------
 
@@ -376,8 +420,10 @@ class DiffDriveController(CommandController):
         return self._problem
 
     def setpoints(self) -> dict[str, float]:
-        """Return each wheel's commanded velocity (rad/s)."""
-        return {handle.name: handle.velocity_target for handle in self._left + self._right}
+        """Return each wheel's commanded velocity (rad/s), by wheel name."""
+        outputs = self._left_outputs + self._right_outputs
+        return {wheel: output.value if isinstance(output, Reference) else output.velocity_target
+                for wheel, output in zip(self.joint_names, outputs, strict=True)}
 
     @property
     def limited_command(self) -> tuple[float, float]:
@@ -410,12 +456,8 @@ class DiffDriveController(CommandController):
         self._update_odometry(linear, angular, time, period)
         self._publish(time)
         separation, left_radius, right_radius = self._geometry()
-        left_velocity = (linear - angular * separation / 2.0) / left_radius
-        right_velocity = (linear + angular * separation / 2.0) / right_radius
-        for handle in self._left:
-            handle.velocity_target = left_velocity
-        for handle in self._right:
-            handle.velocity_target = right_velocity
+        self._drive((linear - angular * separation / 2.0) / left_radius,
+                    (linear + angular * separation / 2.0) / right_radius)
 
     def _update_references(self, time: float) -> None:
         """Write the newest command to the references; zeros once it is stale (braking)."""

@@ -44,6 +44,17 @@ than wall time):
 * ``scaling``: serial chains of 2, 8 and 32 revolute joints, each with a
   position controller, at real_time_factor 0 with no subscriber:
   ``steps_per_s`` and ``node_cpu_us_per_step`` (keys are the joint counts).
+* ``scenes``: two scenes with contacts (:mod:`pan_tilt_sim.tools.bench_scenes`),
+  each in two cases that differ in what touches: ``driving_base``
+  (``on_ground``: the rover driving a circle in the room on its wheels and
+  caster, its lidar unwatched; ``base_fixed``: the same with
+  ``fixed_base:=true``, its wheels touching nothing) and ``grasp``
+  (``holding``: the fingers squeezing a box the lift holds up; ``open``: the
+  fingers open, the box on the ground).  Per case, at real_time_factor 0
+  with no subscriber: ``steps_per_s``, ``node_cpu_us_per_step``,
+  ``real_time_multiple`` (sim seconds per wall second), ``contact_points``
+  (PyBullet's per step, the case run in this process) and, for the grasp,
+  ``box_height_m`` (the box's centre, which says whether it is held).
 * ``service_round_trip``: sim_node at real_time_factor 1 (the default) answering
   ``SERVICE_CALLERS`` callers of its simulation_interfaces services
   (``get_entity_state`` and ``get_simulation_state``, half each) from one process
@@ -108,6 +119,7 @@ from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package
 from pan_tilt_sim.sim.engine import Simulation, make_simulation
 from pan_tilt_sim.sim.physics import Physics
 from pan_tilt_sim.sim.profiling import pybullet_step_cost
+from pan_tilt_sim.tools import bench_scenes
 from pan_tilt_sim.tools.sensor_cost import sensor_costs
 
 DEFAULT_TIME_STEP = 0.001  # s, sim_node's default time_step
@@ -162,12 +174,15 @@ class Plan:
     chain_s: float
     sensor_sim_s: float = 2.0  # sim seconds with every sensor watched
     services_s: float = 5.0  # wall seconds of service calls
+    scene_s: float = 5.0  # wall seconds each case of a contact scene is measured
+    scene_contact_s: float = 1.0  # sim seconds over which a case's contacts are counted
 
 
 FULL_PLAN = Plan(raw_s=3.0, raw_sim_s=RAW_SIM_S, warmup_s=1.0, fast_s=5.0, paced_s=10.0,
                  startup_runs=STARTUP_RUNS, chain_s=3.0)
 QUICK_PLAN = Plan(raw_s=0.3, raw_sim_s=QUICK_RAW_SIM_S, warmup_s=0.2, fast_s=0.6, paced_s=0.6,
-                  startup_runs=1, chain_s=0.4, sensor_sim_s=0.3, services_s=0.5)
+                  startup_runs=1, chain_s=0.4, sensor_sim_s=0.3, services_s=0.5,
+                  scene_s=0.4, scene_contact_s=0.1)
 
 
 class BenchError(RuntimeError):
@@ -184,6 +199,10 @@ class Model:
     # Command topic -> the two position targets it alternates between.
     commands: dict[str, tuple[float, float]]
     robot: str = ''  # the robot's entity name (its URDF name)
+    # sim_node parameters beyond the two files (name -> value as on the command line).
+    parameters: dict[str, str] = dataclasses.field(default_factory=dict)
+    # Topic -> a message sent unchanged every COMMAND_PERIOD_S.
+    messages: dict[str, object] = dataclasses.field(default_factory=dict)
 
 
 def load_model(description_file: pathlib.Path, controllers_file: pathlib.Path) -> Model:
@@ -464,7 +483,8 @@ class NodeProcess(ChildProcess):
     def __init__(self, model: Model, parameters: dict[str, str], env: dict[str, str],
                  log_file: pathlib.Path) -> None:
         arguments = {'robot_description_file': str(model.description_file),
-                     'controllers_file': str(model.controllers_file), **parameters}
+                     'controllers_file': str(model.controllers_file), **model.parameters,
+                     **parameters}
         command = module_command('pan_tilt_sim', '--ros-args')
         for name, value in arguments.items():
             command += ['-p', f'{name}:={value}']
@@ -517,11 +537,15 @@ class Probe:
 
     def command(self, topic: str, value: float) -> None:
         """Publish a position command."""
+        self.publish(topic, Float64(data=value))
+
+    def publish(self, topic: str, message: object) -> None:
+        """Publish ``message`` on ``topic`` (a publisher of its type, made on first use)."""
         publisher = self._publishers.get(topic)
         if publisher is None:
-            publisher = self.node.create_publisher(Float64, topic, QoSProfile(depth=1))
+            publisher = self.node.create_publisher(type(message), topic, QoSProfile(depth=1))
             self._publishers[topic] = publisher
-        publisher.publish(Float64(data=value))
+        publisher.publish(message)
 
 
 class Bench:
@@ -812,11 +836,12 @@ class Bench:
 
 
 class Commander:
-    """Alternates every position controller between its two targets."""
+    """Alternates every position controller between its two targets; resends the messages."""
 
     def __init__(self, probe: Probe, model: Model) -> None:
         self._probe = probe
         self._commands = model.commands
+        self._messages = model.messages
         self._next = time.monotonic()
         self._which = 0
 
@@ -827,6 +852,8 @@ class Commander:
             return
         for topic, targets in self._commands.items():
             self._probe.command(topic, targets[self._which])
+        for topic, message in self._messages.items():
+            self._probe.publish(topic, message)
         self._which = 1 - self._which
         self._next = now + COMMAND_PERIOD_S
 
@@ -868,6 +895,7 @@ def run_once(bench: Bench, model: Model) -> dict:
         bench.log(f'chain of {joints} joints at real_time_factor 0')
         urdf, controllers = chain_files(joints, bench.folder)
         scaling[str(joints)] = bench.fast(load_model(urdf, controllers), plan.chain_s)
+    scenes = scene_figures(bench)
     bench.log('sensors, every topic watched')
     sensors = {name: figures['us_per_message'] for name, figures in sensor_costs(
         sim_seconds=plan.sensor_sim_s, domain_id=bench.domain_id).items()}
@@ -878,10 +906,39 @@ def run_once(bench: Bench, model: Model) -> dict:
         'startup_s': startup,
         'startup_floor_s': startup_floor,
         'scaling': scaling,
+        'scenes': scenes,
         'sensor_us_per_message': sensors,
     }
     if service_round_trip is not None:
         figures['service_round_trip'] = service_round_trip
+    return figures
+
+
+def scene_figures(bench: Bench) -> dict[str, dict[str, dict[str, float]]]:
+    """Measure each case of the contact scenes (:mod:`pan_tilt_sim.tools.bench_scenes`).
+
+    Per case: sim_node's ``steps_per_s`` and ``node_cpu_us_per_step`` at
+    real_time_factor 0 (as :meth:`Bench.fast`, nobody subscribed to anything
+    but the probe's JointState samples), ``real_time_multiple`` (sim seconds
+    per wall second), and, from the same case run in this process,
+    ``contact_points`` per step (and ``box_height_m``, the grasp's box).
+    """
+    scenes = {'driving_base': bench_scenes.driving_base(package_share(), bench.folder),
+              'grasp': bench_scenes.grasp(bench.folder)}
+    figures: dict[str, dict[str, dict[str, float]]] = {}
+    for scene, cases in scenes.items():
+        figures[scene] = {}
+        for case_name, case in cases.items():
+            bench.log(f'{scene.replace("_", " ")}, {case_name.replace("_", " ")}, '
+                      'at real_time_factor 0')
+            model = Model(case.description_file, case.controllers_file,
+                          case.joint_states_topic, {}, parameters=case.parameters,
+                          messages=case.messages)
+            fast = bench.fast(model, bench.plan.scene_s)
+            figures[scene][case_name] = {
+                **fast, 'real_time_multiple': fast['steps_per_s'] * bench.time_step,
+                **bench_scenes.contact_points(case, bench.time_step,
+                                              count_s=bench.plan.scene_contact_s)}
     return figures
 
 

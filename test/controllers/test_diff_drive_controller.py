@@ -14,7 +14,7 @@ import yaml
 from mobile_fixtures import WHEEL_RADIUS, WHEEL_SEPARATION, drive_parameters, write_rover
 
 from pan_tilt_sim.controllers import JointHandle, registry
-from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult
+from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult, Reference
 from pan_tilt_sim.controllers.diff_drive_controller import DiffDriveController
 from pan_tilt_sim.controllers.manager import ControllerManager
 from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError, RateLimiter, RateLimits
@@ -370,3 +370,85 @@ def test_the_limited_twist_leaves_on_cmd_vel_out_at_the_update_rate():
     run(drive, handles, 0.1, command=twist(0.3, 0.2))
     assert len(samples) == 10
     assert samples[-1][1:] == pytest.approx((0.1, 0.2))
+
+
+def pid_chain_file(tmp_path, **drive):
+    """Write example 16's chain for the rover: each wheel a velocity PID's reference."""
+    pids = {side: f'pid_controller_{side}_wheel_joint' for side in ('left', 'right')}
+    document = {'controller_manager': {'ros__parameters': {
+        **{pid: {'type': 'pid_controller/PidController'} for pid in pids.values()},
+        NAME: {'type': 'diff_drive_controller/DiffDriveController'}}}}
+    for side, pid in pids.items():
+        document[pid] = {'ros__parameters': {
+            'dof_names': [f'{side}_wheel_joint'], 'command_interface': 'velocity',
+            'reference_and_state_interfaces': ['velocity'],
+            'gains': {f'{side}_wheel_joint': {'p': 0.5, 'i': 2.5, 'd': 0.0}}}}
+    document[NAME] = {'ros__parameters': drive_parameters(
+        left_wheel_names=[f"{pids['left']}/left_wheel_joint"],
+        right_wheel_names=[f"{pids['right']}/right_wheel_joint"], cmd_vel_timeout=0.0, **drive)}
+    path = tmp_path / 'pid_chain.yaml'
+    path.write_text(yaml.safe_dump(document))
+    return path
+
+
+def pid_chain(tmp_path, **drive):
+    """Return the manager of example 16's chain on the rover's wheels, and their handles."""
+    description_path, _ = write_rover(tmp_path)
+    description = load_description(description_path)
+    handles = {joint.name: JointHandle(joint) for joint in description.actuated_joints}
+    manager = ControllerManager(load_controllers_config(pid_chain_file(tmp_path, **drive)),
+                                handles, description.model)
+    return manager, handles
+
+
+def test_wheels_named_as_pid_references_get_the_wheel_velocities_written_there(tmp_path):
+    manager, handles = pid_chain(tmp_path)
+    drive = manager.controller(NAME)
+    left = manager.controller('pid_controller_left_wheel_joint')
+    assert left.is_chained and not drive.is_chained
+    # The PIDs drive the wheels; the diff drive drives no joint itself.
+    assert set(drive.actuators()) == set()
+    assert drive.set_command(twist(0.2, 0.5)) is CommandResult.ACCEPTED
+    for update in manager.updates:
+        update(0.0, DT)
+    half = WHEEL_SEPARATION / 2
+    assert left.setpoints() == {'left_wheel_joint': pytest.approx((0.2 - 0.5 * half)
+                                                                  / WHEEL_RADIUS)}
+    assert drive.setpoints() == {
+        'pid_controller_left_wheel_joint/left_wheel_joint': pytest.approx(
+            (0.2 - 0.5 * half) / WHEEL_RADIUS),
+        'pid_controller_right_wheel_joint/right_wheel_joint': pytest.approx(
+            (0.2 + 0.5 * half) / WHEEL_RADIUS)}
+    # The PID turned its reference into the wheel's velocity target.
+    assert handles['left_wheel_joint'].velocity_target != 0.0
+
+
+def test_a_chained_wheel_is_fed_back_by_the_joint_its_pid_reads(tmp_path):
+    manager, handles = pid_chain(tmp_path, position_feedback=False, open_loop=False)
+    drive = manager.controller(NAME)
+    for handle in handles.values():
+        handle.velocity = 4.0  # rad/s: 0.2 m/s straight ahead
+    for step in range(1000):
+        drive.update(step * DT, DT)
+    assert drive.odometry.x == pytest.approx(0.2, rel=1e-3)
+
+
+def test_a_chained_wheel_without_a_joint_behind_it_needs_open_loop(tmp_path):
+    description_path, _ = write_rover(tmp_path)
+    drive = DiffDriveController(NAME, drive_parameters(
+        left_wheel_names=['other/left'], right_wheel_names=['other/right'], open_loop=False),
+        'rover.yaml')
+    left, right = Reference('other/left/velocity'), Reference('other/right/velocity')
+    drive.set_available_references({left.name: left, right.name: right})
+    with pytest.raises(ControllerConfigError,
+                       match=rf"{NAME}\.left_wheel_names: 'other/left' is a reference "
+                             "interface.*set open_loop to true"):
+        drive.configure(wheel_handles())
+    drive = DiffDriveController(NAME, drive_parameters(
+        left_wheel_names=['other/left'], right_wheel_names=['other/right'], open_loop=True),
+        'rover.yaml')
+    drive.set_available_references({left.name: left, right.name: right})
+    drive.configure(wheel_handles())
+    drive.set_command(twist(0.1, 0.0))
+    drive.update(0.0, DT)
+    assert left.value == pytest.approx(0.1 / WHEEL_RADIUS) == right.value

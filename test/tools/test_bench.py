@@ -11,8 +11,9 @@ import sys
 import pytest
 import sim_process
 
+from pan_tilt_sim.share import package_share
 from pan_tilt_sim.sim.engine import make_simulation
-from pan_tilt_sim.tools import bench
+from pan_tilt_sim.tools import bench, bench_scenes
 
 QUICK_TIMEOUT_S = 300
 RAW = {'step_us_cpu', 'steps_per_s', 'calls_us_cpu', 'compiled_step', 'wall_steps_per_s'}
@@ -25,6 +26,9 @@ FACTOR_0 = {
     'recording': {'steps_per_s', 'node_cpu_us_per_step', 'ratio_to_raw'},
 }
 SERVICE_ROUND_TRIP = {'p50_ms', 'p99_ms', 'answers_per_s', 'unanswered'}
+SCENES = {'driving_base': {'on_ground', 'base_fixed'}, 'grasp': {'holding', 'open'}}
+SCENE_CASE = {'steps_per_s', 'node_cpu_us_per_step', 'real_time_multiple', 'contact_points'}
+GRASP_CASE = SCENE_CASE | {'box_height_m'}
 FACTOR_1 = {'cpu_percent', 'cpu_percent_with_joint_states', 'cpu_percent_recording',
             'clock_subscriber_cpu_percent',
             'joint_states_p50_ms', 'joint_states_p99_ms', 'rtf_error'}
@@ -55,7 +59,8 @@ def quick_run():
 def test_quick_prints_exactly_one_json_object_with_every_figure(quick_run):
     figures = json.loads(quick_run[0])
     assert set(figures) == {'raw', 'factor_0', 'factor_1', 'startup_s', 'startup_floor_s',
-                            'scaling', 'sensor_us_per_message', 'service_round_trip'}
+                            'scaling', 'scenes', 'sensor_us_per_message',
+                            'service_round_trip'}
     assert set(figures['service_round_trip']) == SERVICE_ROUND_TRIP
     assert set(figures['raw']) == RAW
     assert {case: set(values) for case, values in figures['factor_0'].items()} == FACTOR_0
@@ -84,6 +89,19 @@ def test_quick_reports_the_cost_of_each_sensor_per_message(quick_run):
     costs = json.loads(quick_run[0])['sensor_us_per_message']
     assert set(costs) == {'depth_camera', 'lidar', 'tilt_imu', 'tilt_ft'}
     assert all(isinstance(cost, float) and cost > 0 for cost in costs.values()), costs
+
+
+@pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
+def test_quick_runs_each_contact_scene_in_each_case_and_reports_its_figures(quick_run):
+    scenes = json.loads(quick_run[0])['scenes']
+    assert {scene: set(cases) for scene, cases in scenes.items()} == SCENES
+    for scene, cases in scenes.items():
+        for case, values in cases.items():
+            assert set(values) == (GRASP_CASE if scene == 'grasp' else SCENE_CASE), case
+            assert values['steps_per_s'] > 0, case
+            # The multiple of real time is the step rate in sim seconds (time_step 0.001 s).
+            assert values['real_time_multiple'] == pytest.approx(
+                values['steps_per_s'] * bench.DEFAULT_TIME_STEP, rel=1e-3, abs=1e-3), case
 
 
 @pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
@@ -231,6 +249,47 @@ def test_pan_tilt_model_commands_both_position_controllers(repo_root):
     assert set(model.commands) == {
         '/ex_urdf_pan_tilt/joint1_position_controller/command',
         '/ex_urdf_pan_tilt/joint2_position_controller/command'}
+
+
+def scene_cases(tmp_path):
+    """Return every case of both contact scenes, written into ``tmp_path``."""
+    return {**bench_scenes.driving_base(package_share(), tmp_path),
+            **bench_scenes.grasp(tmp_path)}
+
+
+def test_the_driving_base_touches_the_ground_only_when_its_base_is_free(tmp_path):
+    cases = scene_cases(tmp_path)
+    on_ground = bench_scenes.contact_points(cases['on_ground'], 0.001)
+    base_fixed = bench_scenes.contact_points(cases['base_fixed'], 0.001)
+    # Two wheels and the caster on the ground, beside the room's ball on it; then the ball alone.
+    assert on_ground['contact_points'] >= 4
+    assert base_fixed['contact_points'] == 1
+
+
+def test_the_driving_base_is_the_shipped_rover_driven_by_a_diff_drive_controller(tmp_path):
+    case = scene_cases(tmp_path)['on_ground']
+    urdf = case.description_file.read_text()
+    assert 'libgazebo_ros_diff_drive.so' not in urdf
+    assert '<ros2_control' in urdf and 'name="lidar"' in urdf
+    model = bench.load_model(case.description_file, case.controllers_file)
+    assert model.joint_states_topic == case.joint_states_topic
+    assert case.parameters['world'].endswith('room.yaml')
+    with make_simulation(str(case.description_file), str(case.controllers_file), 0.001,
+                         fixed_base=False) as simulation:
+        drive = simulation.controller(bench_scenes.BASE_CONTROLLER)
+        assert drive.params['wheel_separation'] == pytest.approx(0.3)
+        assert drive.params['wheel_radius'] == pytest.approx(0.05)
+
+
+def test_the_grasp_holds_the_box_up_and_the_open_gripper_leaves_it_on_the_ground(tmp_path):
+    cases = scene_cases(tmp_path)
+    holding = bench_scenes.contact_points(cases['holding'], 0.001)
+    opened = bench_scenes.contact_points(cases['open'], 0.001)
+    half_box = bench_scenes.BOX_SIZE / 2
+    assert holding['box_height_m'] > half_box + 0.9 * bench_scenes.LIFT_M
+    assert opened['box_height_m'] == pytest.approx(half_box, abs=0.002)
+    # Two fingers' faces on the box; the box's face on the ground.
+    assert holding['contact_points'] >= 4 and opened['contact_points'] >= 1
 
 
 def test_fewer_than_one_run_is_a_usage_error():
