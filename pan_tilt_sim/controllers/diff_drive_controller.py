@@ -66,6 +66,7 @@ from pan_tilt_sim.controllers.base import (
     Reference,
 )
 from pan_tilt_sim.controllers.odometry import Odometry
+from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs
 from pan_tilt_sim.controllers.parameter_spec import (
     BOOL,
     DOUBLE,
@@ -140,7 +141,7 @@ def _limit_params(group: str) -> tuple[Param, ...]:
     )
 
 
-class DiffDriveController(CommandController):
+class DiffDriveController(OdometryOutputs, CommandController):
     """Drives a differential base from a twist and publishes its odometry, as ros2_controllers."""
 
     type_names = ('diff_drive_controller/DiffDriveController',)
@@ -322,14 +323,6 @@ class DiffDriveController(CommandController):
             endpoints.append(StateTopic('~/cmd_vel_out', CommandKind.TWIST_STAMPED.value,
                                         self.set_limited_velocity_sink))
         return tuple(endpoints)
-
-    def set_odometry_sink(self, sink: OdometrySink | None) -> None:
-        """Where odometry samples go: ``sink(time, x, y, heading, linear, angular)``."""
-        self._odometry_sink = sink
-
-    def set_tf_sink(self, sink: TfSink | None) -> None:
-        """Where the odom -> base transform goes: ``sink(time, [(parent, child, transform)])``."""
-        self._tf_sink = sink
 
     def set_limited_velocity_sink(self, sink: TwistSink | None) -> None:
         """Where the limited twist goes: ``sink(time, linear, angular)``."""

@@ -43,6 +43,7 @@ from pan_tilt_sim.controllers.base import (
 )
 from pan_tilt_sim.controllers.diff_drive_controller import OdometrySink, TfSink
 from pan_tilt_sim.controllers.odometry import Odometry
+from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs
 from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
 from pan_tilt_sim.model.drive_plugins import ENCODER, DiffDrivePlugin
 from pan_tilt_sim.model.transforms import Transform
@@ -54,7 +55,7 @@ REACHED = 0.01  # m/s: a wheel this close to its speed is set to it directly (th
 BaseState = tuple[tuple[float, float, float], tuple[float, float, float]]
 
 
-class GazeboDiffDrive(CommandController):
+class GazeboDiffDrive(OdometryOutputs, CommandController):
     """One ``gazebo_ros_diff_drive`` plugin: a Twist in, wheel velocities out, odometry back."""
 
     drives_base: ClassVar[bool] = True
@@ -111,14 +112,6 @@ class GazeboDiffDrive(CommandController):
         if plugin.publish_odom_tf:
             endpoints.append(StateTopic('/tf', 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
         return tuple(endpoints)
-
-    def set_odometry_sink(self, sink: OdometrySink | None) -> None:
-        """Where odometry samples go: ``sink(time, x, y, heading, linear, angular)``."""
-        self._odometry_sink = sink
-
-    def set_tf_sink(self, sink: TfSink | None) -> None:
-        """Where the odom -> base transform goes: ``sink(time, [(parent, child, transform)])``."""
-        self._tf_sink = sink
 
     # --- lifecycle -------------------------------------------------------------------------
 

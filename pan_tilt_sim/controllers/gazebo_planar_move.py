@@ -40,6 +40,7 @@ from pan_tilt_sim.controllers.base import (
 )
 from pan_tilt_sim.controllers.diff_drive_controller import TfSink
 from pan_tilt_sim.controllers.gazebo_p3d import SpatialOdometrySink
+from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs
 from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
 from pan_tilt_sim.model.drive_plugins import ROS1, PlanarMovePlugin
 from pan_tilt_sim.model.transforms import Transform, Vector
@@ -56,7 +57,7 @@ def heading(frame: Transform) -> float:
     return math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
 
 
-class GazeboPlanarMove(CommandController):
+class GazeboPlanarMove(OdometryOutputs, CommandController):
     """One ``gazebo_ros_planar_move`` plugin: a Twist sets the base's planar velocity."""
 
     drives_base: ClassVar[bool] = True
@@ -101,14 +102,6 @@ class GazeboPlanarMove(CommandController):
         if plugin.publish_odom_tf:
             endpoints.append(StateTopic('/tf', 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
         return tuple(endpoints)
-
-    def set_odometry_sink(self, sink: SpatialOdometrySink | None) -> None:
-        """Where odometry samples go: ``sink(time, pose, linear, angular)``."""
-        self._odometry_sink = sink
-
-    def set_tf_sink(self, sink: TfSink | None) -> None:
-        """Where the odom -> base transform goes: ``sink(time, [(parent, child, transform)])``."""
-        self._tf_sink = sink
 
     # --- lifecycle -------------------------------------------------------------------------
 

@@ -43,6 +43,7 @@ from pan_tilt_sim.controllers.base import (
 )
 from pan_tilt_sim.controllers.diff_drive_controller import OdometrySink, TfSink
 from pan_tilt_sim.controllers.odometry import Odometry
+from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs
 from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError, RateLimiter, RateLimits
 from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
 from pan_tilt_sim.model.drive_plugins import GzDiffDrivePlugin
@@ -76,7 +77,7 @@ def gz_limiter(limits: tuple[float, ...], name: str, group: str) -> RateLimiter:
         raise ValueError(f"system '{name}': {group} limits: {err}") from None
 
 
-class GzDiffDrive(CommandController):
+class GzDiffDrive(OdometryOutputs, CommandController):
     """One gz-sim DiffDrive system: a Twist in, wheel velocities out, odometry back."""
 
     drives_base: ClassVar[bool] = True
@@ -120,14 +121,6 @@ class GzDiffDrive(CommandController):
                         'pose_covariance_diagonal': (0.0,) * 6,
                         'twist_covariance_diagonal': (0.0,) * 6}),
             StateTopic(plugin.tf_topic, 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
-
-    def set_odometry_sink(self, sink: OdometrySink | None) -> None:
-        """Where odometry samples go: ``sink(time, x, y, heading, linear, angular)``."""
-        self._odometry_sink = sink
-
-    def set_tf_sink(self, sink: TfSink | None) -> None:
-        """Where the odometry transform goes: ``sink(time, [(parent, child, transform)])``."""
-        self._tf_sink = sink
 
     # --- lifecycle -------------------------------------------------------------------------
 

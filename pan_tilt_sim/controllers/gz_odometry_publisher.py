@@ -25,6 +25,7 @@ from pan_tilt_sim.controllers.base import Controller, JointHandle
 from pan_tilt_sim.controllers.diff_drive_controller import TfSink
 from pan_tilt_sim.controllers.gazebo_p3d import SpatialOdometrySink
 from pan_tilt_sim.controllers.gazebo_planar_move import BaseMotion, heading
+from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs
 from pan_tilt_sim.controllers.surface import Endpoint, StateTopic
 from pan_tilt_sim.model.drive_plugins import GzOdometryPlugin
 from pan_tilt_sim.model.transforms import (
@@ -37,7 +38,7 @@ from pan_tilt_sim.model.transforms import (
 from pan_tilt_sim.schedule import DUE_EPSILON
 
 
-class GzOdometryPublisher(Controller):
+class GzOdometryPublisher(OdometryOutputs, Controller):
     """One gz-sim OdometryPublisher system: the model's true pose and twist as odometry."""
 
     def __init__(self, plugin: GzOdometryPlugin, source: str = '', *,
@@ -66,14 +67,6 @@ class GzOdometryPublisher(Controller):
                             'pose_covariance_diagonal': (0.0,) * 6,
                             'twist_covariance_diagonal': (0.0,) * 6, 'spatial': True}),
                 StateTopic(plugin.tf_topic, 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
-
-    def set_odometry_sink(self, sink: SpatialOdometrySink | None) -> None:
-        """Where odometry samples go (None: nobody listens)."""
-        self._odometry_sink = sink
-
-    def set_tf_sink(self, sink: TfSink | None) -> None:
-        """Where the transform goes (None: nobody listens)."""
-        self._tf_sink = sink
 
     def configure(self, joints: Mapping[str, JointHandle]) -> None:
         """Nothing to bind: the system reads the model's pose."""

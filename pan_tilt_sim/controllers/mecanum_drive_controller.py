@@ -63,6 +63,7 @@ from pan_tilt_sim.controllers.base import (
     JointHandle,
     Reference,
 )
+from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs
 from pan_tilt_sim.controllers.parameter_spec import (
     BOOL,
     DOUBLE,
@@ -211,7 +212,7 @@ class MecanumOdometry:
         return True
 
 
-class MecanumDriveController(CommandController):
+class MecanumDriveController(OdometryOutputs, CommandController):
     """Drives a four-wheel mecanum base from a body twist, as ros2_controllers."""
 
     type_names = ('mecanum_drive_controller/MecanumDriveController',)
@@ -357,14 +358,6 @@ class MecanumDriveController(CommandController):
                                     'control_msgs/msg/MecanumDriveControllerState',
                                     self.set_state_sink, {'frame_id': odom}))
         return tuple(endpoints)
-
-    def set_odometry_sink(self, sink: OdometrySink | None) -> None:
-        """Where odometry goes: ``sink(time, pose, (vx, vy, 0), (0, 0, wz))``."""
-        self._odometry_sink = sink
-
-    def set_tf_sink(self, sink: TfSink | None) -> None:
-        """Where the odom -> base transform goes: ``sink(time, [(parent, child, transform)])``."""
-        self._tf_sink = sink
 
     def set_state_sink(self, sink: StateSink | None) -> None:
         """Where the state goes: ``sink(time, wheel velocities, (vx, vy, wz) reference)``."""

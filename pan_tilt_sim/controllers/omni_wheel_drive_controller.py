@@ -60,6 +60,7 @@ from pan_tilt_sim.controllers.mecanum_drive_controller import (
     frame_prefix,
     yaw_transform,
 )
+from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs
 from pan_tilt_sim.controllers.parameter_spec import (
     BOOL,
     DOUBLE,
@@ -169,7 +170,7 @@ class OmniOdometry:
             math.sin(after) - math.sin(before))
 
 
-class OmniWheelDriveController(CommandController):
+class OmniWheelDriveController(OdometryOutputs, CommandController):
     """Drives a base on three or more omni wheels from a twist, as ros2_controllers."""
 
     type_names = ('omni_wheel_drive_controller/OmniWheelDriveController',)
@@ -291,14 +292,6 @@ class OmniWheelDriveController(CommandController):
         if self.params['enable_odom_tf']:
             endpoints.append(StateTopic('/tf', 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
         return tuple(endpoints)
-
-    def set_odometry_sink(self, sink: OdometrySink | None) -> None:
-        """Where odometry goes: ``sink(time, pose, (vx, vy, 0), (0, 0, wz))``."""
-        self._odometry_sink = sink
-
-    def set_tf_sink(self, sink: TfSink | None) -> None:
-        """Where the odom -> base transform goes: ``sink(time, [(parent, child, transform)])``."""
-        self._tf_sink = sink
 
     # --- lifecycle -------------------------------------------------------------------------
 

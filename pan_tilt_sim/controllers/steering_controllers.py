@@ -64,6 +64,7 @@ from pan_tilt_sim.controllers.base import (
     Reference,
 )
 from pan_tilt_sim.controllers.limits import PositionLimits
+from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs
 from pan_tilt_sim.controllers.parameter_spec import (
     BOOL,
     DOUBLE,
@@ -211,7 +212,7 @@ class SteeringJoints:
                 -limit if target < -limit else target)
 
 
-class SteeringController(CommandController):
+class SteeringController(OdometryOutputs, CommandController):
     """A steered base from a twist: steering angles and wheel speeds out, odometry back.
 
     Subclasses give :attr:`configuration` and build the kinematics from their
@@ -340,14 +341,6 @@ class SteeringController(CommandController):
             StateTopic('~/controller_state', STATUS_MESSAGE, self.set_status_sink,
                        {'frame_id': odom}),
         )
-
-    def set_odometry_sink(self, sink: OdometrySink | None) -> None:
-        """Where odometry samples go: ``sink(time, x, y, heading, linear, angular)``."""
-        self._odometry_sink = sink
-
-    def set_tf_sink(self, sink: TfSink | None) -> None:
-        """Where the odom -> base transform goes: ``sink(time, [(parent, child, transform)])``."""
-        self._tf_sink = sink
 
     def set_status_sink(self, sink: StatusSink | None) -> None:
         """Where the controller's status goes (see :data:`StatusSink`)."""

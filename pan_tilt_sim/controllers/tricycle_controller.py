@@ -53,6 +53,7 @@ from pan_tilt_sim.controllers.base import (
     CommandResult,
     JointHandle,
 )
+from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs
 from pan_tilt_sim.controllers.parameter_spec import (
     BOOL,
     DOUBLE,
@@ -189,7 +190,7 @@ def _limit(group: str, name: str, unit: str) -> Param:
                  f'({unit}, a magnitude for both directions); NaN: none.', finite=False)
 
 
-class TricycleController(CommandController):
+class TricycleController(OdometryOutputs, CommandController):
     """Drives a tricycle's steered and driven wheel from a twist; publishes its odometry."""
 
     type_names = ('tricycle_controller/TricycleController',)
@@ -302,14 +303,6 @@ class TricycleController(CommandController):
             endpoints.append(StateTopic('~/cmd_ackermann', ACKERMANN_MESSAGE,
                                         self.set_ackermann_sink))
         return tuple(endpoints)
-
-    def set_odometry_sink(self, sink: OdometrySink | None) -> None:
-        """Where odometry samples go: ``sink(time, x, y, heading, linear, angular)``."""
-        self._odometry_sink = sink
-
-    def set_tf_sink(self, sink: TfSink | None) -> None:
-        """Where the odom -> base transform goes: ``sink(time, [(parent, child, transform)])``."""
-        self._tf_sink = sink
 
     def set_ackermann_sink(self, sink: AckermannSink | None) -> None:
         """Where the limited command goes: ``sink(time, speed, steering angle)``."""
