@@ -195,7 +195,12 @@ def test_without_spawners_the_controllers_are_listed_as_they_run(ur_style):
     chainable = {name for name, base in zip(types.types, types.base_classes, strict=True)
                  if base != 'controller_interface::ControllerInterface'}
     assert chainable == {'pid_controller/PidController',
-                         'diff_drive_controller/DiffDriveController'}
+                         'diff_drive_controller/DiffDriveController',
+                         'ackermann_steering_controller/AckermannSteeringController',
+                         'bicycle_steering_controller/BicycleSteeringController',
+                         'tricycle_steering_controller/TricycleSteeringController',
+                         'mecanum_drive_controller/MecanumDriveController',
+                         'omni_wheel_drive_controller/OmniWheelDriveController'}
 
 
 def test_switching_from_the_trajectory_controller_to_forward_position_and_back(ur_style):
