@@ -77,14 +77,14 @@ from pan_tilt_sim.controllers.parameter_spec import (
     STRING_ARRAY,
     Param,
     ParameterSpec,
-    Validator,
     fixed_size,
     gt,
     gt_eq,
     not_empty,
     unique,
 )
-from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError, RateLimiter, RateLimits
+from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError, RateLimiter
+from pan_tilt_sim.controllers.shared_parameters import velocity_limit_params, velocity_limiter
 from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.model import ros1_diff_drive
@@ -100,45 +100,6 @@ LIMIT_GROUPS = ('linear.x', 'angular.z')
 OdometrySink = Callable[[float, float, float, float, float, float], None]
 TfSink = Callable[[float, list[tuple[str, str, Transform]]], None]
 TwistSink = Callable[[float, float, float], None]
-
-
-def _or_nan(text: str, accept: Callable[[float], bool]) -> Validator:
-    return Validator(f'{text} or NaN (off)', lambda value: None if math.isnan(value) or accept(
-        value) else f'{value!r} must be {text} or NaN (off)')
-
-
-def _limit_params(group: str) -> tuple[Param, ...]:
-    """Return the entries of one limit group (``linear.x`` or ``angular.z``), as jazzy's."""
-    unit = 'm' if group.startswith('linear') else 'rad'
-    positive = _or_nan('>= 0', lambda value: value >= 0.0)
-    negative = _or_nan('<= 0', lambda value: value <= 0.0)
-
-    def limit(name: str, text: str, rule: Validator) -> Param:
-        return Param(f'{group}.{name}', DOUBLE, math.nan, text, (rule,), finite=False)
-
-    return (
-        Param(f'{group}.has_velocity_limits', BOOL, True,
-              'Deprecated: false turns the velocity limits off (set them to NaN instead).'),
-        Param(f'{group}.has_acceleration_limits', BOOL, True,
-              'Deprecated: false turns the acceleration limits off (set them to NaN instead).'),
-        Param(f'{group}.has_jerk_limits', BOOL, True,
-              'Deprecated: false turns the jerk limits off (set them to NaN instead).'),
-        limit('max_velocity', f'Largest velocity ({unit}/s).', positive),
-        limit('min_velocity', f'Smallest velocity ({unit}/s); NaN: -max_velocity.', negative),
-        limit('max_acceleration', f'Largest acceleration in the positive direction '
-              f'({unit}/s^2).', positive),
-        limit('max_deceleration', f'Largest deceleration while moving in the positive direction '
-              f'({unit}/s^2, <= 0); NaN: max_acceleration_reverse.', negative),
-        Param(f'{group}.min_acceleration', DOUBLE, None,
-              'Deprecated upstream, which ignores it: use max_deceleration.', finite=False,
-              simulated=False),
-        limit('max_acceleration_reverse', f'Largest acceleration in the negative direction '
-              f'({unit}/s^2, <= 0); NaN: -max_acceleration.', negative),
-        limit('max_deceleration_reverse', f'Largest deceleration while moving in the negative '
-              f'direction ({unit}/s^2); NaN: max_acceleration.', positive),
-        limit('max_jerk', f'Largest jerk ({unit}/s^3).', positive),
-        limit('min_jerk', f'Smallest jerk ({unit}/s^3); NaN: -max_jerk.', negative),
-    )
 
 
 class DiffDriveController(OdometryOutputs, CommandController):
@@ -189,8 +150,8 @@ class DiffDriveController(OdometryOutputs, CommandController):
               (gt(0.0),)),
         Param('update_rate', DOUBLE, None, "The controller's update rate (Hz): the rate of "
               '~/cmd_vel_out.', (gt(0.0),)),
-        *_limit_params('linear.x'),
-        *_limit_params('angular.z'),
+        *velocity_limit_params('linear.x', deprecated_switches=True),
+        *velocity_limit_params('angular.z', deprecated_switches=True),
     ])
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
@@ -240,21 +201,8 @@ class DiffDriveController(OdometryOutputs, CommandController):
         return ControllerConfigError(ros1_diff_drive.ros1_message(str(err))) if self.ros1 else err
 
     def _limiter(self, group: str) -> RateLimiter:
-        axis, direction = group.split('.')
-        params = self.params[axis][direction]
-
-        def value(name: str, switch: str) -> float:
-            return params[name] if params[f'has_{switch}_limits'] else math.nan
-
         try:
-            return RateLimiter(RateLimits(
-                min_velocity=value('min_velocity', 'velocity'),
-                max_velocity=value('max_velocity', 'velocity'),
-                max_acceleration_reverse=value('max_acceleration_reverse', 'acceleration'),
-                max_acceleration=value('max_acceleration', 'acceleration'),
-                max_deceleration=value('max_deceleration', 'acceleration'),
-                max_deceleration_reverse=value('max_deceleration_reverse', 'acceleration'),
-                min_jerk=value('min_jerk', 'jerk'), max_jerk=value('max_jerk', 'jerk')))
+            return velocity_limiter(self.params, group)
         except InvalidLimitsError as err:
             raise self.error(group, f'invalid limits: {err}') from None
 

@@ -72,13 +72,17 @@ from pan_tilt_sim.controllers.parameter_spec import (
     STRING,
     Param,
     ParameterSpec,
-    Validator,
     fixed_size,
     gt,
     not_empty,
 )
-from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError, RateLimiter, RateLimits
-from pan_tilt_sim.controllers.shared_parameters import UPDATE_RATE, update_period
+from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError
+from pan_tilt_sim.controllers.shared_parameters import (
+    UPDATE_RATE,
+    update_period,
+    velocity_limit_params,
+    velocity_limiter,
+)
 from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
 from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.schedule import DUE_EPSILON, PeriodicSchedule
@@ -99,45 +103,6 @@ MIN_INTERVAL = 1e-4  # s: odometry updates closer together than this are skipped
 OdometrySink = Callable[[float, Transform, Sequence[float], Sequence[float]], None]
 TfSink = Callable[[float, list[tuple[str, str, Transform]]], None]
 StateSink = Callable[[float, Sequence[float], Sequence[float]], None]
-
-
-def _or_nan(text: str, accept: Callable[[float], bool]) -> Validator:
-    return Validator(f'{text} or NaN (off)', lambda value: None if math.isnan(value) or accept(
-        value) else f'{value!r} must be {text} or NaN (off)')
-
-
-def limit_params(group: str) -> tuple[Param, ...]:
-    """Return one group of velocity limits (``linear.x`` ...), as jazzy's drive controllers."""
-    unit = 'm' if group.startswith('linear') else 'rad'
-    positive = _or_nan('>= 0', lambda value: value >= 0.0)
-    negative = _or_nan('<= 0', lambda value: value <= 0.0)
-
-    def limit(name: str, text: str, rule: Validator) -> Param:
-        return Param(f'{group}.{name}', DOUBLE, math.nan, text, (rule,), finite=False)
-
-    return (
-        limit('max_velocity', f'Largest velocity ({unit}/s).', positive),
-        limit('min_velocity', f'Smallest velocity ({unit}/s); NaN: -max_velocity.', negative),
-        limit('max_acceleration', f'Largest acceleration in the positive direction '
-              f'({unit}/s^2).', positive),
-        limit('max_deceleration', f'Largest deceleration while moving in the positive direction '
-              f'({unit}/s^2, <= 0).', negative),
-        limit('max_acceleration_reverse', f'Largest acceleration in the negative direction '
-              f'({unit}/s^2, <= 0); NaN: -max_acceleration.', negative),
-        limit('max_deceleration_reverse', f'Largest deceleration while moving in the negative '
-              f'direction ({unit}/s^2); NaN: max_acceleration.', positive),
-        limit('max_jerk', f'Largest jerk ({unit}/s^3).', positive),
-        limit('min_jerk', f'Smallest jerk ({unit}/s^3); NaN: -max_jerk.', negative),
-    )
-
-
-def limiter(params: Mapping[str, Any], group: str) -> RateLimiter:
-    """Build the limiter of ``group`` from the nested ``params``; InvalidLimitsError if crossed."""
-    axis, direction = group.split('.')
-    values = params[axis][direction]
-    return RateLimiter(RateLimits(**{name: values[name] for name in (
-        'min_velocity', 'max_velocity', 'max_acceleration_reverse', 'max_acceleration',
-        'max_deceleration', 'max_deceleration_reverse', 'min_jerk', 'max_jerk')}))
 
 
 def frame_prefix(params: Mapping[str, Any], namespace: str) -> str:
@@ -250,7 +215,7 @@ class MecanumDriveController(OdometryOutputs, CommandController):
               "Diagonal of the odometry pose's covariance.", (fixed_size(COVARIANCE_SIZE),),
               read_only=True),
         UPDATE_RATE,
-        *(param for group in LIMIT_GROUPS for param in limit_params(group)),
+        *(param for group in LIMIT_GROUPS for param in velocity_limit_params(group)),
     ])
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
@@ -268,7 +233,7 @@ class MecanumDriveController(OdometryOutputs, CommandController):
         limiters = []
         for group in LIMIT_GROUPS:
             try:
-                limiters.append(limiter(params, group))
+                limiters.append(velocity_limiter(params, group))
             except InvalidLimitsError as err:
                 raise self.error(group, f'invalid limits: {err}') from None
         self._limiters = tuple(limiters)

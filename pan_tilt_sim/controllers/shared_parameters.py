@@ -7,7 +7,8 @@ the pan/tilt example's controllers file writes them.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import math
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from pan_tilt_sim.controllers.parameter_spec import (
@@ -17,12 +18,14 @@ from pan_tilt_sim.controllers.parameter_spec import (
     STRING,
     STRING_ARRAY,
     Param,
+    Validator,
     gt,
     gt_eq,
     names,
     not_empty,
     unique,
 )
+from pan_tilt_sim.controllers.rate_limiter import RateLimiter, RateLimits
 from pan_tilt_sim.model.controller_config import DEFAULT_UPDATE_RATE
 
 UPDATE_RATE = Param('update_rate', DOUBLE, None, "Updates per second of sim time; the "
@@ -81,3 +84,66 @@ def update_period(params: Mapping[str, Any]) -> float:
     """
     rate = params.get(UPDATE_RATE.name)
     return 1.0 / float(rate if rate is not None else DEFAULT_UPDATE_RATE)
+
+
+def _or_nan(text: str, accept: Callable[[float], bool]) -> Validator:
+    return Validator(f'{text} or NaN (off)', lambda value: None if math.isnan(value) or accept(
+        value) else f'{value!r} must be {text} or NaN (off)')
+
+
+def velocity_limit_params(group: str, *, deprecated_switches: bool = False) -> tuple[Param, ...]:
+    """Return one group of velocity limits (``linear.x`` ...), as jazzy's drive controllers.
+
+    Every limit is NaN (off) by default; :func:`velocity_limiter` builds the
+    group's limiter.  ``deprecated_switches`` adds diff_drive_controller's
+    ``has_*_limits`` switches and its ignored ``min_acceleration``.
+    """
+    unit = 'm' if group.startswith('linear') else 'rad'
+    positive = _or_nan('>= 0', lambda value: value >= 0.0)
+    negative = _or_nan('<= 0', lambda value: value <= 0.0)
+
+    def limit(name: str, text: str, rule: Validator) -> Param:
+        return Param(f'{group}.{name}', DOUBLE, math.nan, text, (rule,), finite=False)
+
+    switches = tuple(
+        Param(f'{group}.has_{kind}_limits', BOOL, True,
+              f'Deprecated: false turns the {kind} limits off (set them to NaN instead).')
+        for kind in ('velocity', 'acceleration', 'jerk')) if deprecated_switches else ()
+    ignored = (Param(f'{group}.min_acceleration', DOUBLE, None,
+                     'Deprecated upstream, which ignores it: use max_deceleration.',
+                     finite=False, simulated=False),) if deprecated_switches else ()
+    return (
+        *switches,
+        limit('max_velocity', f'Largest velocity ({unit}/s).', positive),
+        limit('min_velocity', f'Smallest velocity ({unit}/s); NaN: -max_velocity.', negative),
+        limit('max_acceleration', f'Largest acceleration in the positive direction '
+              f'({unit}/s^2).', positive),
+        limit('max_deceleration', f'Largest deceleration while moving in the positive direction '
+              f'({unit}/s^2, <= 0); NaN: max_acceleration_reverse.', negative),
+        *ignored,
+        limit('max_acceleration_reverse', f'Largest acceleration in the negative direction '
+              f'({unit}/s^2, <= 0); NaN: -max_acceleration.', negative),
+        limit('max_deceleration_reverse', f'Largest deceleration while moving in the negative '
+              f'direction ({unit}/s^2); NaN: max_acceleration.', positive),
+        limit('max_jerk', f'Largest jerk ({unit}/s^3).', positive),
+        limit('min_jerk', f'Smallest jerk ({unit}/s^3); NaN: -max_jerk.', negative),
+    )
+
+
+# Which has_*_limits switch turns each limit off (see velocity_limit_params).
+_SWITCHES = {'min_velocity': 'velocity', 'max_velocity': 'velocity',
+             'max_acceleration_reverse': 'acceleration', 'max_acceleration': 'acceleration',
+             'max_deceleration': 'acceleration', 'max_deceleration_reverse': 'acceleration',
+             'min_jerk': 'jerk', 'max_jerk': 'jerk'}
+
+
+def velocity_limiter(params: Mapping[str, Any], group: str) -> RateLimiter:
+    """Build the limiter of ``group`` from the nested ``params``; InvalidLimitsError if crossed.
+
+    A limit whose ``has_*_limits`` switch is present and false is off (NaN).
+    """
+    axis, direction = group.split('.')
+    values = params[axis][direction]
+    return RateLimiter(RateLimits(**{
+        name: values[name] if values.get(f'has_{switch}_limits', True) else math.nan
+        for name, switch in _SWITCHES.items()}))
