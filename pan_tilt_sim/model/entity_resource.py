@@ -18,13 +18,16 @@ which of the standard's result codes it is:
   it: the service answers ``RESULT_OPERATION_FAILED``).
 
 **Limits.**  What one object may be is bounded, so that reading, trying and
-loading it take about a second at most and the world keeps stepping at a
-usable rate afterwards (docs/simulator-control.md gives the measurements):
+loading it take well under a second and the world keeps stepping at a usable
+rate afterwards (docs/simulator-control.md gives the measurements):
 :data:`MAX_ENTITY_BYTES` of URDF text (a file's size is checked before it is
 read, xacro's output after it is made), :data:`MAX_ENTITY_LINKS` links and
-:data:`MAX_ENTITY_MOVABLE_JOINTS` movable joints, counted right after the XML
-is parsed, before anything else looks at it.  PyBullet's cost per step grows
-faster than linearly with a body's movable joints, so they have the tighter bound.
+:data:`MAX_ENTITY_JOINTS` joints, counted right after the XML is parsed,
+before anything else looks at it.  The links and joints are PyBullet's own
+bound: it loads a body of more, but cannot report its state (every
+``getBasePositionAndOrientation``, ``getJointStates`` and ``getLinkState``
+of a body past 127 joints fails), and a body's cost per step grows faster
+than linearly with its joints.
 
 Nothing here touches a simulation, so a refused resource leaves it as it was.
 """
@@ -53,9 +56,8 @@ FORMAT = 'urdf'  # the standard's lower-case name of the one format spawned
 STRING_SOURCE = pathlib.Path('<resource_string>')
 TRUE_TEXTS = ('true', '1')
 MAX_ENTITY_BYTES = 1 << 20  # 1 MiB of URDF text (UTF-8)
-MAX_ENTITY_LINKS = 1000
-MAX_ENTITY_MOVABLE_JOINTS = 200
-MOVABLE_JOINT_TYPES = ('revolute', 'continuous', 'prismatic', 'planar', 'floating')
+MAX_ENTITY_JOINTS = 127  # PyBullet 3.2.7 reports no state of a body with more
+MAX_ENTITY_LINKS = MAX_ENTITY_JOINTS + 1  # a tree of that many joints
 
 
 @dataclasses.dataclass(frozen=True)
@@ -64,7 +66,7 @@ class EntityLimits:
 
     max_bytes: int = MAX_ENTITY_BYTES
     max_links: int = MAX_ENTITY_LINKS
-    max_movable_joints: int = MAX_ENTITY_MOVABLE_JOINTS
+    max_joints: int = MAX_ENTITY_JOINTS
 
 
 DEFAULT_LIMITS = EntityLimits()
@@ -147,22 +149,16 @@ def _check_bytes(size: int, source: pathlib.Path, limits: EntityLimits) -> None:
 
 
 def _check_size(root: ElementTree.Element, source: pathlib.Path, limits: EntityLimits) -> None:
-    """Refuse more links or movable joints than ``limits`` allow, before anything reads them."""
-    links = len(root.findall('link'))
-    if links > limits.max_links:
-        raise EntityResourceError(
-            ResourceProblem.TOO_LARGE,
-            f'{source}: {links} links: an object to spawn may have at most {limits.max_links} '
-            '(loading and stepping more would hold the simulation up; see '
-            'docs/simulator-control.md)')
-    movable = sum(1 for joint in root.findall('joint')
-                  if joint.get('type') in MOVABLE_JOINT_TYPES)
-    if movable > limits.max_movable_joints:
-        raise EntityResourceError(
-            ResourceProblem.TOO_LARGE,
-            f'{source}: {movable} movable joints: an object to spawn may have at most '
-            f"{limits.max_movable_joints} (PyBullet's cost per step grows faster than "
-            'linearly with them; see docs/simulator-control.md)')
+    """Refuse more links or joints than ``limits`` allow, before anything reads them."""
+    for kind, most in (('link', limits.max_links), ('joint', limits.max_joints)):
+        count = len(root.findall(kind))
+        if count > most:
+            raise EntityResourceError(
+                ResourceProblem.TOO_LARGE,
+                f'{source}: {count} {kind}s: an object to spawn may have at most {most} '
+                f'(PyBullet cannot report the state of a body of more than '
+                f'{MAX_ENTITY_JOINTS} joints, and its cost per step grows faster than '
+                'linearly with them; see docs/simulator-control.md)')
 
 
 def _describe(text: str, source: pathlib.Path, base: pathlib.Path,

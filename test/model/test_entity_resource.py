@@ -7,8 +7,8 @@ from entity_fixtures import box_urdf, chain_urdf, write_box
 
 from pan_tilt_sim.model.entity_resource import (
     MAX_ENTITY_BYTES,
+    MAX_ENTITY_JOINTS,
     MAX_ENTITY_LINKS,
-    MAX_ENTITY_MOVABLE_JOINTS,
     EntityLimits,
     EntityResourceError,
     ResourceProblem,
@@ -104,20 +104,14 @@ def _refusal(**kwargs) -> str:
 
 
 def test_an_object_at_the_limits_is_read():
-    at_limit = read_entity_resource(resource_string=chain_urdf(MAX_ENTITY_MOVABLE_JOINTS))
-    assert len(at_limit.model.actuated_joints) == MAX_ENTITY_MOVABLE_JOINTS
-    fixed = read_entity_resource(resource_string=chain_urdf(MAX_ENTITY_LINKS - 1, 'fixed'))
-    assert len(fixed.model.links) == MAX_ENTITY_LINKS
+    at_limit = read_entity_resource(resource_string=chain_urdf(MAX_ENTITY_JOINTS))
+    assert len(at_limit.model.actuated_joints) == MAX_ENTITY_JOINTS
+    assert len(at_limit.model.links) == MAX_ENTITY_LINKS
 
 
-def test_one_movable_joint_past_the_limit_is_refused_naming_it():
-    message = _refusal(resource_string=chain_urdf(MAX_ENTITY_MOVABLE_JOINTS + 1))
-    assert f'{MAX_ENTITY_MOVABLE_JOINTS + 1} movable joints' in message
-    assert f'at most {MAX_ENTITY_MOVABLE_JOINTS}' in message
-
-
-def test_one_link_past_the_limit_is_refused_naming_it():
-    message = _refusal(resource_string=chain_urdf(MAX_ENTITY_LINKS, 'fixed'))
+@pytest.mark.parametrize('joint_type', ['revolute', 'fixed'])
+def test_one_link_past_the_limit_is_refused_naming_it(joint_type):
+    message = _refusal(resource_string=chain_urdf(MAX_ENTITY_LINKS, joint_type))
     assert f'{MAX_ENTITY_LINKS + 1} links' in message
     assert f'at most {MAX_ENTITY_LINKS}' in message
 
@@ -133,7 +127,10 @@ def test_text_past_the_byte_limit_is_refused_before_it_is_parsed(tmp_path):
 
 
 def test_the_limits_can_be_given():
-    small = EntityLimits(max_bytes=10_000, max_links=3, max_movable_joints=1)
-    assert read_entity_resource(resource_string=chain_urdf(1), limits=small).name == 'chain'
-    assert 'at most 1 (' in _refusal(resource_string=chain_urdf(2, 'revolute'), limits=small)
+    small = EntityLimits(max_bytes=10_000, max_links=3, max_joints=2)
+    assert read_entity_resource(resource_string=chain_urdf(2), limits=small).name == 'chain'
     assert '4 links' in _refusal(resource_string=chain_urdf(3, 'fixed'), limits=small)
+    joints = EntityLimits(max_links=10, max_joints=1)
+    assert '2 joints: an object to spawn may have at most 1' in _refusal(
+        resource_string=chain_urdf(2), limits=joints)
+    assert 'at most 10000 bytes' in _refusal(resource_string=chain_urdf(30), limits=small)

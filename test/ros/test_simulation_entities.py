@@ -17,7 +17,7 @@ from node_harness import PROBE_QUEUE, sim_node, stamp_s
 from rosgraph_msgs.msg import Clock
 from sim_interfaces_client import OK, Result, SimInterfaces, msg, pose, position, srv
 
-from pan_tilt_sim.model.entity_resource import MAX_ENTITY_MOVABLE_JOINTS
+from pan_tilt_sim.model.entity_resource import MAX_ENTITY_LINKS
 from pan_tilt_sim.sim import entities as entities_module
 from pan_tilt_sim.sim.bullet import pybullet
 
@@ -495,6 +495,14 @@ HELD_S = 20.0  # the longest a test holds a spawn's preparation
 CLOCK_ADVANCE_S = 0.05  # sim time /clock must gain while a spawn is being prepared
 
 
+def test_a_chain_at_the_limit_is_spawned_and_its_state_reported(sim):
+    assert sim.spawn('chain', resource_string=chain_urdf(MAX_ENTITY_LINKS - 1),
+                     at=pose(1.0, 1.0, 0.5)).result.result == OK
+    assert sim.step(10).result == OK
+    assert position(sim.entity_state('chain'))[0] == pytest.approx(1.0, abs=0.1)
+    assert len(sim.sim.node.features.entities.joint_positions('chain')) == MAX_ENTITY_LINKS - 1
+
+
 def test_clock_keeps_ticking_while_a_spawn_is_read_and_then_the_answer_comes(monkeypatch):
     # The preparation (reading, checking, trying the object) is held until the test has
     # seen /clock advance: it runs off the executor's thread, or the node would stand still.
@@ -529,12 +537,12 @@ def test_clock_keeps_ticking_while_a_spawn_is_read_and_then_the_answer_comes(mon
         assert len(joints) == 20
 
 
-def test_a_chain_one_joint_past_the_limit_is_refused_and_the_simulation_runs_on(sim):
+def test_a_chain_one_link_past_the_limit_is_refused_and_the_simulation_runs_on(sim):
     bodies, entities = _bodies(sim), sim.entities()
-    refused = sim.spawn('chain', resource_string=chain_urdf(MAX_ENTITY_MOVABLE_JOINTS + 1))
+    refused = sim.spawn('chain', resource_string=chain_urdf(MAX_ENTITY_LINKS))
     assert refused.result.result == Result.RESULT_OPERATION_FAILED
     message = refused.result.error_message
-    assert f'at most {MAX_ENTITY_MOVABLE_JOINTS}' in message and '\n' not in message
+    assert f'at most {MAX_ENTITY_LINKS}' in message and '\n' not in message
     assert refused.entity_name == ''
     assert (_bodies(sim), sim.entities()) == (bodies, entities)
     steps = sim.sim.simulation.steps
