@@ -16,8 +16,8 @@ CPU seconds of this process (its only thread does the work):
   world's own).  Past :data:`STEPPED_LINKS` links a step takes seconds, so
   only ``first_step_s`` (one step, alone, in its own client) is given, up to
   :data:`FIRST_STEP_LINKS`.
-* ``world``: world files of 1,000 and 10,000 static boxes (the issue's
-  kind: 0.2 m boxes on a 0.5 m grid, clear of the robot), keyed by count: ``read_s`` (reading
+* ``world``: world files of 1,000 and 10,000 static boxes (0.2 m boxes on a
+  0.5 m grid, clear of the robot), keyed by count: ``read_s`` (reading
   the YAML file), ``spawn_s`` (spawning every object), ``startup_ms_per_entity``
   (both, per object) and ``step_us`` / ``step_us_per_entity`` (physics per
   step with them, less the world's own).  The limit on world files is lifted
