@@ -36,7 +36,7 @@ import tempfile
 import time
 from collections.abc import Callable, Sequence
 
-from pan_tilt_sim.engine import make_simulation
+from pan_tilt_sim.sim.engine import make_simulation
 from pan_tilt_sim.model.entity_resource import EntityLimits, read_entity_resource
 from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.model.world_file import read_world_file
