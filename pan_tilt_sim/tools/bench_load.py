@@ -36,12 +36,12 @@ import tempfile
 import time
 from collections.abc import Callable, Sequence
 
-from pan_tilt_sim.sim.engine import make_simulation
 from pan_tilt_sim.model.entity_resource import EntityLimits, read_entity_resource
 from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.model.world_file import read_world_file
 from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
 from pan_tilt_sim.sim.bullet import pybullet, quiet_native_output
+from pan_tilt_sim.sim.engine import make_simulation
 from pan_tilt_sim.sim.entities import Entities, spawn_world_objects
 from pan_tilt_sim.sim.stability import ObjectTrials
 
