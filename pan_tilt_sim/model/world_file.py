@@ -30,7 +30,7 @@ it, robots touch it.
 A world file lists at most :data:`MAX_WORLD_ENTITIES` objects, each within
 the limits of one spawned object
 (:class:`~pan_tilt_sim.model.entity_resource.EntityLimits`): start-up takes
-about a millisecond per object and every object costs each physics step
+under 2 ms per object and every object costs each physics step
 something (docs/simulator-control.md gives the measurements).
 
 Every problem ends start-up with one line naming the file and the field

@@ -10,7 +10,7 @@ with a :class:`~pan_tilt_sim.errors.DescriptionError` naming the joint and
 the likely cause: the number of the description farthest from 1 in
 magnitude, where overflow and underflow come from.  An object to spawn gets
 the same trial, alone in a PyBullet client of its own, before it enters the
-world (:func:`object_trial`).
+world (:class:`ObjectTrials`).
 
 **The gains.**
 
@@ -69,19 +69,6 @@ def check_startup_stability(physics: Physics, description: RobotDescription) -> 
         f"{description.source}: joint '{joint}' has a non-finite position or velocity after "
         f'{_steps(steps)} with no effort applied: PyBullet cannot integrate this '
         f'robot{_likely(cause)}')
-
-
-def object_trial(path: pathlib.Path, fixed: bool, time_step: float,
-                 model: RobotModel) -> str:
-    """Try the object in URDF file ``path`` alone: say what went non-finite, '' if nothing did.
-
-    One trial in a client of its own (:class:`ObjectTrials` runs many in one).
-    """
-    trials = ObjectTrials(time_step)
-    try:
-        return trials.run(path, fixed, model)
-    finally:
-        trials.close()
 
 
 class ObjectTrials:
