@@ -117,3 +117,17 @@ def flail_urdf(reach: float) -> str:
     flail = (f'<link name="flail"><inertial><origin xyz="0 0 {reach!r}"/><mass value="1"/>'
              '<inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>')
     return _thing(_part('handle'), flail, _hinge('hinge', 'handle', 'flail'))
+
+
+def chain_urdf(joints: int, joint_type: str = 'revolute', name: str = 'chain') -> str:
+    """Return a serial chain of ``joints`` joints (``joints + 1`` links of 0.1 kg, 0.1 m long)."""
+    links = [f'<link name="{name}_{index}"><inertial><mass value="0.1"/>'
+             '<inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial>'
+             '<collision><origin xyz="0 0 0.05"/><geometry><box size="0.02 0.02 0.1"/>'
+             '</geometry></collision></link>' for index in range(joints + 1)]
+    limit = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+    chain = [f'<joint name="{name}_joint_{index}" type="{joint_type}">'
+             f'<parent link="{name}_{index}"/><child link="{name}_{index + 1}"/>'
+             f'<origin xyz="0 0 0.1"/><axis xyz="0 1 0"/>{limit}</joint>'
+             for index in range(joints)]
+    return f'<robot name="{name}">\n' + '\n'.join(links + chain) + '\n</robot>\n'

@@ -132,6 +132,12 @@ class SimInterfaces:
             initial_pose=at or pose(), allow_renaming=allow_renaming,
             entity_namespace=namespace))
 
+    def spawn_async(self, name: str = '', *, resource_string: str = '',
+                    at: PoseStamped | None = None) -> Any:
+        """Send a spawn request (its client warmed up); return its future, not waiting."""
+        return self._client('spawn_entity').call_async(srv.SpawnEntity.Request(
+            name=name, resource_string=resource_string, initial_pose=at or pose()))
+
     def entities(self, **filters: Any) -> list[str]:
         """Return the entity names GetEntities gives for ``filters`` (EntityFilters fields)."""
         response = self.call('get_entities', srv.GetEntities.Request(

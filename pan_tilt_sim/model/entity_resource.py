@@ -13,13 +13,28 @@ which of the standard's result codes it is:
 * ``UNSUPPORTED_FORMAT``: not URDF (an ``.sdf``/``.usd`` file, an ``<sdf>`` root);
 * ``PARSE_ERROR``: not well-formed XML, or a URDF the parser refuses;
 * ``MISSING_ASSETS``: a mesh it names does not exist;
-* ``UNSUPPORTED_ASSETS``: a mesh PyBullet cannot be given (unknown format, garbage).
+* ``UNSUPPORTED_ASSETS``: a mesh PyBullet cannot be given (unknown format, garbage);
+* ``TOO_LARGE``: beyond the :class:`EntityLimits` (the standard has no code of its own for
+  it: the service answers ``RESULT_OPERATION_FAILED``).
+
+**Limits.**  What one object may be is bounded, so that reading, trying and
+loading it take well under a second and the world keeps stepping at a usable
+rate afterwards (docs/simulator-control.md gives the measurements):
+:data:`MAX_ENTITY_BYTES` of URDF text (a file's size is checked before it is
+read, xacro's output after it is made), :data:`MAX_ENTITY_LINKS` links and
+:data:`MAX_ENTITY_JOINTS` joints, counted right after the XML is parsed,
+before anything else looks at it.  The links and joints are PyBullet's own
+bound: it loads a body of more, but cannot report its state (every
+``getBasePositionAndOrientation``, ``getJointStates`` and ``getLinkState``
+of a body past 127 joints fails), and a body's cost per step grows faster
+than linearly with its joints.
 
 Nothing here touches a simulation, so a refused resource leaves it as it was.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 import os
 import pathlib
@@ -40,6 +55,21 @@ SUPPORTED_SUFFIXES = (URDF_SUFFIX, XACRO_SUFFIX)
 FORMAT = 'urdf'  # the standard's lower-case name of the one format spawned
 STRING_SOURCE = pathlib.Path('<resource_string>')
 TRUE_TEXTS = ('true', '1')
+MAX_ENTITY_BYTES = 1 << 20  # 1 MiB of URDF text (UTF-8)
+MAX_ENTITY_JOINTS = 127  # PyBullet 3.2.7 reports no state of a body with more
+MAX_ENTITY_LINKS = MAX_ENTITY_JOINTS + 1  # a tree of that many joints
+
+
+@dataclasses.dataclass(frozen=True)
+class EntityLimits:
+    """The most one object to spawn may be (see the module docstring)."""
+
+    max_bytes: int = MAX_ENTITY_BYTES
+    max_links: int = MAX_ENTITY_LINKS
+    max_joints: int = MAX_ENTITY_JOINTS
+
+
+DEFAULT_LIMITS = EntityLimits()
 
 
 class ResourceProblem(enum.Enum):
@@ -50,6 +80,7 @@ class ResourceProblem(enum.Enum):
     PARSE_ERROR = 'parse error'
     MISSING_ASSETS = 'missing assets'
     UNSUPPORTED_ASSETS = 'unsupported assets'
+    TOO_LARGE = 'too large'
 
 
 class EntityResourceError(DescriptionError):
@@ -61,12 +92,14 @@ class EntityResourceError(DescriptionError):
 
 
 def read_entity_resource(uri: str = '', resource_string: str = '', *,
-                         base_dir: pathlib.Path | None = None) -> RobotDescription:
+                         base_dir: pathlib.Path | None = None,
+                         limits: EntityLimits = DEFAULT_LIMITS) -> RobotDescription:
     """Read the URDF that ``uri`` names, else ``resource_string``; raise EntityResourceError.
 
     ``uri`` wins when both are given (as the standard says).  Relative paths,
     in the URI and in the URDF's meshes, are taken from ``base_dir`` (default:
     the current folder) -- for a URI's meshes, from the file's own folder.
+    Anything beyond ``limits`` is refused (``TOO_LARGE``) before it is read further.
     """
     base = pathlib.Path.cwd() if base_dir is None else base_dir
     if uri:
@@ -79,14 +112,17 @@ def read_entity_resource(uri: str = '', resource_string: str = '', *,
         if not path.is_file():
             raise EntityResourceError(ResourceProblem.NOT_FOUND,
                                       f"'{uri}': no such file ({path})")
+        _check_bytes(path.stat().st_size, path, limits)
         try:
             text, _warnings = read_description_xml(path)
         except DescriptionError as err:
             raise EntityResourceError(ResourceProblem.PARSE_ERROR, str(err)) from None
-        return _describe(text, path, path.parent)
+        _check_bytes(len(text.encode('utf-8')), path, limits)  # xacro's output
+        return _describe(text, path, path.parent, limits)
     if not resource_string.strip():
         raise EntityResourceError(ResourceProblem.NOT_FOUND, 'neither uri nor resource_string')
-    return _describe(resource_string, STRING_SOURCE, base)
+    _check_bytes(len(resource_string.encode('utf-8')), STRING_SOURCE, limits)
+    return _describe(resource_string, STRING_SOURCE, base, limits)
 
 
 def is_static(description: RobotDescription) -> bool:
@@ -103,7 +139,30 @@ def _resolve(uri: str, base: pathlib.Path) -> pathlib.Path:
         raise EntityResourceError(ResourceProblem.NOT_FOUND, str(err)) from None
 
 
-def _describe(text: str, source: pathlib.Path, base: pathlib.Path) -> RobotDescription:
+def _check_bytes(size: int, source: pathlib.Path, limits: EntityLimits) -> None:
+    if size > limits.max_bytes:
+        raise EntityResourceError(
+            ResourceProblem.TOO_LARGE,
+            f'{source}: {size} bytes of URDF: an object to spawn may have at most '
+            f'{limits.max_bytes} bytes (reading it would hold the simulation up; see '
+            'docs/simulator-control.md)')
+
+
+def _check_size(root: ElementTree.Element, source: pathlib.Path, limits: EntityLimits) -> None:
+    """Refuse more links or joints than ``limits`` allow, before anything reads them."""
+    for kind, most in (('link', limits.max_links), ('joint', limits.max_joints)):
+        count = len(root.findall(kind))
+        if count > most:
+            raise EntityResourceError(
+                ResourceProblem.TOO_LARGE,
+                f'{source}: {count} {kind}s: an object to spawn may have at most {most} '
+                f'(PyBullet cannot report the state of a body of more than '
+                f'{MAX_ENTITY_JOINTS} joints, and its cost per step grows faster than '
+                'linearly with them; see docs/simulator-control.md)')
+
+
+def _describe(text: str, source: pathlib.Path, base: pathlib.Path,
+              limits: EntityLimits = DEFAULT_LIMITS) -> RobotDescription:
     try:
         root = ElementTree.fromstring(text)
     except ElementTree.ParseError:
@@ -113,6 +172,8 @@ def _describe(text: str, source: pathlib.Path, base: pathlib.Path) -> RobotDescr
             ResourceProblem.UNSUPPORTED_FORMAT,
             f'{source}: only URDF can be spawned: the root element is <{root.tag}>, '
             f'expected <{URDF_ROOT_TAG}>')
+    if root is not None:
+        _check_size(root, source, limits)
     try:
         root = parse_xml(text, source)
         model = read_model(root, source)

@@ -27,6 +27,12 @@ A shape becomes a one-link URDF (:func:`shape_urdf`), its collision and
 visual the same shape, a cylinder's axis along z; cameras and lidars see
 it, robots touch it.
 
+A world file lists at most :data:`MAX_WORLD_ENTITIES` objects, each within
+the limits of one spawned object
+(:class:`~pan_tilt_sim.model.entity_resource.EntityLimits`): start-up takes
+under 2 ms per object and every object costs each physics step
+something (docs/simulator-control.md gives the measurements).
+
 Every problem ends start-up with one line naming the file and the field
 (:class:`WorldFileError`), or the parameter when its value names nothing
 (:class:`~pan_tilt_sim.errors.ParameterError`).  Reading the objects' URDFs is the entity
@@ -66,6 +72,7 @@ DEFAULT_COLOUR = (0.7, 0.7, 0.7, 1.0)
 DEFAULT_SHAPE_MASS = 1.0  # kg, for a shape that is not static
 POSE_KEYS = ('position', 'orientation', 'rpy')
 NORM_TOLERANCE = 1e-6  # a quaternion whose norm is this close to 0 is no rotation
+MAX_WORLD_ENTITIES = 1000  # objects in one world file
 
 
 class WorldFileError(ConfigurationError):
@@ -117,8 +124,8 @@ def world_from_parameter(value: str) -> World:
     return read_world_file(path)
 
 
-def read_world_file(path: pathlib.Path) -> World:
-    """Read and check a YAML world file."""
+def read_world_file(path: pathlib.Path, max_entities: int = MAX_WORLD_ENTITIES) -> World:
+    """Read and check a YAML world file of at most ``max_entities`` objects."""
     try:
         document = yaml_input.load_file(path)
     except yaml_input.YamlInputError as err:
@@ -133,12 +140,19 @@ def read_world_file(path: pathlib.Path) -> World:
     entries = document.get('entities') or []
     if not isinstance(entries, list):
         raise WorldFileError(f'{path}: entities: must be a list, got {_kind(entries)}')
+    if len(entries) > max_entities:
+        raise WorldFileError(
+            f'{path}: entities: {len(entries)} objects; a world file may list at most '
+            f'{max_entities} (start-up and every physics step grow with them; see '
+            'docs/simulator-control.md)')
     entities = tuple(_entity(entry, path, f'entities[{index}]')
                      for index, entry in enumerate(entries))
-    names = [entity.name for entity in entities if entity.name]
-    for name in names:
-        if names.count(name) > 1:
-            raise WorldFileError(f"{path}: entities: the name '{name}' is used twice")
+    seen: set[str] = set()
+    for entity in entities:
+        if entity.name in seen:
+            raise WorldFileError(f"{path}: entities: the name '{entity.name}' is used twice")
+        if entity.name:
+            seen.add(entity.name)
     return World(scenery, entities, path)
 
 

@@ -12,16 +12,25 @@ ResetSimulation's scope bits TIME, STATE and SPAWNED are served, others are
 FEATURE_UNSUPPORTED.  Entities (:mod:`pan_tilt_sim.sim.entities`) are the robot, the
 targets and URDF objects, their states in the world frame stamped with sim time.  Every
 answer fills ``result`` and says why in ``error_message``; a refused request changes
-nothing.  The services act between batches of physics steps.  docs/simulator-control.md
-is the user's reference.
+nothing.  The services act between batches of physics steps.  A spawn's slow part --
+reading, checking and trying the object (:meth:`Entities.prepare
+<pan_tilt_sim.sim.entities.Entities.prepare>`) -- runs in a thread of its own
+(:class:`Preparations`), one object at a time, while /clock, the topics and the other
+services go on; PyBullet's load follows in the executor's turn, between two batches of
+steps.  An object beyond the limits of :mod:`pan_tilt_sim.model.entity_resource` is
+refused with RESULT_OPERATION_FAILED and one line saying which limit.
+docs/simulator-control.md is the user's reference.
 """
 
 from __future__ import annotations
 
+import collections
 import importlib
 import math
 import pathlib
+import queue
 import re
+import threading
 import types
 import xml.etree.ElementTree as ElementTree
 from collections.abc import Callable, Iterable
@@ -31,6 +40,7 @@ from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from rclpy.service import Service
+from rclpy.task import Future
 
 from pan_tilt_sim.errors import DescriptionError, ParameterError
 from pan_tilt_sim.model import naming
@@ -47,6 +57,7 @@ from pan_tilt_sim.sim.entities import (
     EntityState,
     EntityStateError,
     NotDeletableError,
+    PreparedObject,
     SpawnError,
     SpawnProblem,
     check_twist,
@@ -69,12 +80,61 @@ SCOPE_BITS = 0b111  # TIME | STATE | SPAWNED
 # cancel it.  Longer runs are SimulateSteps goals, which report progress and cancel.
 MAX_STEP_SIMULATION_STEPS = 100_000
 
+AWAITING_SERVICES = ('step_simulation', 'spawn_entity', 'spawn_entities')
 SERVICES = ('get_simulator_features', 'get_simulation_state', 'set_simulation_state',
             'step_simulation', 'reset_simulation', 'get_entities', 'get_entities_states',
             'get_entity_state', 'set_entity_state', 'get_entity_info', 'set_entity_info',
             'get_entity_bounds', 'spawn_entity', 'spawn_entities', 'delete_entity',
             'get_spawnables')
 ACTION = 'simulate_steps'
+
+
+class Preparations:
+    """Jobs run one at a time in a thread of their own; each one's outcome completes a Future.
+
+    The outcome is handed back through a guard condition, so the Future is
+    completed -- and whoever awaits it resumes -- in an executor callback, in
+    its turn between two batches of physics steps.
+    """
+
+    def __init__(self, node: Node, callback_group: ReentrantCallbackGroup) -> None:
+        self._jobs: queue.SimpleQueue = queue.SimpleQueue()
+        self._finished: collections.deque = collections.deque()
+        self._guard = node.create_guard_condition(self._deliver, callback_group=callback_group)
+        self._thread = threading.Thread(target=self._run, name='spawn_preparation',
+                                        daemon=True)
+        self._thread.start()
+
+    def submit(self, job: Callable[[], object]) -> Future:
+        """Queue ``job``; return the Future of its result (or of the exception it raised)."""
+        future = Future()
+        self._jobs.put((job, future))
+        return future
+
+    def close(self) -> None:
+        """Stop after the job in progress (queued jobs are dropped; nobody awaits them)."""
+        self._jobs.put(None)
+
+    def _run(self) -> None:
+        while (item := self._jobs.get()) is not None:
+            job, future = item
+            try:
+                outcome = (job(), None)
+            except Exception as error:  # handed to the caller, who answers with it
+                outcome = (None, error)
+            self._finished.append((future, outcome))
+            try:
+                self._guard.trigger()
+            except Exception:  # the node is gone (rclpy's InvalidHandle): nobody waits
+                return
+
+    def _deliver(self) -> None:
+        while self._finished:
+            future, (result, error) = self._finished.popleft()
+            if error is None:
+                future.set_result(result)
+            else:
+                future.set_exception(error)
 
 
 def interfaces() -> types.SimpleNamespace | None:
@@ -147,9 +207,11 @@ class SimulationServices:
         self._closed = False
         self._goal_jobs: dict[bytes, StepJob] = {}
         self._drop_clashing(namespace, gazebo_services)
-        # The awaiting callbacks (a step request waits for its steps) get their own
-        # group: in the default one they would hold off the steps they wait for.
+        # The awaiting callbacks (a step request waits for its steps, a spawn for its
+        # preparation) get their own group: in the default one they would hold off the
+        # steps they wait for.
         waiting = ReentrantCallbackGroup()
+        self._preparations = Preparations(node, waiting)
         handlers: dict[str, tuple[type, Callable]] = {
             'get_simulator_features': (srv.GetSimulatorFeatures, self._get_features),
             'get_simulation_state': (srv.GetSimulationState, self._get_state),
@@ -171,7 +233,7 @@ class SimulationServices:
         self.services = {
             leaf: node.create_service(
                 kind, service_name(namespace, leaf), handler, qos_profile=SERVICE_QOS,
-                callback_group=waiting if leaf == 'step_simulation' else None)
+                callback_group=waiting if leaf in AWAITING_SERVICES else None)
             for leaf, (kind, handler) in handlers.items()}
         self.action_server = ActionServer(
             node, self._action, self._action_name,
@@ -202,6 +264,7 @@ class SimulationServices:
             return
         self._closed = True
         self._runner.close()
+        self._preparations.close()
         if self._quit_timer is not None:
             self._quit_timer.cancel()
         self.action_server.destroy()
@@ -464,20 +527,20 @@ class SimulationServices:
         response.bounds.points = [_vector(Vector3(), low), _vector(Vector3(), high)]
         return self._ok(response)
 
-    def _spawn_entity(self, request, response):
+    async def _spawn_entity(self, request, response):
         codes = self._srv.SpawnEntity.Response
-        name = self._spawn(request.name, request.allow_renaming, request.uri,
-                           request.resource_string, request.entity_namespace,
-                           request.initial_pose, response.result, codes)
+        name = await self._spawn(request.name, request.allow_renaming, request.uri,
+                                 request.resource_string, request.entity_namespace,
+                                 request.initial_pose, response.result, codes)
         response.entity_name = name
         return response
 
-    def _spawn_entities(self, request, response):
+    async def _spawn_entities(self, request, response):
         codes = self._msg.SpawnResult
         results = []
         for item in request.spawn_requests:
             result = self._msg.SpawnResult()
-            result.entity_name = self._spawn(
+            result.entity_name = await self._spawn(
                 item.name, item.allow_renaming, item.entity_resource.uri,
                 item.entity_resource.resource_string, item.entity_namespace,
                 item.initial_pose, result.result, codes)
@@ -494,20 +557,26 @@ class SimulationServices:
             self._ok(response)
         return response
 
-    def _spawn(self, name: str, allow_renaming: bool, uri: str, resource_string: str,
-               namespace: str, initial_pose, result, codes) -> str:
+    async def _spawn(self, name: str, allow_renaming: bool, uri: str, resource_string: str,
+                     namespace: str, initial_pose, result, codes) -> str:
+        """Spawn one object: checked now, prepared off this thread, loaded in our turn."""
+        entities = self._entities
+        pose = _transform(initial_pose.pose)
+        frame = initial_pose.header.frame_id
         try:
-            spawned = self._entities.spawn(
-                name, uri=uri, resource_string=resource_string,
-                pose=_transform(initial_pose.pose), frame=initial_pose.header.frame_id,
-                allow_renaming=allow_renaming, namespace=namespace)
+            entities.check_request(uri, resource_string, namespace, pose, frame)
+            prepared: PreparedObject = await self._preparations.submit(
+                lambda: entities.prepare(uri, resource_string))
+            spawned = entities.add(prepared, name, pose=pose, frame=frame,
+                                   allow_renaming=allow_renaming, namespace=namespace, uri=uri)
         except SpawnError as err:
-            result.result = (self._msg.Result.RESULT_NOT_FOUND
-                             if err.problem is SpawnProblem.NOT_FOUND
-                             else getattr(codes, err.problem.name))
+            result.result = _SPAWN_RESULTS.get(err.problem.name) or getattr(
+                codes, err.problem.name)
             result.error_message = str(err)
+            if err.problem is SpawnProblem.TOO_LARGE:
+                self._logger.warning(f'spawn refused: {err}', throttle_duration_sec=1.0)
             return ''
-        position = self._entities.state(spawned).pose.translation
+        position = entities.state(spawned).pose.translation
         self._logger.info(
             f"spawned '{spawned}' from {uri or 'a resource string'} at "
             f"({', '.join(f'{c:.3g}' for c in position)})")
@@ -640,6 +709,8 @@ class SimulationServices:
         return response
 
 
+# SpawnProblems without a code of their own in SpawnEntity: simulation_interfaces/msg/Result's.
+_SPAWN_RESULTS = {'NOT_FOUND': 2, 'TOO_LARGE': 4}  # RESULT_NOT_FOUND, RESULT_OPERATION_FAILED
 _STATE_NAMES = {0: 'STOPPED', 1: 'PLAYING', 2: 'PAUSED', 3: 'QUITTING'}
 # simulation_interfaces/msg/EntityCategory values.
 _CATEGORY_CODES = {Category.OBJECT: 0, Category.ROBOT: 1, Category.HUMAN: 2,

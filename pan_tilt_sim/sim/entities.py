@@ -36,14 +36,24 @@ Spawning checks everything before PyBullet is touched, so a refused request
 leaves the simulation as it was; :class:`SpawnError` says which of the
 standard's result codes applies (:class:`SpawnProblem`).  An object is tried
 alone in a PyBullet client of its own first
-(:func:`~pan_tilt_sim.sim.stability.object_trial`): one whose state is not
+(:class:`~pan_tilt_sim.sim.stability.ObjectTrials`): one whose state is not
 finite within the first steps never enters the world (RESOURCE_PARSE_ERROR).
+One beyond the :class:`~pan_tilt_sim.model.entity_resource.EntityLimits` is
+refused before it is read further (TOO_LARGE).
+
+A spawn is three steps: :meth:`Entities.check_request` (cheap: the name
+space, the pose, the frame), :meth:`Entities.prepare` (the slow part --
+reading, checking and trying the object -- which touches neither the
+simulation's client nor the records, so it may run in another thread, one
+preparation at a time) and :meth:`Entities.add` (PyBullet's load into the
+world, which must not overlap a step).  :meth:`Entities.spawn` does all three.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import enum
+import itertools
 import math
 import pathlib
 import re
@@ -53,6 +63,8 @@ from collections.abc import Callable, Sequence
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.entity_resource import (
+    DEFAULT_LIMITS,
+    EntityLimits,
     EntityResourceError,
     ResourceProblem,
     is_static,
@@ -67,7 +79,7 @@ from pan_tilt_sim.sim.physics import (
     apply_surface_friction,
     link_indices,
 )
-from pan_tilt_sim.sim.stability import object_trial
+from pan_tilt_sim.sim.stability import ObjectTrials
 from pan_tilt_sim.sim.world import add_ground_plane, grounded_links
 
 WORLD_FRAMES = ('', 'world')  # frame ids that mean the world frame
@@ -125,6 +137,7 @@ class SpawnProblem(enum.Enum):
     UNSUPPORTED_ASSETS = 'unsupported assets'
     INVALID_POSE = 'invalid pose'
     NOT_FOUND = 'not found'
+    TOO_LARGE = 'too large'
 
 
 _RESOURCE_PROBLEMS = {
@@ -133,6 +146,7 @@ _RESOURCE_PROBLEMS = {
     ResourceProblem.PARSE_ERROR: SpawnProblem.RESOURCE_PARSE_ERROR,
     ResourceProblem.MISSING_ASSETS: SpawnProblem.MISSING_ASSETS,
     ResourceProblem.UNSUPPORTED_ASSETS: SpawnProblem.UNSUPPORTED_ASSETS,
+    ResourceProblem.TOO_LARGE: SpawnProblem.TOO_LARGE,
 }
 
 
@@ -191,6 +205,14 @@ class Entity:
 
 
 @dataclasses.dataclass(frozen=True)
+class PreparedObject:
+    """An object read, checked and tried (:meth:`Entities.prepare`), ready to load."""
+
+    resource: RobotDescription
+    path: pathlib.Path  # PyBullet's copy of its URDF, removed once loaded
+
+
+@dataclasses.dataclass(frozen=True)
 class EntityState:
     """Where an entity is and how it moves, in the world frame."""
 
@@ -203,8 +225,10 @@ class Entities:
     """The named bodies of one simulation (see the module docstring)."""
 
     def __init__(self, physics: Physics, robot_name: str, *, targets: dict[str, int] | None = None,
-                 ground: bool = True) -> None:
+                 ground: bool = True, limits: EntityLimits = DEFAULT_LIMITS) -> None:
         self._physics = physics
+        self.limits = limits
+        self._trials = ObjectTrials(physics.time_step)
         self._client = physics.client_id
         self._robot = physics.body_id
         self._ground_wanted = ground
@@ -214,7 +238,7 @@ class Entities:
         self._grounded = (grounded_links(self._client, self._robot) if physics.fixed_base
                           else [])
         self._workdir = tempfile.TemporaryDirectory(prefix='pan_tilt_sim_entities_')
-        self._files = 0
+        self._files = itertools.count(1)
         self._entities: dict[str, Entity] = {}
         self._world_file: dict[str, _WorldFileObject] = {}
         robot = self._record(robot_name, self._robot, Origin.ROBOT, static=physics.fixed_base,
@@ -356,29 +380,70 @@ class Entities:
 
         Raises :class:`SpawnError` -- and changes nothing -- when the request
         cannot be honoured.  ``pose`` is given in ``frame`` ('' or ``world``,
-        an entity's name, or a link of the robot).
+        an entity's name, or a link of the robot).  :meth:`check_request`,
+        :meth:`prepare` and :meth:`add` in one.
         """
+        self.check_request(uri, resource_string, namespace, pose, frame)
+        prepared = self.prepare(uri, resource_string, base_dir)
+        return self.add(prepared, name, pose=pose, frame=frame, allow_renaming=allow_renaming,
+                        namespace=namespace, description=description, tags=tags, origin=origin,
+                        uri=uri)
+
+    def check_request(self, uri: str, resource_string: str, namespace: str, pose: Transform,
+                      frame: str) -> None:
+        """Refuse (:class:`SpawnError`) a request naming nothing, or a bad namespace or pose."""
         if not uri and not resource_string:
             raise SpawnError(SpawnProblem.NO_RESOURCE, 'give a uri or a resource_string')
         if namespace and not naming.is_valid_namespace(namespace):
             raise SpawnError(SpawnProblem.NAMESPACE_INVALID,
                              f"'{namespace}' is not a valid ROS namespace "
                              f'({naming.NAMESPACE_RULE})')
-        pose = checked_pose(pose, lambda text: SpawnError(SpawnProblem.INVALID_POSE, text))
+        checked_pose(pose, lambda text: SpawnError(SpawnProblem.INVALID_POSE, text))
+        self._reference(frame)
+
+    def prepare(self, uri: str = '', resource_string: str = '',
+                base_dir: pathlib.Path | None = None) -> PreparedObject:
+        """Read, check (within :attr:`limits`) and try an object; :class:`SpawnError` if it fails.
+
+        Touches neither the simulation's PyBullet client nor the records: any
+        thread may call it, one call at a time.
+        """
         try:
-            reference = self.frame_pose(frame)
-        except KeyError:
-            raise SpawnError(SpawnProblem.INVALID_POSE,
-                             f"unknown frame '{frame}' (use '' or 'world', an entity's name, or "
-                             'a link of the robot)') from None
-        try:
-            resource = read_entity_resource(uri, resource_string, base_dir=base_dir)
+            resource = read_entity_resource(uri, resource_string, base_dir=base_dir,
+                                            limits=self.limits)
         except EntityResourceError as err:
             raise SpawnError(_RESOURCE_PROBLEMS[err.problem], str(err)) from None
-        name = self._free_name(name or resource.name, allow_renaming)
-        placed = checked_pose(reference.then(pose),
-                              lambda text: SpawnError(SpawnProblem.INVALID_POSE, text))
-        entity = self._load(resource, name, placed, origin)
+        path = pathlib.Path(self._workdir.name, f'{next(self._files)}.urdf')
+        path.write_text(resource.physics_urdf, encoding='utf-8')
+        try:
+            problem = self._trials.run(path, is_static(resource), resource.model)
+        except BaseException:
+            path.unlink(missing_ok=True)
+            raise
+        if problem:
+            path.unlink(missing_ok=True)
+            raise SpawnError(SpawnProblem.RESOURCE_PARSE_ERROR, f'{resource.source}: {problem}')
+        return PreparedObject(resource, path)
+
+    def add(self, prepared: PreparedObject, name: str = '', *, pose: Transform = WORLD_ORIGIN,
+            frame: str = '', allow_renaming: bool = False, namespace: str = '',
+            description: str = '', tags: Sequence[str] = (), origin: Origin = Origin.SPAWNED,
+            uri: str = '') -> str:
+        """Load a prepared object into the world (between two steps); return its name.
+
+        The name and the pose are checked now, against the world as it is now;
+        :class:`SpawnError` (nothing changed) if they cannot be honoured.
+        ``uri`` only words the description.
+        """
+        resource = prepared.resource
+        try:
+            name = self._free_name(name or resource.name, allow_renaming)
+            pose = checked_pose(pose, lambda text: SpawnError(SpawnProblem.INVALID_POSE, text))
+            placed = checked_pose(self._reference(frame).then(pose),
+                                  lambda text: SpawnError(SpawnProblem.INVALID_POSE, text))
+            entity = self._load(resource, name, placed, origin, prepared.path)
+        finally:
+            prepared.path.unlink(missing_ok=True)
         entity.namespace = namespace
         entity.info.description = description or (
             f"'{resource.model.name}' from {uri}" if uri else
@@ -391,6 +456,14 @@ class Entities:
         self._entities[name] = entity
         self._ensure_ground()
         return name
+
+    def _reference(self, frame: str) -> Transform:
+        try:
+            return self.frame_pose(frame)
+        except KeyError:
+            raise SpawnError(SpawnProblem.INVALID_POSE,
+                             f"unknown frame '{frame}' (use '' or 'world', an entity's name, or "
+                             'a link of the robot)') from None
 
     def delete(self, name: str) -> None:
         """Remove a spawned (or world file) object; KeyError if unknown, else NotDeletableError."""
@@ -432,7 +505,8 @@ class Entities:
         self.reset_state()
 
     def close(self) -> None:
-        """Remove the temporary files (the bodies go with the PyBullet client)."""
+        """Remove the temporary files and the trial client (the bodies go with the simulation's)."""
+        self._trials.close()
         self._workdir.cleanup()
 
     # --- inside ---------------------------------------------------------------------------
@@ -462,16 +536,14 @@ class Entities:
         return f'{base}_{number}'
 
     def _load(self, resource: RobotDescription, name: str, pose: Transform,
-              origin: Origin) -> Entity:
-        self._files += 1
-        path = pathlib.Path(self._workdir.name, f'{self._files}.urdf')
-        path.write_text(resource.physics_urdf, encoding='utf-8')
+              origin: Origin, path: pathlib.Path | None = None) -> Entity:
+        """Load a checked and tried object (its URDF file at ``path``, else written now)."""
+        if path is None:
+            path = pathlib.Path(self._workdir.name, f'{next(self._files)}.urdf')
+            path.write_text(resource.physics_urdf, encoding='utf-8')
         fixed = is_static(resource)
         client = self._client
         try:
-            problem = object_trial(path, fixed, self._physics.time_step, resource.model)
-            if problem:
-                raise SpawnError(SpawnProblem.RESOURCE_PARSE_ERROR, f'{resource.source}: {problem}')
             with quiet_native_output():
                 body = pybullet.loadURDF(
                     str(path), pose.translation, pose.rotation, useFixedBase=fixed,
@@ -480,7 +552,7 @@ class Entities:
             raise SpawnError(SpawnProblem.RESOURCE_PARSE_ERROR,
                              f'{resource.source}: PyBullet cannot load it: {err}') from None
         finally:
-            path.unlink()
+            path.unlink(missing_ok=True)
         # No drag that neither the URDF nor Gazebo has (PyBullet's default 0.04), as
         # for the robot (sim/physics.py).
         pybullet.changeDynamics(body, BASE_LINK_INDEX, linearDamping=0.0, angularDamping=0.0,

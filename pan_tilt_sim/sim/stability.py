@@ -10,7 +10,7 @@ with a :class:`~pan_tilt_sim.errors.DescriptionError` naming the joint and
 the likely cause: the number of the description farthest from 1 in
 magnitude, where overflow and underflow come from.  An object to spawn gets
 the same trial, alone in a PyBullet client of its own, before it enters the
-world (:func:`object_trial`).
+world (:class:`ObjectTrials`).
 
 **The gains.**
 
@@ -71,21 +71,30 @@ def check_startup_stability(physics: Physics, description: RobotDescription) -> 
         f'robot{_likely(cause)}')
 
 
-def object_trial(path: pathlib.Path, fixed: bool, time_step: float,
-                 model: RobotModel) -> str:
-    """Try the object in URDF file ``path`` alone: say what went non-finite, '' if nothing did.
+class ObjectTrials:
+    """Objects tried one after the other in one PyBullet client of their own.
 
-    The object is loaded ``fixed`` to the world or free, with the URDF's
-    inertia, under gravity, into a PyBullet client of its own, and stepped
-    :data:`STARTUP_TRIAL_STEPS` times with its joints passive.  A URDF PyBullet
-    cannot load is not this function's business: the answer is '' and loading
-    it for real says why.
+    :meth:`run` loads the object ``fixed`` to the world or free, with the
+    URDF's inertia, under gravity, and steps it :data:`STARTUP_TRIAL_STEPS`
+    times with its joints passive, then removes it.  A fixed object without
+    joints cannot move, so it is not stepped.  Connecting a client costs more
+    than a small object's trial, so the client is made once, on the first
+    trial, and kept until :meth:`close`.  One thread at a time.
     """
-    with quiet_native_output():
-        client = pybullet.connect(pybullet.DIRECT)
-    try:
-        pybullet.setGravity(0.0, 0.0, -STANDARD_GRAVITY, physicsClientId=client)
-        pybullet.setTimeStep(time_step, physicsClientId=client)
+
+    def __init__(self, time_step: float) -> None:
+        self._time_step = time_step
+        self._client: int | None = None
+
+    def run(self, path: pathlib.Path, fixed: bool, model: RobotModel) -> str:
+        """Return what went non-finite ('' if nothing did, or PyBullet cannot load it).
+
+        A URDF PyBullet cannot load is not this method's business: the answer
+        is '' and loading it for real says why.
+        """
+        if fixed and not any(joint.kind.is_actuated for joint in model.joints):
+            return ''
+        client = self._connect()
         try:
             with quiet_native_output():
                 body = pybullet.loadURDF(str(path), useFixedBase=fixed,
@@ -93,6 +102,28 @@ def object_trial(path: pathlib.Path, fixed: bool, time_step: float,
                                          physicsClientId=client)
         except pybullet.error:
             return ''
+        try:
+            return self._steps_finite(client, body, model)
+        finally:
+            pybullet.removeBody(body, physicsClientId=client)
+
+    def close(self) -> None:
+        """Disconnect the trial client (idempotent)."""
+        if self._client is not None:
+            pybullet.disconnect(physicsClientId=self._client)
+            self._client = None
+
+    def _connect(self) -> int:
+        if self._client is None:
+            with quiet_native_output():
+                client = pybullet.connect(pybullet.DIRECT)
+            pybullet.setGravity(0.0, 0.0, -STANDARD_GRAVITY, physicsClientId=client)
+            pybullet.setTimeStep(self._time_step, physicsClientId=client)
+            self._client = client
+        return self._client
+
+    @staticmethod
+    def _steps_finite(client: int, body: int, model: RobotModel) -> str:
         joints = list(range(pybullet.getNumJoints(body, physicsClientId=client)))
         if joints:  # passive: PyBullet's default motors off
             pybullet.setJointMotorControlArray(body, joints, pybullet.VELOCITY_CONTROL,
@@ -116,8 +147,6 @@ def object_trial(path: pathlib.Path, fixed: bool, time_step: float,
                 return (f'{what} is not finite after {_steps(count)} alone, with no effort '
                         f'applied: PyBullet cannot integrate this object{_likely(cause)}')
         return ''
-    finally:
-        pybullet.disconnect(physicsClientId=client)
 
 
 def _steps(count: int) -> str:

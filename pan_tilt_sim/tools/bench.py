@@ -67,7 +67,9 @@ than wall time):
   (:mod:`pan_tilt_sim.tools.sensor_cost`, in this process).
 
 ``--tune`` measures something else instead: evaluations per second of
-``tune``/``sweep`` on each back end (:mod:`pan_tilt_sim.tools.tune_bench`).
+``tune``/``sweep`` on each back end (:mod:`pan_tilt_sim.tools.tune_bench`);
+``--load``: what spawned objects and world files cost to read, load and step
+(:mod:`pan_tilt_sim.tools.bench_load`).
 
 If the two raw rates (thread CPU, wall) are more than ``RAW_AGREEMENT``
 apart, a warning on stderr says the run's ratios are not to be trusted.
@@ -1003,6 +1005,9 @@ def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     parser.add_argument('--tune', action='store_true',
                         help='measure tune/sweep evaluations per second on each back end '
                         'instead (local processes, a two-node Ray cluster; see tune_bench)')
+    parser.add_argument('--load', action='store_true',
+                        help='measure what spawned objects and world files cost to read, load '
+                        'and step instead (in this process; see bench_load)')
     args = parser.parse_args(argv)
     if args.runs < 1:
         parser.error('--runs must be at least 1')
@@ -1019,6 +1024,11 @@ def main(argv: Sequence[str] | None = None) -> None:
 
         tune_bench.main(['--runs', str(args.runs)] + ['--quick'] * args.quick
                         + ['--verbose'] * args.verbose)
+        return
+    if args.load:
+        from pan_tilt_sim.tools import bench_load
+
+        bench_load.main(['--quick'] * args.quick + ['--verbose'] * args.verbose)
         return
     domain_id = args.domain_id if args.domain_id is not None else default_domain_id()
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),

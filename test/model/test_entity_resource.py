@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import pytest
-from entity_fixtures import box_urdf, write_box
+from entity_fixtures import box_urdf, chain_urdf, write_box
 
 from pan_tilt_sim.model.entity_resource import (
+    MAX_ENTITY_BYTES,
+    MAX_ENTITY_JOINTS,
+    MAX_ENTITY_LINKS,
+    EntityLimits,
     EntityResourceError,
     ResourceProblem,
     is_static,
@@ -87,3 +91,46 @@ def test_each_failure_has_its_problem(tmp_path):
 def test_gazebo_static_marks_an_object_fixed():
     assert is_static(read_entity_resource(resource_string=box_urdf(static=True)))
     assert not is_static(read_entity_resource(resource_string=box_urdf()))
+
+
+# --- limits: what one object may be --------------------------------------------------------
+
+def _refusal(**kwargs) -> str:
+    with pytest.raises(EntityResourceError) as error:
+        read_entity_resource(**kwargs)
+    assert error.value.problem is ResourceProblem.TOO_LARGE
+    assert '\n' not in str(error.value)
+    return str(error.value)
+
+
+def test_an_object_at_the_limits_is_read():
+    at_limit = read_entity_resource(resource_string=chain_urdf(MAX_ENTITY_JOINTS))
+    assert len(at_limit.model.actuated_joints) == MAX_ENTITY_JOINTS
+    assert len(at_limit.model.links) == MAX_ENTITY_LINKS
+
+
+@pytest.mark.parametrize('joint_type', ['revolute', 'fixed'])
+def test_one_link_past_the_limit_is_refused_naming_it(joint_type):
+    message = _refusal(resource_string=chain_urdf(MAX_ENTITY_LINKS, joint_type))
+    assert f'{MAX_ENTITY_LINKS + 1} links' in message
+    assert f'at most {MAX_ENTITY_LINKS}' in message
+
+
+def test_text_past_the_byte_limit_is_refused_before_it_is_parsed(tmp_path):
+    padding = ' ' * MAX_ENTITY_BYTES  # well-formed: a box and blank space
+    message = _refusal(resource_string=box_urdf() + padding)
+    assert f'at most {MAX_ENTITY_BYTES} bytes' in message
+    path = tmp_path / 'big.urdf'
+    path.write_text(box_urdf() + padding)
+    assert f'at most {MAX_ENTITY_BYTES} bytes' in _refusal(uri=str(path))
+    assert str(path) in _refusal(uri=str(path))
+
+
+def test_the_limits_can_be_given():
+    small = EntityLimits(max_bytes=10_000, max_links=3, max_joints=2)
+    assert read_entity_resource(resource_string=chain_urdf(2), limits=small).name == 'chain'
+    assert '4 links' in _refusal(resource_string=chain_urdf(3, 'fixed'), limits=small)
+    joints = EntityLimits(max_links=10, max_joints=1)
+    assert '2 joints: an object to spawn may have at most 1' in _refusal(
+        resource_string=chain_urdf(2), limits=joints)
+    assert 'at most 10000 bytes' in _refusal(resource_string=chain_urdf(30), limits=small)

@@ -7,7 +7,13 @@ from robot_fixtures import write_text
 
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.description import load_description
-from pan_tilt_sim.model.inertials import MOVABLE_INERTIA, MOVABLE_MASS, with_massive_root
+from pan_tilt_sim.model.inertials import (
+    MOVABLE_INERTIA,
+    MOVABLE_MASS,
+    frozen_joints,
+    with_massive_root,
+)
+from pan_tilt_sim.model.urdf import parse_urdf
 
 INERTIAL = ('<inertial><mass value="{m}"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" '
             'ixz="0" iyz="0"/></inertial>')
@@ -114,3 +120,19 @@ def test_a_free_bases_massless_root_gets_a_negligible_mass_and_a_massive_one_is_
                               '<joint name="axle" type="continuous"><parent link="base"/>'
                               '<child link="wheel"/></joint>')
     assert with_massive_root(massive.physics_urdf, massive.model) == massive.physics_urdf
+
+
+def test_nested_and_branching_massless_subtrees_each_list_every_link_below_their_joint(tmp_path):
+    # base (massive) - a - b - c, and b - d: every joint moves only massless links.
+    joints = [('ja', 'base', 'a'), ('jb', 'a', 'b'), ('jc', 'b', 'c'), ('jd', 'b', 'd')]
+    body = f'<link name="base">{INERTIAL.format(m=1)}</link>' + ''.join(
+        f'<link name="{name}"/>' for name in 'abcd') + ''.join(
+        f'<joint name="{joint}" type="continuous"><parent link="{parent}"/>'
+        f'<child link="{child}"/></joint>' for joint, parent, child in joints)
+    model = parse_urdf(f'<robot name="r">{body}</robot>', tmp_path / 'r.urdf')
+    frozen = {joint: set(links) for joint, links in frozen_joints(model).items()}
+    assert frozen == {'ja': set('abcd'), 'jb': set('bcd'), 'jc': {'c'}, 'jd': {'d'}}
+    assert frozen_joints(model)['ja'][0] == 'a'  # the joint's own child first
+    heavy = body.replace('<link name="d"/>', f'<link name="d">{INERTIAL.format(m=1)}</link>')
+    model = parse_urdf(f'<robot name="r">{heavy}</robot>', tmp_path / 'r.urdf')
+    assert set(frozen_joints(model)) == {'jc'}  # d's mass moves with ja, jb and jd

@@ -10,6 +10,7 @@ import pytest
 
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model.world_file import (
+    MAX_WORLD_ENTITIES,
     SCENERIES,
     EntitySpec,
     WorldFileError,
@@ -168,3 +169,32 @@ def test_the_shipped_room_reads(repo_root):
     world = read_world_file(repo_root / 'config' / 'worlds' / 'room.yaml')
     assert [entity.name for entity in world.entities] == [
         'wall_east', 'wall_west', 'wall_north', 'wall_south', 'crate', 'pillar', 'ball']
+
+
+def _boxes(count: int, named: bool = False) -> str:
+    return 'entities:\n' + ''.join(
+        f"  - {{{f'name: b{index}, ' if named else ''}shape: box, size: [0.1, 0.1, 0.1], "
+        f"pose: {{position: [{index}, 0, 0.05]}}}}\n" for index in range(count))
+
+
+def test_a_world_file_of_more_objects_than_the_limit_is_refused_naming_file_and_limit(tmp_path):
+    path = _world(tmp_path, _boxes(MAX_WORLD_ENTITIES + 1))
+    with pytest.raises(WorldFileError) as error:
+        read_world_file(path)
+    message = str(error.value)
+    assert message.startswith(f'{path}: entities: {MAX_WORLD_ENTITIES + 1} objects')
+    assert f'at most {MAX_WORLD_ENTITIES}' in message
+    assert '\n' not in message
+
+
+def test_a_world_file_at_the_limit_reads_and_the_limit_can_be_given(tmp_path):
+    assert len(read_world_file(_world(tmp_path, _boxes(3)), max_entities=3).entities) == 3
+    with pytest.raises(WorldFileError, match='at most 2 '):
+        read_world_file(_world(tmp_path, _boxes(3)), max_entities=2)
+
+
+def test_names_used_twice_are_found_among_many(tmp_path):
+    text = _boxes(MAX_WORLD_ENTITIES - 1, named=True) + (
+        '  - {name: b0, shape: sphere, size: [0.1]}\n')
+    with pytest.raises(WorldFileError, match="the name 'b0' is used twice"):
+        read_world_file(_world(tmp_path, text))

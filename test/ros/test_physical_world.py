@@ -18,7 +18,7 @@ from sensor_msgs.msg import Image
 from sim_interfaces_client import OK, SimInterfaces, msg, pose, position
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from pan_tilt_sim.model.world_file import WorldFileError
+from pan_tilt_sim.model.world_file import MAX_WORLD_ENTITIES, WorldFileError
 from pan_tilt_sim.share import package_share
 from pan_tilt_sim.sim.camera import CameraSettings, intrinsics
 
@@ -172,6 +172,18 @@ def _info_request(entity: str):
 def msg_scope(name: str) -> int:
     from sim_interfaces_client import srv
     return getattr(srv.ResetSimulation.Request, name)
+
+
+def test_a_world_file_past_the_object_limit_ends_start_up_at_once_naming_the_limit(tmp_path):
+    world = tmp_path / 'world.yaml'
+    world.write_text('entities:\n' + ''.join(
+        f'  - {{shape: box, size: [0.1, 0.1, 0.1], pose: {{position: [{index}, 5, 0.05]}}}}\n'
+        for index in range(MAX_WORLD_ENTITIES + 1)))
+    with pytest.raises(WorldFileError, match=rf'world.yaml: entities: {MAX_WORLD_ENTITIES + 1} '
+                                             rf'objects; a world file may list at most '
+                                             rf'{MAX_WORLD_ENTITIES} '):
+        with sim_node(world=str(world)):
+            pass
 
 
 def test_a_bad_world_file_ends_start_up_naming_the_file_and_entry(tmp_path):

@@ -8,13 +8,17 @@ targets world (the robot, four static target cubes, the ground).
 from __future__ import annotations
 
 import math
+import threading
 
 import pytest
-from entity_fixtures import UNSPAWNABLE, box_urdf, write_box
+from entity_fixtures import UNSPAWNABLE, box_urdf, chain_urdf, write_box
 from geometry_msgs.msg import Twist
-from node_harness import sim_node
+from node_harness import PROBE_QUEUE, sim_node, stamp_s
+from rosgraph_msgs.msg import Clock
 from sim_interfaces_client import OK, Result, SimInterfaces, msg, pose, position, srv
 
+from pan_tilt_sim.model.entity_resource import MAX_ENTITY_LINKS
+from pan_tilt_sim.sim import entities as entities_module
 from pan_tilt_sim.sim.bullet import pybullet
 
 ROBOT = 'ex_urdf_pan_tilt'
@@ -483,3 +487,64 @@ def test_unknown_reset_scopes_are_unsupported(moved):
     assert result.error_message
     assert moved.sim.simulation.time == time
     assert 'box' in moved.entities()
+
+
+# --- a big spawn does not stop the simulation ------------------------------------------------
+
+HELD_S = 20.0  # the longest a test holds a spawn's preparation
+CLOCK_ADVANCE_S = 0.05  # sim time /clock must gain while a spawn is being prepared
+
+
+def test_a_chain_at_the_limit_is_spawned_and_its_state_reported(sim):
+    assert sim.spawn('chain', resource_string=chain_urdf(MAX_ENTITY_LINKS - 1),
+                     at=pose(1.0, 1.0, 0.5)).result.result == OK
+    assert sim.step(10).result == OK
+    assert position(sim.entity_state('chain'))[0] == pytest.approx(1.0, abs=0.1)
+    assert len(sim.sim.node.features.entities.joint_positions('chain')) == MAX_ENTITY_LINKS - 1
+
+
+def test_clock_keeps_ticking_while_a_spawn_is_read_and_then_the_answer_comes(monkeypatch):
+    # The preparation (reading, checking, trying the object) is held until the test has
+    # seen /clock advance: it runs off the executor's thread, or the node would stand still.
+    reading, release = threading.Event(), threading.Event()
+    read = entities_module.read_entity_resource
+
+    def held_read(*args, **kwargs):
+        reading.set()
+        release.wait(HELD_S)
+        return read(*args, **kwargs)
+
+    monkeypatch.setattr(entities_module, 'read_entity_resource', held_read)
+    with sim_node() as under_test:  # playing, as fast as it goes
+        sim = SimInterfaces(under_test)
+        clock = under_test.collect(Clock, '/clock', PROBE_QUEUE)
+        future = sim.spawn_async('chain', resource_string=chain_urdf(20), at=pose(1.0, 1.0, 0.5))
+        try:
+            assert under_test.spin_until(reading.is_set, HELD_S)
+            assert under_test.spin_until(lambda: bool(clock))
+            started = stamp_s(clock[-1])
+            advanced = under_test.spin_until(
+                lambda: stamp_s(clock[-1]) >= started + CLOCK_ADVANCE_S, HELD_S)
+            assert advanced and not future.done(), '/clock stood still while a spawn was read'
+        finally:
+            release.set()
+        assert under_test.spin_until(future.done), 'the spawn was never answered'
+        response = future.result()
+        assert response.result.result == OK, response.result.error_message
+        assert response.entity_name == 'chain'
+        assert 'chain' in sim.entities()
+        joints = sim.sim.node.features.entities.joint_positions('chain')
+        assert len(joints) == 20
+
+
+def test_a_chain_one_link_past_the_limit_is_refused_and_the_simulation_runs_on(sim):
+    bodies, entities = _bodies(sim), sim.entities()
+    refused = sim.spawn('chain', resource_string=chain_urdf(MAX_ENTITY_LINKS))
+    assert refused.result.result == Result.RESULT_OPERATION_FAILED
+    message = refused.result.error_message
+    assert f'at most {MAX_ENTITY_LINKS}' in message and '\n' not in message
+    assert refused.entity_name == ''
+    assert (_bodies(sim), sim.entities()) == (bodies, entities)
+    steps = sim.sim.simulation.steps
+    assert sim.step(10).result == OK
+    assert sim.sim.simulation.steps == steps + 10
