@@ -10,16 +10,19 @@ BOX_RGBA = (0.9, 0.1, 0.9, 1.0)  # magenta: no target, the ground or the pan/til
 def box_urdf(name: str = 'box', size: tuple[float, float, float] = (0.2, 0.2, 0.2),
              mass: float = 1.0, rgba: tuple[float, float, float, float] = BOX_RGBA, *,
              static: bool = False, com: tuple[float, float, float] = (0.0, 0.0, 0.0),
-             mesh: str | None = None) -> str:
+             mesh: str | None = None, mu: float | None = None) -> str:
     """Return the URDF of a one-link box (a solid box's inertia about ``com``).
 
-    ``mesh`` replaces the visual geometry with a mesh file name.
+    ``mesh`` replaces the visual geometry with a mesh file name; ``mu`` gives
+    the box ``<mu1>``/``<mu2>`` (without it, PyBullet's 0.5).
     """
     x, y, z = size
     colour = ' '.join(str(c) for c in rgba)
     geometry = f'<geometry><box size="{x} {y} {z}"/></geometry>'
     visual = f'<geometry><mesh filename="{mesh}"/></geometry>' if mesh else geometry
     gazebo = '<gazebo><static>true</static></gazebo>' if static else ''
+    if mu is not None:
+        gazebo += f'<gazebo reference="{name}_link"><mu1>{mu}</mu1><mu2>{mu}</mu2></gazebo>'
     return f"""<?xml version="1.0"?>
 <robot name="{name}">
   <link name="{name}_link">

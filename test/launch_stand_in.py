@@ -1,15 +1,16 @@
 """A small stand-in of ROS 2's launch API that runs a ros2_control launch file's shape.
 
-``launch`` and ``launch_ros`` are not on PyPI.  :func:`load` runs a launch
-file's ``generate_launch_description()`` against stand-in modules that record
-what it asks for (Node, RegisterEventHandler + OnProcessExit, Command,
-PathJoinSubstitution, PathSubstitution, FindPackageShare, FindExecutable, LaunchConfiguration,
-IfElseSubstitution, DeclareLaunchArgument with its choices, IfCondition, UnlessCondition,
-OpaqueFunction, ParameterFile; IncludeLaunchDescription is recorded and refused when it would
-run), and :class:`StandInLaunch` carries it out as launch would: the arguments declared (a
-default performed, a value outside ``choices`` refused) and each OpaqueFunction's function
-called with a context of the arguments so far, its actions carried out in its place; then
-the nodes, as launch_ros would start them:
+``launch`` and ``launch_ros`` are not on PyPI. :func:`load` runs a launch file's
+``generate_launch_description()`` against stand-in modules that record what it asks for (Node,
+RegisterEventHandler + OnProcessExit, Command, PathJoinSubstitution, PathSubstitution,
+FindPackageShare, FindExecutable, LaunchConfiguration, IfElseSubstitution,
+DeclareLaunchArgument with its choices, IfCondition, UnlessCondition, OpaqueFunction,
+ParameterFile; IncludeLaunchDescription is recorded and refused when it would run;
+controller_manager.launch_utils' generate_controllers_spawner_launch_description, whose
+LaunchDescription is carried out in its place), and :class:`StandInLaunch` carries it out as
+launch would: the arguments declared (a default performed, a value outside ``choices``
+refused) and each OpaqueFunction's function called with a context of the arguments so far, its
+actions carried out in its place; then the nodes, as launch_ros would start them:
 
 * ``pan_tilt_sim``'s ``sim_node`` as a process, ``--ros-args -r
   __node:=<name>`` and its parameters as ``--params-file`` arguments (a dict
@@ -42,7 +43,8 @@ HERE = pathlib.Path(__file__).resolve().parent
 STAND_IN_MODULES = ('launch', 'launch.actions', 'launch.conditions', 'launch.event_handlers',
                     'launch.launch_description_sources', 'launch.substitutions', 'launch_ros',
                     'launch_ros.actions', 'launch_ros.parameter_descriptions',
-                    'launch_ros.substitutions')
+                    'launch_ros.substitutions', 'controller_manager',
+                    'controller_manager.launch_utils')
 SUBSTITUTION = re.compile(r'\$\(var ([A-Za-z0-9_]+)\)')
 # The texts launch reads as a true or false condition (any case); any other is an error.
 TRUE_TEXTS, FALSE_TEXTS = ('true', '1'), ('false', '0')
@@ -174,6 +176,25 @@ class LaunchConfiguration(Substitution):
     """launch.substitutions.LaunchConfiguration."""
 
 
+def generate_controllers_spawner_launch_description(
+        controller_names: list, controller_params_files: list | None = None,
+        extra_spawner_args: list | None = None) -> list:
+    """controller_manager.launch_utils' helper: one spawner for ``controller_names``.
+
+    As jazzy's: the ``controller_manager_name`` launch argument (default
+    ``controller_manager``) names the manager, each params file is a
+    ``--param-file``, then the extra arguments.  (Its ``unload_on_kill``
+    argument adds nothing unless set, and is not carried out here.)
+    """
+    arguments = [*controller_names, '--controller-manager',
+                 LaunchConfiguration('controller_manager_name')]
+    for path in controller_params_files or ():
+        arguments += ['--param-file', path]
+    arguments += list(extra_spawner_args or ())
+    return [DeclareLaunchArgument('controller_manager_name', default_value='controller_manager'),
+            Node(package='controller_manager', executable='spawner', arguments=arguments)]
+
+
 def modules() -> dict[str, types.ModuleType]:
     """Return the stand-in modules, by name."""
     made = {name: types.ModuleType(name) for name in STAND_IN_MODULES}
@@ -196,6 +217,8 @@ def modules() -> dict[str, types.ModuleType]:
     made['launch.substitutions'].IfElseSubstitution = IfElseSubstitution
     made['launch_ros.actions'].Node = Node
     made['launch_ros.substitutions'].FindPackageShare = FindPackageShare
+    made['controller_manager.launch_utils'].generate_controllers_spawner_launch_description = (
+        generate_controllers_spawner_launch_description)
     return made
 
 
@@ -361,6 +384,8 @@ class StandInLaunch:
                 action.declare(self.arguments)
             if isinstance(action, OpaqueFunction):
                 left += self._carry_out(action.run(self.arguments))
+            elif isinstance(action, list):  # a LaunchDescription among the actions
+                left += self._carry_out(action)
             else:
                 left.append(action)
         return left

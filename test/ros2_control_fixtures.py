@@ -15,6 +15,15 @@ urdf_sim_tutorial), written here from scratch:
   forward velocity / position groups), two vendor controllers and a vendor
   broadcaster, the joints written ``$(var prefix)jointN``.
 * :data:`HEAD_YAML` -- a ROS 1 file holding one controller and nothing else.
+* :func:`three_dof_urdf` and :data:`THREE_DOF_YAML` -- ros2_control_demos
+  example 13's ThreeDofBot in small: three joints whose mock hardware
+  declares ``position`` and ``pid_gain`` command and state interfaces, and
+  its controllers -- a global broadcaster under the controller_manager, the
+  others typed in their own sections (jazzy's way): a local broadcaster of
+  ``position`` and ``pid_gain``, a position group and a ``pid_gain`` group.
+  :func:`three_dof_launch` -- its launch file's shape, sim_node as the
+  control node and the ``--inactive`` spawner of
+  ``generate_controllers_spawner_launch_description``.
 """
 
 from __future__ import annotations
@@ -172,3 +181,70 @@ def write_arm(folder: pathlib.Path, controllers: str = UR_STYLE_YAML) -> pathlib
     """Write the arm's xacro and, beside it, the controllers file it names; return the xacro."""
     write(folder, CONTROLLERS_FILE, controllers)
     return write(folder, 'two_link_arm.urdf.xacro', ARM_XACRO)
+
+
+THREE_DOF_JOINTS = ('threedofbot_joint1', 'threedofbot_joint2', 'threedofbot_joint3')
+PID_GAIN_CONTROLLER = 'threedofbot_pid_gain_controller'
+THREE_DOF_ACTIVE = ('joint_state_broadcaster', 'threedofbot_joint_state_broadcaster',
+                    'threedofbot_position_controller')
+
+
+def three_dof_urdf(pid_gain_joints: tuple[str, ...] = THREE_DOF_JOINTS) -> str:
+    """Return the three-joint robot; ``pid_gain_joints`` declare the ``pid_gain`` interfaces."""
+    from robot_fixtures import JointDef, star_robot_urdf
+
+    entries = ''.join(
+        f'<joint name="{joint}"><command_interface name="position">'
+        '<param name="min">-1</param><param name="max">1</param></command_interface>'
+        '<state_interface name="position"/>'
+        + ('<command_interface name="pid_gain"/><state_interface name="pid_gain"/>'
+           if joint in pid_gain_joints else '')
+        + '</joint>' for joint in THREE_DOF_JOINTS)
+    block = ('<ros2_control name="FakeThreeDofBot" type="system"><hardware>'
+             f'<plugin>mock_components/GenericSystem</plugin></hardware>{entries}</ros2_control>')
+    urdf = star_robot_urdf([JointDef(joint) for joint in THREE_DOF_JOINTS], 'threedofbot')
+    return urdf.replace('</robot>', f'{block}</robot>')
+
+
+def _group(interface: str) -> str:
+    return ('    type: forward_command_controller/ForwardCommandController\n    joints:\n'
+            + ''.join(f'      - {joint}\n' for joint in THREE_DOF_JOINTS)
+            + f'    interface_name: {interface}\n')
+
+
+THREE_DOF_YAML = (
+    'controller_manager:\n  ros__parameters:\n    update_rate: 100\n'
+    '    joint_state_broadcaster:\n      type: joint_state_broadcaster/JointStateBroadcaster\n'
+    '\nthreedofbot_joint_state_broadcaster:\n  ros__parameters:\n'
+    '    type: joint_state_broadcaster/JointStateBroadcaster\n    use_local_topics: True\n'
+    '    joints:\n' + ''.join(f'      - {joint}\n' for joint in THREE_DOF_JOINTS)
+    + '    interfaces:\n      - position\n      - pid_gain\n'
+    '\nthreedofbot_position_controller:\n  ros__parameters:\n' + _group('position')
+    + f'\n{PID_GAIN_CONTROLLER}:\n  ros__parameters:\n' + _group('pid_gain'))
+
+
+def three_dof_launch(urdf: pathlib.Path, controllers: pathlib.Path) -> str:
+    """Return the launch file's text: its control node, robot_state_publisher, two spawners."""
+    return textwrap.dedent(f"""\
+        from launch import LaunchDescription
+        from launch.substitutions import Command
+        from launch_ros.actions import Node
+        from controller_manager.launch_utils import (
+            generate_controllers_spawner_launch_description)
+
+
+        def generate_launch_description():
+            return LaunchDescription([
+                Node(package='pan_tilt_sim', executable='sim_node', name='controller_manager',
+                     parameters=['{controllers}', {{'real_time_factor': 0.0}}]),
+                Node(package='robot_state_publisher', executable='robot_state_publisher',
+                     parameters=[{{'robot_description': Command(['xacro ', '{urdf}'])}}]),
+                generate_controllers_spawner_launch_description(
+                    ['joint_state_broadcaster'], controller_params_files=['{controllers}']),
+                generate_controllers_spawner_launch_description(
+                    ['threedofbot_joint_state_broadcaster', 'threedofbot_position_controller',
+                     '{PID_GAIN_CONTROLLER}'],
+                    controller_params_files=['{controllers}'],
+                    extra_spawner_args=['--inactive']),
+            ])
+        """)

@@ -168,14 +168,15 @@ class JointHandle:
     is what drives the joint now: the simulation sets it from the active
     controllers (:meth:`Controller.actuators`).
 
-    ``control`` is the joint's entry in the URDF's ``<ros2_control>`` block,
-    if it has one.  The joint's state interfaces (:attr:`state_interface_names`)
-    are the :data:`MEASURED_STATES` -- the physics measures all three for
-    every joint -- then the other ``<state_interface>`` entries the block
-    declares for it (:attr:`other_states`).  The physics measures none of
-    those: each keeps the value it starts with (its ``initial_value``, else
-    NaN), as a state interface of ros2_control's mock hardware does when
-    nothing commands it.
+    ``control`` is the joint's entry in the URDF's ``<ros2_control>`` block, if
+    it has one; :attr:`declared_commands` are its command interfaces (None for a
+    joint outside every block). The joint's state interfaces
+    (:attr:`state_interface_names`) are the :data:`MEASURED_STATES` -- the
+    physics measures all three for every joint -- then the other
+    ``<state_interface>`` entries the block declares for it
+    (:attr:`other_states`). The physics measures none of those: each keeps the
+    value it starts with (its ``initial_value``, else NaN), as a state interface
+    of ros2_control's mock hardware does when nothing commands it.
 
     ``force_limit`` (N*m or N, may be inf) is the most the ideal actuator's
     motor may apply: the joint's effort limit, which the simulation restores
@@ -186,13 +187,15 @@ class JointHandle:
 
     __slots__ = ('spec', 'position', 'velocity', 'effort', 'velocity_target',
                  'initial_position', 'plugin_gains', 'tracking_gain', 'actuator',
-                 'other_states', 'force_limit')
+                 'other_states', 'force_limit', 'declared_commands')
 
     def __init__(self, spec: JointSpec, initial_position: float | None = None,
                  plugin_gains: PidGains | None = None,
                  tracking_gain: float = TRACKING_GAIN,
                  control: ControlJoint | None = None) -> None:
         self.spec = spec
+        self.declared_commands: tuple[str, ...] | None = (
+            None if control is None else control.command_interface_names)
         # Unmeasured state interfaces, in the block's order, and the value each holds
         # (read-only by contract; a plain dict so that handles can be copied).
         self.other_states: Mapping[str, float] = {
@@ -371,6 +374,15 @@ class Controller(abc.ABC):
         ``<ros2_control>`` block lacks one of them cannot be driven by this
         controller, and the block's hardware may refuse some combinations
         (:mod:`pan_tilt_sim.model.command_modes`).
+        """
+        return {}
+
+    def undrivable_interfaces(self) -> dict[str, str]:
+        """Return, by joint, a claimed command interface the simulation cannot drive.
+
+        Only ones the joint's ``<ros2_control>`` block declares (any other
+        is refused at configure): such a controller configures, as upstream,
+        but cannot be activated here.  None by default.
         """
         return {}
 

@@ -21,12 +21,14 @@ interface (limits, ramp, actuator), which it is built from, with gains from
   (:mod:`~pan_tilt_sim.controllers.joint_acceleration_controller`).
 
 ros2_control lets a ``<ros2_control>`` block name any command interface, so
-any ``interface_name`` is taken when the file is read; configuring the
-controller refuses, naming the joint, one the simulator cannot drive
-(``pid_gain``, say).  Whether the joint's block gives it the interface, and
-whether the block's hardware accepts it beside the others, is the
-:mod:`~pan_tilt_sim.controllers.manager`'s question when the controller is
-activated.
+any ``interface_name`` is taken when the file is read.  One the simulator
+cannot drive (``pid_gain``, say): configuring the controller refuses it,
+naming the joint, unless the joint's ``<ros2_control>`` entry declares it --
+then the controller configures, as upstream's does, and the
+:mod:`~pan_tilt_sim.controllers.manager` refuses to activate it
+(:meth:`ForwardCommandController.undrivable_interfaces`).  Whether the
+joint's block gives it the interface, and whether the block's hardware
+accepts it beside the others, is also the manager's question at activation.
 
 An entry of ``joints`` may instead name a chainable controller's degree of
 freedom, ``<controller>/<dof>``, as ros2_control's chained controllers do: the
@@ -103,6 +105,8 @@ class ForwardCommandController(MultiJointController):
         interface: str = self.fixed_interface or self.params[INTERFACE_FIELD]
         self.interface_name = interface
         gains = joint_gains_from_params(self, self._joint_names)
+        # Joints whose block declares ``interface`` though the simulator cannot drive it.
+        self._undrivable: tuple[str, ...] = ()
         # No members for an interface the simulator cannot drive: configure() refuses it on a
         # joint (a chained reference may carry any interface its controller exports).
         member_type = INTERFACE_CONTROLLERS.get(interface)
@@ -127,6 +131,10 @@ class ForwardCommandController(MultiJointController):
         """Return ``interface_name`` for every joint."""
         return {joint: (self.interface_name,) for joint in self._joint_names}
 
+    def undrivable_interfaces(self) -> dict[str, str]:
+        """Return ``interface_name`` for each joint it cannot drive though its block declares it."""
+        return dict.fromkeys(self._undrivable, self.interface_name)
+
     def pids(self) -> dict[str, Pid]:
         """Return each joint's PID (none for the effort interface or the ideal actuator)."""
         return {joint: pid for member in self._members for joint, pid in member.pids().items()}
@@ -145,9 +153,12 @@ class ForwardCommandController(MultiJointController):
         """Bind every entry to its joint or reference (named in errors as one of ``joints``).
 
         Refuses an ``interface_name`` the simulator cannot drive on a joint,
-        naming the joint and the interface.
+        naming the joint and the interface -- unless the joint's
+        ``<ros2_control>`` entry declares it: then the controller configures
+        with :meth:`undrivable_interfaces` naming the joint.
         """
         members: list[CommandController] = []
+        undrivable: list[str] = []
         for index, entry in enumerate(self._joint_names):
             member = self._members[index] if self._members else None
             own = member.replaced if isinstance(member, ReferenceForwarder) else member
@@ -156,10 +167,16 @@ class ForwardCommandController(MultiJointController):
                 members.append(ReferenceForwarder(self.name, entry, self.interface_name, target,
                                                   own, self._source))
             elif own is None:
-                raise self.error(INTERFACE_FIELD, f"joint '{entry}' interface "
-                                 f"'{self.interface_name}': the simulator can drive {DRIVABLE}")
+                if self.interface_name not in (target.declared_commands or ()):
+                    raise self.error(INTERFACE_FIELD, f"joint '{entry}' interface "
+                                     f"'{self.interface_name}': the simulator can drive "
+                                     f'{DRIVABLE}')
+                undrivable.append(entry)
             else:
                 members.append(own)
+        self._undrivable = tuple(undrivable)
+        if undrivable:  # never activated (the manager refuses): nothing to drive or step
+            members = []
         self._members = tuple(members)
         for member in members:
             member.configure(joints)

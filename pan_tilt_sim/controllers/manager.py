@@ -25,6 +25,12 @@ same with the controllers of one :class:`ControllersConfig`:
   (``<gpio>/<interface>``), each by one active controller at a time.  The
   robot's sensors and gpios (:mod:`.hardware_interfaces`) are handed to every
   controller before it is configured.
+* A controller on a command interface the joint's block declares but the
+  simulation cannot drive (example 13's ``pid_gain``) loads and configures,
+  as upstream's does; its activation is refused with one line naming the
+  joint and the interface, in controller_manager's words.  With ``active``
+  unset it stays inactive, that line in :attr:`ControllerManager.refused`;
+  listed in ``active``, it ends start-up.
 * The block's hardware may refuse a combination of command interfaces --
   two on one joint, different command modes on its joints -- as its
   ``prepare_command_mode_switch`` does; which hardware refuses what, and
@@ -71,6 +77,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
 from pan_tilt_sim.controllers.base import Controller, JointHandle, Reference
+from pan_tilt_sim.controllers.forward_command_controller import DRIVABLE
 from pan_tilt_sim.controllers.hardware_interfaces import NO_HARDWARE, HardwareInterfaces
 from pan_tilt_sim.controllers.registry import (
     create_controller,
@@ -133,6 +140,9 @@ class ControllerManager:
         self._switch_listeners: list[Callable[[], None]] = []
         self._set_active(set())
         self.skipped: tuple[SkippedController, ...] = ()
+        # Start-up: configured controllers left inactive because activating them is refused,
+        # by name, with the one line that says why (see activation_refusal).
+        self.refused: dict[str, str] = {}
         if autostart:
             self._start(config.controllers, active, active_name)
 
@@ -192,6 +202,13 @@ class ControllerManager:
             + [SkippedController(spec.name, str(spec.type), failures[spec.name])
                for spec in specs if spec.name in failures])
         active_names = set(self._by_name) if wanted is None else set(wanted)
+        refused = {name: refusal for name in self._by_name if name in active_names
+                   and (refusal := self.activation_refusal(name)) is not None}
+        for name in wanted or ():
+            if name in refused:
+                raise ControllerConfigError(f'{active_name}: {refused[name]}')
+        self.refused = refused
+        active_names -= set(refused)
         problem = self._problem(active_names)
         if problem is not None:
             joint, first, second, interface = problem
@@ -413,6 +430,11 @@ class ControllerManager:
                 activate.remove(name)
                 refuse(f"could not activate controller '{name}': it is unconfigured and must "
                        "be configured (to 'inactive') first")
+        for name in list(activate):
+            refusal = self.activation_refusal(name)
+            if refusal is not None:
+                activate.remove(name)
+                refuse(refusal)
         # The chains, as controller_manager's check_following_controllers_for_activate and
         # check_preceding_controllers_for_deactivate; leaving one out may fail another.
         changed = True
@@ -449,6 +471,21 @@ class ControllerManager:
         for listener in self._switch_listeners:
             listener()
         return dropped
+
+    def activation_refusal(self, name: str) -> str | None:
+        """Return why the loaded controller ``name`` cannot be activated here, or None.
+
+        A claimed command interface the joint's ``<ros2_control>`` block
+        declares but the simulation cannot drive: one line naming the joint
+        and the interface, as controller_manager words a claim it cannot serve.
+        """
+        undrivable = self._by_name[name].undrivable_interfaces()
+        if not undrivable:
+            return None
+        joint, interface = next(iter(undrivable.items()))
+        return (f"Unable to activate controller '{name}' since the command interface "
+                f"'{joint}/{interface}' is not available: the simulation can drive "
+                f'{DRIVABLE}')
 
     def add_switch_listener(self, listener: Callable[[], None]) -> None:
         """Call ``listener()`` after every switch (the simulation re-drives the joints)."""

@@ -60,6 +60,12 @@ DESCRIPTION_TOPIC = 'robot_description'  # relative, as the controller_manager s
 # As the controller_manager subscribes it: the last description, kept for late joiners.
 # Parameters of the controller_manager that its arguments also give each controller.
 SHARED_WITH_CONTROLLERS = (UPDATE_RATE_FIELD, 'use_sim_time')
+# sim_node's own parameters that it declares only after it has read the controllers (its
+# sensors, TF, simulation_interfaces and controller_manager services), by first name part:
+# like every parameter sim_node declares, none is a controller's, though a launch file's
+# `parameters=[{...}]` (a `/**` wildcard) and `-p` give them to every node.
+DECLARED_AFTER_CONTROLLERS = ('world', 'camera', 'publish_tf', 'sensors',
+                              'simulation_interfaces', 'defaults')
 DESCRIPTION_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
@@ -154,15 +160,17 @@ def shared_parameters(node: Node, arguments: RosArguments, controller: str) -> d
 
     The controller's sections of the node's ``--params-file`` files (its
     own and the wildcards that match it) and the ``-p`` values for it --
-    without sim_node's own parameters (``real_time_factor``, the
-    controllers' types...), which wildcards and ``-p`` give every node but
-    no controller has; ``update_rate`` and ``use_sim_time`` stay.
+    without sim_node's own parameters (``real_time_factor``, ``world``, the
+    controllers' types...), declared yet or not, which wildcards and ``-p``
+    give every node but no controller has; ``update_rate`` and
+    ``use_sim_time`` stay.
     """
     params = node_parameters(arguments.params_files, controller)
     merge_parameters(params, unflatten(arguments.parameters_for(controller)))
     return {key: value for key, value in params.items()
             if key in SHARED_WITH_CONTROLLERS or not (
-                node.has_parameter(key) or node.get_parameters_by_prefix(key))}
+                key in DECLARED_AFTER_CONTROLLERS or node.has_parameter(key)
+                or node.get_parameters_by_prefix(key))}
 
 
 def wait_for_description(node: Node, build: Callable[[RobotDescription], None]) -> Any:

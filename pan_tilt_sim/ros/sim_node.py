@@ -611,7 +611,10 @@ class SimNode(Node):
         for skipped in manager.skipped:
             logger.info(f"controller '{skipped.name}' (type '{skipped.type}') skipped: "
                         f'{skipped.reason}')
-        inactive = [c.name for c in manager.controllers if not manager.is_active(c.name)]
+        for refusal in manager.refused.values():  # configured; this simulation cannot activate it
+            logger.warning(refusal)
+        inactive = [c.name for c in manager.controllers
+                    if not manager.is_active(c.name) and c.name not in manager.refused]
         if inactive:
             logger.info(f"loaded but inactive (not in 'active_controllers'): "
                         f"{', '.join(inactive)}")

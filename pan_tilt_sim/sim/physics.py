@@ -17,10 +17,11 @@ polygon hulls it makes of them otherwise, so that wheels roll round, and
 each of its links' contact friction is the URDF's ``<gazebo reference>``
 ``mu1``/``mu2`` (the smaller; Gazebo's 1 by default), and its contact spring
 the ``kp``/``kd`` where the URDF gives them (:mod:`pan_tilt_sim.model.surfaces`);
-the ground plane's friction is then 1, so that on it a link's own coefficient
-decides, as on Gazebo's high-friction ground (PyBullet multiplies the two
-coefficients, Gazebo takes the smaller).  A welded robot keeps PyBullet's
-contacts, as before.
+the ground plane's friction is 1 (as under objects, see
+:func:`~pan_tilt_sim.sim.world.add_ground_plane`), so that on it a link's own
+coefficient decides, as on Gazebo's high-friction ground (PyBullet multiplies
+the two coefficients, Gazebo takes the smaller).  A welded robot keeps
+PyBullet's contacts, as before.
 PyBullet's hidden drag on every link (linear and angular damping 0.04,
 not in the URDF, not in Gazebo) is switched off, and its speed cap
 (``maxJointVelocity``, 100 rad/s) raised to twice the fastest URDF velocity
@@ -128,7 +129,6 @@ MEASURING_RANGE = 2.0 * MEASURING_HEIGHT
 CLOSEST_DISTANCE = 8  # index of the distance in one of pybullet.getClosestPoints' points
 DYNAMICS_INERTIAL_POSITION = 3  # pybullet.getDynamicsInfo: the centre of mass in the link frame
 DYNAMICS_INERTIAL_ORIENTATION = 4
-GROUND_FRICTION = 1.0  # under a free robot (see the module docstring)
 
 LogFunction = Callable[[str], None]
 
@@ -269,9 +269,6 @@ class Physics:
         self.ground: int | None = None
         if not fixed_base:
             self.ground = add_ground_plane(self._client, self._body, [])
-            pybullet.changeDynamics(self.ground, BASE_LINK_INDEX,
-                                    lateralFriction=GROUND_FRICTION,
-                                    physicsClientId=self._client)
         self._initial_base = self._place_base(initial_pose)
 
     @property

@@ -55,6 +55,7 @@ GROUND_RGBA = (*(channel / 255.0 for channel in GROUND_RGB), 1.0)
 STATIC_MASS = 0.0  # PyBullet: mass 0 makes a body static
 NO_SHAPE = -1
 BASE_LINK = -1  # PyBullet's link index of a body's base
+GROUND_FRICTION = 1.0  # the ground plane's (see add_ground_plane)
 # A body without a visual shape is drawn by TinyRenderer from its collision
 # shape (a plane: the whole lower half of every view, shaded pixel by pixel); a
 # speck of a visual shape, fully transparent, keeps the ground plane unseen.
@@ -136,6 +137,11 @@ def grounded_links(client: int, robot: int) -> list[int]:
 def add_ground_plane(client: int, robot: int, grounded: list[int]) -> int:
     """Add the plane z = 0 as a static collision body, not touching ``grounded`` links; return it.
 
+    Its friction is :data:`GROUND_FRICTION`: PyBullet multiplies the two
+    surfaces' coefficients, so on the ground a link's or an object's own
+    coefficient decides, as on Gazebo's ground plane (mu 100 and 50, of which
+    Gazebo takes the smaller of each pair).
+
     ``grounded`` are the robot's links that touched the ground in its initial
     pose (:func:`grounded_links`).  The camera does not draw the plane (it
     paints the ground itself) and rays hit it where the analytic ground is
@@ -147,6 +153,8 @@ def add_ground_plane(client: int, robot: int, grounded: list[int]) -> int:
     plane = pybullet.createMultiBody(
         baseMass=STATIC_MASS, baseCollisionShapeIndex=shape, baseVisualShapeIndex=speck,
         useMaximalCoordinates=True, physicsClientId=client)
+    pybullet.changeDynamics(plane, BASE_LINK, lateralFriction=GROUND_FRICTION,
+                            physicsClientId=client)
     for link in grounded:
         pybullet.setCollisionFilterPair(plane, robot, BASE_LINK, link, enableCollision=0,
                                         physicsClientId=client)

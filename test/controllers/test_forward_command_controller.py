@@ -41,7 +41,7 @@ from robot_fixtures import (
     write_text,
 )
 
-from pan_tilt_sim.controllers import CommandKind, CommandResult, create_controller
+from pan_tilt_sim.controllers import CommandKind, CommandResult, JointHandle, create_controller
 from pan_tilt_sim.controllers.actuator import SETPOINT_ACCELERATION, TRACKING_GAIN
 from pan_tilt_sim.controllers.base import MAX_COMMAND_MAGNITUDE, ActuatorKind, Drive
 from pan_tilt_sim.controllers.manager import ACTIVE, INACTIVE, UNCONFIGURED
@@ -520,6 +520,26 @@ def test_an_interface_the_simulator_cannot_drive_is_read_then_refused_at_configu
     assert str(caught.value) == (
         f"test.yaml: grp.interface_name: joint 'shoulder' interface '{interface}': the "
         'simulator can drive position, velocity, effort and acceleration')
+
+
+def test_one_the_joints_block_declares_configures_and_names_the_joints_it_cannot_drive():
+    from pan_tilt_sim.model.robot import ControlInterface, ControlJoint
+
+    handles = make_handles()
+    for name in ('shoulder', 'slide'):
+        handles[name] = JointHandle(handles[name].spec, control=ControlJoint(
+            name, command_interfaces=(ControlInterface('position'),
+                                      ControlInterface('pid_gain'))))
+    controller = create_controller('grp', FORWARD, {'joints': ['shoulder', 'slide'],
+                                                    'interface_name': 'pid_gain'}, 'test.yaml')
+    assert controller.undrivable_interfaces() == {}
+    controller.configure(handles)
+    assert controller.undrivable_interfaces() == {'shoulder': 'pid_gain', 'slide': 'pid_gain'}
+    assert controller.members == () and controller.actuators() == {}
+    # A joint whose block lacks it is still refused.
+    handles['slide'] = make_handles()['slide']
+    with pytest.raises(ControllerConfigError, match="joint 'slide' interface 'pid_gain'"):
+        controller.configure(handles)
 
 
 def test_an_unknown_gain_is_named_in_a_warning_with_the_closest_known_one():

@@ -390,7 +390,8 @@ def rrbot(tmp_path):
         urdf = star_robot_urdf([JointDef('joint1'), JointDef('joint2')], 'rrbot').replace(
             '</robot>', f'{block}</robot>')
         description = load_description(write(tmp_path, 'rrbot.urdf', urdf))
-        handles = {joint.name: JointHandle(joint) for joint in description.actuated_joints}
+        handles = {joint.name: JointHandle(joint, control=description.model.control_joint(
+            joint.name)) for joint in description.actuated_joints}
         config = load_controllers_config(write(tmp_path, 'rrbot.yaml', MULTI_INTERFACE_YAML))
         return ControllerManager(config, handles, description.model, active=active)
     return build
@@ -482,16 +483,74 @@ def test_gazebo_and_mock_hardware_take_position_and_velocity_on_one_joint(rrbot,
     assert [c.name for c in manager.active] == ['velocity_joint2', JSB]
 
 
-def test_an_interface_the_simulator_cannot_drive_is_refused_naming_joint_and_interface(rrbot):
+PID_GAIN_REFUSAL = (
+    "Unable to activate controller 'pid_gain_controller' since the command interface "
+    "'joint1/pid_gain' is not available: the simulation can drive position, velocity, effort "
+    'and acceleration')
+
+
+def test_a_declared_interface_the_simulator_cannot_drive_configures_but_is_not_activated(
+        rrbot):
+    manager = rrbot(GAZEBO_PLUGIN, active=[JSB, 'forward_acceleration_controller'])
+    assert manager.skipped == ()
+    assert manager.state('pid_gain_controller') == INACTIVE
+    assert manager.refused == {}  # not asked for: nothing to say at start-up
+    assert manager.activation_refusal('pid_gain_controller') == PID_GAIN_REFUSAL
+    with pytest.raises(ControllerSwitchError) as caught:
+        manager.switch(activate=['pid_gain_controller'],
+                       deactivate=['forward_acceleration_controller'])
+    assert str(caught.value) == PID_GAIN_REFUSAL
+    assert manager.is_active('forward_acceleration_controller')
+    # BEST_EFFORT leaves it out with the same line; the rest of the switch happens.
+    dropped = manager.switch(activate=['pid_gain_controller', 'position_joint1',
+                                       'position_joint2'],
+                             deactivate=['forward_acceleration_controller'], strict=False)
+    assert dropped == [PID_GAIN_REFUSAL]
+    assert {c.name for c in manager.active} == {JSB, 'position_joint1', 'position_joint2'}
+
+
+def test_listed_as_active_a_controller_the_simulator_cannot_drive_ends_start_up(rrbot):
     with pytest.raises(ControllerConfigError) as caught:
         rrbot(GAZEBO_PLUGIN, active=[JSB, 'pid_gain_controller'])
+    assert str(caught.value) == f"the parameter 'active_controllers': {PID_GAIN_REFUSAL}"
+
+
+def example_13_manager(tmp_path, pid_gain_joints=('joint1', 'joint2')):
+    """Example 13's shape with every controller active: a broadcaster, position and pid_gain."""
+    entries = ''.join(
+        f'<joint name="{joint}"><command_interface name="position"/>'
+        + ('<command_interface name="pid_gain"/>' if joint in pid_gain_joints else '')
+        + '<state_interface name="position"/></joint>' for joint in ('joint1', 'joint2'))
+    block = ('<ros2_control name="FakeThreeDofBot" type="system"><hardware><plugin>'
+             f'{MOCK_PLUGIN}</plugin></hardware>{entries}</ros2_control>')
+    urdf = star_robot_urdf([JointDef('joint1'), JointDef('joint2')], 'bot').replace(
+        '</robot>', f'{block}</robot>')
+    description = load_description(write(tmp_path, 'bot.urdf', urdf))
+    handles = {joint.name: JointHandle(joint, control=description.model.control_joint(
+        joint.name)) for joint in description.actuated_joints}
+    config = load_controllers_config(write(tmp_path, 'bot.yaml', (
+        'controller_manager:\n  ros__parameters:\n    joint_state_broadcaster:\n'
+        '      type: joint_state_broadcaster/JointStateBroadcaster\n'
+        'position_controller:\n  ros__parameters:\n' + forward(('joint1', 'joint2'), 'position')
+        + 'pid_gain_controller:\n  ros__parameters:\n'
+        + forward(('joint1', 'joint2'), 'pid_gain'))))
+    return ControllerManager(config, handles, description.model)
+
+
+def test_with_every_controller_active_it_stays_inactive_with_its_line_and_the_rest_run(
+        tmp_path):
+    manager = example_13_manager(tmp_path)
+    assert {c.name for c in manager.active} == {JSB, 'position_controller'}
+    assert manager.state('pid_gain_controller') == INACTIVE
+    assert manager.refused == {'pid_gain_controller': PID_GAIN_REFUSAL}
+
+
+def test_an_interface_the_block_does_not_declare_is_refused_at_configure(tmp_path):
+    with pytest.raises(ControllerConfigError) as caught:
+        example_13_manager(tmp_path, pid_gain_joints=('joint1',))
     assert str(caught.value).endswith(
-        ": pid_gain_controller.interface_name: joint 'joint1' interface 'pid_gain': the "
+        ": pid_gain_controller.interface_name: joint 'joint2' interface 'pid_gain': the "
         'simulator can drive position, velocity, effort and acceleration')
-    manager = rrbot(GAZEBO_PLUGIN, active=[JSB, 'forward_acceleration_controller'])
-    (skipped,) = manager.skipped
-    assert skipped.name == 'pid_gain_controller'
-    assert "joint 'joint1' interface 'pid_gain'" in skipped.reason
 
 
 # --- gpio command interfaces ---------------------------------------------------------------

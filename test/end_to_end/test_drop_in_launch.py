@@ -129,6 +129,37 @@ def test_a_gz_shaped_launch_built_in_an_opaque_function_spawns_and_the_arm_follo
     assert "Received robot description from topic '/robot_description'" in errors['sim_node']
 
 
+def test_example_13s_inactive_spawner_of_a_pid_gain_controller_exits_0(monkeypatch, tmp_path):
+    from ros2_control_fixtures import (
+        PID_GAIN_CONTROLLER,
+        THREE_DOF_YAML,
+        three_dof_launch,
+        three_dof_urdf,
+        write,
+    )
+
+    # ros2_control_demos example 13's shape: the pid_gain controller is spawned --inactive
+    # through controller_manager.launch_utils, as its launch file does.
+    urdf = write(tmp_path, 'threedofbot.urdf', three_dof_urdf())
+    controllers = write(tmp_path, 'three_robots_controllers.yaml', THREE_DOF_YAML)
+    launch_file = write(tmp_path, 'three_robots.launch.py', three_dof_launch(urdf, controllers))
+    launch = launch_stand_in.StandInLaunch(launch_stand_in.load(launch_file, monkeypatch),
+                                           tmp_path)
+    harness = NodeHarness()
+    try:
+        launch.start_processes()
+        assert launch.run_spawners(harness) == [0, 0]
+        listed = {name: c.state for name, c in Spawner(harness).controllers().items()}
+        assert listed == {'joint_state_broadcaster': 'active',
+                          'threedofbot_joint_state_broadcaster': 'inactive',
+                          'threedofbot_position_controller': 'inactive',
+                          PID_GAIN_CONTROLLER: 'inactive'}
+    finally:
+        harness.close()
+        errors = launch.close()
+    assert 'unknown parameter' not in errors['sim_node']  # real_time_factor, given under /**
+
+
 def _cpu_seconds(pid: int) -> float:
     """User + system CPU seconds of process ``pid`` so far (Linux /proc)."""
     fields = open(f'/proc/{pid}/stat').read().rpartition(')')[2].split()

@@ -147,6 +147,43 @@ def test_controllers_given_as_node_parameters_in_the_managers_layout_need_no_par
     assert f'{FORWARD}.real_time_factor: unknown parameter' not in capfd.readouterr().err
 
 
+def own_parameters(node) -> dict:
+    """Return the parameters a built drop-in sim_node declares for itself, by name.
+
+    Not the controllers' fields (``<controller>.type``...) nor gains, named
+    after the controllers, nor those declared without a value.
+    """
+    controllers = set(node.simulation.manager.declared) | {
+        controller.name for controller in node.simulation.manager.controllers}
+    return {name: parameter.value for name, parameter in
+            node.get_parameters_by_prefix('').items()
+            if name.split('.')[0] not in controllers and parameter.value is not None}
+
+
+def test_none_of_its_own_parameters_given_to_every_node_is_handed_to_a_controller(
+        tmp_path, capfd):
+    # As a launch file's `parameters=[{'world': ...}]` for the controller manager: launch_ros
+    # writes them under `/**`, which every controller's node matches too.
+    controllers = write_yaml(tmp_path, 'controllers.yaml', MANAGER_YAML)
+    with drop_in_node('--params-file', str(controllers)) as (harness, node):
+        publish_description(harness, arm_urdf(tmp_path))
+        wait_built(harness, node)
+        own = own_parameters(node)
+    assert {'world', 'publish_tf', 'camera.rate', 'real_time_factor'} <= set(own)
+    wildcard = write_yaml(tmp_path, 'launch_params.yaml',
+                          yaml.safe_dump({'/**': {'ros__parameters': own}}))
+    capfd.readouterr()
+    with drop_in_node('--params-file', str(controllers), '--params-file', str(wildcard)) as (
+            harness, node):
+        publish_description(harness, arm_urdf(tmp_path))
+        sim = wait_built(harness, node)
+        spawner = Spawner(sim)
+        assert spawner.spawn(JSB) == 0 and spawner.spawn(FORWARD) == 0
+        for name in (JSB, FORWARD):
+            assert node.simulation.manager.controller(name).config_warnings == []
+    assert 'unknown parameter' not in capfd.readouterr().err
+
+
 def test_a_gazebo_robots_plugin_file_gives_the_controller_manager_its_controllers(
         tmp_path, capfd):
     from ros2_control_fixtures import write_arm

@@ -25,6 +25,7 @@ from pan_tilt_sim.sim.camera import CameraSettings, intrinsics
 ARM = str(package_share() / 'urdf' / 'three_joint_arm.xacro')
 ARM_JOINTS = ['shoulder_joint', 'extend_joint', 'wrist_joint']
 PUSHED = (0.2, 0.2, 0.5)  # a tall box the boom and the hand can reach (m)
+PUSHED_MU = 0.125  # slippery on the ground: pushed by the sweeping boom, it slides rather than tips
 CHROMA_TOLERANCE = 0.08
 
 
@@ -46,7 +47,8 @@ def test_start_paused_spawn_step_read_push_read_through_simulation_interfaces():
         client = SimInterfaces(sim)
         assert client.state() == msg.SimulationState.STATE_STOPPED
 
-        spawned = client.spawn('box', resource_string=box_urdf(size=PUSHED, mass=1.0),
+        spawned = client.spawn('box', resource_string=box_urdf(size=PUSHED, mass=1.0,
+                                                               mu=PUSHED_MU),
                                at=pose(0.3, 0.3, PUSHED[2] / 2 + 0.03))
         assert spawned.result.result == OK, spawned.result.error_message
         assert client.step(500).result == OK
