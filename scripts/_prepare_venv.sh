@@ -118,24 +118,20 @@ _pts_pybullet_key() {
 
 # _pts_pybullet_wheel SPEC [FIND_LINKS]: install SPEC from a wheel, on PyPI
 # (or in FIND_LINKS), in place of whichever PyBullet distributions the venv
-# has (both are removed first: with both installed, removing one would take
-# the module's files from the other). Fails (quietly) when there is no wheel
-# for this Python and platform; any other failure (no network, say) ends the
-# script.
+# has: both are removed first (with both installed, removing one would take
+# the module's files from the other). Fails, leaving none installed, when
+# there is no wheel for this Python and platform; any other failure (no
+# network, say) ends the script.
 _pts_pybullet_wheel() {
     local spec=$1 links=() errors
     [[ -n ${2:-} ]] && links=(--find-links "$2")
-    if ! errors=$("$VENV/bin/python" -m pip install --dry-run --quiet --disable-pip-version-check \
-            --ignore-installed --no-deps --only-binary=:all: "${links[@]}" "$spec" 2>&1); then
-        grep -q 'No matching distribution' <<<"$errors" && return 1
-        echo "$errors" >&2
-        _pts_die "looking for a wheel of $spec failed"
-    fi
     "$VENV/bin/python" -m pip uninstall --quiet --disable-pip-version-check --yes \
         "${_PTS_PYBULLET_DISTRIBUTIONS[@]}" >/dev/null 2>&1 || true
-    "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --no-deps \
-            --only-binary=:all: "${links[@]}" "$spec" \
-        || _pts_die "installing $spec failed"
+    errors=$("$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --no-deps \
+        --only-binary=:all: "${links[@]}" "$spec" 2>&1) && return 0
+    grep -q 'No matching distribution' <<<"$errors" && return 1
+    echo "$errors" >&2
+    _pts_die "installing $spec failed"
 }
 
 # Install PyBullet 3.2.7's source as ONE distribution (requirements.txt says
@@ -159,6 +155,9 @@ _pts_pybullet() {
     fi
     if [[ $(_pts_pybullet_wish) == auto ]] && fork=$(_pts_requirement pybullet-arm64) \
             && _pts_pybullet_wheel "$fork"; then
+        _pts_say "$spec has no wheel for Python $(pts_python_version "$VENV/bin/python") here:" \
+            "installed $fork, its source rebuilt (docs/install.md; PAN_TILT_SIM_PYBULLET=upstream" \
+            "builds upstream's instead)"
         echo "$key" >"$stamp"
         return 0
     fi
