@@ -7,10 +7,13 @@
 #   default Python, 3.12 or else 3.11 (see _find_python.sh), or with
 #   PAN_TILT_SIM_PYTHON; an existing venv on a supported version is kept
 #   unless PAN_TILT_SIM_PYTHON names another version;
-# * PyBullet has no wheel on PyPI for some supported versions (3.12): the
-#   first install builds one from its source (several minutes, once) into
-#   PAN_TILT_SIM_WHEELS (default ~/.cache/pan_tilt_sim/wheels), which every
-#   later install, in any venv or clone, takes it from;
+# * installs PyBullet 3.2.7's source as one distribution (requirements.txt,
+#   docs/install.md): upstream's wheel where PyPI has one (3.11), else
+#   pybullet-arm64's wheel (3.12), else upstream's built from its source
+#   (several minutes, once) into PAN_TILT_SIM_WHEELS (default
+#   ~/.cache/pan_tilt_sim/wheels), which every later install, in any venv
+#   or clone, takes it from; again when PAN_TILT_SIM_PYBULLET or those
+#   requirement lines change;
 # * pip-installs requirements.txt (runtime) or requirements-test.txt (test)
 #   only when those files changed since the last install (hash in a stamp);
 # * installs this package (not editable) from a throw-away copy of the
@@ -32,6 +35,7 @@
 # Environment: PAN_TILT_SIM_VENV (venv path), PAN_TILT_SIM_PYTHON
 # (interpreter to create it with, default: the machine's default Python),
 # PAN_TILT_SIM_WHEELS (where wheels built from source are kept),
+# PAN_TILT_SIM_PYBULLET: auto (default) or upstream (never pybullet-arm64),
 # PAN_TILT_SIM_INTERFACES: auto (default: `test` builds the interface
 # packages, `runtime` uses whatever is built), build (`runtime` builds them
 # too, installing requirements-build.txt) or skip (never build);
@@ -83,22 +87,80 @@ sys.exit(not os.path.exists(os.path.join(sysconfig.get_paths()["include"], "Pyth
     echo "${missing[*]}"
 }
 
-# The requirement line for a package in requirements.txt, comment and spaces
-# stripped (none: fail).
+# The requirement line for a package in requirements.txt, comment, environment
+# marker and spaces stripped (none: fail).
 _pts_requirement() {
     local line
     line=$(grep -E -m1 "^[[:space:]]*$1([^[:alnum:]_.-]|\$)" "$REPO/requirements.txt") || return 1
     line=${line%%#*}
+    line=${line%%;*}
     echo "${line//[[:space:]]/}"
 }
 
-# Install requirements.txt's PyBullet from a wheel: PyPI's, or one built here
-# before; where there is none for this Python, build it from the sdist once,
-# into $_PTS_WHEELS, saying so first and showing that it goes on.
+# PyBullet's two distributions (requirements.txt, docs/install.md): both
+# install the module `pybullet`, into the same files, so a venv holds one.
+_PTS_PYBULLET_DISTRIBUTIONS=(pybullet pybullet-arm64)
+
+# What PAN_TILT_SIM_PYBULLET asks for: auto (default) or upstream.
+_pts_pybullet_wish() {
+    local want=${PAN_TILT_SIM_PYBULLET:-auto}
+    case $want in
+        auto|upstream) echo "$want" ;;
+        *) _pts_die "PAN_TILT_SIM_PYBULLET is auto or upstream, not '$want'" ;;
+    esac
+}
+
+# What decides which PyBullet the venv gets: the wish and both requirement
+# lines. A change to it reinstalls PyBullet (the stamp below).
+_pts_pybullet_key() {
+    { _pts_pybullet_wish; grep -E '^[[:space:]]*pybullet' "$REPO/requirements.txt"; } | _pts_hash
+}
+
+# _pts_pybullet_wheel SPEC [FIND_LINKS]: install SPEC from a wheel, on PyPI
+# (or in FIND_LINKS), in place of whichever PyBullet distributions the venv
+# has: both are removed first (with both installed, removing one would take
+# the module's files from the other). Fails, leaving none installed, when
+# there is no wheel for this Python and platform; any other failure (no
+# network, say) ends the script.
+_pts_pybullet_wheel() {
+    local spec=$1 links=() errors
+    [[ -n ${2:-} ]] && links=(--find-links "$2")
+    "$VENV/bin/python" -m pip uninstall --quiet --disable-pip-version-check --yes \
+        "${_PTS_PYBULLET_DISTRIBUTIONS[@]}" >/dev/null 2>&1 || true
+    errors=$("$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --no-deps \
+        --only-binary=:all: "${links[@]}" "$spec" 2>&1) && return 0
+    grep -q 'No matching distribution' <<<"$errors" && return 1
+    echo "$errors" >&2
+    _pts_die "installing $spec failed"
+}
+
+# Install PyBullet 3.2.7's source as ONE distribution (requirements.txt says
+# which and why):
+#  1. upstream's own wheel, where PyPI has one for this Python and platform;
+#  2. else pybullet-arm64's wheel (the same source rebuilt), where PyPI has one,
+#     unless PAN_TILT_SIM_PYBULLET=upstream;
+#  3. else upstream's, from a wheel built here before or, where there is none
+#     for this Python, built from the sdist once into $_PTS_WHEELS, saying so
+#     first and showing that it goes on.
 _pts_pybullet() {
-    local spec version lock_fd errors build_deps=() tmp log heartbeat status=0 started missing
-    local elapsed
+    local spec fork version lock_fd build_deps=() tmp log heartbeat status=0 started missing
+    local elapsed stamp=$VENV/.pan_tilt_sim-pybullet key
     spec=$(_pts_requirement pybullet) || return 0
+    _pts_pybullet_wish >/dev/null
+    key=$(_pts_pybullet_key)
+    [[ "$(cat "$stamp" 2>/dev/null)" == "$key" ]] && return 0
+    if _pts_pybullet_wheel "$spec"; then
+        echo "$key" >"$stamp"
+        return 0
+    fi
+    if [[ $(_pts_pybullet_wish) == auto ]] && fork=$(_pts_requirement pybullet-arm64) \
+            && _pts_pybullet_wheel "$fork"; then
+        _pts_say "$spec has no wheel for Python $(pts_python_version "$VENV/bin/python") here:" \
+            "installed $fork, its source rebuilt (docs/install.md; PAN_TILT_SIM_PYBULLET=upstream" \
+            "builds upstream's instead)"
+        echo "$key" >"$stamp"
+        return 0
+    fi
     mkdir -p -- "$_PTS_WHEELS"
     # One build at a time per wheel folder (two venvs being made at once).
     exec {lock_fd}>"$_PTS_WHEELS/.lock"
@@ -106,15 +168,10 @@ _pts_pybullet() {
         _pts_say "waiting for another install to finish with $_PTS_WHEELS"
         flock "$lock_fd"
     fi
-    if errors=$("$VENV/bin/python" -m pip install --quiet --disable-pip-version-check \
-            --no-deps --only-binary=:all: --find-links "$_PTS_WHEELS" "$spec" 2>&1); then
+    if _pts_pybullet_wheel "$spec" "$_PTS_WHEELS"; then
         exec {lock_fd}>&-
+        echo "$key" >"$stamp"
         return 0
-    fi
-    # Anything but "no wheel" (no network, say) is not fixed by building.
-    if ! grep -q 'No matching distribution' <<<"$errors"; then
-        echo "$errors" >&2
-        _pts_die "installing $spec failed"
     fi
     version=$(pts_python_version "$VENV/bin/python")
     missing=$(_pts_missing_build_packages)
@@ -171,10 +228,19 @@ _pts_pybullet() {
     elapsed=$((SECONDS - started))
     _pts_say "built PyBullet in $((elapsed / 60)) min $((elapsed % 60)) s;" \
         "kept in $_PTS_WHEELS"
-    "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --no-deps \
-            --only-binary=:all: --find-links "$_PTS_WHEELS" "$spec" \
+    _pts_pybullet_wheel "$spec" "$_PTS_WHEELS" \
         || _pts_die "installing the PyBullet wheel built in $_PTS_WHEELS failed"
     exec {lock_fd}>&-
+    echo "$key" >"$stamp"
+}
+
+# _pts_without_pybullet DIR: copy the requirements files into DIR, with
+# requirements.txt's PyBullet lines left out (_pts_pybullet installs one of
+# them); the files' own -r references then resolve inside DIR.
+_pts_without_pybullet() {
+    cp -- "$REPO"/requirements*.txt "$1"/
+    grep -v -E '^[[:space:]]*pybullet([^[:alnum:]_.]|$)' "$REPO/requirements.txt" \
+        >"$1/requirements.txt" || true
 }
 
 _pts_hash() { sha256sum | cut -d' ' -f1; }
@@ -244,7 +310,7 @@ _pts_interfaces() {
 }
 
 prepare_venv() {
-    local mode=$1 reqs deps_hash deps_stamp src_hash src_stamp
+    local mode=$1 reqs deps_hash deps_stamp src_hash src_stamp tmp
     case $mode in
         runtime) reqs=$REPO/requirements.txt ;;
         test) reqs=$REPO/requirements-test.txt ;;
@@ -266,13 +332,19 @@ prepare_venv() {
     deps_hash=$(cat "$REPO/requirements.txt" "$REPO/requirements-test.txt" \
         "$REPO/requirements-build.txt" "$REPO/requirements-viewer.txt" | _pts_hash)
     deps_stamp=$VENV/.pan_tilt_sim-deps-$mode
+    # PyBullet first, on its own stamp: PAN_TILT_SIM_PYBULLET changes it too.
+    _pts_pybullet
     if [[ "$(cat "$deps_stamp" 2>/dev/null)" != "$deps_hash" \
             && "$(cat "$VENV/.pan_tilt_sim-deps-test" 2>/dev/null)" != "$deps_hash" ]]; then
-        _pts_pybullet
         _pts_say "installing dependencies from ${reqs#"$REPO"/} (first run: about a minute)"
-        "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check \
-                --find-links "$_PTS_WHEELS" -r "$reqs" \
-            || _pts_die "installing dependencies failed"
+        tmp=$(mktemp -d "${TMPDIR:-/tmp}/pan_tilt_sim-requirements.XXXXXX")
+        _pts_without_pybullet "$tmp"
+        if ! "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check \
+                -r "$tmp/${reqs##*/}"; then
+            rm -rf -- "$tmp"
+            _pts_die "installing dependencies failed"
+        fi
+        rm -rf -- "$tmp"
         echo "$deps_hash" >"$deps_stamp"
     fi
 

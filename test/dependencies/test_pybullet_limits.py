@@ -19,6 +19,7 @@ import textwrap
 import pytest
 
 from pan_tilt_sim.model.urdf import MAX_MASS, MAX_NAME_BYTES
+from pan_tilt_sim.sim.bullet import pybullet
 
 CHILD_BUDGET_S = 60.0
 # What each child does first: connect, gravity, load the robot in argv[1] as the simulator does.
@@ -153,11 +154,18 @@ def test_pybullet_silently_drops_a_cycle_that_hangs_off_nothing(tmp_path):
 
 def test_pybullet_loads_an_orphan_alone_beside_a_cycle_through_the_root_and_may_then_die(
         tmp_path):
-    """The cycle is dropped, and what is left of it in PyBullet's memory can kill the process."""
+    """The cycle is dropped, and what is left of it in PyBullet's memory can kill the process.
+
+    When depends on the heap's layout: a build with NumPy support (upstream's
+    wheels, ours built from source) has reported by then; pybullet-arm64's
+    wheels, built without it, can die before reporting, as the length of the
+    file's path decides.
+    """
     urdf = robot(link('a'), link('b'), link('c'), joint('j1', 'a', 'b'), joint('j2', 'b', 'a'))
     child = run_child(tmp_path, urdf, LOAD_AND_LIST)
-    assert result(child, then_may_crash=True) == {'joints': []}
     assert child.returncode in (0, -signal.SIGSEGV, -signal.SIGABRT)
+    if pybullet.isNumpyEnabled() or child.returncode == 0 or 'RESULT ' in child.stdout:
+        assert result(child, then_may_crash=True) == {'joints': []}
 
 
 # --- joint types and axes ------------------------------------------------------------------
