@@ -451,7 +451,7 @@ class _Reader:
         if shape.tag == 'box':
             return Shape(origin, Geometry('box', size=self.vector(shape, 'size', ZERO_VECTOR,
                                                                    owner)), rgba)
-        if shape.tag in ('cylinder', 'sphere'):
+        if shape.tag in ('cylinder', 'sphere', 'capsule'):  # capsule: PyBullet's extension
             return Shape(origin, Geometry(shape.tag,
                                           radius=self.number(shape, 'radius', 0.0, owner),
                                           length=self.number(shape, 'length', 0.0, owner)),
