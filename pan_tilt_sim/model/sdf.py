@@ -527,6 +527,8 @@ class ModelConverter:
                                              f'{where}: <inertial><inertia>')
             origin = self.placed(inertial.find('pose'), contents, frame, info.scope,
                                  f'{where}: <inertial>')
+        if self.static:  # PyBullet's static body: mass 0 (its meshes collide as triangles)
+            mass, moments = 0.0, dict.fromkeys(moments, 0.0)
         out_inertial = ElementTree.SubElement(out, 'inertial')
         origin_element(out_inertial, origin)
         ElementTree.SubElement(out_inertial, 'mass', value=repr(mass))
