@@ -2,8 +2,9 @@
 
 :func:`rover_sdf` is a small differential-drive robot as gz-sim users write
 them: a chassis box, two revolute wheels whose joints sit where the wheels
-turn, a ball-jointed caster, a gpu_lidar on a mast, an IMU, gz-sim's
-DiffDrive and JointStatePublisher systems.  :func:`cylinders_world` is an
+turn, a ball-jointed caster behind them that carries part of the weight, a
+gpu_lidar on a mast, an IMU, gz-sim's DiffDrive and JointStatePublisher
+systems.  :func:`cylinders_world` is an
 SDF world with a ground plane and static cylinders.
 """
 
@@ -63,7 +64,7 @@ def rover_sdf(*, version: str = '1.9', name: str = 'sdf_rover', lidar_noise: flo
   <model name="{name}">
     <link name="chassis">
       <pose>0 0 0 0 0 0</pose>
-      <inertial><pose>0 0 {CHASSIS_HEIGHT} 0 0 0</pose><mass>4.0</mass>
+      <inertial><pose>{CASTER_X / 3} 0 {CHASSIS_HEIGHT} 0 0 0</pose><mass>4.0</mass>
         <inertia><ixx>0.03</ixx><iyy>0.06</iyy><izz>0.07</izz></inertia></inertial>
       <collision name="body">
         <pose>0 0 {CHASSIS_HEIGHT} 0 0 0</pose>

@@ -689,6 +689,8 @@ class ModelConverter:
         origin_element(out, inverse(frames[parent]).then(frames[child]))
         ElementTree.SubElement(out, 'parent', link=parent)
         ElementTree.SubElement(out, 'child', link=child)
+        if kind == SPHERICAL:  # no axis of its own; PyBullet's reader warns without one
+            ElementTree.SubElement(out, 'axis', xyz='0 0 1')
         if kind in ('fixed', SPHERICAL):
             return
         axis = self.axis(axis_element, full, info, where)

@@ -142,7 +142,8 @@ def parse_xml(urdf_xml: str, source: pathlib.Path) -> ElementTree.Element:
         raise DescriptionError(f'{source}:{line}: not well-formed XML: {err.msg}') from None
     if root.tag != URDF_ROOT_TAG:
         raise DescriptionError(
-            f'{source}: not a URDF: the root element is <{root.tag}>, expected <{URDF_ROOT_TAG}>')
+            f'{source}: not a URDF: the root element is <{root.tag}>, expected <{URDF_ROOT_TAG}> '
+            '(or an SDF: <sdf>)')
     return root
 
 
