@@ -125,6 +125,14 @@ def is_fuel_uri(uri: str) -> bool:
     return uri.startswith(FUEL_SCHEMES) and '/models/' in uri
 
 
+def fuel_model_name(uri: str) -> str:
+    """Return the model name of a Fuel URI, lower case (``Ground Plane`` -> ``ground plane``)."""
+    parts = [urllib.parse.unquote(part) for part in urllib.parse.urlparse(uri).path.split('/')
+             if part]
+    index = parts.index('models') if 'models' in parts else len(parts)
+    return parts[index + 1].lower() if index + 1 < len(parts) else ''
+
+
 def fuel_cache_folder(uri: str) -> pathlib.Path:
     """Return the folder of the local Fuel cache where the model ``uri`` names would be.
 

@@ -57,6 +57,9 @@ KNOWN_CLASSIC_PLUGINS = ('libgazebo_ros_init.so', 'libgazebo_ros_factory.so',
                          'libgazebo_ros_api_plugin.so', 'libgazebo_ros_paths_plugin.so')
 SYSTEM_PREFIXES = ('gz-sim-', 'libgz-sim-', 'ignition-gazebo-', 'libignition-gazebo-',
                    'gz-sim8-', 'gz-sim7-')
+# Fuel models read by their name when not in the local cache (lower case).
+FUEL_GROUND_PLANES = ('ground plane', 'ground_plane')
+FUEL_LIGHTS = ('sun',)
 GROUND_PLANE = object()  # what an <include> of a ground plane model reads as
 GROUND_TOLERANCE = 1e-9  # m, rad: how close to z = 0, facing up, a ground plane must be
 
@@ -164,6 +167,13 @@ class _WorldReader:
         """Return the included model's spec, GROUND_PLANE, or None (skipped, with a warning)."""
         uri = (element.findtext('uri') or '').strip()
         where = f'<include><uri>{uri}</uri>'
+        if sdf_resources.is_fuel_uri(uri) and sdf_resources.resolve_fuel_uri(uri) is None:
+            # Gazebo's own two, which every Fuel-based world includes: known without a download.
+            name = sdf_resources.fuel_model_name(uri)
+            if name in FUEL_GROUND_PLANES and element.find('pose') is None:
+                return GROUND_PLANE
+            if name in FUEL_LIGHTS:
+                return None
         try:
             model, folder, version = _included_model(element, self.path, self.path.parent)
         except DescriptionError as err:

@@ -172,3 +172,12 @@ def test_yaml_worlds_and_sceneries_still_work(tmp_path):
     assert world_from_parameter('ground').scenery == GROUND
     path = write(tmp_path / 'w.yaml', 'scenery: empty\nentities: []\n')
     assert world_from_parameter(str(path)).scenery == EMPTY
+
+
+def test_fuels_ground_plane_and_sun_are_known_without_the_cache(tmp_path, monkeypatch):
+    monkeypatch.setenv('GZ_FUEL_CACHE_PATH', str(tmp_path / 'empty_cache'))
+    body = ('<include><uri>https://fuel.gazebosim.org/1.0/OpenRobotics/models/Ground Plane</uri>'
+            '</include><include><uri>https://fuel.gazebosim.org/1.0/OpenRobotics/models/Sun'
+            '</uri></include>')
+    loaded = read(tmp_path, world(body))
+    assert (loaded.scenery, loaded.entities, loaded.warnings) == (GROUND, (), ())
