@@ -13,7 +13,6 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import io
-import os
 import pathlib
 import xml.etree.ElementTree as ElementTree
 from collections.abc import Sequence
@@ -21,16 +20,15 @@ from xml.parsers.expat import ExpatError
 
 from pan_tilt_sim.errors import DescriptionError, one_line
 from pan_tilt_sim.model.inertials import complete_inertials
-from pan_tilt_sim.model.resources import localize_meshes
-from pan_tilt_sim.model.robot import JointSpec, RobotModel
+from pan_tilt_sim.model.resources import localize_meshes, mesh_cache_dir
+from pan_tilt_sim.model.robot import JointKind, JointSpec, RobotModel
+from pan_tilt_sim.model.sdf import is_sdf_text, sdf_robot_to_urdf
 from pan_tilt_sim.model.urdf import parse_xml, read_model
 
 XACRO_SUFFIX = '.xacro'
 MAPPING_SEPARATOR = ':='
 # Lines xacro adds after a warning to say where it was.
 XACRO_LOCATION_PREFIXES = ('when processing file:', 'included from:')
-# Converted meshes are kept between runs (keyed on content) under the user cache.
-MESH_CACHE_SUBDIR = pathlib.Path('pan_tilt_sim', 'meshes')
 
 
 @dataclasses.dataclass(frozen=True)
@@ -173,6 +171,8 @@ def description_from_text(urdf_xml: str, source: str,
 
 def _description(urdf_xml: str, source: pathlib.Path, base_dir: pathlib.Path,
                  warnings: tuple[str, ...]) -> RobotDescription:
+    if is_sdf_text(urdf_xml):
+        urdf_xml, warnings = sdf_as_urdf(urdf_xml, source, base_dir, warnings)
     root = parse_xml(urdf_xml, source)
     model = read_model(root, source)
     if not model.actuated_joints:
@@ -181,11 +181,34 @@ def _description(urdf_xml: str, source: pathlib.Path, base_dir: pathlib.Path,
     physics_urdf, physics_warnings = physics_copy(root, model, base_dir, source)
     return RobotDescription(
         model=model,
-        urdf_xml=urdf_xml,
+        urdf_xml=published_urdf(urdf_xml, model),
         physics_urdf=physics_urdf,
         source=source,
         warnings=warnings + physics_warnings,
     )
+
+
+def sdf_as_urdf(text: str, source: pathlib.Path, base_dir: pathlib.Path,
+                warnings: tuple[str, ...] = ()) -> tuple[str, tuple[str, ...]]:
+    """Return the URDF an SDF robot becomes (:mod:`pan_tilt_sim.model.sdf`), and the warnings."""
+    conversion = sdf_robot_to_urdf(text, source, base_dir)
+    return conversion.urdf_xml, warnings + conversion.warnings
+
+
+def published_urdf(urdf_xml: str, model: RobotModel) -> str:
+    """Return the URDF robot_description publishes: ``urdf_xml``, its ball joints made fixed.
+
+    A ball joint (PyBullet's ``spherical``, from an SDF) is no URDF joint type
+    robot_state_publisher and RViz know; as a fixed joint they show its link
+    where it is mounted.
+    """
+    if not any(joint.kind is JointKind.SPHERICAL for joint in model.joints):
+        return urdf_xml
+    root = ElementTree.fromstring(urdf_xml)
+    for element in root.findall('joint'):
+        if element.get('type') == JointKind.SPHERICAL.value:
+            element.set('type', JointKind.FIXED.value)
+    return ElementTree.tostring(root, encoding='unicode')
 
 
 def physics_copy(root: ElementTree.Element, model: RobotModel, base_dir: pathlib.Path,
@@ -221,12 +244,6 @@ def unit_axes(root: ElementTree.Element, model: RobotModel) -> None:
         joint = model.joint(element.get('name', ''))
         if axis is not None and joint.kind.is_actuated:
             axis.set('xyz', ' '.join(repr(value) for value in joint.axis))
-
-
-def mesh_cache_dir() -> pathlib.Path:
-    """Return where converted meshes are cached (``$XDG_CACHE_HOME`` or ``~/.cache``)."""
-    base = os.environ.get('XDG_CACHE_HOME') or pathlib.Path.home() / '.cache'
-    return pathlib.Path(base) / MESH_CACHE_SUBDIR
 
 
 def _expat_reason(err: ExpatError) -> str:

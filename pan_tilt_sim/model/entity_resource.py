@@ -2,7 +2,8 @@
 
 ``simulation_interfaces/srv/SpawnEntity`` names its resource by ``uri``
 (``package://``, ``file://`` or a path; a ``.xacro`` file is expanded without
-arguments) or gives it inline as ``resource_string`` (URDF text).  This
+arguments) or gives it inline as ``resource_string`` (URDF or SDF text; an
+SDF model becomes URDF as the robot's does, :mod:`pan_tilt_sim.model.sdf`).  This
 module reads it with the robot's own parser (:mod:`pan_tilt_sim.model.urdf`)
 and makes PyBullet's copy the same way (:mod:`pan_tilt_sim.model.resources`),
 but an object may have no movable joint at all (a box).  Every failure is an
@@ -10,7 +11,7 @@ but an object may have no movable joint at all (a box).  Every failure is an
 which of the standard's result codes it is:
 
 * ``NOT_FOUND``: the URI names no file (or an unknown package);
-* ``UNSUPPORTED_FORMAT``: not URDF (an ``.sdf``/``.usd`` file, an ``<sdf>`` root);
+* ``UNSUPPORTED_FORMAT``: neither URDF nor SDF (a ``.usd`` file, another root element);
 * ``PARSE_ERROR``: not well-formed XML, or a URDF the parser refuses;
 * ``MISSING_ASSETS``: a mesh it names does not exist;
 * ``UNSUPPORTED_ASSETS``: a mesh PyBullet cannot be given (unknown format, garbage);
@@ -48,11 +49,13 @@ from pan_tilt_sim.model.description import (
     read_description_xml,
 )
 from pan_tilt_sim.model.resources import mesh_elements, resolve_resource
+from pan_tilt_sim.model.sdf import SDF_ROOT_TAG, sdf_robot_to_urdf
 from pan_tilt_sim.model.urdf import URDF_ROOT_TAG, parse_xml, read_model
 
 URDF_SUFFIX = '.urdf'
-SUPPORTED_SUFFIXES = (URDF_SUFFIX, XACRO_SUFFIX)
-FORMAT = 'urdf'  # the standard's lower-case name of the one format spawned
+SDF_SUFFIX = '.sdf'
+SUPPORTED_SUFFIXES = (URDF_SUFFIX, SDF_SUFFIX, XACRO_SUFFIX)
+FORMATS = ('urdf', 'sdf')  # the standard's lower-case names of the formats spawned
 STRING_SOURCE = pathlib.Path('<resource_string>')
 TRUE_TEXTS = ('true', '1')
 MAX_ENTITY_BYTES = 1 << 20  # 1 MiB of URDF text (UTF-8)
@@ -107,7 +110,7 @@ def read_entity_resource(uri: str = '', resource_string: str = '', *,
         if path.suffix.lower() not in SUPPORTED_SUFFIXES:
             raise EntityResourceError(
                 ResourceProblem.UNSUPPORTED_FORMAT,
-                f"'{uri}': only URDF can be spawned (.urdf or .xacro), got "
+                f"'{uri}': only URDF and SDF can be spawned (.urdf, .sdf or .xacro), got "
                 f"'{path.suffix or path.name}'")
         if not path.is_file():
             raise EntityResourceError(ResourceProblem.NOT_FOUND,
@@ -167,11 +170,19 @@ def _describe(text: str, source: pathlib.Path, base: pathlib.Path,
         root = ElementTree.fromstring(text)
     except ElementTree.ParseError:
         root = None  # parse_xml says where
+    if root is not None and root.tag == SDF_ROOT_TAG:
+        try:
+            text = sdf_robot_to_urdf(text, source, base).urdf_xml
+        except DescriptionError as err:
+            problem = (ResourceProblem.MISSING_ASSETS if 'no model path' in str(err)
+                       or 'no such file' in str(err) else ResourceProblem.PARSE_ERROR)
+            raise EntityResourceError(problem, str(err)) from None
+        root = ElementTree.fromstring(text)
     if root is not None and root.tag != URDF_ROOT_TAG:
         raise EntityResourceError(
             ResourceProblem.UNSUPPORTED_FORMAT,
-            f'{source}: only URDF can be spawned: the root element is <{root.tag}>, '
-            f'expected <{URDF_ROOT_TAG}>')
+            f'{source}: only URDF and SDF can be spawned: the root element is <{root.tag}>, '
+            f'expected <{URDF_ROOT_TAG}> or <{SDF_ROOT_TAG}>')
     if root is not None:
         _check_size(root, source, limits)
     try:

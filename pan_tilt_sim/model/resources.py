@@ -88,6 +88,8 @@ _COLLADA_POLYGON_PRIMITIVES = ('polylist', 'polygons', 'trifans', 'tristrips')
 CONVERTER_VERSION = b'resources-1'
 """Part of every cache key: bump it when converted output changes."""
 CACHE_DIGEST_CHARS = 16
+# Converted meshes are kept between runs (keyed on content) under the user cache.
+MESH_CACHE_SUBDIR = pathlib.Path('pan_tilt_sim', 'meshes')
 
 
 class _UnusableError(Exception):
@@ -697,3 +699,9 @@ def write_binary_stl(target: pathlib.Path, triangles: np.ndarray) -> None:
         out.write(np.uint32(len(triangles)).tobytes())
         out.write(records.tobytes())
     os.replace(partial, target)
+
+
+def mesh_cache_dir() -> pathlib.Path:
+    """Return where converted meshes are cached (``$XDG_CACHE_HOME`` or ``~/.cache``)."""
+    base = os.environ.get('XDG_CACHE_HOME') or pathlib.Path.home() / '.cache'
+    return pathlib.Path(base) / MESH_CACHE_SUBDIR

@@ -54,6 +54,9 @@ class JointKind(enum.Enum):
     FIXED = 'fixed'
     FLOATING = 'floating'
     PLANAR = 'planar'
+    # PyBullet's three-degree-of-freedom ball joint (SDF's ``ball``; no URDF type of
+    # urdfdom's): it turns freely, no controller drives it and no joint state reports it.
+    SPHERICAL = 'spherical'
 
     @property
     def is_actuated(self) -> bool:
@@ -91,7 +94,7 @@ class Inertial:
 
 @dataclasses.dataclass(frozen=True)
 class Geometry:
-    """A ``<geometry>``: a box (``size``), cylinder (``radius``, ``length``), sphere or mesh.
+    """A ``<geometry>``: box (``size``), cylinder or capsule (``radius``, ``length``), sphere, mesh.
 
     A mesh keeps its ``filename`` as written (``package://...``) and its
     ``scale`` (per axis, applied to the file's own units).
@@ -113,6 +116,8 @@ class Geometry:
             return (self.radius, self.radius, self.length / 2.0)
         if self.kind == 'sphere':
             return (self.radius, self.radius, self.radius)
+        if self.kind == 'capsule':  # a cylinder of ``length`` with hemispheres on its ends
+            return (self.radius, self.radius, self.length / 2.0 + self.radius)
         return None
 
 

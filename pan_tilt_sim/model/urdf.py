@@ -142,7 +142,8 @@ def parse_xml(urdf_xml: str, source: pathlib.Path) -> ElementTree.Element:
         raise DescriptionError(f'{source}:{line}: not well-formed XML: {err.msg}') from None
     if root.tag != URDF_ROOT_TAG:
         raise DescriptionError(
-            f'{source}: not a URDF: the root element is <{root.tag}>, expected <{URDF_ROOT_TAG}>')
+            f'{source}: not a URDF: the root element is <{root.tag}>, expected <{URDF_ROOT_TAG}> '
+            '(or an SDF: <sdf>)')
     return root
 
 
@@ -451,7 +452,7 @@ class _Reader:
         if shape.tag == 'box':
             return Shape(origin, Geometry('box', size=self.vector(shape, 'size', ZERO_VECTOR,
                                                                    owner)), rgba)
-        if shape.tag in ('cylinder', 'sphere'):
+        if shape.tag in ('cylinder', 'sphere', 'capsule'):  # capsule: PyBullet's extension
             return Shape(origin, Geometry(shape.tag,
                                           radius=self.number(shape, 'radius', 0.0, owner),
                                           length=self.number(shape, 'length', 0.0, owner)),

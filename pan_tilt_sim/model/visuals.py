@@ -93,6 +93,16 @@ def shape_mesh(geometry: Geometry, base_dir: pathlib.Path,
         return cylinder_mesh(geometry.radius, geometry.length)
     if geometry.kind == 'sphere':
         return sphere_mesh(geometry.radius)
+    if geometry.kind == 'capsule':  # a cylinder and a sphere on each end
+        parts = [cylinder_mesh(geometry.radius, geometry.length)]
+        for end in (-0.5, 0.5):
+            vertices, faces = sphere_mesh(geometry.radius)
+            parts.append((vertices + np.array([0.0, 0.0, end * geometry.length],
+                                              dtype=vertices.dtype), faces))
+        offsets = np.cumsum([0] + [len(vertices) for vertices, _faces in parts[:-1]])
+        return (np.concatenate([vertices for vertices, _faces in parts]),
+                np.concatenate([faces + offset for (_v, faces), offset in zip(
+                    parts, offsets, strict=True)]).astype(np.uint32))
     if geometry.kind == 'mesh':
         path = resolve_resource(geometry.filename, base_dir)
         cache = {} if files is None else files
@@ -104,7 +114,7 @@ def shape_mesh(geometry: Geometry, base_dir: pathlib.Path,
             faces = faces[:, ::-1].copy()
         return triangles.reshape(-1, 3).astype(np.float32), faces
     raise DescriptionError(f'<{geometry.kind}> is not a URDF geometry (box, cylinder, '
-                           'sphere, mesh)')
+                           'sphere, capsule, mesh)')
 
 
 def placed(vertices: np.ndarray, origin: Transform) -> np.ndarray:

@@ -2,8 +2,9 @@
 
 A scenery name is one of :data:`SCENERIES`: ``empty`` (nothing), ``ground``
 (a ground plane) or ``targets`` (the ground plane and four coloured cubes).
-Anything else is a world file -- a path, ``file://`` or ``package://`` URI --
-in YAML, one entry per object, each what a ``SpawnEntity`` request would
+Anything else is a world file -- a path, ``file://`` or ``package://`` URI:
+an SDF world (``.sdf``, ``.world``, ``.sdf.xacro``; :mod:`pan_tilt_sim.model.sdf_world`),
+or YAML, one entry per object, each what a ``SpawnEntity`` request would
 give::
 
     scenery: ground            # empty | ground | targets (default: ground)
@@ -50,6 +51,12 @@ from typing import Any
 from pan_tilt_sim.errors import ConfigurationError, ParameterError
 from pan_tilt_sim.model import yaml_input
 from pan_tilt_sim.model.resources import resolve_resource
+from pan_tilt_sim.model.sdf_world import (
+    SdfWorldError,
+    WorldPhysics,
+    is_sdf_world_path,
+    read_sdf_world,
+)
 from pan_tilt_sim.model.transforms import (
     IDENTITY_ROTATION,
     ZERO_VECTOR,
@@ -99,6 +106,9 @@ class World:
     scenery: str
     entities: tuple[EntitySpec, ...] = ()
     source: pathlib.Path | None = None  # the world file, if one was given
+    physics: WorldPhysics | None = None  # an SDF world's <physics>; None for the others
+    # What reading it left out (an SDF world's missing models, unknown plugins), one line each.
+    warnings: tuple[str, ...] = ()
 
     @property
     def base_dir(self) -> pathlib.Path:
@@ -121,11 +131,31 @@ def world_from_parameter(value: str) -> World:
         raise ParameterError(
             f"parameter 'world': '{value}' is none of {', '.join(SCENERIES)}, and no world "
             f'file ({path}: no such file)')
+    if is_sdf_world_path(path):
+        return read_sdf_world_file(path)
     return read_world_file(path)
 
 
+<<<<<<< HEAD
 def read_world_file(path: pathlib.Path, max_entities: int = MAX_WORLD_ENTITIES) -> World:
     """Read and check a YAML world file of at most ``max_entities`` objects."""
+=======
+def read_sdf_world_file(path: pathlib.Path) -> World:
+    """Read an SDF world file (:mod:`pan_tilt_sim.model.sdf_world`) into a :class:`World`."""
+    try:
+        found = read_sdf_world(path)
+    except SdfWorldError as err:
+        raise WorldFileError(str(err)) from None
+    entities = tuple(EntitySpec(name=model.name, resource_string=model.urdf_xml,
+                                position=model.position, orientation=model.orientation)
+                     for model in found.models)
+    return World(GROUND if found.ground else EMPTY, entities, path, physics=found.physics,
+                 warnings=found.warnings)
+
+
+def read_world_file(path: pathlib.Path) -> World:
+    """Read and check a YAML world file."""
+>>>>>>> wip/sdf
     try:
         document = yaml_input.load_file(path)
     except yaml_input.YamlInputError as err:

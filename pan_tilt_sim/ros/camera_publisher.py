@@ -63,9 +63,9 @@ def declare_world(node: Node) -> World:
     return world_from_parameter(params.declare(
         node, 'world', params.STRING, DEFAULT_WORLD,
         f"Scenery around the robot: {', '.join(WORLDS)} (ground: a ground plane; targets: "
-        'the ground and coloured target cubes, static; cameras and lidars see them), or a '
+        'the ground and coloured target cubes, static; cameras and lidars see them), a '
         'YAML world file (path, file:// or package:// URI) naming a scenery and URDF objects '
-        'to spawn at start.'))
+        'to spawn at start, or an SDF world (.sdf, .world, .sdf.xacro).'))
 
 
 def declare_camera(node: Node, links: Sequence[str],

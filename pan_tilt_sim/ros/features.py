@@ -19,6 +19,7 @@ from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.base_pose import FIXED_BASE
 from pan_tilt_sim.model.sensors import SensorKind
+from pan_tilt_sim.model.world_file import World
 from pan_tilt_sim.ros.camera_publisher import CameraPublisher, declare_camera, declare_world
 from pan_tilt_sim.ros.robot_state import RobotStatePublisher
 from pan_tilt_sim.ros.sensor_publishers import SensorSet, declare_noise_seed
@@ -37,11 +38,13 @@ class NodeFeatures:
 
     def __init__(self, node: Node, simulation: Simulation, robot_namespace: str, *,
                  gui: bool = False, sensor_namespace: str = '',
-                 publish_description: bool = True, publish_tf_default: bool = True) -> None:
+                 publish_description: bool = True, publish_tf_default: bool = True,
+                 world: World | None = None) -> None:
         description = simulation.description
         model = description.model
         self._time_step = simulation.time_step
-        self.world = declare_world(node)
+        # The world parameter's value, when the caller has read it already.
+        self.world = world if world is not None else declare_world(node)
         world = self.world.scenery
         if not simulation.physics.fixed_base and not has_ground(world):
             raise ParameterError(

@@ -154,14 +154,24 @@ class SimParameters:
     record_sensors: bool
 
 
-def declare_parameters(node: Node, *, controller_manager: bool = False) -> SimParameters:
+def declare_parameters(node: Node, *, controller_manager: bool = False,
+                       world_physics: Any = None) -> SimParameters:
     """Declare every parameter on ``node`` and return their checked values.
+
+    ``world_physics`` (an SDF world's :class:`~pan_tilt_sim.model.sdf_world.WorldPhysics`)
+    gives ``time_step`` and ``real_time_factor`` their defaults where it sets them.
 
     ``controller_manager``: the node runs in ros2_control_node's place
     (see :mod:`pan_tilt_sim.ros.drop_in`): other defaults, and the
     parameters that ros2_control_node's own ones replace are refused.
     """
-    values = {spec.name: declare(node, spec.name, spec.type, spec.default, spec.description,
+    defaults = {}
+    if world_physics is not None:
+        defaults = {name: value for name, value in (
+            ('time_step', world_physics.time_step),
+            ('real_time_factor', world_physics.real_time_factor)) if value is not None}
+    values = {spec.name: declare(node, spec.name, spec.type,
+                                 defaults.get(spec.name, spec.default), spec.description,
                                  read_only=spec.read_only)
               for spec in _specs(controller_manager)}
     values['xacro_args'] = tuple(values['xacro_args'])
@@ -269,3 +279,33 @@ def _describe(value: Any) -> str:
     kind = {bool: 'bool', int: 'integer', float: 'double', str: 'string'}.get(
         type(value), type(value).__name__)
     return f'{kind} {value!r}'
+
+
+def given_parameters(node: Node) -> set[str]:
+    """Return the names of the parameters the user set (command line, launch, overrides)."""
+    # rclpy keeps them in the node; it has no public accessor.
+    return set(getattr(node, '_parameter_overrides', {}) or {})
+
+
+
+def world_physics_line(physics: Any, settings: SimParameters, given: set[str]) -> str:
+    """Say, in one line, which of an SDF world's ``<physics>`` values and the parameters won.
+
+    ``physics`` is a :class:`~pan_tilt_sim.model.sdf_world.WorldPhysics` (or
+    None: '' is returned, as when the world says nothing).
+    """
+    if physics is None:
+        return ''
+    said = []
+    for name, value, unit in (('time_step', physics.time_step, ' s'),
+                              ('real_time_factor', physics.real_time_factor, '')):
+        if value is None:
+            continue
+        if name in given:
+            said.append(f"{name} {getattr(settings, name):g}{unit} (the parameter; the world's "
+                        f'<physics> says {value:g}{unit})')
+        else:
+            said.append(f"{name} {value:g}{unit} (the world's <physics>)")
+    if physics.solver_iterations is not None:
+        said.append(f"{physics.solver_iterations} solver iterations (the world's <iters>)")
+    return 'physics: ' + '; '.join(said) if said else ''

@@ -41,6 +41,7 @@ from pan_tilt_sim.ros import (
     topic_hardware,
     view_feed,
 )
+from pan_tilt_sim.ros.camera_publisher import declare_world
 from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.controller_bindings import ControllerBindings
 from pan_tilt_sim.ros.features import NodeFeatures
@@ -136,8 +137,18 @@ class SimNode(Node):
 
     def _start(self, physics_thread: bool, overrides: Sequence[Parameter]) -> None:
         """Read the parameters; build now from a file, or once the robot_description topic says."""
+        # The world first: an SDF world's <physics> gives time_step and real_time_factor
+        # their defaults (the user's parameters win), so that the parameters say what runs.
+        self._world = declare_world(self)
+        for line in self._world.warnings:
+            self.get_logger().warning(line)
         self.settings = parameters.declare_parameters(
-            self, controller_manager=self.is_controller_manager)
+            self, controller_manager=self.is_controller_manager,
+            world_physics=self._world.physics)
+        physics_line = parameters.world_physics_line(self._world.physics, self.settings,
+                                                     parameters.given_parameters(self))
+        if physics_line:
+            self.get_logger().info(physics_line)
         self._manager_settings = (
             drop_in.declare_manager_parameters(self, self._arguments, overrides)
             if self.is_controller_manager else None)
@@ -176,6 +187,7 @@ class SimNode(Node):
             self.is_controller_manager) else naming.resolve_robot_namespace(
             self.get_namespace(), self.settings.robot_namespace,
             controllers.namespace, description.plugin_namespace)
+        world = self._world
         self.simulation = Simulation(
             description, controllers, self.settings.time_step, gui=self.settings.gui,
             active_controllers=(None if self._topic_settings is not None
@@ -184,6 +196,8 @@ class SimNode(Node):
             autostart_controllers=(self._topic_settings is not None
                                    or self.settings.autostart_controllers),
             fixed_base=self.settings.fixed_base, initial_pose=self.settings.initial_pose)
+        if world.physics is not None and world.physics.solver_iterations is not None:
+            self.simulation.physics.set_solver_iterations(world.physics.solver_iterations)
         if self.settings.record:
             # Before the first publisher: /clock, the state topics and TF are all recorded.
             self.recorder = Recorder(
@@ -228,7 +242,7 @@ class SimNode(Node):
             self, self.simulation, self.robot_namespace, gui=self.settings.gui,
             sensor_namespace=naming.normalize(self.get_namespace())
             or naming.normalize(self.settings.robot_namespace),
-            publish_description=not from_topic,
+            publish_description=not from_topic, world=world,
             publish_tf_default=not self.is_controller_manager)
         self._start_controller_manager(controllers)
         self._publish_clock()

@@ -69,7 +69,7 @@ NAMESPACE_PARAMETER = 'simulation_interfaces.namespace'
 PRIVATE = '~'
 DEFAULT_NAMESPACE = PRIVATE
 WORLD_FRAME = 'world'
-SPAWN_FORMATS = ['urdf']
+SPAWN_FORMATS = ['urdf', 'sdf']
 QUIT_GRACE_S = 0.1  # wall time between QUITTING's answer and the shutdown (DDS delivers it)
 # GetSpawnables with no sources: the objects this package ships.
 SPAWNABLES_FOLDER = pathlib.PurePosixPath('urdf', 'objects')

@@ -77,6 +77,7 @@ from pan_tilt_sim.sim.physics import (
     BASE_LINK_INDEX,
     Physics,
     apply_surface_friction,
+    free_ball_joints,
     link_indices,
 )
 from pan_tilt_sim.sim.stability import ObjectTrials
@@ -566,12 +567,15 @@ class Entities:
         joints = pybullet.getNumJoints(body, physicsClientId=client)
         names = [pybullet.getJointInfo(body, index, physicsClientId=client)[1].decode()
                  for index in range(joints)]
-        if joints:
+        balls = free_ball_joints(body, client)
+        single = [index for index in range(joints) if index not in balls]
+        if single:
             friction = {joint.name: joint.friction for joint in resource.joints}
             pybullet.setJointMotorControlArray(
-                body, list(range(joints)), pybullet.VELOCITY_CONTROL,
-                targetVelocities=[0.0] * joints,
-                forces=[friction.get(joint, 0.0) for joint in names], physicsClientId=client)
+                body, single, pybullet.VELOCITY_CONTROL,
+                targetVelocities=[0.0] * len(single),
+                forces=[friction.get(names[index], 0.0) for index in single],
+                physicsClientId=client)
         static = fixed or pybullet.getDynamicsInfo(
             body, BASE_LINK_INDEX, physicsClientId=client)[DYNAMICS_MASS] == 0.0
         category = Category.STATIC_OBJECT if static else Category.DYNAMIC_OBJECT

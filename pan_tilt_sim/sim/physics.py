@@ -118,6 +118,7 @@ EXPLICIT_DAMPING_SHARE = 0.1
 # fractions of its range (0 = lower, 1 = upper), or at these angles without limits.
 RANGE_FRACTIONS = (0.5, 0.25, 0.75)
 FREE_POSES = (0.0, math.pi / 2.0, -math.pi / 2.0)
+BALL_DOFS = 3  # a spherical joint's velocity columns
 NO_MOTOR = 0.0  # force 0 removes a joint's motor row from PyBullet's solver
 MOTOR_VELOCITY_GAIN = 1.0  # a velocity motor that reaches its target in one step if it can
 # A free base's six degrees of freedom come first in PyBullet's mass matrix.
@@ -186,6 +187,25 @@ def apply_surfaces(client: int, body: int, model: RobotModel) -> None:
                                     physicsClientId=client)
 
 
+def free_ball_joints(body: int, client: int) -> list[int]:
+    """Take the motor PyBullet puts on each ball joint of ``body``; return their indices.
+
+    PyBullet holds a spherical joint at its start with a motor (as it does a
+    revolute one); a ball joint turns freely, as SDF's and Gazebo's does.
+    """
+    found = []
+    for index in range(pybullet.getNumJoints(body, physicsClientId=client)):
+        if pybullet.getJointInfo(body, index, physicsClientId=client)[2] != (
+                pybullet.JOINT_SPHERICAL):
+            continue
+        pybullet.setJointMotorControlMultiDof(
+            body, index, pybullet.POSITION_CONTROL, targetPosition=[0.0, 0.0, 0.0, 1.0],
+            targetVelocity=[0.0, 0.0, 0.0], positionGain=0.0, velocityGain=0.0,
+            force=[0.0, 0.0, 0.0], physicsClientId=client)
+        found.append(index)
+    return found
+
+
 def link_indices(body: int, client: int) -> dict[str, int]:
     """Return PyBullet's index of every link of ``body``, by URDF name (the base: -1)."""
     base = pybullet.getBodyInfo(body, physicsClientId=client)[0].decode('utf-8')
@@ -249,6 +269,7 @@ class Physics:
         self._mimics = mimic_couplings(self._joints, description.source)
         self.velocity_cap = velocity_cap(self._joints)
         self._remove_hidden_damping()
+        self._balls = free_ball_joints(self._body, self._client)
         apply_surface_friction(self._body, self._link_indices,
                                description.model.link_frictions, self._client)
         self._couple_mimic_joints(index_of)
@@ -480,6 +501,9 @@ class Physics:
         for index, position in zip(self._indices, positions, strict=True):
             pybullet.resetJointState(
                 self._body, index, position, targetVelocity=0.0, physicsClientId=self._client)
+        for index in self._balls:  # ball joints back to their mounting, at rest
+            pybullet.resetJointStateMultiDof(self._body, index, [0.0, 0.0, 0.0, 1.0],
+                                             [0.0, 0.0, 0.0], physicsClientId=self._client)
         self._drives.restart()
 
     def trial(self, steps: int) -> tuple[int, list] | None:
@@ -514,7 +538,7 @@ class Physics:
         """
         if positions is None:
             positions = [state[STATE_POSITION] for state in self.read_states()]
-        dofs = [0.0] * len(self._dof_indices)
+        dofs = [0.0] * self._dof_count
         for index, position in zip(self._indices, positions, strict=True):
             dofs[self._dof_indices[index]] = position
         matrix = numpy.array(pybullet.calculateMassMatrix(
@@ -544,7 +568,7 @@ class Physics:
             return [0.0] * len(self._indices)
         if positions is None:
             positions = [state[STATE_POSITION] for state in self.read_states()]
-        dofs = [0.0] * len(self._dof_indices)
+        dofs = [0.0] * self._dof_count
         for index, position in zip(self._indices, positions, strict=True):
             dofs[self._dof_indices[index]] = position
         zeros = [0.0] * len(dofs)
@@ -554,6 +578,11 @@ class Physics:
         except pybullet.error:
             return [0.0] * len(self._indices)
         return [torques[self._dof_indices[index]] for index in self._indices]
+
+    def set_solver_iterations(self, iterations: int) -> None:
+        """Set PyBullet's constraint solver iterations per step (an SDF world's ``<iters>``)."""
+        pybullet.setPhysicsEngineParameter(numSolverIterations=int(iterations),
+                                           physicsClientId=self._client)
 
     def close(self) -> None:
         """Disconnect the PyBullet client and remove temporary files (idempotent)."""
@@ -605,12 +634,15 @@ class Physics:
         client = self._client
         base = pybullet.getBodyInfo(self._body, physicsClientId=client)[0].decode('utf-8')
         joints, links, dofs = {}, {base: BASE_LINK_INDEX}, {}
+        self._dof_count = 0
         for index in range(pybullet.getNumJoints(self._body, physicsClientId=client)):
             info = pybullet.getJointInfo(self._body, index, physicsClientId=client)
             joints[info[1].decode('utf-8')] = index
             links[info[12].decode('utf-8')] = index  # a joint's child link has its index
             if info[3] >= 0:  # qIndex: the joint has a degree of freedom
-                dofs[index] = len(dofs)
+                dofs[index] = self._dof_count
+                # uIndex columns: a ball joint (SDF's, PyBullet's spherical) turns in three.
+                self._dof_count += BALL_DOFS if info[2] == pybullet.JOINT_SPHERICAL else 1
         return joints, links, dofs
 
     def _remove_hidden_damping(self) -> None:

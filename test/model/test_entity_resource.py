@@ -65,17 +65,22 @@ def test_meshes_are_made_loadable_relative_to_the_file(tmp_path, repo_root):
 
 
 def test_each_failure_has_its_problem(tmp_path):
-    sdf = tmp_path / 'model.sdf'
-    sdf.write_text('<sdf/>')
+    usd = tmp_path / 'model.usd'
+    usd.write_text('#usda 1.0')
     garbage = tmp_path / 'garbage.stl'
     garbage.write_bytes(b'not a mesh')
     assert _problem() is ResourceProblem.NOT_FOUND
     assert _problem(uri=str(tmp_path / 'missing.urdf')) is ResourceProblem.NOT_FOUND
     assert _problem(uri='package://no_such_package/x.urdf') is ResourceProblem.NOT_FOUND
     assert _problem(uri='http://example.com/x.urdf') is ResourceProblem.NOT_FOUND
-    assert _problem(uri=str(sdf)) is ResourceProblem.UNSUPPORTED_FORMAT
-    assert _problem(resource_string='<sdf version="1.9"/>') is (
-        ResourceProblem.UNSUPPORTED_FORMAT)
+    assert _problem(uri=str(usd)) is ResourceProblem.UNSUPPORTED_FORMAT
+    assert _problem(resource_string='<mujoco model="m"/>') is ResourceProblem.UNSUPPORTED_FORMAT
+    assert _problem(resource_string='<sdf version="1.3"><model name="m"/></sdf>') is (
+        ResourceProblem.PARSE_ERROR)
+    assert _problem(resource_string='<sdf version="1.9"><model name="m"><link name="l">'
+                    '<collision name="c"><geometry><mesh><uri>model://gone/m.stl</uri></mesh>'
+                    '</geometry></collision></link></model></sdf>') is (
+        ResourceProblem.MISSING_ASSETS)
     assert _problem(resource_string='<robot name="x"><link') is ResourceProblem.PARSE_ERROR
     assert _problem(resource_string='<robot><link name="a"/></robot>') is (
         ResourceProblem.PARSE_ERROR)  # no name
@@ -91,6 +96,18 @@ def test_each_failure_has_its_problem(tmp_path):
 def test_gazebo_static_marks_an_object_fixed():
     assert is_static(read_entity_resource(resource_string=box_urdf(static=True)))
     assert not is_static(read_entity_resource(resource_string=box_urdf()))
+
+
+def test_an_sdf_model_is_spawned_as_the_urdf_it_becomes(tmp_path):
+    path = tmp_path / 'crate.sdf'
+    path.write_text('<sdf version="1.9"><model name="crate"><static>true</static>'
+                    '<link name="box"><collision name="c"><geometry><box><size>1 1 1</size>'
+                    '</box></geometry></collision></link></model></sdf>')
+    for description in (read_entity_resource(uri=str(path)),
+                        read_entity_resource(resource_string=path.read_text())):
+        assert description.model.name == 'crate'
+        assert description.model.links[0].collisions[0].geometry.size == (1.0, 1.0, 1.0)
+        assert is_static(description)
 
 
 # --- limits: what one object may be --------------------------------------------------------

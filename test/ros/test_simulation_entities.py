@@ -163,18 +163,17 @@ def test_an_object_pybullet_would_crash_on_is_refused_and_the_node_goes_on(sim):
 
 
 def test_each_refusal_has_its_code(sim, tmp_path):
-    sdf = tmp_path / 'model.sdf'
-    sdf.write_text('<sdf version="1.7"><model name="m"/></sdf>')
+    usd = tmp_path / 'model.usd'
+    usd.write_text('#usda 1.0')
     cases = [
         (sim.spawn('x'), Spawn.NO_RESOURCE),
-        (sim.spawn('x', uri=str(sdf)), Spawn.UNSUPPORTED_FORMAT),
-        (sim.spawn('x', resource_string='<sdf version="1.7"><model name="m"/></sdf>'),
-         Spawn.UNSUPPORTED_FORMAT),
+        (sim.spawn('x', uri=str(usd)), Spawn.UNSUPPORTED_FORMAT),
+        (sim.spawn('x', resource_string='<mujoco model="m"/>'), Spawn.UNSUPPORTED_FORMAT),
         (sim.spawn('x', uri=str(tmp_path / 'missing.urdf')), Result.RESULT_NOT_FOUND),
         (sim.spawn('x', uri='package://no_such_package/box.urdf'), Result.RESULT_NOT_FOUND),
         (sim.spawn('x', resource_string=box_urdf(mesh=str(tmp_path / 'gone.stl'))),
          Spawn.MISSING_ASSETS),
-        (sim.spawn('x', resource_string=box_urdf(mesh=str(sdf))), Spawn.UNSUPPORTED_ASSETS),
+        (sim.spawn('x', resource_string=box_urdf(mesh=str(usd))), Spawn.UNSUPPORTED_ASSETS),
         (sim.spawn('x', resource_string=box_urdf(),
                    at=pose(orientation=(0.0, 0.0, 0.0, 0.0))), Spawn.INVALID_POSE),
         (sim.spawn('x', resource_string=box_urdf(), at=pose(float('nan'))), Spawn.INVALID_POSE),

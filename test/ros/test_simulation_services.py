@@ -93,7 +93,7 @@ def test_features_are_what_is_implemented_and_nothing_else(paused):
                     Features.WORLD_LOADING, Features.WORLD_RESOURCE_STRING,
                     Features.AVAILABLE_WORLDS):
         assert missing not in claimed
-    assert list(features.spawn_formats) == ['urdf']
+    assert list(features.spawn_formats) == ['urdf', 'sdf']
     assert f'{TIME_STEP} s' in features.custom_info
 
 

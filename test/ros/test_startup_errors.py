@@ -25,6 +25,7 @@ from pan_tilt_sim.errors import (
     DescriptionError,
     ParameterError,
 )
+from pan_tilt_sim.model.world_file import WorldFileError
 from pan_tilt_sim.ros.sim_node import SimNode
 from pan_tilt_sim.share import package_share
 
@@ -60,7 +61,17 @@ _ABC = (*_AB, _link('c'))
 # Files the cases below point at, written into a temporary folder per test.
 FILES = {
     'not_xml.urdf': 'hello, this is not XML\n',
-    'sdf.urdf': '<sdf version="1.6"><model name="m"/></sdf>\n',
+    'mjcf.urdf': '<mujoco model="m"/>\n',
+    'old.sdf': '<sdf version="1.3"><model name="m"><link name="a"/></model></sdf>\n',
+    'two_models.sdf': '<sdf version="1.9"><model name="m"><link name="a"/></model>'
+                      '<model name="n"><link name="b"/></model></sdf>\n',
+    'ghost_link.sdf': '<sdf version="1.9"><model name="m"><link name="a"/>'
+                      '<joint name="j" type="revolute"><parent>a</parent><child>ghost</child>'
+                      '</joint></model></sdf>\n',
+    'missing_include.sdf': '<sdf version="1.9"><model name="m"><link name="a"/><include>'
+                           '<uri>model://no_such_model</uri></include></model></sdf>\n',
+    'bad_world.sdf': '<sdf version="1.9"><world name="w"><physics><max_step_size>zero'
+                     '</max_step_size></physics></world></sdf>\n',
     'binary.urdf': b'\xff\xfe\x00\x01binary',
     'syntax.xacro': _XACRO_HEAD + '<link name="a">\n</robot>\n',
     'undefined_property.xacro': _XACRO_HEAD + '<link name="${no_such_property}"/>\n</robot>\n',
@@ -169,8 +180,24 @@ CASES = [
           DescriptionError, '{dir}', 'is a directory'),
     _case('description not XML', {'robot_description_file': '{dir}/not_xml.urdf'},
           DescriptionError, '{dir}/not_xml.urdf:1', 'not well-formed XML'),
-    _case('description not URDF', {'robot_description_file': '{dir}/sdf.urdf'},
-          DescriptionError, '{dir}/sdf.urdf', 'not a URDF', '<sdf>'),
+    _case('description neither URDF nor SDF', {'robot_description_file': '{dir}/mjcf.urdf'},
+          DescriptionError, '{dir}/mjcf.urdf', 'not a URDF', '<mujoco>'),
+    # SDF robots and worlds.
+    _case('SDF version not supported', {'robot_description_file': '{dir}/old.sdf'},
+          DescriptionError, '{dir}/old.sdf: <sdf version="1.3">: SDFormat version 1.3 is not '
+          'supported'),
+    _case('SDF with several models', {'robot_description_file': '{dir}/two_models.sdf'},
+          DescriptionError, '{dir}/two_models.sdf: <sdf>: a robot is one top-level <model>, '
+          'found 2'),
+    _case('SDF joint naming a missing link', {'robot_description_file': '{dir}/ghost_link.sdf'},
+          DescriptionError, '{dir}/ghost_link.sdf: <joint name="j">: <child>ghost</child> is '
+          'not a link of the model'),
+    _case('SDF include of a missing model',
+          {'robot_description_file': '{dir}/missing_include.sdf'}, DescriptionError,
+          "{dir}/missing_include.sdf: <include><uri>model://no_such_model</uri>: model "
+          "'no_such_model' is in no model path"),
+    _case('SDF world physics not a number', {'world': '{dir}/bad_world.sdf'},
+          WorldFileError, '{dir}/bad_world.sdf: <physics name="">: <max_step_size>zero'),
     _case('description unreadable bytes', {'robot_description_file': '{dir}/binary.urdf'},
           DescriptionError, '{dir}/binary.urdf', 'cannot read'),
     _case('xacro syntax error', {'robot_description_file': '{dir}/syntax.xacro'},

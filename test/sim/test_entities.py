@@ -396,3 +396,20 @@ def test_the_robot_can_be_moved_and_a_reset_puts_it_back(pan_tilt):
     assert link[:2] == pytest.approx((1.0, 2.0), abs=0.05)  # its links went along
     entities.reset_state()
     assert entities.state(robot).pose.translation == pytest.approx((0.0, 0.0, 0.0))
+
+
+def test_a_static_sdf_mesh_is_hit_where_its_triangles_are_not_on_its_hull(pan_tilt, tmp_path):
+    # Two parallel walls 2 m apart as one mesh: a convex hull would fill the gap between them.
+    (tmp_path / 'walls.obj').write_text(
+        'v -1 -1 0\nv 1 -1 0\nv 1 -1 1\nv -1 -1 1\nv -1 1 0\nv 1 1 0\nv 1 1 1\nv -1 1 1\n'
+        'f 1 2 3\nf 1 3 4\nf 5 7 6\nf 5 8 7\n')
+    sdf = ('<sdf version="1.9"><model name="walls"><static>true</static><link name="l">'
+           '<collision name="c"><geometry><mesh><uri>walls.obj</uri></mesh></geometry>'
+           '</collision></link></model></sdf>')
+    simulation, entities = pan_tilt
+    entities.spawn('walls', resource_string=sdf, base_dir=tmp_path,
+                   pose=Transform((10.0, 0.0, 0.0)))
+    client = simulation.physics.client_id
+    hit = pybullet.rayTest((10.0, 0.0, 0.5), (10.0, 5.0, 0.5), physicsClientId=client)[0]
+    assert hit[0] == entities.get('walls').body
+    assert hit[3] == pytest.approx((10.0, 1.0, 0.5), abs=1e-3)

@@ -1,6 +1,7 @@
-"""Fuzzing the load path: any URDF starts with finite states or is refused in one line.
+"""Fuzzing the load path: any URDF or SDF starts with finite states or is refused in one line.
 
-Whatever description :func:`urdf_strategies.robots` draws, starting a
+Whatever description :func:`urdf_strategies.robots` (or, for SDF,
+:func:`sdf_strategies.sdf_robots`) draws, starting a
 simulation of it (as sim_node does) and spawning it as an object (as
 SpawnEntity does) either works -- every joint state and the object's pose
 still finite after a few hundred steps -- or ends in a ConfigurationError
@@ -27,6 +28,7 @@ import tempfile
 import pytest
 import sim_process
 from hypothesis import HealthCheck, event, given, settings
+from sdf_strategies import FuzzSdf, sdf_robots
 from urdf_strategies import FuzzRobot, robots
 
 SLOW_ENV = 'PAN_TILT_SIM_SLOW'
@@ -146,6 +148,22 @@ def test_any_description_loads_with_finite_states_or_is_refused_in_one_line(work
     assert loaded['outcome'] in ROBOT_OUTCOMES, loaded.get('traceback')
     assert spawned['outcome'] in OBJECT_OUTCOMES, spawned.get('traceback')
     for what, part in (('robot', loaded), ('object', spawned)):
+        if part['outcome'] == 'refused':
+            _one_line(part, what)
+        else:
+            assert part['finite'], f'the {what} has a NaN or infinite state'
+
+
+@settings(max_examples=_examples() // 2, deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(robot=sdf_robots())
+def test_any_sdf_robot_loads_with_finite_states_or_is_refused_in_one_line(worker,
+                                                                          robot: FuzzSdf):
+    answer = worker.run(robot.request(STEPS))
+    for what, part, outcomes in (('robot', answer['robot'], ROBOT_OUTCOMES),
+                                 ('object', answer['object'], OBJECT_OUTCOMES)):
+        event(f"{what}: {part['outcome']}")
+        assert part['outcome'] in outcomes, part.get('traceback')
         if part['outcome'] == 'refused':
             _one_line(part, what)
         else:

@@ -191,3 +191,38 @@ def test_message_lines_merge_split_messages_and_drop_repeats_and_the_banner():
             'b3Warning[b.cpp,3]:\nBad inertia\nb3Error[c.cpp,4]:\nboom\n')
     assert message_lines(text) == [
         "link 'tool0': No inertial data for link, using mass=1", 'Bad inertia', 'boom']
+
+
+BALL_PENDULUM_SDF = '''<sdf version="1.9"><model name="pendulum">
+  <link name="base"><inertial><mass>1</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy>
+    <izz>0.01</izz></inertia></inertial></link>
+  <link name="bob"><pose>0.3 0 1 0 0 0</pose><inertial><mass>1</mass><inertia><ixx>0.001</ixx>
+    <iyy>0.001</iyy><izz>0.001</izz></inertia></inertial></link>
+  <link name="arm"><inertial><mass>1</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy>
+    <izz>0.01</izz></inertia></inertial></link>
+  <joint name="ball" type="ball"><parent>base</parent><child>bob</child>
+    <pose>-0.3 0 0 0 0 0</pose></joint>
+  <joint name="turn" type="revolute"><parent>base</parent><child>arm</child>
+    <axis><xyz>0 0 1</xyz><limit><lower>-1</lower><upper>1</upper></limit></axis></joint>
+</model></sdf>'''
+
+
+def test_an_sdf_ball_joint_swings_freely_in_three_degrees_of_freedom(tmp_path):
+    path = tmp_path / 'pendulum.sdf'
+    path.write_text(BALL_PENDULUM_SDF)
+    with Physics(load_description(path), 0.001) as physics:
+        client, body = physics.client_id, physics.body_id
+        start = pybullet.getLinkState(body, physics.link_index('bob'),
+                                      physicsClientId=client)[0]
+        assert start == pytest.approx((0.3, 0.0, 1.0), abs=1e-6)
+        for _ in range(300):
+            pybullet.stepSimulation(physicsClientId=client)
+        # Held out sideways from its pivot, the bob falls: a welded or motor-held ball stays.
+        x, _y, z = pybullet.getLinkState(body, physics.link_index('bob'),
+                                         physicsClientId=client)[0]
+        assert z < 0.85 and math.hypot(x + 0.0, z - 1.0) == pytest.approx(0.3, abs=1e-3)
+        # The revolute joint's column comes after the ball's three: its arm's own 0.01 kg m^2.
+        assert physics.effective_inertias() == pytest.approx([0.01])
+        physics.reset_joints()
+        assert pybullet.getLinkState(body, physics.link_index('bob'), physicsClientId=client)[
+            0] == pytest.approx((0.3, 0.0, 1.0), abs=1e-6)
