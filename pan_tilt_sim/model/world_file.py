@@ -136,16 +136,16 @@ def world_from_parameter(value: str) -> World:
     return read_world_file(path)
 
 
-<<<<<<< HEAD
-def read_world_file(path: pathlib.Path, max_entities: int = MAX_WORLD_ENTITIES) -> World:
-    """Read and check a YAML world file of at most ``max_entities`` objects."""
-=======
-def read_sdf_world_file(path: pathlib.Path) -> World:
-    """Read an SDF world file (:mod:`pan_tilt_sim.model.sdf_world`) into a :class:`World`."""
+def read_sdf_world_file(path: pathlib.Path, max_entities: int = MAX_WORLD_ENTITIES) -> World:
+    """Read an SDF world file of at most ``max_entities`` models into a :class:`World`."""
     try:
         found = read_sdf_world(path)
     except SdfWorldError as err:
         raise WorldFileError(str(err)) from None
+    if len(found.models) > max_entities:
+        raise WorldFileError(
+            f'{path}: <world>: {len(found.models)} models; a world file may hold at most '
+            f'{max_entities} (see docs/simulator-control.md)')
     entities = tuple(EntitySpec(name=model.name, resource_string=model.urdf_xml,
                                 position=model.position, orientation=model.orientation)
                      for model in found.models)
@@ -153,9 +153,8 @@ def read_sdf_world_file(path: pathlib.Path) -> World:
                  warnings=found.warnings)
 
 
-def read_world_file(path: pathlib.Path) -> World:
-    """Read and check a YAML world file."""
->>>>>>> wip/sdf
+def read_world_file(path: pathlib.Path, max_entities: int = MAX_WORLD_ENTITIES) -> World:
+    """Read and check a YAML world file of at most ``max_entities`` objects."""
     try:
         document = yaml_input.load_file(path)
     except yaml_input.YamlInputError as err:

@@ -10,7 +10,13 @@ from sdf_fixtures import box_model_sdf, cylinders_world, model_folder, write
 
 from pan_tilt_sim.model.sdf_world import WorldPhysics, is_sdf_world_path
 from pan_tilt_sim.model.urdf import parse_urdf
-from pan_tilt_sim.model.world_file import EMPTY, GROUND, WorldFileError, world_from_parameter
+from pan_tilt_sim.model.world_file import (
+    EMPTY,
+    GROUND,
+    WorldFileError,
+    read_sdf_world_file,
+    world_from_parameter,
+)
 
 
 def world_file(folder: pathlib.Path, text: str, name: str = 'world.sdf') -> pathlib.Path:
@@ -181,3 +187,11 @@ def test_fuels_ground_plane_and_sun_are_known_without_the_cache(tmp_path, monkey
             '</uri></include>')
     loaded = read(tmp_path, world(body))
     assert (loaded.scenery, loaded.entities, loaded.warnings) == (GROUND, (), ())
+
+
+def test_an_sdf_world_past_the_object_limit_ends_start_up_naming_the_limit(tmp_path):
+    path = world_file(tmp_path, cylinders_world([(1.0, 0.0, 0.2), (2.0, 0.0, 0.2),
+                                                 (3.0, 0.0, 0.2)]))
+    assert len(read_sdf_world_file(path, max_entities=3).entities) == 3
+    with pytest.raises(WorldFileError, match='3 models; a world file may hold at most 2'):
+        read_sdf_world_file(path, max_entities=2)
