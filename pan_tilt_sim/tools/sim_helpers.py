@@ -194,7 +194,7 @@ class SimHelpers:
     # --- time -------------------------------------------------------------------------------
 
     def step(self, seconds: float) -> None:
-        """Run ``seconds`` of sim time, letting the test's nodes take every message on the way."""
+        """Run ``seconds`` of sim time (in whole steps); the test's nodes take every message."""
         steps = self._steps(seconds)
         turn = self._steps(self._turn)
         self._settle()
