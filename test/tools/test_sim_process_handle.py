@@ -11,6 +11,10 @@ from pan_tilt_sim.tools.pytest_plugin import SimFactory
 from pan_tilt_sim.tools.sim_process_handle import parameter_argument
 
 PAN_COMMAND = '/ex_urdf_pan_tilt/joint1_position_controller/command'
+ROVER = 'package://pan_tilt_sim/urdf/diff_drive_rover.urdf'
+ARM = 'package://pan_tilt_sim/urdf/three_joint_arm.xacro'
+ARM_CONTROLLERS = 'package://pan_tilt_sim/config/three_joint_arm_controllers.yaml'
+ARM_JOINTS = ('shoulder_joint', 'extend_joint', 'wrist_joint')
 BOX = ('<robot name="box"><link name="box"><inertial><mass value="1"/><inertia ixx="0.01" '
        'iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry>'
        '<box size="0.2 0.2 0.2"/></geometry></collision></link></robot>')
@@ -55,3 +59,19 @@ def test_closing_stops_the_program(request):
     s = factory()
     factory.close()
     assert s.process.returncode is not None
+
+
+def test_drive_over_dds_returns_the_true_pose_and_the_odometry(sim_process):
+    s = sim_process(robot=ROVER)
+    end = s.drive('cmd_vel', 0.3, 0.0, 1.5)
+    assert s.time == pytest.approx(1.5, abs=0.011)
+    assert 0.2 < end.pose.position.x < 0.5
+    assert end.odometry.pose.pose.position.x == pytest.approx(end.pose.position.x, abs=0.05)
+
+
+def test_follow_joint_trajectory_over_dds(sim_process):
+    s = sim_process(robot=ARM, controllers=ARM_CONTROLLERS)
+    result = s.follow_joint_trajectory('arm_controller', [(1.0, (0.6, 0.1, 1.0))])
+    assert result.error_code == 0, result.error_string
+    reached = s.joint_positions()
+    assert [reached[j] for j in ARM_JOINTS] == pytest.approx((0.6, 0.1, 1.0), abs=0.03)
