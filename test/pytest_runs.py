@@ -27,10 +27,10 @@ def spare_domain_base() -> int:
     return SPARE_DOMAIN_BASE + 2 * (os.getpid() % SPARE_DOMAIN_PAIRS)
 
 
-def run_pytest(folder: pathlib.Path, *args: str, env: dict[str, str] | None = None
-               ) -> subprocess.CompletedProcess:
+def run_pytest(folder: pathlib.Path, *args: str, env: dict[str, str] | None = None,
+               unset: tuple[str, ...] = ()) -> subprocess.CompletedProcess:
     """Run pytest in ``folder`` (its own rootdir, no cache) and return what it did."""
-    environment = dict(os.environ)
+    environment = {name: value for name, value in os.environ.items() if name not in unset}
     environment['PYTHONPATH'] = os.pathsep.join(
         [str(TEST_DIR), *filter(None, environment.get('PYTHONPATH', '').split(os.pathsep))])
     environment.pop(pytest_plugin.RECORD_FAILED, None)

@@ -12,9 +12,11 @@ Installed with the package and inert until a test asks for its fixtures:
 * ``sim_process``: the same helpers for sim_node started as a program
   (:mod:`pan_tilt_sim.tools.sim_process_handle`).
 
-Under pytest-xdist each worker gets a ROS domain of its own:
-``ROS_DOMAIN_ID`` = the base (``--ros-domain-base``, else the controller's
-``ROS_DOMAIN_ID``, else 0) + the worker's number.  With
+In a session whose tests use these fixtures, DDS stays on loopback unless
+``ROS_AUTOMATIC_DISCOVERY_RANGE`` says otherwise, and under pytest-xdist each
+worker gets a ROS domain of its own: ``ROS_DOMAIN_ID`` = the base
+(``--ros-domain-base``, else the controller's ``ROS_DOMAIN_ID``, else 0) +
+the worker's number.  Other sessions are left as they are.  With
 ``--sim-record-failed=<folder>`` or ``PAN_TILT_SIM_RECORD_FAILED=<folder>``
 every simulation records its run as a rosbag2 bag; the bags of passing
 tests are removed, a failing test's report names its bags.
@@ -38,6 +40,7 @@ MAX_DOMAIN_ID = 232
 _UNSAFE = re.compile(r'[^A-Za-z0-9_.-]+')
 _WORKER_NUMBER = re.compile(r'(\d+)$')
 _BAGS_KEY = pytest.StashKey[list]()
+FIXTURES = {'sim', 'sim_process'}
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -88,17 +91,33 @@ class _XdistController:
 
 
 def pytest_configure(config: pytest.Config) -> None:
-    """Loopback DDS unless told otherwise; under xdist, one ROS domain per worker."""
+    """In xdist's controller: have the workers told the domain base chosen here."""
+    if getattr(config, 'workerinput', None) is None and config.pluginmanager.hasplugin('xdist'):
+        config.pluginmanager.register(_XdistController(domain_base(config)),
+                                      'pan_tilt_sim_xdist_domains')
+
+
+def uses_the_plugin(session: pytest.Session) -> bool:
+    """Whether this session asks for the plugin: a test uses its fixtures, or --ros-domain-base."""
+    return session.config.getoption('ros_domain_base') is not None or any(
+        FIXTURES & set(getattr(item, 'fixturenames', ())) for item in session.items)
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_finish(session: pytest.Session) -> None:
+    """Before the first test: loopback DDS unless told otherwise, one domain per xdist worker.
+
+    Only where the session uses the plugin: other projects' test runs stay as they were.
+    """
+    if not uses_the_plugin(session):
+        return
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    workerinput = getattr(config, 'workerinput', None)
+    workerinput = getattr(session.config, 'workerinput', None)
     if workerinput is not None:
         base = workerinput.get('pan_tilt_sim_domain_base')
         if base is None:
-            base = domain_base(config)
+            base = domain_base(session.config)
         os.environ[DOMAIN_ENV] = str(worker_domain(base, workerinput['workerid']))
-    elif config.pluginmanager.hasplugin('xdist'):
-        config.pluginmanager.register(_XdistController(domain_base(config)),
-                                      'pan_tilt_sim_xdist_domains')
 
 
 def record_root(config: pytest.Config) -> Path | None:

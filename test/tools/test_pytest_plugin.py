@@ -55,6 +55,27 @@ def test_under_n_2_the_workers_use_the_base_plus_their_number(tmp_path):
     assert seen == {'gw0': str(base), 'gw1': str(base + 1)}
 
 
+def test_a_session_without_the_fixtures_keeps_its_domain_and_discovery_range(tmp_path):
+    write_tests(tmp_path, 'test_plain.py', '''
+        import os
+
+        import pytest
+
+        @pytest.mark.parametrize('n', range(4))
+        def test_note_domain(n, worker_id):
+            with open(f'domain_{worker_id}_{n}', 'w') as out:
+                out.write(os.environ['ROS_DOMAIN_ID'] + ' '
+                          + os.environ.get('ROS_AUTOMATIC_DISCOVERY_RANGE', 'unset'))
+        ''')
+    domain = str(spare_domain_base())
+    environment = {'ROS_DOMAIN_ID': domain}
+    result = run_pytest(tmp_path, '-n', '2', '--dist', 'load', env=environment,
+                        unset=('ROS_AUTOMATIC_DISCOVERY_RANGE',))
+    assert result.returncode == 0, result.stdout + result.stderr
+    seen = {path.name.split('_')[1]: path.read_text() for path in tmp_path.glob('domain_*')}
+    assert seen == {'gw0': f'{domain} unset', 'gw1': f'{domain} unset'}
+
+
 def test_a_failed_tests_run_is_kept_as_a_bag_and_named_in_its_report(tmp_path):
     write_tests(tmp_path, 'test_bags.py', '''
         def test_fails(sim):
