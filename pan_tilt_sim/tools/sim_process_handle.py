@@ -32,6 +32,7 @@ from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
+from pan_tilt_sim.model.transforms import quaternion_from_rpy
 from pan_tilt_sim.tools.sim_helpers import (
     DEFAULT_TURN_S,
     SimHelpers,
@@ -180,12 +181,18 @@ class SimProcessHandle(SimHelpers):
 
     def spawn(self, uri: str = '', *, name: str = '', resource_string: str = '',
               position: tuple[float, float, float] = (0.0, 0.0, 0.0),
-              frame: str = '', allow_renaming: bool = False) -> str:
-        """Put a URDF object into the world (spawn_entity); return its name."""
+              rpy: tuple[float, float, float] = (0.0, 0.0, 0.0), frame: str = '',
+              allow_renaming: bool = False) -> str:
+        """Put a URDF object into the world (spawn_entity); return its name.
+
+        ``position`` (m) and ``rpy`` (rad) are in ``frame``, as for the in-process handle.
+        """
         request = self._services.SpawnEntity.Request(
             name=name, allow_renaming=allow_renaming, uri=uri, resource_string=resource_string)
         (request.initial_pose.pose.position.x, request.initial_pose.pose.position.y,
          request.initial_pose.pose.position.z) = (float(c) for c in position)
+        orientation = request.initial_pose.pose.orientation
+        orientation.x, orientation.y, orientation.z, orientation.w = quaternion_from_rpy(*rpy)
         request.initial_pose.header.frame_id = frame
         response = self._call('spawn_entity', request)
         if response.result.result != 1:
