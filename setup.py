@@ -87,5 +87,7 @@ setup(
     python_requires='>=3.10',
     entry_points={
         'console_scripts': [f'{name} = {target}' for name, target in EXECUTABLES.items()],
+        # The sim fixtures for users' tests (inert unless a test asks for them).
+        'pytest11': ['pan_tilt_sim = pan_tilt_sim.tools.pytest_plugin'],
     },
 )

@@ -10,20 +10,16 @@ or PlotJuggler.  Nodes made by fixtures wider than one test are not recorded.
 from __future__ import annotations
 
 import os
-import re
 import shutil
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-RECORD_FAILED = 'PAN_TILT_SIM_RECORD_FAILED'
-_UNSAFE = re.compile(r'[^A-Za-z0-9_.-]+')
+# The variable and the folder layout of the installed pytest plugin's sim fixture.
+from pan_tilt_sim.tools.pytest_plugin import RECORD_FAILED, bag_folder_of
 
-
-def bag_folder_of(root: Path, nodeid: str) -> Path:
-    """Return the folder of a test's bags: its node id made a file name."""
-    return root / _UNSAFE.sub('_', nodeid).strip('_')
+__all__ = ['RECORD_FAILED', 'bag_folder_of']
 
 
 @pytest.hookimpl(hookwrapper=True)

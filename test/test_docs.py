@@ -502,6 +502,24 @@ def check_run_tests(command: Command, arguments: tuple[str, ...]) -> None:
             assert (REPO / word).exists(), f'{command.where}: no {word}'
 
 
+@functools.cache
+def pytest_help() -> str:
+    """``pytest --help`` as installed here: with this package's plugin and pytest-xdist."""
+    return subprocess.run([str(BIN / 'pytest'), '--help'], capture_output=True, text=True,
+                          cwd=tempfile.gettempdir(), timeout=RUN_BUDGET_S, check=True).stdout
+
+
+def check_pytest(command: Command, arguments: tuple[str, ...]) -> None:
+    """Each option is one pytest knows (this package's plugin's too); paths exist."""
+    for word in arguments:
+        if word.startswith('-'):
+            option = word.partition('=')[0]
+            assert re.search(rf'(?<![\w-]){re.escape(option)}(?![\w-])', pytest_help()), \
+                f'{command.where}: pytest has no option {option}'
+        elif not re.fullmatch(r'\d+', word):  # an option's number, else a path
+            assert (REPO / word).exists(), f'{command.where}: no {word}'
+
+
 def check_environment(command: Command) -> None:
     """Each variable set before a command is one the package's scripts or tests read."""
     sources = [*(REPO / 'scripts').iterdir(), *(REPO / 'test').glob('*.py'),
@@ -547,6 +565,9 @@ def check(command: Command, setup: Setup, tmp_path: pathlib.Path) -> Setup:
             assert result.returncode == 0, f'{command.where}: {result.stdout}{result.stderr}'
         else:
             check_example(command, setup, rest)
+        return setup
+    if head == '.venv/bin/pytest':
+        check_pytest(command, rest)
         return setup
     if head.startswith('.venv/bin/'):
         check_executable(command, head.rpartition('/')[2], rest, tmp_path)

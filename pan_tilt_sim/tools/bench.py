@@ -69,7 +69,10 @@ than wall time):
 ``--tune`` measures something else instead: evaluations per second of
 ``tune``/``sweep`` on each back end (:mod:`pan_tilt_sim.tools.tune_bench`);
 ``--load``: what spawned objects and world files cost to read, load and step
-(:mod:`pan_tilt_sim.tools.bench_load`).
+(:mod:`pan_tilt_sim.tools.bench_load`); ``--test-session``: a user's pytest
+session, go-to-goal tests each on a fresh ``sim`` fixture, in one process and
+under ``-n 2`` (:mod:`pan_tilt_sim.tools.bench_test_session`; the domain and
+the next one).
 
 If the two raw rates (thread CPU, wall) are more than ``RAW_AGREEMENT``
 apart, a warning on stderr says the run's ratios are not to be trusted.
@@ -1002,6 +1005,10 @@ def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
                         'a temporary folder, removed afterwards)')
     parser.add_argument('--verbose', action='store_true',
                         help="say on stderr what runs, and each run's figures")
+    parser.add_argument('--test-session', action='store_true',
+                        help='measure a pytest session instead: go-to-goal tests of a user '
+                        'package, each on a fresh sim fixture, in one process and under -n 2 '
+                        '(see bench_test_session)')
     parser.add_argument('--tune', action='store_true',
                         help='measure tune/sweep evaluations per second on each back end '
                         'instead (local processes, a two-node Ray cluster; see tune_bench)')
@@ -1031,6 +1038,16 @@ def main(argv: Sequence[str] | None = None) -> None:
         bench_load.main(['--quick'] * args.quick + ['--verbose'] * args.verbose)
         return
     domain_id = args.domain_id if args.domain_id is not None else default_domain_id()
+    if args.test_session:
+        from pan_tilt_sim.tools import bench_test_session
+
+        try:
+            figures = bench_test_session.measure(args.quick, domain_id)
+        except RuntimeError as err:
+            print(f'bench: error: {err}', file=sys.stderr)
+            sys.exit(EXIT_FAILURE)
+        print(json.dumps(rounded(figures)), flush=True)
+        return
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     # The probe lives in this process: the same discovery range as the nodes.

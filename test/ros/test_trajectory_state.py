@@ -29,9 +29,9 @@ QUERY = '/arm_controller/query_state'
 
 
 @pytest.fixture
-def sim():
-    with sim_node(robot_description_file=str(ARM), controllers_file=str(CONTROLLERS)) as sim:
-        yield sim
+def arm():
+    with sim_node(robot_description_file=str(ARM), controllers_file=str(CONTROLLERS)) as arm:
+        yield arm
 
 
 def swing(seconds: float = 2.0) -> JointTrajectory:
@@ -40,26 +40,26 @@ def swing(seconds: float = 2.0) -> JointTrajectory:
         positions=[0.6, 0.1, 1.0], time_from_start=Time(sec=int(seconds)))])
 
 
-def query(sim, seconds: float):
+def query(arm, seconds: float):
     from control_msgs.srv import QueryTrajectoryState
 
     whole = int(seconds)
     request = QueryTrajectoryState.Request(
         time=Time(sec=whole, nanosec=round((seconds - whole) * 1e9)))
-    return sim.call(QueryTrajectoryState, QUERY, request)
+    return arm.call(QueryTrajectoryState, QUERY, request)
 
 
-def test_controller_state_is_published_every_update_with_desired_measured_and_error(sim):
+def test_controller_state_is_published_every_update_with_desired_measured_and_error(arm):
     from control_msgs.msg import JointTrajectoryControllerState
 
-    states = sim.collect(JointTrajectoryControllerState, STATE_TOPIC, PROBE_QUEUE)
-    sim.wait_for_subscribers(STATE_TOPIC)
-    sim.command('arm_controller', swing())
-    sim.run_for(0.5)
+    states = arm.collect(JointTrajectoryControllerState, STATE_TOPIC, PROBE_QUEUE)
+    arm.wait_for_subscribers(STATE_TOPIC)
+    arm.command('arm_controller', swing())
+    arm.run_for(0.5)
     assert len(states) > 10, f'{len(states)} messages on {STATE_TOPIC}'
     stamps = [stamp_s(state) for state in states[-10:]]
     steps = [later - earlier for earlier, later in zip(stamps, stamps[1:], strict=False)]
-    assert steps == pytest.approx([sim.simulation.time_step] * 9)  # every physics step
+    assert steps == pytest.approx([arm.simulation.time_step] * 9)  # every physics step
     last = states[-1]
     assert list(last.joint_names) == JOINTS
     assert 0.0 < last.reference.positions[0] < 0.6  # on its way
@@ -71,11 +71,11 @@ def test_controller_state_is_published_every_update_with_desired_measured_and_er
     assert len(last.output.effort) == 3 and not last.output.positions  # an effort interface
 
 
-def test_query_state_answers_the_desired_state_at_a_time_within_the_trajectory(sim):
-    sim.send_paused('arm_controller', swing())
-    sim.run_for(0.2)
-    controller = sim.simulation.controller('arm_controller')
-    answer = query(sim, 1.5)
+def test_query_state_answers_the_desired_state_at_a_time_within_the_trajectory(arm):
+    arm.send_paused('arm_controller', swing())
+    arm.run_for(0.2)
+    controller = arm.simulation.controller('arm_controller')
+    answer = query(arm, 1.5)
     assert answer.success, answer.message
     assert list(answer.name) == JOINTS
     expected = controller.query_state(1.5)
@@ -85,17 +85,17 @@ def test_query_state_answers_the_desired_state_at_a_time_within_the_trajectory(s
     assert 0.0 < answer.position[0] < 0.6
 
 
-def test_query_state_past_the_end_fails_with_upstreams_text(sim):
-    sim.send_paused('arm_controller', swing(1.0))
-    sim.run_for(0.1)
-    answer = query(sim, 30.0)
+def test_query_state_past_the_end_fails_with_upstreams_text(arm):
+    arm.send_paused('arm_controller', swing(1.0))
+    arm.run_for(0.1)
+    answer = query(arm, 30.0)
     assert not answer.success
     assert answer.message == 'Requested sample time precedes the current trajectory end time.'
 
 
-def test_query_state_fails_while_the_controller_is_inactive(sim):
-    sim.simulation.manager.switch(deactivate=['arm_controller'])
-    answer = query(sim, 0.0)
+def test_query_state_fails_while_the_controller_is_inactive(arm):
+    arm.simulation.manager.switch(deactivate=['arm_controller'])
+    answer = query(arm, 0.0)
     assert not answer.success
     assert answer.message == "Can't sample trajectory. Controller is not active."
-    assert sim.own_services()[QUERY] == 'control_msgs/srv/QueryTrajectoryState'
+    assert arm.own_services()[QUERY] == 'control_msgs/srv/QueryTrajectoryState'
