@@ -136,6 +136,27 @@ def intrinsics(settings: CameraSettings) -> Intrinsics:
     return centred_intrinsics(settings.width, settings.height, focal)
 
 
+# In PyBullet's projection matrix (column-major, 16 values): row 0 and row 1 of column 2.
+PROJECTION_X_SHIFT, PROJECTION_Y_SHIFT = 8, 9
+
+
+def projection_matrix(vertical_fov: float, width: int, height: int, near: float, far: float,
+                      client: int) -> list[float]:
+    """Return PyBullet's projection for ``width`` x ``height`` pixels, centred as the intrinsics.
+
+    TinyRenderer samples pixel ``i`` at normalised device coordinate
+    ``2 i / width - 1`` -- the principal point at ``width / 2``, half a pixel
+    from the ``(width - 1) / 2`` of the intrinsics (:func:`centred_intrinsics`),
+    which CameraInfo publishes; the view shifted by half a pixel in both axes
+    puts it there.  ``vertical_fov`` in degrees.
+    """
+    matrix = list(pybullet.computeProjectionMatrixFOV(vertical_fov, width / height, near, far,
+                                                      physicsClientId=client))
+    matrix[PROJECTION_X_SHIFT] += 1.0 / width
+    matrix[PROJECTION_Y_SHIFT] += 1.0 / height
+    return matrix
+
+
 def vertical_fov_deg(settings: CameraSettings) -> float:
     """Return the vertical field of view (PyBullet's ``fov``) for square pixels."""
     half = math.atan(math.tan(math.radians(settings.fov_deg) / 2.0)
@@ -184,9 +205,9 @@ class Renderer:
         initial = {joint.name: position for joint, position in zip(
             physics.joints, physics.initial_positions, strict=True)}
         self.mount = camera_mount(model, settings.link, initial)
-        self._projection = pybullet.computeProjectionMatrixFOV(
-            vertical_fov_deg(settings), settings.width / settings.height,
-            settings.near, settings.far, physicsClientId=self._client)
+        self._projection = projection_matrix(vertical_fov_deg(settings), settings.width,
+                                             settings.height, settings.near, settings.far,
+                                             self._client)
 
     def render(self) -> bytes:
         """Return an rgb8 image (rows top first) of the world as the physics has it now."""
