@@ -25,7 +25,9 @@ the URDF's joints in the test's own kinematics):
 * the link poses the simulation reports (p3d's and the sensors' source,
   and the entity frames) within 1 mm and 0.1 degree of the truth;
 * the drive's odometry and its odom -> base transform agree exactly, and
-  the odometry stays within :data:`ODOMETRY_DRIFT` of the distance driven.
+  the odometry stays within :data:`ODOMETRY_DRIFT` of the distance driven;
+* the base drives level: the simulation never warns that it leant, tipped
+  over or fell.
 
 A sample of the matrix runs by default (:data:`CI_SAMPLE`, one case per drive,
 under a minute); the whole matrix is opt-in:
@@ -37,6 +39,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import logging
 import math
 import os
 
@@ -384,10 +387,26 @@ class Run:
                              f'{self.driven:.2f} m')
 
 
+class BaseWarnings(logging.Handler):
+    """The simulation's warnings that its base leant, tipped over or fell."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.WARNING)
+        self.lines: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        line = record.getMessage()
+        if any(word in line for word in ('has leant', 'tipped over', 'fell below')):
+            self.lines.append(line)
+
+
 def _run_path(tmp_path, drive: str, root: str, mount: str) -> list[str]:
     urdf, config, world = write_robot(tmp_path, drive, root, mount)
+    warnings = BaseWarnings()
+    logger = logging.getLogger(f'consistency.{drive}.{root}.{mount}')
+    logger.addHandler(warnings)
     simulation = make_simulation(str(urdf), str(config) if config else None, DT,
-                                 fixed_base=None)
+                                 fixed_base=None, logger=logger)
     try:
         entities = Entities(simulation.physics, simulation.description.model.name)
         spawn_world_objects(entities, read_world_file(world))
@@ -413,7 +432,8 @@ def _run_path(tmp_path, drive: str, root: str, mount: str) -> list[str]:
             run.check_odometry(f'{where}, end')
             if last:
                 run.check_force_torque(f'{where}, end')
-        return run.failures
+        # The robots drive level: a base that leans reads the floor, right but not as meant.
+        return run.failures + [f'the base: {line}' for line in warnings.lines]
     finally:
         simulation.close()
 
