@@ -33,7 +33,8 @@ from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.model.transforms import Transform, Vector, quaternion_from_matrix, rotate
 from pan_tilt_sim.sim.bullet import pybullet
-from pan_tilt_sim.sim.physics import BASE_LINK_INDEX, Physics
+from pan_tilt_sim.sim.physics import Physics
+from pan_tilt_sim.sim.sensors.mount import LinkReader
 from pan_tilt_sim.sim.world import DEFAULT_WORLD, GROUND_RGB, has_ground
 
 DEFAULT_LINK = 'tilt_link'
@@ -136,6 +137,27 @@ def intrinsics(settings: CameraSettings) -> Intrinsics:
     return centred_intrinsics(settings.width, settings.height, focal)
 
 
+# In PyBullet's projection matrix (column-major, 16 values): row 0 and row 1 of column 2.
+PROJECTION_X_SHIFT, PROJECTION_Y_SHIFT = 8, 9
+
+
+def projection_matrix(vertical_fov: float, width: int, height: int, near: float, far: float,
+                      client: int) -> list[float]:
+    """Return PyBullet's projection for ``width`` x ``height`` pixels, centred as the intrinsics.
+
+    TinyRenderer samples pixel ``i`` at normalised device coordinate
+    ``2 i / width - 1`` -- the principal point at ``width / 2``, half a pixel
+    from the ``(width - 1) / 2`` of the intrinsics (:func:`centred_intrinsics`),
+    which CameraInfo publishes; the view shifted by half a pixel in both axes
+    puts it there.  ``vertical_fov`` in degrees.
+    """
+    matrix = list(pybullet.computeProjectionMatrixFOV(vertical_fov, width / height, near, far,
+                                                      physicsClientId=client))
+    matrix[PROJECTION_X_SHIFT] += 1.0 / width
+    matrix[PROJECTION_Y_SHIFT] += 1.0 / height
+    return matrix
+
+
 def vertical_fov_deg(settings: CameraSettings) -> float:
     """Return the vertical field of view (PyBullet's ``fov``) for square pixels."""
     half = math.atan(math.tan(math.radians(settings.fov_deg) / 2.0)
@@ -170,12 +192,11 @@ class Renderer:
         self.settings = settings
         self._client = physics.client_id
         try:
-            self._link_index = physics.link_index(settings.link)
+            self._link = LinkReader(physics, settings.link)
         except KeyError:
             raise ParameterError(
                 f"parameter 'camera.link': '{settings.link}' is not a link of the robot "
                 f"(links: {', '.join(model.link_names)})") from None
-        self._body = physics.body_id
         self._ground = has_ground(world)
         camera = intrinsics(settings)
         # Each pixel's viewing ray in optical axes: ((u - cx) / fx, (v - cy) / fy, 1).
@@ -184,9 +205,9 @@ class Renderer:
         initial = {joint.name: position for joint, position in zip(
             physics.joints, physics.initial_positions, strict=True)}
         self.mount = camera_mount(model, settings.link, initial)
-        self._projection = pybullet.computeProjectionMatrixFOV(
-            vertical_fov_deg(settings), settings.width / settings.height,
-            settings.near, settings.far, physicsClientId=self._client)
+        self._projection = projection_matrix(vertical_fov_deg(settings), settings.width,
+                                             settings.height, settings.near, settings.far,
+                                             self._client)
 
     def render(self) -> bytes:
         """Return an rgb8 image (rows top first) of the world as the physics has it now."""
@@ -222,16 +243,13 @@ class Renderer:
         pixels[background & (ray_z * eye[2] < 0.0)] = GROUND_RGB
 
     def link_pose(self) -> Transform:
-        """Return the camera link's pose in the world frame, as the scene has it now."""
-        if self._link_index == BASE_LINK_INDEX:
-            position, orientation = pybullet.getBasePositionAndOrientation(
-                self._body, physicsClientId=self._client)
-        else:
-            state = pybullet.getLinkState(self._body, self._link_index,
-                                          computeForwardKinematics=True,
-                                          physicsClientId=self._client)
-            position, orientation = state[4], state[5]  # the URDF link frame
-        return Transform(tuple(position), tuple(orientation))
+        """Return the camera link's URDF frame in the world, as the scene has it now.
+
+        The root link's too: PyBullet reports a body's base by its centre of
+        mass, which :class:`~pan_tilt_sim.sim.sensors.mount.LinkReader` takes
+        back to the link frame, as for every other sensor.
+        """
+        return self._link.frame()
 
 
 def nothing_drawn(buffer: numpy.ndarray) -> numpy.ndarray:

@@ -25,7 +25,9 @@ joint starts, what PyBullet said while loading the robot, and which PID
 gains are too high for their joint's inertia at this time step
 (:mod:`pan_tilt_sim.sim.stability`).
 While running, a joint at PyBullet's speed cap or with a non-finite state
-gets a warning (at most one per joint per second).
+gets a warning (at most one per joint per second), and so does a free base
+that tipped over or fell below the ground plane; a free base that leans (on
+its nose, say: its sensors tilted with it) gets one warning per lean.
 """
 
 from __future__ import annotations
@@ -74,6 +76,11 @@ LOGGER_NAME = 'pan_tilt_sim'
 AT_CAP = 0.99
 WARNING_THROTTLE_S = 1.0  # wall seconds between two warnings about one joint
 TIPPED_TILT = 60.0  # deg: a free base tilted more than this from upright has tipped over
+# deg and sim seconds: a free base tilted more than LEANING_TILT for LEANING_TIME leans on
+# something besides its wheels (its nose, a side) or stands on a slope; its braking and
+# accelerating rock it by a few degrees for a fraction of a second only.
+LEANING_TILT = 5.0
+LEANING_TIME = 0.5
 BELOW_GROUND = -1.0  # m: a free base frame this far below the ground plane fell off it
 # The fewest steps handed to the compiled laws at once: below it, collecting
 # the laws and taking their state back costs more than the steps save.
@@ -229,6 +236,10 @@ class Simulation:
         self.manager.add_switch_listener(self._apply_actuators)
         self._speed_limit = AT_CAP * self.physics.velocity_cap
         self._last_warning: dict[str, float] = {}
+        # Sim time since which the free base leans, or stands upright; whether the lean was said.
+        self._leaning_since: float | None = None
+        self._upright_since: float | None = None
+        self._lean_reported = False
         self.startup_report = self._startup_report(description, starts, load_messages)
 
     def _apply_actuators(self) -> None:
@@ -515,12 +526,14 @@ class Simulation:
 
         Tipped over: tilted more than :data:`TIPPED_TILT` from upright; fallen:
         its frame below :data:`BELOW_GROUND`.  Instability is never silent, and
-        it does not stop the run.
+        it does not stop the run.  A base that leans (:meth:`_check_lean`) is
+        said once per lean.
         """
         frame = self.physics.base_frame()
         x, y, z = frame.translation
         qx, qy, _qz, _qw = frame.rotation
         tilt = math.degrees(math.acos(max(-1.0, min(1.0, 1.0 - 2.0 * (qx * qx + qy * qy)))))
+        self._check_lean(frame, tilt)
         problems = []
         if tilt > TIPPED_TILT:
             problems.append(('base tipped over',
@@ -536,6 +549,52 @@ class Simulation:
                 f"at sim time {self.time:.3f} s: robot '{self.description.model.name}' {problem} "
                 f'(base at x {x:.2f} m, y {y:.2f} m, z {z:.2f} m); the simulation goes on')
 
+    def _check_lean(self, frame: Transform, tilt: float) -> None:
+        """Warn once when the free base has leant more than LEANING_TILT for LEANING_TIME.
+
+        A base resting on its nose or a side looks right where only x, y and
+        yaw are read (odometry, a planar GetEntityState), but every sensor on
+        it is tilted with it: a level lidar's beams meet the floor at its
+        height / sin(tilt), wherever the robot drives.  The line gives the
+        lean, the links touching the ground and the likely cause; it is
+        said again only after the base stood upright for LEANING_TIME (a base
+        rocking on its nose is one lean).
+        """
+        now = self.time
+        if tilt <= LEANING_TILT:
+            self._leaning_since = None
+            if self._upright_since is None:
+                self._upright_since = now
+            if now - self._upright_since >= LEANING_TIME - DUE_EPSILON:
+                self._lean_reported = False
+            return
+        self._upright_since = None
+        if self._leaning_since is None:
+            self._leaning_since = now
+        if self._lean_reported or now - self._leaning_since < LEANING_TIME - DUE_EPSILON:
+            return
+        self._lean_reported = True
+        if tilt > TIPPED_TILT:
+            return  # the tipped-over warning says it
+        qx, qy, qz, qw = frame.rotation
+        # REP 103 angles of the base: pitch > 0 puts its nose (+x) down, roll > 0 its left up.
+        pitch = math.degrees(math.asin(max(-1.0, min(1.0, 2.0 * (qw * qy - qz * qx)))))
+        roll = math.degrees(math.atan2(2.0 * (qw * qx + qy * qz), 1.0 - 2.0 * (qx * qx + qy * qy)))
+        ways = []
+        if abs(pitch) > LEANING_TILT / 2:
+            ways.append(f"nose {'down' if pitch > 0 else 'up'} {abs(pitch):.0f} deg")
+        if abs(roll) > LEANING_TILT / 2:
+            ways.append(f"{'right' if roll > 0 else 'left'} side down {abs(roll):.0f} deg")
+        touching = ', '.join(self.physics.links_on_ground()) or 'no link on the ground plane'
+        x, y, _ = frame.translation
+        self._logger.warning(
+            f"at sim time {now:.3f} s: robot '{self.description.model.name}' has leant "
+            f"{tilt:.0f} deg from upright for {LEANING_TIME:g} s ({', '.join(ways)}; base at "
+            f"x {x:.2f} m, y {y:.2f} m), touching the ground with: {touching}. Sensors on its "
+            'base are tilted with it (a level lidar sees the floor). On flat ground its centre '
+            'of mass is outside what its wheels and casters hold up, or braking tips it; the '
+            'simulation goes on')
+
     def reset(self, *, reset_time: bool = True) -> None:
         """Put base and joints back at their start, reset controllers; sim time to 0 if asked."""
         for handle in self._handle_list:
@@ -550,6 +609,8 @@ class Simulation:
             self._apply_actuators()
         if reset_time:
             self._steps = 0
+        self._leaning_since = self._upright_since = None
+        self._lean_reported = False
         self.hardware.reset()
 
     def reset_time(self) -> None:
@@ -562,6 +623,11 @@ class Simulation:
         for controller in [*self.plugins, *self.controllers]:
             controller.reset()
         self._steps = 0
+        # A lean, or standing upright, goes on, timed on the new clock.
+        if self._leaning_since is not None:
+            self._leaning_since = 0.0
+        if self._upright_since is not None:
+            self._upright_since = 0.0
         for sensor in self.hardware.interfaces.sensors.values():  # their readings' past is gone
             if sensor.source is not None:
                 sensor.source.reset()

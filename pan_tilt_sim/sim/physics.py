@@ -128,6 +128,7 @@ MEASURING_HEIGHT = 100.0
 # How far below that the closest-point query looks for the ground (m).
 MEASURING_RANGE = 2.0 * MEASURING_HEIGHT
 CLOSEST_DISTANCE = 8  # index of the distance in one of pybullet.getClosestPoints' points
+CONTACT_LINK_A = 3  # index of body A's link in one of pybullet.getContactPoints' points
 DYNAMICS_INERTIAL_POSITION = 3  # pybullet.getDynamicsInfo: the centre of mass in the link frame
 DYNAMICS_INERTIAL_ORIENTATION = 4
 
@@ -390,6 +391,19 @@ class Physics:
     def link_index(self, name: str) -> int:
         """PyBullet's index of the link called ``name`` (-1: the base); KeyError if none."""
         return self._link_indices[name]
+
+    def links_on_ground(self) -> tuple[str, ...]:
+        """Return the robot's links touching the ground plane now, in link order (none: welded).
+
+        From the contacts of the last step: what a free base stands or lies on.
+        """
+        if self.ground is None:
+            return ()
+        touching = {contact[CONTACT_LINK_A] for contact in pybullet.getContactPoints(
+            bodyA=self._body, bodyB=self.ground, physicsClientId=self._client)}
+        return tuple(name for name, index in sorted(self._link_indices.items(),
+                                                    key=lambda item: item[1])
+                     if index in touching)
 
     @property
     def compiled_step(self) -> bool:

@@ -344,3 +344,26 @@ def test_an_unknown_world_is_an_error_naming_the_choices():
 def test_an_integer_fov_is_accepted():
     with sim_node(**{'camera.fov_deg': 90}) as harness:
         assert harness.node.features.camera.settings.fov_deg == 90.0
+
+
+def test_on_the_root_link_the_camera_sits_on_its_frame_not_its_centre_of_mass(tmp_path):
+    # PyBullet reports a body's base by its centre of mass, here 0.3 m from the link frame.
+    urdf = tmp_path / 'offset.urdf'
+    urdf.write_text(
+        '<robot name="offset"><link name="base_link"><inertial><origin xyz="0.3 0 0.1"/>'
+        '<mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/>'
+        '</inertial><visual><geometry><box size="0.1 0.1 0.2"/></geometry></visual></link>'
+        '<joint name="spin" type="revolute"><parent link="base_link"/><child link="arm"/>'
+        '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+        '<link name="arm"><inertial><mass value="0.1"/>'
+        '<inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial>'
+        '</link></robot>', encoding='utf-8')
+    description = load_description(urdf)
+    physics = Physics(description, 0.001)
+    try:
+        renderer = Renderer(physics, description.model, CameraSettings(link='base_link'), 'empty')
+        frame = renderer.link_pose()
+        assert frame.translation == pytest.approx(physics.base_frame().translation, abs=1e-9)
+        assert frame.translation == pytest.approx((0.0, 0.0, 0.0), abs=1e-9)
+    finally:
+        physics.close()

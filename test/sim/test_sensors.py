@@ -28,6 +28,7 @@ from pan_tilt_sim.model.sensors import (
     Noise,
     SensorSpec,
 )
+from pan_tilt_sim.model.transforms import rotation_matrix
 from pan_tilt_sim.sim.engine import Simulation, make_simulation
 from pan_tilt_sim.sim.physics import STANDARD_GRAVITY
 from pan_tilt_sim.sim.sensors.force_torque import ForceTorque
@@ -67,6 +68,31 @@ def test_depth_camera_facing_a_wall_measures_its_distance_within_one_percent(rig
     # Planar depth: the same for every pixel on a wall facing the camera.
     assert numpy.abs(view.depth - WALL_X).max() <= ONE_PERCENT * WALL_X
     assert view.rgb.shape == (48, 64, 3)
+
+
+@pytest.mark.parametrize(('yaw', 'pitch'), [(0.5, 0.0), (0.0, 0.4), (-0.4, -0.3)])
+def test_each_pixel_sees_along_the_ray_its_published_intrinsics_give(rig, yaw, pitch):
+    # Turned to the wall, the depth changes across the image: a pixel that looked half a
+    # pixel off its CameraInfo ray (TinyRenderer's own principal point is w/2, h/2) reads
+    # a depth 2 % off at this size.
+    from dataclasses import replace
+
+    from pan_tilt_sim.model.transforms import Transform, quaternion_from_rpy
+
+    spec = sensor(rig, 'depth_camera')
+    turned = replace(spec, pose=Transform(rotation=quaternion_from_rpy(0.0, pitch, yaw)))
+    camera = VisionSensor(rig.physics, turned, 'empty')
+    optical = numpy.array(rotation_matrix(camera.optical_pose().rotation))
+    intrinsics = camera.intrinsics
+    u, v = numpy.meshgrid((numpy.arange(64) - intrinsics.cx) / intrinsics.fx,
+                          (numpy.arange(48) - intrinsics.cy) / intrinsics.fy)
+    rays = numpy.stack([u, v, numpy.ones_like(u)], axis=-1) @ optical.T  # world, z_optical = 1
+    # The wall's face is the plane x = WALL_X; the camera is at the origin's x.
+    expected = WALL_X / rays[..., 0]
+    view = camera.render()
+    seen = numpy.isfinite(view.depth)
+    assert seen.sum() > 1000
+    assert numpy.abs(view.depth[seen] - expected[seen]).max() <= 1e-3 * WALL_X
 
 
 @pytest.mark.parametrize(('near', 'far'), [(0.01, 100.0), (0.5, 3.0), (1.9, 2.2)])

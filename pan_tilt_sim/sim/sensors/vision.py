@@ -29,7 +29,12 @@ import numpy
 from pan_tilt_sim.model.sensors import CameraSpec, SensorSpec, data_frame
 from pan_tilt_sim.model.transforms import Transform, rotation_matrix
 from pan_tilt_sim.sim.bullet import pybullet
-from pan_tilt_sim.sim.camera import Intrinsics, centred_intrinsics, nothing_drawn
+from pan_tilt_sim.sim.camera import (
+    Intrinsics,
+    centred_intrinsics,
+    nothing_drawn,
+    projection_matrix,
+)
 from pan_tilt_sim.sim.physics import Physics
 from pan_tilt_sim.sim.sensors.mount import LinkReader
 from pan_tilt_sim.sim.sensors.noise import NoiseModel
@@ -80,9 +85,8 @@ class VisionSensor:
         ray_x = (numpy.arange(camera.width) - intrinsics.cx) / intrinsics.fx
         ray_y = (numpy.arange(camera.height) - intrinsics.cy) / intrinsics.fy
         self.ray_x, self.ray_y = numpy.meshgrid(ray_x, ray_y)
-        self._projection = pybullet.computeProjectionMatrixFOV(
-            math.degrees(camera.vertical_fov), camera.width / camera.height, self.near,
-            self.far, physicsClientId=self._client)
+        self._projection = projection_matrix(math.degrees(camera.vertical_fov), camera.width,
+                                             camera.height, self.near, self.far, self._client)
 
     def optical_pose(self) -> Transform:
         """Return the optical frame's pose in the world, as the scene has it now."""
