@@ -36,6 +36,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
 from pan_tilt_sim.errors import ControllerConfigError
+from pan_tilt_sim.model.frame_ids import frame_id_problem
 
 BOOL, INT, DOUBLE, STRING = 'bool', 'int', 'double', 'string'
 BOOL_ARRAY, INT_ARRAY, DOUBLE_ARRAY, STRING_ARRAY = (
@@ -114,6 +115,26 @@ def fixed_size(size: int) -> Validator:
     """Require an array of exactly ``size`` elements."""
     return Validator(f'{size} elements', lambda value: None if len(value) == size else
                      f'must have {size} elements, has {len(value)}')
+
+
+def frame_id() -> Validator:
+    """Require a valid frame id (see :func:`frame_id_problem`)."""
+    return Validator('a frame id', frame_id_problem)
+
+
+def frame_id_or_empty() -> Validator:
+    """Require an empty string (the parameter's fallback) or a valid frame id."""
+    return Validator('empty or a frame id',
+                     lambda value: frame_id_problem(value) if value else None)
+
+
+def frame_id_prefix() -> Validator:
+    """Require an empty prefix or a frame id, with an optional trailing '/'."""
+    def check(value: str) -> str | None:
+        if not value or value == '/':
+            return None
+        return frame_id_problem(value.removesuffix('/') if len(value) > 1 else value)
+    return Validator('empty or a frame id prefix', check)
 
 
 def _each(text: str, accept: Callable[[Any], bool]) -> Validator:

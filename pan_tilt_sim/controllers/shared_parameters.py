@@ -37,6 +37,23 @@ JOINTS = Param('joints', STRING_ARRAY, REQUIRED, 'The joints this controller dri
                'the order of every command.', (not_empty(), names(), unique()), read_only=True,
                example=['joint1'])
 
+# A length or radius whose default 0 means 'not set' (upstream's convention); a negative
+# one has no meaning.
+UNSET_OR_LENGTH = (gt_eq(0.0),)
+
+
+def same_frames_problem(params: Mapping[str, Any]) -> str | None:
+    """Say why ``odom_frame_id`` and ``base_frame_id`` cannot make a transform, or None.
+
+    The odom -> base transform needs two frames; tf2 strips one leading '/'
+    of each, so ``/odom`` and ``odom`` are one frame.  Any prefix is shared.
+    """
+    odom, base = params['odom_frame_id'], params['base_frame_id']
+    if odom.removeprefix('/') == base.removeprefix('/'):
+        return (f"'{base}' is odom_frame_id too: the odom -> base transform needs two "
+                'different frames')
+    return None
+
 
 def pid_gains(prefix: str) -> tuple[Param, ...]:
     """Return the PID gain entries under ``prefix`` (``pid`` or ``gains.__map_joints``).
