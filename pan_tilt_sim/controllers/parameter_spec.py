@@ -36,7 +36,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
 from pan_tilt_sim.errors import ControllerConfigError
-from pan_tilt_sim.model.frame_ids import frame_id_problem
+from pan_tilt_sim.model.frame_ids import FRAME_ID_RULE, frame_id_problem
 
 BOOL, INT, DOUBLE, STRING = 'bool', 'int', 'double', 'string'
 BOOL_ARRAY, INT_ARRAY, DOUBLE_ARRAY, STRING_ARRAY = (
@@ -131,9 +131,9 @@ def frame_id_or_empty() -> Validator:
 def frame_id_prefix() -> Validator:
     """Require an empty prefix or a frame id, with an optional trailing '/'."""
     def check(value: str) -> str | None:
-        if not value or value == '/':
+        if not value or value == '/' or frame_id_problem(value.removesuffix('/')) is None:
             return None
-        return frame_id_problem(value.removesuffix('/') if len(value) > 1 else value)
+        return f"{value!r} is not a valid frame id prefix ({FRAME_ID_RULE}, then one '/')"
     return Validator('empty or a frame id prefix', check)
 
 
