@@ -2,8 +2,8 @@
 
 Multipliers, radii, separations, wheelbases and tracks, timeouts and frame ids:
 each is checked by the type's parameter spec, so a wrong value ends start-up
-with ``<file>: <controller>.<field>: <what is wrong>`` (issue 42) instead of
-a ZeroDivisionError, a self-transform or a confusing run-time warning.
+with ``<file>: <controller>.<field>: <what is wrong>`` instead of a
+ZeroDivisionError, a self-transform or a confusing run-time warning.
 """
 
 from __future__ import annotations

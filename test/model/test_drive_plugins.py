@@ -359,7 +359,7 @@ def test_a_gz_joint_state_publisher_naming_a_fixed_joint_ends_start_up():
             '<joint_name>caster_joint</joint_name></plugin>'))
 
 
-# --- a plugin's wheels and frames get a controller's checks (issue 42) ------------------------
+# --- a plugin's wheels and frames get a controller's checks ---------------------------------
 
 def bare_ros1(*elements: str) -> str:
     return ('<plugin name="drive" filename="libgazebo_ros_diff_drive.so">'

@@ -364,7 +364,7 @@ def test_camera_focal_length_follows_the_horizontal_fov():
     assert sensor.camera.vertical_fov == pytest.approx(2 * math.atan(0.75))
 
 
-# --- sizes and angles within their limits (issue 42) -------------------------------------
+# --- sizes and angles within their limits ------------------------------------------------
 
 @pytest.mark.parametrize(('body', 'problem'), [
     pytest.param(RAY.replace('<samples>5<', '<samples>10000000<'),
