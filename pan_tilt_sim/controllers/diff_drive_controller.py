@@ -83,6 +83,7 @@ from pan_tilt_sim.controllers.parameter_spec import (
     gt,
     gt_eq,
     not_empty,
+    rate,
     unique,
 )
 from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError, RateLimiter
@@ -153,9 +154,9 @@ class DiffDriveController(OdometryOutputs, CommandController):
         Param('velocity_rolling_window_size', INT, 10, "Updates in the odometry twist's "
               'rolling mean.', (gt_eq(1),)),
         Param('publish_rate', DOUBLE, 50.0, 'Odometry and TF messages per second of sim time.',
-              (gt(0.0),)),
+              (rate(),)),
         Param('update_rate', DOUBLE, None, "The controller's update rate (Hz): the rate of "
-              '~/cmd_vel_out.', (gt(0.0),)),
+              '~/cmd_vel_out.', (rate(),)),
         *velocity_limit_params('linear.x', deprecated_switches=True),
         *velocity_limit_params('angular.z', deprecated_switches=True),
     ])

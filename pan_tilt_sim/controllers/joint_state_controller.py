@@ -65,8 +65,8 @@ from pan_tilt_sim.controllers.parameter_spec import (
     STRING_ARRAY,
     Param,
     ParameterSpec,
-    gt,
     names,
+    rate,
     unique,
 )
 from pan_tilt_sim.controllers.surface import PRIVATE, Endpoint, StateTopic
@@ -97,9 +97,9 @@ class JointStateController(Controller):
                   'joint_state_broadcaster/JointStateBroadcaster')
     parameters = ParameterSpec([
         Param('publish_rate', DOUBLE, None, 'Samples per second of sim time (ROS 1).',
-              (gt(0.0),)),
+              (rate(),)),
         Param('update_rate', DOUBLE, None, "The controller's update rate (Hz); the "
-              "controller_manager's by default.", (gt(0.0),)),
+              "controller_manager's by default.", (rate(),)),
         Param('joints', STRING_ARRAY, [], 'With interfaces: the joints to publish, in this '
               'order; if either is empty, every movable joint.', (names(), unique()),
               read_only=True),

@@ -37,6 +37,7 @@ from typing import Any
 
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.model.frame_ids import FRAME_ID_RULE, frame_id_problem
+from pan_tilt_sim.model.rates import rate_problem
 
 BOOL, INT, DOUBLE, STRING = 'bool', 'int', 'double', 'string'
 BOOL_ARRAY, INT_ARRAY, DOUBLE_ARRAY, STRING_ARRAY = (
@@ -85,6 +86,12 @@ def gt_eq(bound: float) -> Validator:
 def bounds(lower: float, upper: float) -> Validator:
     """Require a value within [lower, upper] (each element, for an array)."""
     return _each(f'in [{lower:g}, {upper:g}]', lambda value: lower <= value <= upper)
+
+
+def rate(*, zero_allowed: bool = False) -> Validator:
+    """Require a rate (Hz) > 0 whose period is finite (``zero_allowed``: or 0)."""
+    return Validator('>= 0 Hz, finite period' if zero_allowed else '> 0 Hz, finite period',
+                     lambda value: rate_problem(value, zero_allowed=zero_allowed))
 
 
 def one_of(*choices: Any) -> Validator:

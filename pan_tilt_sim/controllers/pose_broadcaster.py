@@ -27,8 +27,8 @@ from pan_tilt_sim.controllers.parameter_spec import (
     ParameterSpec,
     frame_id,
     frame_id_or_empty,
-    gt_eq,
     not_empty,
+    rate,
 )
 from pan_tilt_sim.controllers.sensor_broadcaster import FRAME_ID, SensorBroadcaster
 from pan_tilt_sim.controllers.shared_parameters import UPDATE_RATE
@@ -70,7 +70,8 @@ class PoseBroadcaster(SensorBroadcaster):
         Param('tf.child_frame_id', STRING, '', "The transform's child frame; pose_name "
               'if empty.', (frame_id_or_empty(),), read_only=True),
         Param('tf.publish_rate', DOUBLE, 0.0, 'Limit the transforms to this rate (Hz); 0: '
-              'every sample (deprecated upstream).', (gt_eq(0.0),), read_only=True),
+              'every sample (deprecated upstream).', (rate(zero_allowed=True),),
+              read_only=True),
     ])
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:

@@ -19,10 +19,10 @@ from pan_tilt_sim.controllers.parameter_spec import (
     STRING_ARRAY,
     Param,
     Validator,
-    gt,
     gt_eq,
     names,
     not_empty,
+    rate,
     unique,
 )
 from pan_tilt_sim.controllers.rate_limiter import RateLimiter, RateLimits
@@ -30,7 +30,7 @@ from pan_tilt_sim.model.controller_config import DEFAULT_UPDATE_RATE
 
 UPDATE_RATE = Param('update_rate', DOUBLE, None, "Updates per second of sim time; the "
                     "controller_manager's rate (100 Hz unless the file says otherwise) by "
-                    'default.', (gt(0.0),))
+                    'default.', (rate(),))
 JOINT = Param('joint', STRING, REQUIRED, 'The joint this controller drives.',
               (not_empty(),), read_only=True, example='joint1')
 JOINTS = Param('joints', STRING_ARRAY, REQUIRED, 'The joints this controller drives, in '

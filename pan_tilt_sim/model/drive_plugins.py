@@ -80,6 +80,7 @@ from xml.etree import ElementTree
 
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.frame_ids import frame_id_problem
+from pan_tilt_sim.model.rates import rate_problem
 from pan_tilt_sim.model.sensors import (
     GZ_WORLD,
     ROS1,
@@ -104,6 +105,7 @@ ROS1_DIFF_DRIVE_KEYS = {'leftJoint', 'rightJoint', 'wheelSeparation', 'wheelDiam
                         'publishOdomTF', 'publishTf', 'updateRate', 'wheelTorque',
                         'wheelAcceleration', 'odometrySource', 'robotNamespace'}
 UNPLANAR_COVARIANCE = 1e12  # z, roll, pitch: what the plugins put there
+RATE_KEYS = ('rate', 'frequency')  # elements (lower case) whose value is a rate in Hz
 
 
 @dataclasses.dataclass(frozen=True)
@@ -286,7 +288,12 @@ class _PluginReader:
 
     def number(self, key: str, default: float, *, positive: bool = False,
                non_negative: bool = False) -> float:
-        return self.check(key, self.text(key, ''), default, positive, non_negative)
+        value = self.check(key, self.text(key, ''), default, positive, non_negative)
+        if key.lower().endswith(RATE_KEYS):  # a rate: its period must be finite too
+            problem = rate_problem(value, zero_allowed=not positive)
+            if problem:
+                raise self.error(key, problem)
+        return value
 
     def check(self, key: str, text: str, default: float, positive: bool = False,
               non_negative: bool = False) -> float:

@@ -60,6 +60,7 @@ from pan_tilt_sim.model.drive_plugins import (
     read_p3d_plugins,
     read_planar_move_plugins,
 )
+from pan_tilt_sim.model.rates import rate_problem
 from pan_tilt_sim.model.robot import (
     DEFAULT_AXIS,
     INITIAL_VALUE,
@@ -849,6 +850,9 @@ class _SensorReader:
         rate = self.number(element, 'update_rate', 0.0, owner)
         if rate < 0.0:
             raise self.error(owner, f'<update_rate> must be >= 0 Hz, got {rate:g}')
+        problem = rate_problem(rate, zero_allowed=True)
+        if problem:
+            raise self.error(owner, f'<update_rate> {problem}')
         return rate
 
     def pose(self, element: ElementTree.Element | None, owner: str) -> Transform:

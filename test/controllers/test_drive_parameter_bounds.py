@@ -127,3 +127,15 @@ def test_upstream_defaults_and_valid_values_still_configure():
                           'f.yaml')
     create_controller('c', DIFF, _params(DIFF, 'wheel_separation_multiplier', 1.05), 'f.yaml')
     create_controller('c', TRICYCLE, _params(TRICYCLE, 'cmd_vel_timeout', 0), 'f.yaml')
+
+
+@pytest.mark.parametrize(('type_name', 'field'), [
+    ('joint_state_broadcaster/JointStateBroadcaster', 'publish_rate'),
+    ('joint_state_broadcaster/JointStateBroadcaster', 'update_rate'),
+    (DIFF, 'publish_rate'),
+    (DIFF, 'update_rate'),
+    (MECANUM, 'update_rate'),
+    ('pose_broadcaster/PoseBroadcaster', 'tf.publish_rate'),
+])
+def test_a_rate_so_small_its_period_overflows_is_refused(type_name, field):
+    _refused(type_name, field, 5e-324, '5e-324 must be a rate > 0 Hz')

@@ -456,3 +456,17 @@ def test_a_gz_odometry_publisher_with_one_frame_for_both_ends_start_up():
     with pytest.raises(DescriptionError, match="<robot_base_frame> 'odom' is <odom_frame> too"):
         model(GZ_DIFF_DRIVE, ground_truth=GZ_ODOMETRY.replace('>base_link<', '>odom<'),
               joint_states='')
+
+
+@pytest.mark.parametrize(('plugin', 'element'), [
+    (bare_ros2('<update_rate>5e-324</update_rate>'), 'update_rate'),
+    (bare_gz('<left_joint>left_wheel_joint</left_joint>',
+             '<right_joint>right_wheel_joint</right_joint>',
+             '<odom_publish_frequency>1e-320</odom_publish_frequency>'),
+     'odom_publish_frequency'),
+    ('<plugin name="move" filename="libgazebo_ros_planar_move.so">'
+     '<publish_rate>5e-324</publish_rate></plugin>', 'publish_rate'),
+])
+def test_a_plugin_rate_whose_period_overflows_ends_start_up(plugin, element):
+    with pytest.raises(DescriptionError, match=f'<{element}> .* must be a rate > 0 Hz'):
+        model(plugin)

@@ -428,3 +428,10 @@ def test_a_4k_image_is_taken():
     body = '<camera><image><width>3840</width><height>2160</height></image></camera>'
     _, sensor = only_sensor(robot(sensor_block('arm', 'camera', body)))
     assert (sensor.camera.width, sensor.camera.height) == (3840, 2160)
+
+
+def test_a_sensor_rate_whose_period_overflows_ends_start_up():
+    with pytest.raises(DescriptionError, match=r"sensor 'cam': <update_rate> 5e-324 must be a "
+                                               'rate > 0 Hz'):
+        parse_urdf(robot(sensor_block('arm', 'camera', '<update_rate>5e-324</update_rate>',
+                                      name='cam')), SOURCE)
