@@ -64,10 +64,13 @@ after the plugin in ``<ros><namespace>`` with its ``<remapping>``s; ROS 1
 in ``robotNamespace`` -- absent: the root (as spawn_model sets it), given
 empty: the robot's name, as gazebo_plugins' GazeboRos takes it (see
 :mod:`pan_tilt_sim.model.sensors`).  A wheel
-the robot does not have, a number that is not one, or a separation,
-diameter, torque or rate that is not positive ends start-up
-(:class:`~pan_tilt_sim.errors.DescriptionError` naming the plugin and the
-element).
+the robot does not have, a wheel that is a fixed or ``<mimic>`` joint or
+another wheel's joint too, a number that is not one, a separation,
+diameter, torque or rate that is not positive (or a rate whose period
+overflows), an odometry or base frame that is no valid frame id, or one
+frame for both, ends start-up (:class:`~pan_tilt_sim.errors.DescriptionError`
+naming the file, the plugin and the element) -- the checks a driving
+controller makes.
 """
 
 from __future__ import annotations
