@@ -214,6 +214,9 @@ MAX_IMAGE_PIXELS = 3840 * 2160
 IMAGE_PIXELS_REASON = "4K UHD (3840 x 2160): what PyBullet's CPU renderer draws in " \
     'reasonable time and memory'
 MAX_SCAN_ANGLE = 2.0 * math.pi  # rad: a scan angle beyond a full turn either way means nothing
+# A camera's clip range: far / near at most this.  PyBullet renders with a float32 depth
+# buffer; from a ratio of 1e8 on its every depth is NaN (test/sim/test_sensors.py).
+MAX_CLIP_RATIO = 1e6
 
 
 def scan_axis_problem(axis: ScanAxis, tag: str) -> str | None:
@@ -246,6 +249,21 @@ def scan_size_problem(ray: RaySpec) -> str | None:
     if beams > MAX_SCAN_BEAMS:
         return (f'{ray.horizontal.count} x {ray.vertical.count} = {beams} beams per scan is '
                 f'more than the limit of {MAX_SCAN_BEAMS} ({SCAN_BEAMS_REASON})')
+    return None
+
+
+def clip_problem(camera: CameraSpec) -> str | None:
+    """Say why a camera's clip planes (and a depth camera's own) cannot render, or None."""
+    planes = [('<clip>', camera.near, camera.far)]
+    if camera.depth_near is not None or camera.depth_far is not None:
+        planes.append(('<depth_camera><clip>', camera.depth_near or camera.near,
+                       camera.depth_far or camera.far))
+    for tag, near, far in planes:
+        if not 0.0 < near < far:
+            return f'{tag} needs 0 < near < far, got near {near:g}, far {far:g}'
+        if far / near > MAX_CLIP_RATIO:
+            return (f'{tag} far / near = {far / near:g} is more than the limit of '
+                    f'{MAX_CLIP_RATIO:g} (PyBullet renders every depth as NaN from 1e8 on)')
     return None
 
 

@@ -102,6 +102,7 @@ from pan_tilt_sim.model.sensors import (
     ScanAxis,
     SensorKind,
     SensorSpec,
+    clip_problem,
     image_size_problem,
     plugin_stem,
     scan_size_problem,
@@ -912,7 +913,7 @@ class _SensorReader:
             format=(element.findtext('image/format') or default.format).strip(),
             noise=self.noise(element.find('noise'), owner),
             depth_near=depth_near, depth_far=depth_far)
-        problem = image_size_problem(camera)
+        problem = image_size_problem(camera) or clip_problem(camera)
         if problem:
             raise self.error(owner, problem)
         return camera

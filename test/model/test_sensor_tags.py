@@ -435,3 +435,18 @@ def test_a_sensor_rate_whose_period_overflows_ends_start_up():
                                                'rate > 0 Hz'):
         parse_urdf(robot(sensor_block('arm', 'camera', '<update_rate>5e-324</update_rate>',
                                       name='cam')), SOURCE)
+
+
+@pytest.mark.parametrize(('clip', 'problem'), [
+    ('<clip><near>0.1</near><far>1e300</far></clip>',
+     '<clip> far / near = 1e+301 is more than the limit of 1e+06'),
+    ('<clip><near>1e-300</near><far>0.05</far></clip>', '<clip> far / near = 5e+298'),
+    ('<clip><near>0.1</near><far>10</far></clip><depth_camera><clip><near>1e-9</near>'
+     '<far>10</far></clip></depth_camera>', '<depth_camera><clip> far / near = 1e+10'),
+])
+def test_clip_planes_a_depth_buffer_cannot_hold_end_start_up(clip, problem):
+    with pytest.raises(DescriptionError) as raised:
+        parse_urdf(robot(sensor_block('arm', 'camera', f'<camera>{clip}</camera>', name='cam')),
+                   SOURCE)
+    assert str(raised.value).startswith(f"{SOURCE}: sensor 'cam': ")
+    assert problem in str(raised.value)

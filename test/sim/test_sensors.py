@@ -174,6 +174,17 @@ def test_the_ground_has_its_depth_at_every_image_size(rig, width, height):
             camera.render(), _expected_ground_depth(camera, pitch), far)
 
 
+def test_pybullet_renders_a_clip_ratio_at_the_models_limit_and_nothing_but_nan_at_1e8(rig):
+    from pan_tilt_sim.model.sensors import MAX_CLIP_RATIO
+
+    near = 0.01
+    at_limit = _ground_view(rig, 32, 24, near, near * MAX_CLIP_RATIO, math.pi / 2).render()
+    assert not numpy.isnan(at_limit.depth).any()
+    assert numpy.isfinite(at_limit.depth).any()  # the ground is seen
+    beyond = _ground_view(rig, 32, 24, near, near * 1e8, math.pi / 2).render()
+    assert numpy.isnan(beyond.depth).all()
+
+
 # --- lidar --------------------------------------------------------------------------------------
 
 def test_lidar_centre_beam_meets_the_wall_within_the_declared_resolution(rig):
