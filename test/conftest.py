@@ -46,9 +46,12 @@ def repo_root() -> pathlib.Path:
 
 
 def pytest_configure(config: pytest.Config) -> None:
-    """Register the opt-in markers: ``soak`` and ``matrix``, off unless asked for."""
+    """Register the opt-in markers: minutes-long tests, off unless asked for."""
     config.addinivalue_line(
         'markers', 'soak: flood and soak tests (minutes); run only with PAN_TILT_SIM_SLOW=1')
+    config.addinivalue_line(
+        'markers', 'fuzz: thousands of fuzzed inputs (minutes); run only with '
+        'PAN_TILT_SIM_SLOW=1')
     config.addinivalue_line(
         'markers', 'matrix: the whole consistency matrix (every drive, root link and sensor '
                    'mount; minutes); run only with PAN_TILT_SIM_MATRIX=1')

@@ -17,7 +17,14 @@ from __future__ import annotations
 
 import sys
 
-from pan_tilt_sim.controllers.parameter_spec import DOUBLE, REQUIRED, Param, ParameterSpec, gt
+from pan_tilt_sim.controllers.parameter_spec import (
+    DOUBLE,
+    REQUIRED,
+    Param,
+    ParameterSpec,
+    gt,
+)
+from pan_tilt_sim.controllers.shared_parameters import UNSET_OR_LENGTH
 from pan_tilt_sim.controllers.steering_controllers import SteeringController, library_parameters
 from pan_tilt_sim.controllers.steering_odometry import Configuration, SteeringKinematics
 
@@ -33,19 +40,26 @@ class AckermannSteeringController(SteeringController):
     parameters = ParameterSpec([
         *library_parameters(['joint1', 'joint3'], ['joint2', 'joint4']),
         Param('front_wheel_track', DOUBLE, 0.0, "Deprecated: use 'traction_track_width' or "
-              "'steering_track_width'."),
+              "'steering_track_width'.",
+              validators=UNSET_OR_LENGTH),
         Param('steering_track_width', DOUBLE, 0.0, 'Distance between the steering joints (m); '
-              '0: traction_track_width.'),
+              '0: traction_track_width.',
+              validators=UNSET_OR_LENGTH),
         Param('rear_wheel_track', DOUBLE, 0.0, "Deprecated: use 'traction_track_width' or "
-              "'steering_track_width'."),
+              "'steering_track_width'.",
+              validators=UNSET_OR_LENGTH),
         Param('traction_track_width', DOUBLE, 0.0, 'Distance between the traction wheels (m).',
-              example=0.3),
+              example=0.3,
+              validators=UNSET_OR_LENGTH),
         Param('wheelbase', DOUBLE, REQUIRED, 'Distance between the front and rear axles (m).',
               (gt(0.0),), example=0.5),
         Param('traction_wheels_radius', DOUBLE, 0.0, 'Radius of the traction wheels (m).',
-              example=0.05),
-        Param('front_wheels_radius', DOUBLE, 0.0, "Deprecated: use 'traction_wheels_radius'."),
-        Param('rear_wheels_radius', DOUBLE, 0.0, "Deprecated: use 'traction_wheels_radius'."),
+              example=0.05,
+              validators=UNSET_OR_LENGTH),
+        Param('front_wheels_radius', DOUBLE, 0.0, "Deprecated: use 'traction_wheels_radius'.",
+              validators=UNSET_OR_LENGTH),
+        Param('rear_wheels_radius', DOUBLE, 0.0, "Deprecated: use 'traction_wheels_radius'.",
+              validators=UNSET_OR_LENGTH),
     ])
     def kinematics(self) -> SteeringKinematics:
         """Return Ackermann kinematics from the (deprecation-mapped) geometry parameters."""

@@ -11,7 +11,14 @@ where given, with a warning, as upstream.
 
 from __future__ import annotations
 
-from pan_tilt_sim.controllers.parameter_spec import DOUBLE, REQUIRED, Param, ParameterSpec, gt
+from pan_tilt_sim.controllers.parameter_spec import (
+    DOUBLE,
+    REQUIRED,
+    Param,
+    ParameterSpec,
+    gt,
+)
+from pan_tilt_sim.controllers.shared_parameters import UNSET_OR_LENGTH
 from pan_tilt_sim.controllers.steering_controllers import SteeringController, library_parameters
 from pan_tilt_sim.controllers.steering_odometry import Configuration, SteeringKinematics
 
@@ -27,11 +34,14 @@ class BicycleSteeringController(SteeringController):
         Param('wheelbase', DOUBLE, REQUIRED, 'Distance between the front and rear wheel (m).',
               (gt(0.0),), example=0.5),
         Param('traction_wheel_radius', DOUBLE, 0.0, 'Radius of the traction wheel (m).',
-              example=0.05),
+              example=0.05,
+              validators=UNSET_OR_LENGTH),
         Param('front_wheel_radius', DOUBLE, 0.0, "Deprecated: use 'traction_wheel_radius'.",
-              read_only=True),
+              read_only=True,
+              validators=UNSET_OR_LENGTH),
         Param('rear_wheel_radius', DOUBLE, 0.0, "Deprecated: use 'traction_wheel_radius'.",
-              read_only=True),
+              read_only=True,
+              validators=UNSET_OR_LENGTH),
     ])
 
     def kinematics(self) -> SteeringKinematics:

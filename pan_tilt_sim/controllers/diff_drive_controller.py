@@ -78,13 +78,20 @@ from pan_tilt_sim.controllers.parameter_spec import (
     Param,
     ParameterSpec,
     fixed_size,
+    frame_id,
+    frame_id_prefix,
     gt,
     gt_eq,
     not_empty,
+    rate,
     unique,
 )
 from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError, RateLimiter
-from pan_tilt_sim.controllers.shared_parameters import velocity_limit_params, velocity_limiter
+from pan_tilt_sim.controllers.shared_parameters import (
+    same_frames_problem,
+    velocity_limit_params,
+    velocity_limiter,
+)
 from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.model import ros1_diff_drive
@@ -120,17 +127,17 @@ class DiffDriveController(OdometryOutputs, CommandController):
         Param('wheel_radius', DOUBLE, REQUIRED, 'Radius of the wheels (m).', (gt(0.0),),
               example=0.05),
         Param('wheel_separation_multiplier', DOUBLE, 1.0,
-              'Correction factor of wheel_separation.'),
+              'Correction factor of wheel_separation.', (gt(0.0),)),
         Param('left_wheel_radius_multiplier', DOUBLE, 1.0,
-              'Correction factor of wheel_radius for the left wheels.'),
+              'Correction factor of wheel_radius for the left wheels.', (gt(0.0),)),
         Param('right_wheel_radius_multiplier', DOUBLE, 1.0,
-              'Correction factor of wheel_radius for the right wheels.'),
+              'Correction factor of wheel_radius for the right wheels.', (gt(0.0),)),
         Param('tf_frame_prefix_enable', BOOL, True, 'Prefix the frame ids with tf_frame_prefix.'),
         Param('tf_frame_prefix', STRING, '', "The frame ids' prefix; empty: the controller's "
-              'namespace.'),
-        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.'),
+              'namespace.', (frame_id_prefix(),)),
+        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.', (frame_id(),)),
         Param('base_frame_id', STRING, 'base_link', "The robot's base frame, child of "
-              'odom_frame_id.'),
+              'odom_frame_id.', (frame_id(),)),
         Param('pose_covariance_diagonal', DOUBLE_ARRAY, [0.0] * COVARIANCE_SIZE,
               "Diagonal of the odometry pose's covariance (x, y, z, roll, pitch, yaw).",
               (fixed_size(COVARIANCE_SIZE),)),
@@ -147,9 +154,9 @@ class DiffDriveController(OdometryOutputs, CommandController):
         Param('velocity_rolling_window_size', INT, 10, "Updates in the odometry twist's "
               'rolling mean.', (gt_eq(1),)),
         Param('publish_rate', DOUBLE, 50.0, 'Odometry and TF messages per second of sim time.',
-              (gt(0.0),)),
+              (rate(),)),
         Param('update_rate', DOUBLE, None, "The controller's update rate (Hz): the rate of "
-              '~/cmd_vel_out.', (gt(0.0),)),
+              '~/cmd_vel_out.', (rate(),)),
         *velocity_limit_params('linear.x', deprecated_switches=True),
         *velocity_limit_params('angular.z', deprecated_switches=True),
     ])
@@ -173,6 +180,9 @@ class DiffDriveController(OdometryOutputs, CommandController):
         both = [wheel for wheel in left if wheel in right]
         if both:
             raise self.error(RIGHT, f"'{both[0]}' is also one of {LEFT}")
+        same_frames = same_frames_problem(self.params)
+        if same_frames:
+            raise self.error('base_frame_id', same_frames)
         self._left_names, self._right_names = tuple(left), tuple(right)
         self._limiters = tuple(self._limiter(group) for group in LIMIT_GROUPS)
         self._references = {f'{name}/linear/{VELOCITY}': Reference(f'{name}/linear/{VELOCITY}'),

@@ -24,7 +24,7 @@ from pan_tilt_sim.controllers.parameter_spec import (
     STRING,
     Param,
     ParameterSpec,
-    not_empty,
+    frame_id,
 )
 from pan_tilt_sim.controllers.sensor_broadcaster import (
     FRAME_ID,
@@ -72,7 +72,7 @@ class ForceTorqueSensorBroadcaster(SensorBroadcaster):
     parameters = ParameterSpec([
         UPDATE_RATE,
         Param(FRAME_ID, STRING, REQUIRED, 'The frame the wrench is published in (the '
-              'simulation gives it there when it names a link).', (not_empty(),),
+              'simulation gives it there when it names a link).', (frame_id(),),
               read_only=True, example='tool0'),
         Param(SENSOR_NAME, STRING, '', 'The sensor whose six standard interfaces '
               '(<sensor_name>/force.x ... torque.z) are read; or give interface_names.',

@@ -10,8 +10,10 @@ effort type (:mod:`.effort_gripper_action_controller`) and the parallel
 type (:mod:`.parallel_gripper_action_controller`) build on:
 
 * a goal is accepted whenever the controller is active (one whose position
-  or ``max_effort`` is not a finite number is refused: upstream would send
-  it to the hardware); it replaces the command at once and the goal it
+  or ``max_effort`` is not a finite number, or whose ``max_effort`` (or
+  a parallel gripper's velocity) is negative, is refused with a throttled
+  warning: upstream would send it to the hardware, and a negative cap has
+  no meaning); it replaces the command at once and the goal it
   preempts ends ABORTED with an empty result (GripperCommand's fields all
   zero and false, ParallelGripperCommand's ``state`` without entries).
   Upstream asks for CANCELED there, a transition ROS 2's goal state machine
@@ -253,7 +255,11 @@ class GripperActionController(Controller):
         return GripperRequest(position, self._default_effort)
 
     def check_goal(self, request: GripperRequest) -> str | None:
-        """Return why ``request`` cannot be run, or None (upstream accepts every goal)."""
+        """Return why ``request`` cannot be run, or None (upstream accepts every goal).
+
+        Stricter than upstream on purpose: a cap (``max_effort``, a parallel
+        gripper's velocity) is >= 0, 0 meaning none but the URDF's limit.
+        """
         values = (request.position, request.max_effort) + (
             () if request.max_velocity is None else (request.max_velocity,))
         if not all(map(is_sane_number, values)):
@@ -261,6 +267,12 @@ class GripperActionController(Controller):
                     + ('' if request.max_velocity is None
                        else f'and max velocity {request.max_velocity!r} ')
                     + 'must be finite numbers')
+        if request.max_effort < 0.0:
+            return (f'max_effort {request.max_effort!r} must be >= 0 (0: no cap but the '
+                    "joint's URDF effort limit)")
+        if request.max_velocity is not None and request.max_velocity < 0.0:
+            return (f'max velocity {request.max_velocity!r} must be >= 0 (0: the '
+                    "joint's URDF velocity limit)")
         return None
 
     def start_goal(self, request: GripperRequest, now: float) -> GripperGoal:

@@ -23,6 +23,7 @@ from pan_tilt_sim.controllers.parameter_spec import (
     Param,
     ParameterSpec,
     fixed_size,
+    frame_id,
     not_empty,
 )
 from pan_tilt_sim.controllers.sensor_broadcaster import (
@@ -53,7 +54,7 @@ class IMUSensorBroadcaster(SensorBroadcaster):
               '(<sensor_name>/orientation.x ... linear_acceleration.z) are read.',
               (not_empty(),), read_only=True, example='sensor1'),
         Param(FRAME_ID, STRING, REQUIRED, 'The frame the readings are published in.',
-              (not_empty(),), read_only=True, example='imu_link'),
+              (frame_id(),), read_only=True, example='imu_link'),
         *(Param(name, DOUBLE_ARRAY, ZERO_COVARIANCE,
                 f'Static {name.removeprefix("static_covariance_").replace("_", " ")} '
                 'covariance, row major about x, y, z.', (fixed_size(9),))

@@ -35,7 +35,8 @@ Which interfaces, as joint_state_broadcaster (jazzy) chooses them:
 * ``map_interface_to_joint_state.<field>`` names the interface published
   as JointState's ``<field>``; a joint without it publishes its own
   ``<field>`` interface there if selected, else NaN.  A mapping is ignored
-  when ``interfaces`` names the field itself, as upstream.  In the dynamic
+  when ``interfaces`` names the field itself, as upstream.  A mapped
+  interface no published joint has gets one warning (upstream is silent).  In the dynamic
   message every interface keeps its own name (upstream files a mapped one
   under the field's name, where it can collide with the joint's own
   interface of that name).
@@ -64,8 +65,8 @@ from pan_tilt_sim.controllers.parameter_spec import (
     STRING_ARRAY,
     Param,
     ParameterSpec,
-    gt,
     names,
+    rate,
     unique,
 )
 from pan_tilt_sim.controllers.surface import PRIVATE, Endpoint, StateTopic
@@ -96,9 +97,9 @@ class JointStateController(Controller):
                   'joint_state_broadcaster/JointStateBroadcaster')
     parameters = ParameterSpec([
         Param('publish_rate', DOUBLE, None, 'Samples per second of sim time (ROS 1).',
-              (gt(0.0),)),
+              (rate(),)),
         Param('update_rate', DOUBLE, None, "The controller's update rate (Hz); the "
-              "controller_manager's by default.", (gt(0.0),)),
+              "controller_manager's by default.", (rate(),)),
         Param('joints', STRING_ARRAY, [], 'With interfaces: the joints to publish, in this '
               'order; if either is empty, every movable joint.', (names(), unique()),
               read_only=True),
@@ -211,6 +212,13 @@ class JointStateController(Controller):
         self.dynamic_values = []
         self._joint_state_reads, self._dynamic_reads = [], []
         fields = (self.positions, self.velocities, self.efforts)
+        offered = {interface for names in self._selected.values() for interface in names}
+        for joint_field, field_sources in sources.items():
+            mapped = field_sources[0]
+            if mapped != joint_field and mapped not in offered:
+                self._warn(f'{MAP_FIELD}.{joint_field}',
+                           f"'{mapped}' is not a state interface of any published joint: "
+                           f"JointState.{joint_field} is each joint's own '{joint_field}'")
         for handle in handles:
             selected = self._selected[handle.name]
             chosen = [next((name for name in sources[joint_field] if name in selected), None)

@@ -73,12 +73,16 @@ from pan_tilt_sim.controllers.parameter_spec import (
     Param,
     ParameterSpec,
     fixed_size,
+    frame_id,
+    frame_id_prefix,
     gt,
+    gt_eq,
     not_empty,
 )
 from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError
 from pan_tilt_sim.controllers.shared_parameters import (
     UPDATE_RATE,
+    same_frames_problem,
     update_period,
     velocity_limit_params,
     velocity_limiter,
@@ -187,7 +191,7 @@ class MecanumDriveController(OdometryOutputs, CommandController):
     command_kind = CommandKind.TWIST_STAMPED
     parameters = ParameterSpec([
         Param('reference_timeout', DOUBLE, 0.0, 'Seconds of sim time a reference is used; '
-              '0: for one update only.'),
+              '0: for one update only.', (gt_eq(0.0),)),
         *(param for position in WHEELS for param in _wheel_params(position)),
         Param('kinematics.base_frame_offset.x', DOUBLE, 0.0, 'Offset of base_frame_id from '
               "the wheels' centre along its x axis (m).", read_only=True),
@@ -203,9 +207,11 @@ class MecanumDriveController(OdometryOutputs, CommandController):
               read_only=True, example=0.3),
         Param('tf_frame_prefix_enable', BOOL, True, 'Prefix the frame ids with tf_frame_prefix.'),
         Param('tf_frame_prefix', STRING, '', "The frame ids' prefix; empty: the controller's "
-              'namespace.', read_only=True),
-        Param('base_frame_id', STRING, 'base_link', "The robot's base frame.", read_only=True),
-        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.', read_only=True),
+              'namespace.', (frame_id_prefix(),), read_only=True),
+        Param('base_frame_id', STRING, 'base_link', "The robot's base frame.", (frame_id(),),
+              read_only=True),
+        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.', (frame_id(),),
+              read_only=True),
         Param('enable_odom_tf', BOOL, True, 'Publish odom_frame_id -> base_frame_id on '
               '~/tf_odometry.'),
         Param('twist_covariance_diagonal', DOUBLE_ARRAY, [0.1] * COVARIANCE_SIZE,
@@ -220,6 +226,9 @@ class MecanumDriveController(OdometryOutputs, CommandController):
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
+        same_frames = same_frames_problem(self.params)
+        if same_frames:
+            raise self.error('base_frame_id', same_frames)
         params = self.params
         self._command_names = tuple(params[f'{wheel}_wheel_command_joint_name']
                                     for wheel in WHEELS)

@@ -71,12 +71,19 @@ from pan_tilt_sim.controllers.parameter_spec import (
     Param,
     ParameterSpec,
     fixed_size,
+    frame_id,
+    frame_id_prefix,
     gt,
+    gt_eq,
     names,
     not_empty,
     unique,
 )
-from pan_tilt_sim.controllers.shared_parameters import UPDATE_RATE, update_period
+from pan_tilt_sim.controllers.shared_parameters import (
+    UPDATE_RATE,
+    same_frames_problem,
+    update_period,
+)
 from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
 from pan_tilt_sim.schedule import DUE_EPSILON, PeriodicSchedule
 
@@ -191,9 +198,11 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
         Param('tf_frame_prefix_enable', BOOL, True, 'Prefix the frame ids with tf_frame_prefix.',
               read_only=True),
         Param('tf_frame_prefix', STRING, '', "The frame ids' prefix; empty: the controller's "
-              'namespace.', read_only=True),
-        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.', read_only=True),
-        Param('base_frame_id', STRING, 'base_link', "The robot's base frame.", read_only=True),
+              'namespace.', (frame_id_prefix(),), read_only=True),
+        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.', (frame_id(),),
+              read_only=True),
+        Param('base_frame_id', STRING, 'base_link', "The robot's base frame.", (frame_id(),),
+              read_only=True),
         Param('diagonal_covariance.pose', DOUBLE_ARRAY, [0.0] * COVARIANCE_SIZE,
               "Diagonal of the odometry pose's covariance.", (fixed_size(COVARIANCE_SIZE),),
               read_only=True),
@@ -207,12 +216,15 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
         Param('enable_odom_tf', BOOL, True, 'Publish odom_frame_id -> base_frame_id on /tf.',
               read_only=True),
         Param('cmd_vel_timeout', DOUBLE, 0.5, 'Seconds of sim time after which the last '
-              'command is stale and the wheels brake.', read_only=True),
+              'command is stale and the wheels brake.', (gt_eq(0.0),), read_only=True),
         UPDATE_RATE,
     ])
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
+        same_frames = same_frames_problem(self.params)
+        if same_frames:
+            raise self.error('base_frame_id', same_frames)
         params = self.params
         self._wheel_names = tuple(params[WHEEL_NAMES])
         if len(self._wheel_names) < MIN_WHEELS:

@@ -36,6 +36,8 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
 from pan_tilt_sim.errors import ControllerConfigError
+from pan_tilt_sim.model.frame_ids import FRAME_ID_RULE, frame_id_problem
+from pan_tilt_sim.model.rates import rate_problem
 
 BOOL, INT, DOUBLE, STRING = 'bool', 'int', 'double', 'string'
 BOOL_ARRAY, INT_ARRAY, DOUBLE_ARRAY, STRING_ARRAY = (
@@ -86,6 +88,12 @@ def bounds(lower: float, upper: float) -> Validator:
     return _each(f'in [{lower:g}, {upper:g}]', lambda value: lower <= value <= upper)
 
 
+def rate(*, zero_allowed: bool = False) -> Validator:
+    """Require a rate (Hz) > 0 whose period is finite (``zero_allowed``: or 0)."""
+    return Validator('>= 0 Hz, finite period' if zero_allowed else '> 0 Hz, finite period',
+                     lambda value: rate_problem(value, zero_allowed=zero_allowed))
+
+
 def one_of(*choices: Any) -> Validator:
     """Require one of ``choices`` (each element, for an array: ``subset_of``)."""
     listed = ', '.join(str(choice) for choice in choices)
@@ -114,6 +122,26 @@ def fixed_size(size: int) -> Validator:
     """Require an array of exactly ``size`` elements."""
     return Validator(f'{size} elements', lambda value: None if len(value) == size else
                      f'must have {size} elements, has {len(value)}')
+
+
+def frame_id() -> Validator:
+    """Require a valid frame id (see :func:`frame_id_problem`)."""
+    return Validator('a frame id', frame_id_problem)
+
+
+def frame_id_or_empty() -> Validator:
+    """Require an empty string (the parameter's fallback) or a valid frame id."""
+    return Validator('empty or a frame id',
+                     lambda value: frame_id_problem(value) if value else None)
+
+
+def frame_id_prefix() -> Validator:
+    """Require an empty prefix or a frame id, with an optional trailing '/'."""
+    def check(value: str) -> str | None:
+        if not value or value == '/' or frame_id_problem(value.removesuffix('/')) is None:
+            return None
+        return f"{value!r} is not a valid frame id prefix ({FRAME_ID_RULE}, then one '/')"
+    return Validator('empty or a frame id prefix', check)
 
 
 def _each(text: str, accept: Callable[[Any], bool]) -> Validator:

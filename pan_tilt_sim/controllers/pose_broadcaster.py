@@ -25,8 +25,10 @@ from pan_tilt_sim.controllers.parameter_spec import (
     STRING,
     Param,
     ParameterSpec,
-    gt_eq,
+    frame_id,
+    frame_id_or_empty,
     not_empty,
+    rate,
 )
 from pan_tilt_sim.controllers.sensor_broadcaster import FRAME_ID, SensorBroadcaster
 from pan_tilt_sim.controllers.shared_parameters import UPDATE_RATE
@@ -59,16 +61,17 @@ class PoseBroadcaster(SensorBroadcaster):
     parameters = ParameterSpec([
         UPDATE_RATE,
         Param(FRAME_ID, STRING, REQUIRED, 'The frame the pose is given in (and the '
-              "transform's parent).", (not_empty(),), read_only=True, example='world'),
+              "transform's parent).", (frame_id(),), read_only=True, example='world'),
         Param(POSE_NAME, STRING, REQUIRED, 'The sensor whose interfaces '
               '(<pose_name>/position.x ... orientation.w) are read.', (not_empty(),),
               read_only=True, example='sensor1'),
         Param('tf.enable', BOOL, True, 'Also publish the pose as a transform on /tf.',
               read_only=True),
         Param('tf.child_frame_id', STRING, '', "The transform's child frame; pose_name "
-              'if empty.', read_only=True),
+              'if empty.', (frame_id_or_empty(),), read_only=True),
         Param('tf.publish_rate', DOUBLE, 0.0, 'Limit the transforms to this rate (Hz); 0: '
-              'every sample (deprecated upstream).', (gt_eq(0.0),), read_only=True),
+              'every sample (deprecated upstream).', (rate(zero_allowed=True),),
+              read_only=True),
     ])
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:

@@ -19,6 +19,7 @@ from pan_tilt_sim.controllers.parameter_spec import (
     STRING,
     Param,
     ParameterSpec,
+    frame_id,
     not_empty,
 )
 from pan_tilt_sim.controllers.sensor_broadcaster import (
@@ -43,7 +44,7 @@ class RangeSensorBroadcaster(SensorBroadcaster):
         Param(SENSOR_NAME, STRING, REQUIRED, 'The sensor whose <sensor_name>/range is read.',
               (not_empty(),), read_only=True, example='sensor1'),
         Param(FRAME_ID, STRING, REQUIRED, 'The frame the reading is published in.',
-              (not_empty(),), read_only=True, example='range_link'),
+              (frame_id(),), read_only=True, example='range_link'),
         Param('radiation_type', INT, 0, 'The radiation the sensor uses: 0 ultrasound, '
               '1 infrared.', read_only=True),
         Param('field_of_view', DOUBLE, 0.52, 'The arc the distance reading is valid for '

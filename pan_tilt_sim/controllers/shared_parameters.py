@@ -19,10 +19,10 @@ from pan_tilt_sim.controllers.parameter_spec import (
     STRING_ARRAY,
     Param,
     Validator,
-    gt,
     gt_eq,
     names,
     not_empty,
+    rate,
     unique,
 )
 from pan_tilt_sim.controllers.rate_limiter import RateLimiter, RateLimits
@@ -30,12 +30,29 @@ from pan_tilt_sim.model.controller_config import DEFAULT_UPDATE_RATE
 
 UPDATE_RATE = Param('update_rate', DOUBLE, None, "Updates per second of sim time; the "
                     "controller_manager's rate (100 Hz unless the file says otherwise) by "
-                    'default.', (gt(0.0),))
+                    'default.', (rate(),))
 JOINT = Param('joint', STRING, REQUIRED, 'The joint this controller drives.',
               (not_empty(),), read_only=True, example='joint1')
 JOINTS = Param('joints', STRING_ARRAY, REQUIRED, 'The joints this controller drives, in '
                'the order of every command.', (not_empty(), names(), unique()), read_only=True,
                example=['joint1'])
+
+# A length or radius whose default 0 means 'not set' (upstream's convention); a negative
+# one has no meaning.
+UNSET_OR_LENGTH = (gt_eq(0.0),)
+
+
+def same_frames_problem(params: Mapping[str, Any]) -> str | None:
+    """Say why ``odom_frame_id`` and ``base_frame_id`` cannot make a transform, or None.
+
+    The odom -> base transform needs two frames; tf2 strips one leading '/'
+    of each, so ``/odom`` and ``odom`` are one frame.  Any prefix is shared.
+    """
+    odom, base = params['odom_frame_id'], params['base_frame_id']
+    if odom.removeprefix('/') == base.removeprefix('/'):
+        return (f"'{base}' is odom_frame_id too: the odom -> base transform needs two "
+                'different frames')
+    return None
 
 
 def pid_gains(prefix: str) -> tuple[Param, ...]:

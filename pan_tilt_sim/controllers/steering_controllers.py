@@ -75,10 +75,16 @@ from pan_tilt_sim.controllers.parameter_spec import (
     Param,
     Validator,
     fixed_size,
+    frame_id,
     gt,
+    gt_eq,
     unique,
 )
-from pan_tilt_sim.controllers.shared_parameters import UPDATE_RATE, update_period
+from pan_tilt_sim.controllers.shared_parameters import (
+    UPDATE_RATE,
+    same_frames_problem,
+    update_period,
+)
 from pan_tilt_sim.controllers.steering_odometry import Configuration, SteeringKinematics
 from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
 from pan_tilt_sim.model.transforms import Transform
@@ -117,7 +123,8 @@ def library_parameters(traction: list[str], steering: list[str]) -> tuple[Param,
     """
     return (
         Param('reference_timeout', DOUBLE, 1.0, 'Seconds of sim time after which a reference '
-              'is dropped (the traction wheels stop); 0: each reference is used for one update.'),
+              'is dropped (the traction wheels stop); 0: each reference is used for one update.',
+              (gt_eq(0.0),)),
         Param('front_steering', BOOL, True, 'Deprecated: whether front_wheels_names are the '
               'steering joints (else rear_wheels_names are); use the joints_names parameters.',
               read_only=True),
@@ -143,8 +150,8 @@ def library_parameters(traction: list[str], steering: list[str]) -> tuple[Param,
         Param('velocity_rolling_window_size', INT, 10, "Updates in the odometry twist's rolling "
               'mean.', (gt(0),)),
         Param('base_frame_id', STRING, 'base_link', "The robot's base frame, child of "
-              'odom_frame_id.'),
-        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.'),
+              'odom_frame_id.', (frame_id(),)),
+        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.', (frame_id(),)),
         Param('enable_odom_tf', BOOL, True, 'Publish odom_frame_id -> base_frame_id on '
               '~/tf_odometry.'),
         Param('twist_covariance_diagonal', DOUBLE_ARRAY, DEFAULT_COVARIANCE,
@@ -228,6 +235,9 @@ class SteeringController(OdometryOutputs, CommandController):
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
+        same_frames = same_frames_problem(self.params)
+        if same_frames:
+            raise self.error('base_frame_id', same_frames)
         self._names = self._joint_lists()
         self._kinematics = self.kinematics()
         self._references = {f'{name}/linear/{VELOCITY}': Reference(f'{name}/linear/{VELOCITY}'),

@@ -64,10 +64,16 @@ from pan_tilt_sim.controllers.parameter_spec import (
     Param,
     ParameterSpec,
     fixed_size,
+    frame_id,
     gt,
+    gt_eq,
     not_empty,
 )
-from pan_tilt_sim.controllers.shared_parameters import UPDATE_RATE, update_period
+from pan_tilt_sim.controllers.shared_parameters import (
+    UPDATE_RATE,
+    same_frames_problem,
+    update_period,
+)
 from pan_tilt_sim.controllers.steering_controllers import OdometrySink, SteeringJoints, TfSink
 from pan_tilt_sim.controllers.steering_odometry import Configuration, SteeringKinematics
 from pan_tilt_sim.controllers.surface import (
@@ -206,9 +212,9 @@ class TricycleController(OdometryOutputs, CommandController):
               '(m).', (gt(0.0),), example=0.5),
         Param('wheel_radius', DOUBLE, REQUIRED, 'Radius of the driven wheel (m).', (gt(0.0),),
               example=0.05),
-        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.'),
+        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.', (frame_id(),)),
         Param('base_frame_id', STRING, 'base_link', "The robot's base frame, child of "
-              'odom_frame_id.'),
+              'odom_frame_id.', (frame_id(),)),
         Param('pose_covariance_diagonal', DOUBLE_ARRAY, [0.0] * COVARIANCE_SIZE,
               "Diagonal of the odometry pose's covariance (x, y, z, roll, pitch, yaw).",
               (fixed_size(COVARIANCE_SIZE),)),
@@ -219,7 +225,7 @@ class TricycleController(OdometryOutputs, CommandController):
         Param('odom_only_twist', BOOL, False, "Publish only the odometry's twist (its pose "
               'stays zero).'),
         Param('cmd_vel_timeout', INT, 500, 'Milliseconds of sim time after which a command is '
-              'stale and the wheel stops.'),
+              'stale and the wheel stops.', (gt_eq(0),)),
         Param('publish_ackermann_command', BOOL, False, 'Publish the limited command on '
               '~/cmd_ackermann.'),
         Param('velocity_rolling_window_size', INT, 10, "Updates in the odometry twist's rolling "
@@ -238,6 +244,9 @@ class TricycleController(OdometryOutputs, CommandController):
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
+        same_frames = same_frames_problem(self.params)
+        if same_frames:
+            raise self.error('base_frame_id', same_frames)
         params = self.params
         try:
             self._traction_limiter = TractionLimiter(params['traction'])

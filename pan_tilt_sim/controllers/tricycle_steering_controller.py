@@ -13,7 +13,14 @@ from __future__ import annotations
 
 import sys
 
-from pan_tilt_sim.controllers.parameter_spec import DOUBLE, REQUIRED, Param, ParameterSpec, gt
+from pan_tilt_sim.controllers.parameter_spec import (
+    DOUBLE,
+    REQUIRED,
+    Param,
+    ParameterSpec,
+    gt,
+)
+from pan_tilt_sim.controllers.shared_parameters import UNSET_OR_LENGTH
 from pan_tilt_sim.controllers.steering_controllers import SteeringController, library_parameters
 from pan_tilt_sim.controllers.steering_odometry import Configuration, SteeringKinematics
 
@@ -28,15 +35,20 @@ class TricycleSteeringController(SteeringController):
     kind = 'Tricycle'
     parameters = ParameterSpec([
         *library_parameters(['joint1', 'joint3'], ['joint2']),
-        Param('wheel_track', DOUBLE, 0.0, "Deprecated: use 'traction_track_width'."),
+        Param('wheel_track', DOUBLE, 0.0, "Deprecated: use 'traction_track_width'.",
+              validators=UNSET_OR_LENGTH),
         Param('traction_track_width', DOUBLE, 0.0, 'Distance between the traction wheels (m).',
-              example=0.3),
+              example=0.3,
+              validators=UNSET_OR_LENGTH),
         Param('wheelbase', DOUBLE, REQUIRED, 'Distance between the steered wheel and the '
               'traction axle (m).', (gt(0.0),), example=0.5),
         Param('traction_wheels_radius', DOUBLE, 0.0, 'Radius of the traction wheels (m).',
-              example=0.05),
-        Param('front_wheels_radius', DOUBLE, 0.0, "Deprecated: use 'traction_wheels_radius'."),
-        Param('rear_wheels_radius', DOUBLE, 0.0, "Deprecated: use 'traction_wheels_radius'."),
+              example=0.05,
+              validators=UNSET_OR_LENGTH),
+        Param('front_wheels_radius', DOUBLE, 0.0, "Deprecated: use 'traction_wheels_radius'.",
+              validators=UNSET_OR_LENGTH),
+        Param('rear_wheels_radius', DOUBLE, 0.0, "Deprecated: use 'traction_wheels_radius'.",
+              validators=UNSET_OR_LENGTH),
     ])
 
     def kinematics(self) -> SteeringKinematics:

@@ -62,7 +62,6 @@ from __future__ import annotations
 
 import dataclasses
 import fnmatch
-import math
 import os
 import pathlib
 import re
@@ -71,6 +70,7 @@ from typing import TYPE_CHECKING, Any
 
 from pan_tilt_sim.errors import ConfigurationError, ControllerConfigError
 from pan_tilt_sim.model import naming, yaml_input
+from pan_tilt_sim.model.rates import rate_problem
 from pan_tilt_sim.model.resources import resolve_resource
 from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_ROBOT_NAME, package_share
 
@@ -623,11 +623,10 @@ def _ros2_control_config(nodes: list[tuple[str, dict[str, Any]]],
 
 def _update_rate(manager: Mapping[str, Any], path: str) -> float:
     rate = manager.get(UPDATE_RATE_FIELD, DEFAULT_UPDATE_RATE)
-    if isinstance(rate, bool) or not isinstance(rate, int | float) or not (
-            math.isfinite(rate) and rate > 0):
+    if isinstance(rate, bool) or not isinstance(rate, int | float) or rate_problem(rate):
         raise ControllerConfigError(
             f'{path}: {CONTROLLER_MANAGER}.{ROS2_PARAMETERS}.{UPDATE_RATE_FIELD}: '
-            f'{rate!r} must be a number of Hz > 0')
+            f'{rate!r} must be a number of Hz > 0 whose period 1 / rate is finite')
     return float(rate)
 
 

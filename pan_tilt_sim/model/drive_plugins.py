@@ -64,10 +64,13 @@ after the plugin in ``<ros><namespace>`` with its ``<remapping>``s; ROS 1
 in ``robotNamespace`` -- absent: the root (as spawn_model sets it), given
 empty: the robot's name, as gazebo_plugins' GazeboRos takes it (see
 :mod:`pan_tilt_sim.model.sensors`).  A wheel
-the robot does not have, a number that is not one, or a separation,
-diameter, torque or rate that is not positive ends start-up
-(:class:`~pan_tilt_sim.errors.DescriptionError` naming the plugin and the
-element).
+the robot does not have, a wheel that is a fixed or ``<mimic>`` joint or
+another wheel's joint too, a number that is not one, a separation,
+diameter, torque or rate that is not positive (or a rate whose period
+overflows), an odometry or base frame that is no valid frame id, or one
+frame for both, ends start-up (:class:`~pan_tilt_sim.errors.DescriptionError`
+naming the file, the plugin and the element) -- the checks a driving
+controller makes.
 """
 
 from __future__ import annotations
@@ -79,6 +82,8 @@ from collections.abc import Collection, Mapping
 from xml.etree import ElementTree
 
 from pan_tilt_sim.errors import DescriptionError
+from pan_tilt_sim.model.frame_ids import frame_id_problem
+from pan_tilt_sim.model.rates import rate_problem
 from pan_tilt_sim.model.sensors import (
     GZ_WORLD,
     ROS1,
@@ -103,6 +108,7 @@ ROS1_DIFF_DRIVE_KEYS = {'leftJoint', 'rightJoint', 'wheelSeparation', 'wheelDiam
                         'publishOdomTF', 'publishTf', 'updateRate', 'wheelTorque',
                         'wheelAcceleration', 'odometrySource', 'robotNamespace'}
 UNPLANAR_COVARIANCE = 1e12  # z, roll, pitch: what the plugins put there
+RATE_KEYS = ('rate', 'frequency')  # elements (lower case) whose value is a rate in Hz
 
 
 @dataclasses.dataclass(frozen=True)
@@ -285,7 +291,12 @@ class _PluginReader:
 
     def number(self, key: str, default: float, *, positive: bool = False,
                non_negative: bool = False) -> float:
-        return self.check(key, self.text(key, ''), default, positive, non_negative)
+        value = self.check(key, self.text(key, ''), default, positive, non_negative)
+        if key.lower().endswith(RATE_KEYS):  # a rate: its period must be finite too
+            problem = rate_problem(value, zero_allowed=not positive)
+            if problem:
+                raise self.error(key, problem)
+        return value
 
     def check(self, key: str, text: str, default: float, positive: bool = False,
               non_negative: bool = False) -> float:
@@ -399,14 +410,54 @@ def read_drive_plugins(root: ElementTree.Element, source: pathlib.Path | str,
                 ros1 = bool(set(reader.texts) & ROS1_DIFF_DRIVE_KEYS) and 'ros' not in \
                     reader.texts
                 plugin = _ros1_diff_drive(reader) if ros1 else _ros2_diff_drive(reader)
-                for role, wheels in (('left', plugin.left_joints),
-                                     ('right', plugin.right_joints)):
-                    key = f'{role}Joint' if ros1 else f'{role}_joint'
-                    for wheel in wheels:
-                        if wheel not in joints:
-                            raise reader.error(key, f"'{wheel}' is not a joint of this robot")
+                keys = ('leftJoint', 'rightJoint') if ros1 else ('left_joint', 'right_joint')
+                _check_wheels(reader, ((keys[0], plugin.left_joints),
+                                       (keys[1], plugin.right_joints)), joints)
+                frames = ('odometryFrame', 'robotBaseFrame') if ros1 else (
+                    'odometry_frame', 'robot_base_frame')
+                _check_frames(reader, ((frames[0], plugin.odometry_frame),
+                                       (frames[1], plugin.robot_base_frame)))
                 plugins.append(plugin)
     return tuple(plugins)
+
+
+def _check_wheels(reader: _PluginReader, keyed: tuple[tuple[str, tuple[str, ...]], ...],
+                  joints: Mapping[str, object]) -> None:
+    """Refuse a wheel that is no joint, no movable one, a mimic, or named twice.
+
+    The checks a driving controller makes of its wheels (distinct, movable,
+    commandable), the error naming the file, the plugin and the element.
+    """
+    seen: dict[str, str] = {}
+    for key, wheels in keyed:
+        for wheel in wheels:
+            joint = joints.get(wheel)
+            if joint is None:
+                raise reader.error(key, f"'{wheel}' is not a joint of this robot")
+            kind = getattr(joint, 'kind', None)
+            if kind is not None and not kind.is_actuated:
+                raise reader.error(key, f"'{wheel}' is a {kind.value} joint: a wheel must be a "
+                                   'movable (revolute or continuous) joint')
+            mimic = getattr(joint, 'mimic', None)
+            if mimic is not None:
+                raise reader.error(key, f"'{wheel}' mimics '{mimic.joint}': it follows that "
+                                   'joint and cannot be driven')
+            if wheel in seen:
+                raise reader.error(key, f"'{wheel}' is already a wheel (<{seen[wheel]}>): each "
+                                   'wheel needs its own joint')
+            seen[wheel] = key
+
+
+def _check_frames(reader: _PluginReader, keyed: tuple[tuple[str, str], ...]) -> None:
+    """Refuse a frame that is no valid frame id, and an odometry frame equal to the base's."""
+    for key, frame in keyed:
+        problem = frame_id_problem(frame)
+        if problem:
+            raise reader.error(key, problem)
+    (parent_key, parent), (child_key, child) = keyed
+    if parent.removeprefix('/') == child.removeprefix('/'):
+        raise reader.error(child_key, f"'{child}' is <{parent_key}> too: the odometry's "
+                           'transform needs two different frames')
 
 
 def _ros2_diff_drive(reader: _PluginReader) -> DiffDrivePlugin:
@@ -533,6 +584,8 @@ def read_planar_move_plugins(root: ElementTree.Element,
                 command_topic=reader.text('commandTopic', 'cmd_vel'),
                 odometry_topic=reader.text('odometryTopic', 'odom'),
                 namespace=reader.ros1_namespace()))
+            _check_frames(reader, (('odometryFrame', plugins[-1].odometry_frame),
+                                   ('robotBaseFrame', plugins[-1].robot_base_frame)))
             continue
         namespace, remappings = reader.ros()
         plugins.append(PlanarMovePlugin(
@@ -546,6 +599,8 @@ def read_planar_move_plugins(root: ElementTree.Element,
             covariance=(reader.number('covariance_x', 1e-5), reader.number('covariance_y', 1e-5),
                         reader.number('covariance_yaw', 1e-3)),
             namespace=namespace, remappings=remappings))
+        _check_frames(reader, (('odometry_frame', plugins[-1].odometry_frame),
+                               ('robot_base_frame', plugins[-1].robot_base_frame)))
     return tuple(plugins)
 
 
@@ -658,9 +713,7 @@ def read_gz_plugins(root: ElementTree.Element, source: pathlib.Path | str,
         for key, wheels in (('left_joint', left), ('right_joint', right)):
             if not wheels:
                 raise reader.error(key, 'is missing: the system needs at least one on each side')
-            for wheel in wheels:
-                if wheel not in joints:
-                    raise reader.error(key, f"'{wheel}' is not a joint of this robot")
+        _check_wheels(reader, (('left_joint', left), ('right_joint', right)), joints)
         limits = {}
         for group in ('linear', 'angular'):
             values = {}
@@ -674,6 +727,9 @@ def read_gz_plugins(root: ElementTree.Element, source: pathlib.Path | str,
                     raise reader.error(f'min_{group}_{what}', f'{low:g} is above max_{group}_'
                                        f'{what} {high:g}')
             limits[group] = tuple(values.values())
+        frame = reader.text('frame_id', f'{model}/odom')
+        child = reader.text('child_frame_id', f'{model}/{_root_link(root)}')
+        _check_frames(reader, (('frame_id', frame), ('child_frame_id', child)))
         drives.append(GzDiffDrivePlugin(
             name=reader.name, left_joints=left, right_joints=right,
             wheel_separation=reader.number('wheel_separation', 1.0, positive=True),
@@ -682,8 +738,7 @@ def read_gz_plugins(root: ElementTree.Element, source: pathlib.Path | str,
             command_topic=gz_topic(reader.text('topic', f'/model/{model}/cmd_vel')),
             odometry_topic=gz_topic(reader.text('odom_topic', f'/model/{model}/odometry')),
             tf_topic=gz_topic(reader.text('tf_topic', f'/model/{model}/tf')),
-            frame_id=reader.text('frame_id', f'{model}/odom'),
-            child_frame_id=reader.text('child_frame_id', f'{model}/{_root_link(root)}'),
+            frame_id=frame, child_frame_id=child,
             linear_limits=limits['linear'], angular_limits=limits['angular']))
     odometries = []
     for element in _model_plugins(root, GZ_ODOMETRY_FILES, GZ_ODOMETRY_NAMES):
@@ -691,9 +746,11 @@ def read_gz_plugins(root: ElementTree.Element, source: pathlib.Path | str,
         dimensions = reader.number('dimensions', 2.0)
         if dimensions not in (2.0, 3.0):
             raise reader.error('dimensions', f'must be 2 or 3, got {dimensions:g}')
+        odom_frame = reader.text('odom_frame', f'{model}/odom')
+        base_frame = reader.text('robot_base_frame', f'{model}/base_footprint')
+        _check_frames(reader, (('odom_frame', odom_frame), ('robot_base_frame', base_frame)))
         odometries.append(GzOdometryPlugin(
-            name=reader.name, odom_frame=reader.text('odom_frame', f'{model}/odom'),
-            robot_base_frame=reader.text('robot_base_frame', f'{model}/base_footprint'),
+            name=reader.name, odom_frame=odom_frame, robot_base_frame=base_frame,
             odom_publish_frequency=reader.number('odom_publish_frequency', 50.0, positive=True),
             odometry_topic=gz_topic(reader.text('odom_topic', f'/model/{model}/odometry')),
             tf_topic=gz_topic(reader.text('tf_topic', f'/model/{model}/pose')),

@@ -203,6 +203,79 @@ class RaySpec:
         return self.vertical.count
 
 
+# Bounds of a sensor's sizes, each with the reason the error gives (see sensor_size_problem).
+# A scan: as many beams as the densest real lidars return per scan (128 channels x 2048
+# columns); each beam is one PyBullet ray cast every scan.
+MAX_SCAN_BEAMS = 128 * 2048
+SCAN_BEAMS_REASON = 'the densest real lidars: 128 channels x 2048 columns'
+# An image: 4K UHD.  PyBullet renders on the CPU; a larger image costs seconds and
+# hundreds of MB per frame (rgb, depth, and a depth camera's point cloud).
+MAX_IMAGE_PIXELS = 3840 * 2160
+IMAGE_PIXELS_REASON = "4K UHD (3840 x 2160): what PyBullet's CPU renderer draws in " \
+    'reasonable time and memory'
+MAX_SCAN_ANGLE = 2.0 * math.pi  # rad: a scan angle beyond a full turn either way means nothing
+# A camera's clip range: far / near at most this.  PyBullet renders with a float32 depth
+# buffer; from a ratio of 1e8 on its every depth is NaN (test/sim/test_sensors.py).
+MAX_CLIP_RATIO = 1e6
+
+
+def scan_axis_problem(axis: ScanAxis, tag: str) -> str | None:
+    """Say what is wrong with one axis of a scan (``tag``: horizontal, vertical), or None."""
+    for name in ('min_angle', 'max_angle'):
+        value = getattr(axis, name)
+        if not -MAX_SCAN_ANGLE <= value <= MAX_SCAN_ANGLE:
+            return (f'<{tag}><{name}> {value:g} rad is beyond +-2 pi: a scan angle must lie '
+                    'within one turn either way')
+    if axis.count > 1 and not axis.min_angle < axis.max_angle:
+        return (f'<{tag}> needs min_angle < max_angle for {axis.count} beams, got min_angle '
+                f'{axis.min_angle:g}, max_angle {axis.max_angle:g}')
+    if axis.max_angle < axis.min_angle:
+        return (f'<{tag}> max_angle {axis.max_angle:g} is below min_angle '
+                f'{axis.min_angle:g}')
+    return None
+
+
+def scan_size_problem(ray: RaySpec) -> str | None:
+    """Say what is wrong with a scan's angles or beam count (at most MAX_SCAN_BEAMS), or None."""
+    for tag in ('horizontal', 'vertical'):
+        axis = getattr(ray, tag)
+        if axis.samples * axis.resolution > MAX_SCAN_BEAMS:  # before counting: may overflow
+            return (f'<{tag}> {axis.samples} samples x resolution {axis.resolution:g} is more '
+                    f'than the limit of {MAX_SCAN_BEAMS} beams per scan ({SCAN_BEAMS_REASON})')
+        problem = scan_axis_problem(axis, tag)
+        if problem:
+            return problem
+    beams = ray.horizontal.count * ray.vertical.count
+    if beams > MAX_SCAN_BEAMS:
+        return (f'{ray.horizontal.count} x {ray.vertical.count} = {beams} beams per scan is '
+                f'more than the limit of {MAX_SCAN_BEAMS} ({SCAN_BEAMS_REASON})')
+    return None
+
+
+def clip_problem(camera: CameraSpec) -> str | None:
+    """Say why a camera's clip planes (and a depth camera's own) cannot render, or None."""
+    planes = [('<clip>', camera.near, camera.far)]
+    if camera.depth_near is not None or camera.depth_far is not None:
+        planes.append(('<depth_camera><clip>', camera.depth_near or camera.near,
+                       camera.depth_far or camera.far))
+    for tag, near, far in planes:
+        if not 0.0 < near < far:
+            return f'{tag} needs 0 < near < far, got near {near:g}, far {far:g}'
+        if far / near > MAX_CLIP_RATIO:
+            return (f'{tag} far / near = {far / near:g} is more than the limit of '
+                    f'{MAX_CLIP_RATIO:g} (PyBullet renders every depth as NaN from 1e8 on)')
+    return None
+
+
+def image_size_problem(camera: CameraSpec) -> str | None:
+    """Say why a camera's image is too large (more than MAX_IMAGE_PIXELS), or None."""
+    pixels = camera.width * camera.height
+    if pixels > MAX_IMAGE_PIXELS:
+        return (f'{camera.width} x {camera.height} = {pixels} pixels per image is more than '
+                f'the limit of {MAX_IMAGE_PIXELS} ({IMAGE_PIXELS_REASON})')
+    return None
+
+
 @dataclasses.dataclass(frozen=True)
 class ImuSpec:
     """An ``<imu>``: noise per axis of angular velocity (rad/s) and linear acceleration."""

@@ -60,6 +60,7 @@ from pan_tilt_sim.model.drive_plugins import (
     read_p3d_plugins,
     read_planar_move_plugins,
 )
+from pan_tilt_sim.model.rates import rate_problem
 from pan_tilt_sim.model.robot import (
     DEFAULT_AXIS,
     INITIAL_VALUE,
@@ -101,7 +102,10 @@ from pan_tilt_sim.model.sensors import (
     ScanAxis,
     SensorKind,
     SensorSpec,
+    clip_problem,
+    image_size_problem,
     plugin_stem,
+    scan_size_problem,
 )
 from pan_tilt_sim.model.surfaces import read_surfaces
 from pan_tilt_sim.model.transforms import ZERO_VECTOR, Transform, Vector, quaternion_from_rpy
@@ -848,6 +852,9 @@ class _SensorReader:
         rate = self.number(element, 'update_rate', 0.0, owner)
         if rate < 0.0:
             raise self.error(owner, f'<update_rate> must be >= 0 Hz, got {rate:g}')
+        problem = rate_problem(rate, zero_allowed=True)
+        if problem:
+            raise self.error(owner, f'<update_rate> {problem}')
         return rate
 
     def pose(self, element: ElementTree.Element | None, owner: str) -> Transform:
@@ -900,13 +907,17 @@ class _SensorReader:
                              f'far {far:g}')
         depth_near = self.number(element, 'depth_camera/clip/near', 0.0, owner) or None
         depth_far = self.number(element, 'depth_camera/clip/far', 0.0, owner) or None
-        return CameraSpec(
+        camera = CameraSpec(
             width=self.integer(element, 'image/width', default.width, owner),
             height=self.integer(element, 'image/height', default.height, owner),
             horizontal_fov=fov, near=near, far=far,
             format=(element.findtext('image/format') or default.format).strip(),
             noise=self.noise(element.find('noise'), owner),
             depth_near=depth_near, depth_far=depth_far)
+        problem = image_size_problem(camera) or clip_problem(camera)
+        if problem:
+            raise self.error(owner, problem)
+        return camera
 
     def scan_axis(self, element: ElementTree.Element | None, owner: str,
                   default_samples: int) -> ScanAxis:
@@ -920,9 +931,6 @@ class _SensorReader:
         if axis.resolution <= 0.0:
             raise self.error(owner, f'<{element.tag}><resolution> must be > 0, got '
                              f'{axis.resolution:g}')
-        if axis.max_angle < axis.min_angle:
-            raise self.error(owner, f'<{element.tag}> max_angle {axis.max_angle:g} is below '
-                             f'min_angle {axis.min_angle:g}')
         return axis
 
     def ray(self, element: ElementTree.Element | None, owner: str) -> RaySpec:
@@ -938,10 +946,14 @@ class _SensorReader:
         if not 0.0 <= range_min < range_max:
             raise self.error(owner, f'<range> needs 0 <= min < max, got min {range_min:g}, '
                              f'max {range_max:g}')
-        return RaySpec(horizontal=horizontal, vertical=vertical, range_min=range_min,
-                       range_max=range_max,
-                       range_resolution=self.number(element, 'range/resolution', 0.0, owner),
-                       noise=self.noise(element.find('noise'), owner))
+        ray = RaySpec(horizontal=horizontal, vertical=vertical, range_min=range_min,
+                      range_max=range_max,
+                      range_resolution=self.number(element, 'range/resolution', 0.0, owner),
+                      noise=self.noise(element.find('noise'), owner))
+        problem = scan_size_problem(ray)
+        if problem:
+            raise self.error(owner, problem)
+        return ray
 
     def imu(self, element: ElementTree.Element | None, owner: str) -> ImuSpec:
         if element is None:

@@ -45,6 +45,7 @@ from pan_tilt_sim.controllers.gripper_action_controller import (
 from pan_tilt_sim.ros.goal_handles import cancel_running, end_handle
 
 ACTION = 'gripper_cmd'
+WARNING_THROTTLE_S = 1.0  # wall seconds between two warnings about refused goals
 
 
 class GripperActionServer(abc.ABC):
@@ -92,7 +93,8 @@ class GripperActionServer(abc.ABC):
         if request is not None:
             problem = self._controller.check_goal(request) or ''
         if problem:
-            self._logger.error(f'{self._label}: goal rejected: {problem}')
+            self._logger.warning(f'{self._label}: goal rejected: {problem}',
+                                 throttle_duration_sec=WARNING_THROTTLE_S)
             return GoalResponse.REJECT
         return GoalResponse.ACCEPT
 

@@ -224,6 +224,17 @@ def test_a_goal_that_is_not_finite_is_refused(position, max_effort):
     assert gripper.controller.check_goal(GripperRequest(0.01, 1.0)) is None
 
 
+@pytest.mark.parametrize('request_', [GripperRequest(0.01, -10.0), GripperRequest(0.01, -1e-9),
+                                      GripperRequest(0.01, 1.0, -0.1)])
+def test_a_goal_with_a_negative_cap_is_refused(request_):
+    problem = HandMovedGripper().controller.check_goal(request_)
+    assert problem is not None and 'must be >= 0' in problem
+
+
+def test_a_goal_with_max_effort_0_is_taken_as_no_cap():
+    assert HandMovedGripper().controller.check_goal(GripperRequest(0.01, 0.0)) is None
+
+
 # --- how the joint is driven ---------------------------------------------------------------
 
 @pytest.mark.parametrize(('max_effort', 'force'), [

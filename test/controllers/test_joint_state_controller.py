@@ -251,6 +251,18 @@ def test_a_mapping_is_ignored_where_interfaces_names_the_field_itself():
         "as JointState.position: 'interfaces' names 'position' itself"]
 
 
+def test_a_mapped_interface_no_joint_has_gets_one_warning_and_the_field_stays_its_own():
+    controller, (names, positions, *_), _dynamic = sample(
+        map_interface_to_joint_state={'position': 'nonexistent_iface'})
+    assert names == ['a', 'b', 'c'] and positions == [0.1, 0.2, pytest.approx(0.3)]
+    assert controller.config_warnings == [
+        "test.yaml: jsb.map_interface_to_joint_state.position: 'nonexistent_iface' is not a "
+        "state interface of any published joint: JointState.position is each joint's own "
+        "'position'"]
+    controller.configure(handles())  # configured again: still one warning
+    assert len(controller.config_warnings) == 1
+
+
 def test_only_interfaces_mapped_to_a_field_put_a_joint_into_joint_states():
     _controller, (names, positions, *_), _dynamic = sample(
         joints=['a', 'b'], interfaces=['temperature', 'velocity'],

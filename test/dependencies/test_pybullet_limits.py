@@ -269,3 +269,18 @@ def test_an_inertia_no_rigid_body_has_is_set_to_zero_with_a_warning(tmp_path):
                       body)
     assert result(child) == {'inertia': [0.0, 0.0, 0.0]}
     assert 'Bad inertia tensor properties, setting inertia to zero' in child.stdout
+
+
+def test_a_ray_batch_answers_at_most_16383_rays_and_takes_no_more_than_16384(client):
+    import pybullet
+
+    from pan_tilt_sim.sim.sensors.lidar import MAX_BATCH
+
+    def cast(count: int) -> int:
+        return len(pybullet.rayTestBatch([[0.0, 0.0, 0.0]] * count, [[1.0, 0.0, 0.0]] * count,
+                                         physicsClientId=client))
+
+    assert cast(MAX_BATCH) == MAX_BATCH == 16383
+    assert cast(MAX_BATCH + 1) == MAX_BATCH  # one ray taken and never answered
+    with pytest.raises(pybullet.error, match='exceed the maximum batch size'):
+        cast(MAX_BATCH + 2)

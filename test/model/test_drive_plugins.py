@@ -1,6 +1,7 @@
 """Gazebo drive plugins in a URDF: each generation's element names, defaults and topics."""
 
 import pathlib
+import re
 
 import pytest
 from mobile_fixtures import (
@@ -356,3 +357,116 @@ def test_a_gz_joint_state_publisher_naming_a_fixed_joint_ends_start_up():
         model(GZ_DIFF_DRIVE, joint_states=(
             '<plugin filename="gz-sim-joint-state-publisher-system" name="js">'
             '<joint_name>caster_joint</joint_name></plugin>'))
+
+
+# --- a plugin's wheels and frames get a controller's checks ---------------------------------
+
+def bare_ros1(*elements: str) -> str:
+    return ('<plugin name="drive" filename="libgazebo_ros_diff_drive.so">'
+            + ''.join(elements) + '</plugin>')
+
+
+def bare_gz(*elements: str) -> str:
+    return ('<plugin filename="gz-sim-diff-drive-system" name="gz::sim::systems::DiffDrive">'
+            + ''.join(elements) + '</plugin>')
+
+
+def _replace(text: str, old: str, new: str) -> str:
+    assert old in text
+    return text.replace(old, new)
+
+
+@pytest.mark.parametrize(('plugin', 'filename', 'problem'), [
+    pytest.param(_replace(ROS2_DIFF_DRIVE, '<right_joint>right_wheel_joint<',
+                          '<right_joint>left_wheel_joint<'), 'libgazebo_ros_diff_drive.so',
+                 "<right_joint> 'left_wheel_joint' is already a wheel (<left_joint>)",
+                 id='ros2: one joint left and right'),
+    pytest.param(_replace(ROS2_DIFF_DRIVE, '<left_joint>left_wheel_joint<',
+                          '<left_joint>caster_joint<'), 'libgazebo_ros_diff_drive.so',
+                 "<left_joint> 'caster_joint' is a fixed joint: a wheel must be a movable",
+                 id='ros2: a fixed wheel'),
+    pytest.param(_replace(ROS2_DIFF_DRIVE, '<left_joint>left_wheel_joint</left_joint>',
+                          '<left_joint>left_wheel_joint</left_joint>'
+                          '<left_joint>left_wheel_joint</left_joint>'
+                          '<right_joint>right_wheel_joint</right_joint>'
+                          '<num_wheel_pairs>2</num_wheel_pairs>'),
+                 'libgazebo_ros_diff_drive.so',
+                 "<left_joint> 'left_wheel_joint' is already a wheel (<left_joint>)",
+                 id='ros2: one joint in two pairs'),
+    pytest.param(bare_ros1('<leftJoint>right_wheel_joint</leftJoint>',
+                           '<rightJoint>right_wheel_joint</rightJoint>'),
+                 'libgazebo_ros_diff_drive.so',
+                 "<rightJoint> 'right_wheel_joint' is already a wheel (<leftJoint>)",
+                 id='ros1: one joint left and right'),
+    pytest.param(bare_ros1('<leftJoint>caster_joint</leftJoint>',
+                           '<rightJoint>right_wheel_joint</rightJoint>'),
+                 'libgazebo_ros_diff_drive.so', "<leftJoint> 'caster_joint' is a fixed joint",
+                 id='ros1: a fixed wheel'),
+    pytest.param(bare_gz('<left_joint>left_wheel_joint</left_joint>',
+                         '<right_joint>left_wheel_joint</right_joint>'),
+                 'gz-sim-diff-drive-system',
+                 "<right_joint> 'left_wheel_joint' is already a wheel (<left_joint>)",
+                 id='gz: one joint left and right'),
+    pytest.param(bare_gz('<left_joint>left_wheel_joint</left_joint>',
+                         '<right_joint>caster_joint</right_joint>'),
+                 'gz-sim-diff-drive-system', "<right_joint> 'caster_joint' is a fixed joint",
+                 id='gz: a fixed wheel'),
+])
+def test_a_plugin_wheel_twice_or_fixed_ends_start_up_naming_the_file_and_plugin(
+        plugin, filename, problem):
+    with pytest.raises(DescriptionError) as raised:
+        model(plugin)
+    message = str(raised.value)
+    assert message.startswith(f"{SOURCE}: plugin '")
+    assert f'({filename}): {problem}' in message
+
+
+def test_a_plugin_wheel_that_mimics_another_joint_ends_start_up():
+    urdf = plugin_rover_urdf(ROS2_DIFF_DRIVE).replace(
+        '<axis xyz="0 1 0"/>', '<axis xyz="0 1 0"/><mimic joint="left_wheel_joint"/>', 2)
+    urdf = urdf.replace('<mimic joint="left_wheel_joint"/>', '', 1)  # the right wheel mimics
+    with pytest.raises(DescriptionError, match="<right_joint> 'right_wheel_joint' mimics "
+                                               "'left_wheel_joint'"):
+        parse_urdf(urdf, SOURCE)
+
+
+@pytest.mark.parametrize(('plugin', 'problem'), [
+    pytest.param(_replace(ROS2_DIFF_DRIVE, '<odometry_frame>odom<', '<odometry_frame>base_link<'),
+                 "<robot_base_frame> 'base_link' is <odometry_frame> too", id='ros2 same frames'),
+    pytest.param(_replace(ROS2_DIFF_DRIVE, '<odometry_frame>odom<', '<odometry_frame>a b<'),
+                 "<odometry_frame> 'a b' is not a valid frame id", id='ros2 frame with a space'),
+    pytest.param(bare_ros1('<leftJoint>left_wheel_joint</leftJoint>',
+                           '<rightJoint>right_wheel_joint</rightJoint>',
+                           '<robotBaseFrame>/odom</robotBaseFrame>'),
+                 "<robotBaseFrame> '/odom' is <odometryFrame> too", id='ros1 same frames'),
+    pytest.param(bare_gz('<left_joint>left_wheel_joint</left_joint>',
+                         '<right_joint>right_wheel_joint</right_joint>',
+                         '<frame_id>odom//x</frame_id>'),
+                 "<frame_id> 'odom//x' is not a valid frame id", id='gz empty token'),
+    pytest.param('<plugin name="move" filename="libgazebo_ros_planar_move.so">'
+                 '<odometry_frame>..</odometry_frame></plugin>',
+                 "<odometry_frame> '..' is not a valid frame id", id='planar move ..'),
+])
+def test_a_plugin_frame_that_is_no_frame_id_or_the_same_twice_ends_start_up(plugin, problem):
+    with pytest.raises(DescriptionError, match=re.escape(problem)):
+        model(plugin)
+
+
+def test_a_gz_odometry_publisher_with_one_frame_for_both_ends_start_up():
+    with pytest.raises(DescriptionError, match="<robot_base_frame> 'odom' is <odom_frame> too"):
+        model(GZ_DIFF_DRIVE, ground_truth=GZ_ODOMETRY.replace('>base_link<', '>odom<'),
+              joint_states='')
+
+
+@pytest.mark.parametrize(('plugin', 'element'), [
+    (bare_ros2('<update_rate>5e-324</update_rate>'), 'update_rate'),
+    (bare_gz('<left_joint>left_wheel_joint</left_joint>',
+             '<right_joint>right_wheel_joint</right_joint>',
+             '<odom_publish_frequency>1e-320</odom_publish_frequency>'),
+     'odom_publish_frequency'),
+    ('<plugin name="move" filename="libgazebo_ros_planar_move.so">'
+     '<publish_rate>5e-324</publish_rate></plugin>', 'publish_rate'),
+])
+def test_a_plugin_rate_whose_period_overflows_ends_start_up(plugin, element):
+    with pytest.raises(DescriptionError, match=f'<{element}> .* must be a rate > 0 Hz'):
+        model(plugin)

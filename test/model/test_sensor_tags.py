@@ -362,3 +362,91 @@ def test_camera_focal_length_follows_the_horizontal_fov():
         '<image><width>640</width><height>480</height></image></camera>')))
     assert sensor.camera.focal_length == pytest.approx(320.0)
     assert sensor.camera.vertical_fov == pytest.approx(2 * math.atan(0.75))
+
+
+# --- sizes and angles within their limits ------------------------------------------------
+
+@pytest.mark.parametrize(('body', 'problem'), [
+    pytest.param(RAY.replace('<samples>5<', '<samples>10000000<'),
+                 '<horizontal> 10000000 samples x resolution 1 is more than the limit of 262144 '
+                 'beams per scan (the densest real lidars: 128 channels x 2048 columns)',
+                 id='ten million samples'),
+    pytest.param(RAY.replace('<samples>5<', '<samples>1e308<').replace(
+        '<min_angle>', '<resolution>10</resolution><min_angle>'),
+                 'samples x resolution 10 is more than the limit of 262144',
+                 id='a count that overflows a float'),
+    pytest.param(RAY.replace('</horizontal>', '</horizontal><vertical><samples>1000</samples>'
+                             '<min_angle>-0.5</min_angle><max_angle>0.5</max_angle></vertical>'
+                             ).replace('<samples>5<', '<samples>1000<'),
+                 '1000 x 1000 = 1000000 beams per scan is more than the limit of 262144',
+                 id='rows times columns'),
+    pytest.param(RAY.replace('<max_angle>1<', '<max_angle>1e300<'),
+                 '<horizontal><max_angle> 1e+300 rad is beyond +-2 pi', id='max_angle 1e300'),
+    pytest.param(RAY.replace('<min_angle>-1<', '<min_angle>-7<'),
+                 '<horizontal><min_angle> -7 rad is beyond +-2 pi', id='min_angle -7'),
+    pytest.param(RAY.replace('<min_angle>-1<', '<min_angle>1<'),
+                 '<horizontal> needs min_angle < max_angle for 5 beams, got min_angle 1, '
+                 'max_angle 1', id='five beams at one angle'),
+    pytest.param(RAY.replace('<min_angle>-1<', '<min_angle>2<'),
+                 '<horizontal> needs min_angle < max_angle', id='min above max'),
+])
+def test_a_scan_beyond_its_limits_ends_start_up_naming_the_sensor_and_limit(body, problem):
+    with pytest.raises(DescriptionError) as raised:
+        parse_urdf(robot(sensor_block('arm', 'ray', body, name='laser')), SOURCE)
+    assert str(raised.value).startswith(f"{SOURCE}: sensor 'laser': ")
+    assert problem in str(raised.value)
+
+
+def test_a_scan_at_its_limits_and_a_single_beam_at_one_angle_are_taken():
+    full = RAY.replace('<samples>5<', '<samples>2048<').replace(
+        '</horizontal>', '</horizontal><vertical><samples>128</samples><min_angle>-0.3'
+        '</min_angle><max_angle>0.3</max_angle></vertical>').replace(
+        '<min_angle>-1<', '<min_angle>-6.283185307179586<').replace(
+        '<max_angle>1<', '<max_angle>6.283185307179586<')
+    _, sensor = only_sensor(robot(sensor_block('arm', 'ray', full)))
+    assert sensor.ray.horizontal.count * sensor.ray.vertical.count == 262144
+    one = RAY.replace('<samples>5<', '<samples>1<').replace('<min_angle>-1<', '<min_angle>1<')
+    _, sensor = only_sensor(robot(sensor_block('arm', 'ray', one)))
+    assert sensor.ray.horizontal.angles() == (1.0,)
+
+
+@pytest.mark.parametrize(('width', 'height', 'problem'), [
+    (100000, 100000, '100000 x 100000 = 10000000000 pixels per image is more than the limit of '
+     "8294400 (4K UHD (3840 x 2160): what PyBullet's CPU renderer draws"),
+    (3841, 2160, '3841 x 2160 = 8296560 pixels per image'),
+    (8294401, 1, '8294401 x 1 = 8294401 pixels'),
+])
+def test_an_image_beyond_4k_ends_start_up_naming_the_sensor_and_limit(width, height, problem):
+    body = f'<camera><image><width>{width}</width><height>{height}</height></image></camera>'
+    with pytest.raises(DescriptionError) as raised:
+        parse_urdf(robot(sensor_block('arm', 'camera', body, name='cam')), SOURCE)
+    assert str(raised.value).startswith(f"{SOURCE}: sensor 'cam': ")
+    assert problem in str(raised.value)
+
+
+def test_a_4k_image_is_taken():
+    body = '<camera><image><width>3840</width><height>2160</height></image></camera>'
+    _, sensor = only_sensor(robot(sensor_block('arm', 'camera', body)))
+    assert (sensor.camera.width, sensor.camera.height) == (3840, 2160)
+
+
+def test_a_sensor_rate_whose_period_overflows_ends_start_up():
+    with pytest.raises(DescriptionError, match=r"sensor 'cam': <update_rate> 5e-324 must be a "
+                                               'rate > 0 Hz'):
+        parse_urdf(robot(sensor_block('arm', 'camera', '<update_rate>5e-324</update_rate>',
+                                      name='cam')), SOURCE)
+
+
+@pytest.mark.parametrize(('clip', 'problem'), [
+    ('<clip><near>0.1</near><far>1e300</far></clip>',
+     '<clip> far / near = 1e+301 is more than the limit of 1e+06'),
+    ('<clip><near>1e-300</near><far>0.05</far></clip>', '<clip> far / near = 5e+298'),
+    ('<clip><near>0.1</near><far>10</far></clip><depth_camera><clip><near>1e-9</near>'
+     '<far>10</far></clip></depth_camera>', '<depth_camera><clip> far / near = 1e+10'),
+])
+def test_clip_planes_a_depth_buffer_cannot_hold_end_start_up(clip, problem):
+    with pytest.raises(DescriptionError) as raised:
+        parse_urdf(robot(sensor_block('arm', 'camera', f'<camera>{clip}</camera>', name='cam')),
+                   SOURCE)
+    assert str(raised.value).startswith(f"{SOURCE}: sensor 'cam': ")
+    assert problem in str(raised.value)

@@ -158,6 +158,21 @@ def test_a_goal_that_is_not_finite_is_rejected_and_nothing_moves(gripper_node, c
     assert gripper.finger() == pytest.approx(before, abs=1e-4)
 
 
+def test_a_goal_with_a_negative_max_effort_is_rejected_with_a_warning_and_nothing_moves(
+        gripper_node, capfd):
+    gripper = gripper_node()
+    before = gripper.finger()
+    handle = gripper.send(command(gripper, 0.04, max_effort=-10.0))
+    assert not handle.accepted
+    err = capfd.readouterr().err
+    assert 'gripper_controller/gripper_cmd: goal rejected: max_effort -10.0 must be >= 0' in err
+    assert 'WARN' in err
+    gripper.sim.run_for(0.3)
+    assert gripper.finger() == pytest.approx(before, abs=1e-4)
+    status, _result = gripper.result(gripper.send(command(gripper, 0.04, max_effort=0.0)))
+    assert status == goal_status().STATUS_SUCCEEDED  # 0: no cap, the simulation kept running
+
+
 def parallel_goal(gripper, positions, efforts=()):
     goal = gripper.action.Goal()
     goal.command.name = [FINGER_JOINT]

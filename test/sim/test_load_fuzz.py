@@ -9,110 +9,36 @@ still finite after a few hundred steps -- or ends in a ConfigurationError
 hang or a NaN.
 
 PyBullet segfaults on some inputs, so the examples run in a child process
-(test/load_worker.py), one after another: a crash or a hang there is a
-failing example here, and the next example gets a fresh child.  CI runs
+(test/load_worker.py, run by test/worker_process.py), one after another: a
+crash or a hang there is a failing example here, and the next example gets a
+fresh child.  CI runs
 :data:`EXAMPLES` examples; ``PAN_TILT_SIM_SLOW=1`` runs :data:`SLOW_EXAMPLES`.
 """
 
 from __future__ import annotations
 
-import json
 import os
 import pathlib
-import selectors
 import signal
-import subprocess
-import sys
-import tempfile
 
 import pytest
-import sim_process
 from hypothesis import HealthCheck, event, given, settings
 from sdf_strategies import FuzzSdf, sdf_robots
 from urdf_strategies import FuzzRobot, robots
+from worker_process import WorkerProcess
 
 SLOW_ENV = 'PAN_TILT_SIM_SLOW'
 EXAMPLES = 100
 SLOW_EXAMPLES = 2000
 STEPS = 300  # physics steps each loaded robot and spawned object runs
-ANSWER_BUDGET_S = 30.0  # no answer within this: the child hangs
 WORKER = pathlib.Path(__file__).resolve().parents[1] / 'load_worker.py'
 ROBOT_OUTCOMES = ('refused', 'loaded')
 OBJECT_OUTCOMES = ('refused', 'spawned')
 
 
-class LoadWorker:
-    """test/load_worker.py in a child process, started again whenever it died."""
-
-    def __init__(self) -> None:
-        self._process: subprocess.Popen | None = None
-        self._stderr = tempfile.TemporaryFile(mode='w+', encoding='utf-8', errors='replace')
-
-    def run(self, request: dict) -> dict:
-        """Return the child's answer to ``request``; fail if it crashes or falls silent."""
-        process = self._started()
-        try:
-            process.stdin.write(json.dumps(request) + '\n')
-            process.stdin.flush()
-        except BrokenPipeError:
-            pass  # it died: the read below says how
-        with selectors.DefaultSelector() as selector:
-            selector.register(process.stdout, selectors.EVENT_READ)
-            ready = selector.select(ANSWER_BUDGET_S)
-        if not ready:
-            process.kill()
-            process.wait()
-            self._process = None
-            pytest.fail(f'the worker hung: no answer within {ANSWER_BUDGET_S:g} s', False)
-        line = process.stdout.readline()
-        if not line:
-            code = process.wait()
-            self._process = None
-            pytest.fail(f'the worker died ({_ending(code)}); its last output: '
-                        f'{self._tail()!r}', False)
-        return json.loads(line)
-
-    @property
-    def pid(self) -> int:
-        """The child's process id (started if need be)."""
-        return self._started().pid
-
-    def close(self) -> None:
-        """End the child (stdin closed: it returns) and forget its output."""
-        if self._process is not None:
-            self._process.stdin.close()
-            try:
-                self._process.wait(timeout=ANSWER_BUDGET_S)
-            except subprocess.TimeoutExpired:
-                self._process.kill()
-                self._process.wait()
-            self._process = None
-        self._stderr.close()
-
-    def _started(self) -> subprocess.Popen:
-        if self._process is None:
-            self._stderr.seek(0)
-            self._stderr.truncate()
-            self._process = subprocess.Popen(
-                [sys.executable, str(WORKER)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                stderr=self._stderr, text=True, env=sim_process.environment())
-        return self._process
-
-    def _tail(self) -> str:
-        self._stderr.flush()
-        self._stderr.seek(0)
-        return self._stderr.read()[-1500:]
-
-
-def _ending(code: int) -> str:
-    if code < 0:
-        return f'killed by {signal.Signals(-code).name}'
-    return f'exit code {code}'
-
-
 @pytest.fixture(scope='module')
 def worker():
-    child = LoadWorker()
+    child = WorkerProcess(WORKER)
     yield child
     child.close()
 

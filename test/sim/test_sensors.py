@@ -33,7 +33,7 @@ from pan_tilt_sim.sim.engine import Simulation, make_simulation
 from pan_tilt_sim.sim.physics import STANDARD_GRAVITY
 from pan_tilt_sim.sim.sensors.force_torque import ForceTorque
 from pan_tilt_sim.sim.sensors.imu import Imu
-from pan_tilt_sim.sim.sensors.lidar import Lidar
+from pan_tilt_sim.sim.sensors.lidar import MAX_BATCH, Lidar
 from pan_tilt_sim.sim.sensors.noise import NoiseModel, generator
 from pan_tilt_sim.sim.sensors.vision import VisionSensor, linear_depth
 
@@ -200,6 +200,17 @@ def test_the_ground_has_its_depth_at_every_image_size(rig, width, height):
             camera.render(), _expected_ground_depth(camera, pitch), far)
 
 
+def test_pybullet_renders_a_clip_ratio_at_the_models_limit_and_nothing_but_nan_at_1e8(rig):
+    from pan_tilt_sim.model.sensors import MAX_CLIP_RATIO
+
+    near = 0.01
+    at_limit = _ground_view(rig, 32, 24, near, near * MAX_CLIP_RATIO, math.pi / 2).render()
+    assert not numpy.isnan(at_limit.depth).any()
+    assert numpy.isfinite(at_limit.depth).any()  # the ground is seen
+    beyond = _ground_view(rig, 32, 24, near, near * 1e8, math.pi / 2).render()
+    assert numpy.isnan(beyond.depth).all()
+
+
 # --- lidar --------------------------------------------------------------------------------------
 
 def test_lidar_centre_beam_meets_the_wall_within_the_declared_resolution(rig):
@@ -219,6 +230,20 @@ def test_lidar_beams_meet_the_wall_at_their_slant_and_see_nothing_past_its_edges
     expected = WALL_X / numpy.cos(angles[on_wall])
     assert numpy.abs(ranges[on_wall] - expected).max() <= LIDAR_RESOLUTION
     assert numpy.isposinf(ranges[past_edge]).all()  # REP 117: no return within range
+
+
+@pytest.mark.parametrize('samples', [MAX_BATCH, MAX_BATCH + 1, 2 * MAX_BATCH + 5, 40000])
+def test_lidar_of_more_beams_than_one_pybullet_batch_scans_every_beam(rig, samples):
+    from dataclasses import replace
+
+    spec = sensor(rig, 'laser')
+    horizontal = replace(spec.ray.horizontal, samples=samples, resolution=1.0)
+    wide = replace(spec, ray=replace(spec.ray, horizontal=horizontal))
+    ranges = Lidar(rig.physics, wide, 'empty').scan()
+    assert ranges.shape == (1, samples)
+    centre = ranges[0, samples // 2 - 1:samples // 2 + 1]  # the beams either side of 0 rad
+    assert numpy.abs(centre - WALL_X).max() <= LIDAR_RESOLUTION
+    assert not numpy.isnan(ranges).any()
 
 
 def test_lidar_beyond_its_range_sees_nothing(rig):

@@ -28,8 +28,10 @@ from pan_tilt_sim.sim.world import has_ground
 
 HIT_FRACTION = 2  # index of the hit fraction in one rayTestBatch result
 NO_HIT = -1  # object id of a ray that hit nothing
-# PyBullet casts at most this many rays per call (MAX_RAY_INTERSECTION_BATCH_SIZE).
-MAX_BATCH = 16384
+# Rays one rayTestBatch call casts and answers.  PyBullet takes up to its
+# MAX_RAY_INTERSECTION_BATCH_SIZE (16,384) rays a call but answers at most 16,383 of them
+# (test/dependencies/test_pybullet_limits.py); a scan of more is cast in batches of this size.
+MAX_BATCH = 16383
 
 
 def beam_directions(ray: RaySpec) -> numpy.ndarray:
