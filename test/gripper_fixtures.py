@@ -119,9 +119,9 @@ def write_gripper_arm(folder: pathlib.Path, gripper_type: str = (
     return urdf, controllers
 
 
-def grasp_box_urdf(*, mass: float = BOX_MASS, mu: float | None = None) -> str:
-    """Return a cube of :data:`BOX_SIZE`, with ``<mu1>``/``<mu2>`` ``mu`` unless None."""
-    size = BOX_SIZE
+def grasp_box_urdf(*, mass: float = BOX_MASS, mu: float | None = None,
+                   size: float = BOX_SIZE) -> str:
+    """Return a cube of side ``size`` (m), with ``<mu1>``/``<mu2>`` ``mu`` unless None."""
     inertia = mass * size * size / 6.0
     friction = ('' if mu is None else
                 f'<gazebo reference="box_link"><mu1>{mu}</mu1><mu2>{mu}</mu2></gazebo>')

@@ -186,23 +186,6 @@ def world(folder: pathlib.Path):
     return simulation, Entities(simulation.physics, simulation.description.name)
 
 
-def box_urdf(size: float, mass: float, mu: float | None) -> str:
-    inertia = mass * size * size / 6.0
-    friction = ('' if mu is None else
-                f'<gazebo reference="box_link"><mu1>{mu}</mu1><mu2>{mu}</mu2></gazebo>')
-    return f"""<?xml version="1.0"?>
-<robot name="box">
-  <link name="box_link">
-    <inertial><mass value="{mass}"/>
-      <inertia ixx="{inertia}" ixy="0" ixz="0" iyy="{inertia}" iyz="0" izz="{inertia}"/>
-    </inertial>
-    <collision><geometry><box size="{size} {size} {size}"/></geometry></collision>
-  </link>
-  {friction}
-</robot>
-"""
-
-
 FALL_TIME = 1.0  # s
 DROP_HEIGHT = 10.0  # m
 
@@ -210,7 +193,7 @@ DROP_HEIGHT = 10.0  # m
 def test_a_dropped_box_falls_half_g_t_squared(tmp_path):
     simulation, entities = world(tmp_path)
     with simulation:
-        entities.spawn('box', resource_string=box_urdf(0.1, 1.0, None),
+        entities.spawn('box', resource_string=grasp_box_urdf(size=0.1, mass=1.0),
                        pose=Transform((5.0, 0.0, DROP_HEIGHT)))
         simulation.advance(round(FALL_TIME / TIME_STEP))
         fallen = DROP_HEIGHT - entities.state('box').pose.translation[2]
@@ -232,7 +215,7 @@ def slide_distance(folder: pathlib.Path, mu: float | None) -> tuple[float, float
     """Launch a 10 cm box along x on the ground; return how far it slid and its final speed."""
     simulation, entities = world(folder)
     with simulation:
-        entities.spawn('box', resource_string=box_urdf(0.1, 1.0, mu),
+        entities.spawn('box', resource_string=grasp_box_urdf(size=0.1, mass=1.0, mu=mu),
                        pose=Transform((5.0, 0.0, 0.05)))
         simulation.advance(200)  # settled on the ground
         start = entities.state('box').pose
