@@ -44,7 +44,7 @@ than wall time):
 * ``scaling``: serial chains of 2, 8 and 32 revolute joints, each with a
   position controller, at real_time_factor 0 with no subscriber:
   ``steps_per_s`` and ``node_cpu_us_per_step`` (keys are the joint counts).
-* ``scenes``: two scenes with contacts (:mod:`pan_tilt_sim.tools.bench_scenes`),
+* ``scenes`` (:mod:`pan_tilt_sim.tools.bench_scenes`): two scenes with contacts,
   each in two cases that differ in what touches: ``driving_base``
   (``on_ground``: the rover driving a circle in the room on its wheels and
   caster, its lidar unwatched; ``base_fixed``: the same with
@@ -55,6 +55,12 @@ than wall time):
   ``real_time_multiple`` (sim seconds per wall second), ``contact_points``
   (PyBullet's per step, the case run in this process) and, for the grasp,
   ``box_height_m`` (the box's centre, which says whether it is held).
+  And ``tb3_sandbox.circle``: an SDF robot of a TurtleBot3 waffle's sizes
+  driving a circle in an SDF world of nine cylinders and a hexagonal mesh
+  wall, at the world's own ``max_step_size`` (3 ms), ``/scan`` read by a
+  subscriber process: ``steps_per_s``, ``node_cpu_us_per_step``,
+  ``real_time_multiple``, ``subscriber_cpu_percent`` and, from the robot run
+  in this process, ``lidar_us_per_scan`` and ``lidar_us_per_step``.
 * ``service_round_trip``: sim_node at real_time_factor 1 (the default) answering
   ``SERVICE_CALLERS`` callers of its simulation_interfaces services
   (``get_entity_state`` and ``get_simulation_state``, half each) from one process
@@ -107,6 +113,7 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 
 import rclpy
+import yaml
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import QoSProfile
@@ -181,13 +188,14 @@ class Plan:
     services_s: float = 5.0  # wall seconds of service calls
     scene_s: float = 5.0  # wall seconds each case of a contact scene is measured
     scene_contact_s: float = 1.0  # sim seconds over which a case's contacts are counted
+    scene_lidar_s: float = 20.0  # sim seconds over which the sandbox's lidar is timed
 
 
 FULL_PLAN = Plan(raw_s=3.0, raw_sim_s=RAW_SIM_S, warmup_s=1.0, fast_s=5.0, paced_s=10.0,
                  startup_runs=STARTUP_RUNS, chain_s=3.0)
 QUICK_PLAN = Plan(raw_s=0.3, raw_sim_s=QUICK_RAW_SIM_S, warmup_s=0.2, fast_s=0.6, paced_s=0.6,
                   startup_runs=1, chain_s=0.4, sensor_sim_s=0.3, services_s=0.5,
-                  scene_s=0.4, scene_contact_s=0.1)
+                  scene_s=0.4, scene_contact_s=0.1, scene_lidar_s=0.6)
 
 
 class BenchError(RuntimeError):
@@ -199,7 +207,7 @@ class Model:
     """The files of one robot, and the topics the bench talks to."""
 
     description_file: pathlib.Path
-    controllers_file: pathlib.Path
+    controllers_file: pathlib.Path | None  # None: the robot has no controller YAML
     joint_states_topic: str
     # Command topic -> the two position targets it alternates between.
     commands: dict[str, tuple[float, float]]
@@ -488,8 +496,9 @@ class NodeProcess(ChildProcess):
     def __init__(self, model: Model, parameters: dict[str, str], env: dict[str, str],
                  log_file: pathlib.Path) -> None:
         arguments = {'robot_description_file': str(model.description_file),
-                     'controllers_file': str(model.controllers_file), **model.parameters,
-                     **parameters}
+                     **({} if model.controllers_file is None
+                        else {'controllers_file': str(model.controllers_file)}),
+                     **model.parameters, **parameters}
         command = module_command('pan_tilt_sim', '--ros-args')
         for name, value in arguments.items():
             command += ['-p', f'{name}:={value}']
@@ -575,7 +584,7 @@ class Bench:
 
         A recording node must leave a finished bag: BenchError otherwise.
         """
-        parameters = {'time_step': repr(float(self.time_step))}
+        parameters = {'time_step': repr(self.step_of(model))}
         if real_time_factor is not None:
             parameters['real_time_factor'] = repr(float(real_time_factor))
         self._node_count += 1
@@ -590,6 +599,10 @@ class Bench:
             process.stop()
         if record and not (bag / BAG_METADATA).is_file():
             raise BenchError(f'the recording node left no {bag / BAG_METADATA}')
+
+    def step_of(self, model: Model) -> float:
+        """Return the time step ``model`` runs at: its own ``time_step``, else the bench's."""
+        return float(model.parameters.get('time_step', self.time_step))
 
     def spin_until(self, node: ChildProcess, done: Callable[[], bool], timeout: float,
                    what: str, probe: Probe | None = None) -> None:
@@ -633,13 +646,18 @@ class Bench:
                             f'JointState on {model.joint_states_topic}')
         return got[0]
 
-    def fast(self, model: Model, duration: float, case: str = SUBSCRIBER_CASES[0]
-             ) -> dict[str, float]:
-        """Measure sim_node at factor 0 with the subscriber of ``case`` in its own process."""
+    def fast(self, model: Model, duration: float, case: str = SUBSCRIBER_CASES[0],
+             watched: tuple[str, str] | None = None) -> dict[str, float]:
+        """Measure sim_node at factor 0 with the subscriber of ``case`` in its own process.
+
+        ``watched``: (topic, type) read by a subscriber process instead.
+        """
         with contextlib.ExitStack() as running:
             node = running.enter_context(self.node(model, 0.0, record=case == RECORDING_CASE))
             listener = None
-            if case == 'clock_subscriber':
+            if watched is not None:
+                listener = running.enter_context(self.listener(*watched))
+            elif case == 'clock_subscriber':
                 listener = running.enter_context(self.listener(CLOCK_TOPIC, CLOCK_TYPE))
             elif case == 'joint_state_subscriber':
                 listener = running.enter_context(
@@ -654,7 +672,7 @@ class Bench:
             wall_end, sim_end = self.joint_state_sample(node, model)
             node_cpu = busiest_thread_delta(node_threads, node.thread_cpu_seconds())
             listener_cpu = (listener.cpu_seconds() - listener_cpu) if listener else 0.0
-        steps = (sim_end - sim_start) / self.time_step
+        steps = (sim_end - sim_start) / self.step_of(model)
         if steps <= 0 or wall_end <= wall_start:
             raise BenchError(f'sim time did not advance at real_time_factor 0 ({case})')
         figures = {'steps_per_s': steps / (wall_end - wall_start),
@@ -920,16 +938,20 @@ def run_once(bench: Bench, model: Model) -> dict:
 
 
 def scene_figures(bench: Bench) -> dict[str, dict[str, dict[str, float]]]:
-    """Measure each case of the contact scenes (:mod:`pan_tilt_sim.tools.bench_scenes`).
+    """Measure each case of the scenes (:mod:`pan_tilt_sim.tools.bench_scenes`).
 
     Per case: sim_node's ``steps_per_s`` and ``node_cpu_us_per_step`` at
     real_time_factor 0 (as :meth:`Bench.fast`, nobody subscribed to anything
-    but the probe's JointState samples), ``real_time_multiple`` (sim seconds
-    per wall second), and, from the same case run in this process,
-    ``contact_points`` per step (and ``box_height_m``, the grasp's box).
+    but the probe's JointState samples and the case's watched topic),
+    ``real_time_multiple`` (sim seconds per wall second), and, from the same
+    case run in this process, ``contact_points`` per step (and
+    ``box_height_m``, the grasp's box) or, for the sandbox, its lidar's
+    ``lidar_us_per_scan`` and ``lidar_us_per_step`` (the scans' wall time
+    spread over every step).
     """
     scenes = {'driving_base': bench_scenes.driving_base(package_share(), bench.folder),
-              'grasp': bench_scenes.grasp(bench.folder)}
+              'grasp': bench_scenes.grasp(bench.folder),
+              'tb3_sandbox': bench_scenes.tb3_sandbox(bench.folder)}
     figures: dict[str, dict[str, dict[str, float]]] = {}
     for scene, cases in scenes.items():
         figures[scene] = {}
@@ -939,12 +961,35 @@ def scene_figures(bench: Bench) -> dict[str, dict[str, dict[str, float]]]:
             model = Model(case.description_file, case.controllers_file,
                           case.joint_states_topic, {}, parameters=case.parameters,
                           messages=case.messages)
-            fast = bench.fast(model, bench.plan.scene_s)
+            fast = bench.fast(model, bench.plan.scene_s, watched=case.watched)
+            time_step = bench.step_of(model)
+            if case.watched is None:
+                extra = bench_scenes.contact_points(case, time_step,
+                                                    count_s=bench.plan.scene_contact_s)
+            else:
+                extra = lidar_figures(bench, case, time_step)
             figures[scene][case_name] = {
-                **fast, 'real_time_multiple': fast['steps_per_s'] * bench.time_step,
-                **bench_scenes.contact_points(case, bench.time_step,
-                                              count_s=bench.plan.scene_contact_s)}
+                **fast, 'real_time_multiple': fast['steps_per_s'] * time_step, **extra}
     return figures
+
+
+def lidar_figures(bench: Bench, case: bench_scenes.SceneCase,
+                  time_step: float) -> dict[str, float]:
+    """Time ``case``'s one sensor, a lidar, in this process, its watched topic read.
+
+    Returns ``lidar_us_per_scan`` (wall µs per LaserScan: the rays, the
+    message, the publish) and ``lidar_us_per_step`` (the same spread over the
+    steps of the run).
+    """
+    bench.log(f'its lidar, over {bench.plan.scene_lidar_s} sim s in this process')
+    parameters = {name: yaml.safe_load(value) for name, value in case.parameters.items()}
+    costs = sensor_costs(case.description_file, case.controllers_file or '',
+                         sim_seconds=bench.plan.scene_lidar_s, domain_id=bench.domain_id,
+                         parameters=parameters, watch=(case.watched[0],))
+    (lidar,) = costs.values()
+    steps = bench.plan.scene_lidar_s / time_step
+    return {'lidar_us_per_scan': lidar['us_per_message'],
+            'lidar_us_per_step': lidar['us_per_message'] * lidar['messages'] / steps}
 
 
 def median_of(results: Sequence[dict]) -> dict:

@@ -1,4 +1,4 @@
-"""The bench's two contact scenes: a driving base in the room, and a grasp.
+"""The bench's scenes: a driving base in the room, a grasp, and a TurtleBot3-like sandbox.
 
 Each scene is a robot and a world written into the bench's folder from
 package files (the bench runs from an installed package, so it makes its
@@ -22,6 +22,14 @@ contacts PyBullet has to solve:
   squeeze the box with :data:`GRIP_N` and the lift holds it
   :data:`LIFT_M` above the ground; ``open``: the fingers pushed open, the
   lift at the same height, the box resting on the ground.
+* ``tb3_sandbox``: an SDF robot of the TurtleBot3 waffle's sizes and masses
+  (two driven wheels, two ball casters, a 360-beam 5 Hz lidar, gz-sim's
+  DiffDrive and JointStatePublisher) in an SDF world like Nav2's
+  ``tb3_sandbox`` (a ground plane, nine static cylinders on a
+  :data:`PILLAR_GRID` grid, a hexagonal wall given as a static concave OBJ
+  mesh, ``max_step_size`` :data:`SANDBOX_STEP`), all written here.
+  ``circle``: the robot driving a circle between four cylinders, ``/scan``
+  watched.
 
 :func:`contact_points` counts, in this process, the contact points PyBullet
 reports per step in each case (the same files, commands and world).
@@ -30,11 +38,13 @@ reports per step in each case (the same files, commands and world).
 from __future__ import annotations
 
 import dataclasses
+import itertools
+import math
 import pathlib
 import xml.etree.ElementTree as ElementTree
 
 import yaml
-from geometry_msgs.msg import TwistStamped
+from geometry_msgs.msg import Twist, TwistStamped
 from std_msgs.msg import Float64, Float64MultiArray
 
 from pan_tilt_sim.controllers.surface import StampedTwist
@@ -68,6 +78,23 @@ LIFT_M = 0.1  # m
 LIFT_CONTROLLER = 'lift_controller'
 FINGER_CONTROLLER = 'finger_controller'
 
+# The sandbox: sizes and masses of a TurtleBot3 waffle, our own geometry.
+SANDBOX_STEP = 0.003  # s: the world's <physics> max_step_size, as Nav2's tb3_sandbox
+WAFFLE_WHEEL_RADIUS = 0.033  # m
+WAFFLE_WHEEL_SEPARATION = 0.287  # m
+WAFFLE_BASE = (0.27, 0.27, 0.09)  # m: the base box, its bottom 0.01 m above the ground
+WAFFLE_CASTER_RADIUS = 0.005  # m
+WAFFLE_LIDAR_HEIGHT = 0.17  # m: the beam plane above the ground
+SANDBOX_LIDAR = {'samples': 360, 'rate': 5.0, 'range': (0.12, 3.5)}  # beams, Hz, m
+PILLAR_GRID = 1.1  # m between neighbouring cylinders, 3 x 3 about the origin
+PILLAR_RADIUS = 0.15  # m
+PILLAR_HEIGHT = 0.5  # m
+HEXAGON_APOTHEM = 2.2  # m: the wall's inner face from the origin
+HEXAGON_THICKNESS = 0.1  # m
+SANDBOX_CIRCLE_CENTRE = (PILLAR_GRID / 2, PILLAR_GRID / 2)  # m: a cell between four cylinders
+SANDBOX_CIRCLE_RADIUS = 0.3  # m: the robot stays clear of the four cylinders
+SANDBOX_SPEED = 0.2  # m/s
+
 CONTACT_SETTLE_S = 2.0  # sim s before contacts are counted: the grasp closed, the lift up
 CONTACT_COUNT_S = 1.0  # sim s over which contacts are counted
 
@@ -81,10 +108,11 @@ class SceneCase:
     """
 
     description_file: pathlib.Path
-    controllers_file: pathlib.Path
+    controllers_file: pathlib.Path | None  # None: the robot has no controller YAML
     parameters: dict[str, str]
     messages: dict[str, object]
     joint_states_topic: str = '/joint_states'
+    watched: tuple[str, str] | None = None  # (topic, type) a subscriber process reads
 
 
 def rover_urdf(shipped: str) -> str:
@@ -239,6 +267,168 @@ def grasp(folder: pathlib.Path) -> dict[str, SceneCase]:
         f'/{FINGER_CONTROLLER}/commands': Float64MultiArray(data=[grip]),
         f'/{LIFT_CONTROLLER}/command': Float64(data=LIFT_M)})
         for case, grip in (('holding', -GRIP_N), ('open', GRIP_N))}
+
+
+def waffle_sdf() -> str:
+    """Return the sandbox's robot: a waffle-sized base on two wheels and two ball casters.
+
+    Its model frame is on the ground under the wheel axle; gz-sim's DiffDrive
+    takes ``cmd_vel`` and publishes ``odom`` and ``tf``, its
+    JointStatePublisher ``joint_states``, its ``gpu_lidar`` ``scan``.
+    """
+    bx, by, bz = WAFFLE_BASE
+    radius = WAFFLE_WHEEL_RADIUS
+    samples, rate = SANDBOX_LIDAR['samples'], SANDBOX_LIDAR['rate']
+    near, far = SANDBOX_LIDAR['range']
+    inertia = '<inertia><ixx>{0}</ixx><iyy>{0}</iyy><izz>{0}</izz></inertia>'
+
+    def wheel(side: str, y: float) -> str:
+        pose = f'<pose>0 {y} {radius} -1.5707963 0 0</pose>'
+        shape = f'<cylinder><radius>{radius}</radius><length>0.018</length></cylinder>'
+        return (f'<link name="wheel_{side}_link"><inertial>{pose}<mass>0.03</mass>'
+                f'{inertia.format(1.2e-5)}</inertial>'
+                f'<collision name="tyre">{pose}<geometry>{shape}</geometry><surface><friction>'
+                '<ode><mu>1.0</mu><mu2>1.0</mu2></ode></friction></surface></collision>'
+                f'<visual name="tyre">{pose}<geometry>{shape}</geometry></visual></link>'
+                f'<joint name="wheel_{side}_joint" type="revolute"><parent>base_link</parent>'
+                f'<child>wheel_{side}_link</child>{pose}<axis><xyz>0 0 1</xyz></axis></joint>')
+
+    def caster(side: str, y: float) -> str:
+        pose = f'<pose>-0.18 {y} {WAFFLE_CASTER_RADIUS} 0 0 0</pose>'
+        shape = f'<sphere><radius>{WAFFLE_CASTER_RADIUS}</radius></sphere>'
+        return (f'<link name="caster_{side}_link">{pose}<inertial><mass>0.005</mass>'
+                f'{inertia.format(1e-7)}</inertial>'
+                f'<collision name="ball"><geometry>{shape}</geometry><surface><friction><ode>'
+                '<mu>0.05</mu><mu2>0.05</mu2></ode></friction></surface></collision></link>'
+                f'<joint name="caster_{side}_joint" type="ball"><parent>base_link</parent>'
+                f'<child>caster_{side}_link</child></joint>')
+
+    box = f'<box><size>{bx} {by} {bz}</size></box>'
+    return f'''<?xml version="1.0"?>
+<sdf version="1.6">
+  <model name="waffle_like">
+    <link name="base_link">
+      <inertial><pose>-0.06 0 0.05 0 0 0</pose><mass>1.4</mass>
+        <inertia><ixx>0.0095</ixx><iyy>0.0095</iyy><izz>0.017</izz></inertia></inertial>
+      <collision name="base"><pose>-0.06 0 {0.01 + bz / 2} 0 0 0</pose>
+        <geometry>{box}</geometry></collision>
+      <visual name="base"><pose>-0.06 0 {0.01 + bz / 2} 0 0 0</pose>
+        <geometry>{box}</geometry></visual>
+    </link>
+    <link name="base_scan">
+      <pose>-0.06 0 {WAFFLE_LIDAR_HEIGHT - 0.02} 0 0 0</pose>
+      <inertial><mass>0.11</mass>{inertia.format(1e-4)}</inertial>
+      <collision name="head"><geometry><cylinder><radius>0.035</radius><length>0.04</length>
+        </cylinder></geometry></collision>
+      <sensor name="hls_lfcd_lds" type="gpu_lidar">
+        <pose>0 0 0.02 0 0 0</pose><always_on>true</always_on>
+        <update_rate>{rate}</update_rate><topic>scan</topic><gz_frame_id>base_scan</gz_frame_id>
+        <lidar><scan><horizontal><samples>{samples}</samples><resolution>1</resolution>
+          <min_angle>0</min_angle><max_angle>6.28</max_angle></horizontal></scan>
+          <range><min>{near}</min><max>{far}</max><resolution>0.015</resolution></range>
+          <noise><type>gaussian</type><mean>0</mean><stddev>0.01</stddev></noise></lidar>
+      </sensor>
+    </link>
+    <joint name="base_scan_joint" type="fixed"><parent>base_link</parent>
+      <child>base_scan</child></joint>
+    {wheel('left', WAFFLE_WHEEL_SEPARATION / 2)}
+    {wheel('right', -WAFFLE_WHEEL_SEPARATION / 2)}
+    {caster('left', 0.064)}
+    {caster('right', -0.064)}
+    <plugin filename="gz-sim-diff-drive-system" name="gz::sim::systems::DiffDrive">
+      <left_joint>wheel_left_joint</left_joint><right_joint>wheel_right_joint</right_joint>
+      <wheel_separation>{WAFFLE_WHEEL_SEPARATION}</wheel_separation>
+      <wheel_radius>{radius}</wheel_radius>
+      <topic>cmd_vel</topic><odom_topic>odom</odom_topic><tf_topic>tf</tf_topic>
+      <frame_id>odom</frame_id><child_frame_id>base_link</child_frame_id>
+      <odom_publish_frequency>30</odom_publish_frequency>
+    </plugin>
+    <plugin filename="gz-sim-joint-state-publisher-system"
+            name="gz::sim::systems::JointStatePublisher">
+      <topic>joint_states</topic>
+    </plugin>
+  </model>
+</sdf>
+'''
+
+
+def hexagon_obj() -> str:
+    """Return the hexagonal wall as an OBJ: a closed ring, hollow inside (a concave mesh).
+
+    Its inner face is :data:`HEXAGON_APOTHEM` from the origin, it is
+    :data:`HEXAGON_THICKNESS` thick and :data:`PILLAR_HEIGHT` tall, bottom at z = 0.
+    """
+    corners = []  # (inner, outer) corner radii at each of six angles
+    inner = HEXAGON_APOTHEM / math.cos(math.pi / 6)
+    outer = (HEXAGON_APOTHEM + HEXAGON_THICKNESS) / math.cos(math.pi / 6)
+    for corner in range(6):
+        angle = corner * math.pi / 3
+        corners.append([(r * math.cos(angle), r * math.sin(angle)) for r in (inner, outer)])
+    # Vertex 1 + 4 * corner + 0 inner bottom, 1 outer bottom, 2 inner top, 3 outer top.
+    vertices = []
+    for (ix, iy), (ox, oy) in corners:
+        vertices += [(ix, iy, 0.0), (ox, oy, 0.0), (ix, iy, PILLAR_HEIGHT),
+                     (ox, oy, PILLAR_HEIGHT)]
+    faces = []
+    for corner in range(6):
+        a, b = 1 + 4 * corner, 1 + 4 * ((corner + 1) % 6)
+        for quad in ((a + 1, b + 1, b + 3, a + 3),  # outer face
+                     (b, a, a + 2, b + 2),  # inner face
+                     (a + 2, a + 3, b + 3, b + 2),  # top
+                     (a, b, b + 1, a + 1)):  # bottom
+            faces += [(quad[0], quad[1], quad[2]), (quad[0], quad[2], quad[3])]
+    return ''.join([f'v {x:.6f} {y:.6f} {z:.6f}\n' for x, y, z in vertices] +
+                   [f'f {a} {b} {c}\n' for a, b, c in faces])
+
+
+def sandbox_world(mesh: pathlib.Path) -> str:
+    """Return the sandbox world: ground, nine cylinders and the hexagonal wall ``mesh``."""
+    pillars = []
+    for index, (i, j) in enumerate(itertools.product((-1, 0, 1), repeat=2)):
+        shape = (f'<cylinder><radius>{PILLAR_RADIUS}</radius>'
+                 f'<length>{PILLAR_HEIGHT}</length></cylinder>')
+        pillars.append(
+            f'<model name="pillar_{index}"><static>true</static>'
+            f'<pose>{i * PILLAR_GRID} {j * PILLAR_GRID} {PILLAR_HEIGHT / 2} 0 0 0</pose>'
+            f'<link name="link"><collision name="c"><geometry>{shape}</geometry></collision>'
+            f'<visual name="v"><geometry>{shape}</geometry></visual></link></model>')
+    wall = f'<mesh><uri>{mesh.name}</uri></mesh>'
+    return f'''<?xml version="1.0"?>
+<sdf version="1.6">
+  <world name="sandbox">
+    <physics name="3ms" type="ode"><max_step_size>{SANDBOX_STEP}</max_step_size>
+      <real_time_factor>1.0</real_time_factor></physics>
+    <plugin filename="gz-sim-physics-system" name="gz::sim::systems::Physics"/>
+    <plugin filename="gz-sim-sensors-system" name="gz::sim::systems::Sensors"/>
+    <light name="sun" type="directional"><direction>-0.5 0.1 -0.9</direction></light>
+    <model name="ground_plane"><static>true</static><link name="link">
+      <collision name="c"><geometry><plane><normal>0 0 1</normal><size>20 20</size></plane>
+      </geometry></collision></link></model>
+    {''.join(pillars)}
+    <model name="hexagon"><static>true</static><link name="link">
+      <collision name="c"><geometry>{wall}</geometry></collision>
+      <visual name="v"><geometry>{wall}</geometry></visual></link></model>
+  </world>
+</sdf>
+'''
+
+
+def tb3_sandbox(folder: pathlib.Path) -> dict[str, SceneCase]:
+    """Write the sandbox's robot, world and wall mesh into ``folder``; return its case (circle)."""
+    description = folder / 'waffle_like.sdf'
+    description.write_text(waffle_sdf(), encoding='utf-8')
+    mesh = folder / 'hexagon.obj'
+    mesh.write_text(hexagon_obj(), encoding='utf-8')
+    world = folder / 'sandbox.sdf'
+    world.write_text(sandbox_world(mesh), encoding='utf-8')
+    cx, cy = SANDBOX_CIRCLE_CENTRE
+    twist = Twist()
+    twist.linear.x = SANDBOX_SPEED
+    twist.angular.z = SANDBOX_SPEED / SANDBOX_CIRCLE_RADIUS
+    start = f'[{cx}, {cy - SANDBOX_CIRCLE_RADIUS}, 0.0, 0.0]'  # heading +x, turning left
+    return {'circle': SceneCase(description, None, {
+        'world': str(world), 'initial_pose': start, 'time_step': repr(SANDBOX_STEP)},
+        {'/cmd_vel': twist}, watched=('/scan', 'sensor_msgs/msg/LaserScan'))}
 
 
 def _command_value(message: object) -> object:

@@ -18,7 +18,7 @@ import json
 import os
 import pathlib
 import time
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 
 import rclpy
 from rclpy.context import Context
@@ -42,12 +42,18 @@ class SensorCostError(RuntimeError):
 
 
 def sensor_costs(description_file: pathlib.Path | None = None,
-                 controllers_file: pathlib.Path | None = None, sim_seconds: float = 1.0,
-                 domain_id: int | None = None) -> dict[str, dict[str, float]]:
-    """Return ``{sensor: {'us_per_message': ..., 'messages': ...}}`` with every topic watched."""
+                 controllers_file: pathlib.Path | str | None = None, sim_seconds: float = 1.0,
+                 domain_id: int | None = None, parameters: dict[str, object] | None = None,
+                 watch: Collection[str] | None = None) -> dict[str, dict[str, float]]:
+    """Return ``{sensor: {'us_per_message': ..., 'messages': ...}}`` with every topic watched.
+
+    ``parameters``: further sim_node parameters (a world, an initial pose, a
+    time step), name -> value.  ``controllers_file`` ``''``: the robot has none.
+    ``watch``: the topics to subscribe to (default: every sensor topic).
+    """
     share = package_share()
     description = description_file or share / SENSOR_DESCRIPTION
-    controllers = controllers_file or share / DEFAULT_CONTROLLERS
+    controllers = share / DEFAULT_CONTROLLERS if controllers_file is None else controllers_file
     context = Context()
     rclpy.init(args=[], context=context, domain_id=domain_id)
     executor = SingleThreadedExecutor(context=context)
@@ -57,7 +63,8 @@ def sensor_costs(description_file: pathlib.Path | None = None,
             Parameter('robot_description_file', value=str(description)),
             Parameter('controllers_file', value=str(controllers)),
             Parameter('real_time_factor', value=0.0),
-            Parameter('sensors.noise_seed', value=0)])
+            Parameter('sensors.noise_seed', value=0),
+            *(Parameter(name, value=value) for name, value in (parameters or {}).items())])
         probe = rclpy.create_node('sensor_cost_probe', context=context)
         executor.add_node(node)
         executor.add_node(probe)
@@ -65,6 +72,8 @@ def sensor_costs(description_file: pathlib.Path | None = None,
         topics = []
         for publisher in publishers:
             for topic, message_type in publisher.topic_types():
+                if watch is not None and topic not in watch:
+                    continue
                 probe.create_subscription(message_type, topic, lambda _message: None,
                                           QoSProfile(depth=QUEUE_DEPTH))
                 topics.append(topic)

@@ -5,11 +5,17 @@ No timing is asserted here: the figures come from running the command.
 
 import json
 import math
+import statistics
 import subprocess
 import sys
 
 import pytest
 import sim_process
+import yaml
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from node_harness import PROBE_QUEUE, sim_node
+from sensor_msgs.msg import LaserScan
 
 from pan_tilt_sim.share import package_share
 from pan_tilt_sim.sim.engine import make_simulation
@@ -26,9 +32,15 @@ FACTOR_0 = {
     'recording': {'steps_per_s', 'node_cpu_us_per_step', 'ratio_to_raw'},
 }
 SERVICE_ROUND_TRIP = {'p50_ms', 'p99_ms', 'answers_per_s', 'unanswered'}
-SCENES = {'driving_base': {'on_ground', 'base_fixed'}, 'grasp': {'holding', 'open'}}
+SCENES = {'driving_base': {'on_ground', 'base_fixed'}, 'grasp': {'holding', 'open'},
+          'tb3_sandbox': {'circle'}}
 SCENE_CASE = {'steps_per_s', 'node_cpu_us_per_step', 'real_time_multiple', 'contact_points'}
-GRASP_CASE = SCENE_CASE | {'box_height_m'}
+SCENE_CASES = {'driving_base': SCENE_CASE, 'grasp': SCENE_CASE | {'box_height_m'},
+               'tb3_sandbox': {'steps_per_s', 'node_cpu_us_per_step', 'real_time_multiple',
+                               'subscriber_cpu_percent', 'lidar_us_per_scan',
+                               'lidar_us_per_step'}}
+TIME_STEPS = {'driving_base': bench.DEFAULT_TIME_STEP, 'grasp': bench.DEFAULT_TIME_STEP,
+              'tb3_sandbox': bench_scenes.SANDBOX_STEP}  # the sandbox's world says 3 ms
 FACTOR_1 = {'cpu_percent', 'cpu_percent_with_joint_states', 'cpu_percent_recording',
             'clock_subscriber_cpu_percent',
             'joint_states_p50_ms', 'joint_states_p99_ms', 'rtf_error'}
@@ -97,11 +109,14 @@ def test_quick_runs_each_contact_scene_in_each_case_and_reports_its_figures(quic
     assert {scene: set(cases) for scene, cases in scenes.items()} == SCENES
     for scene, cases in scenes.items():
         for case, values in cases.items():
-            assert set(values) == (GRASP_CASE if scene == 'grasp' else SCENE_CASE), case
+            assert set(values) == SCENE_CASES[scene], case
             assert values['steps_per_s'] > 0, case
-            # The multiple of real time is the step rate in sim seconds (time_step 0.001 s).
+            # The multiple of real time is the step rate in sim seconds.
             assert values['real_time_multiple'] == pytest.approx(
-                values['steps_per_s'] * bench.DEFAULT_TIME_STEP, rel=1e-3, abs=1e-3), case
+                values['steps_per_s'] * TIME_STEPS[scene], rel=1e-3, abs=1e-3), case
+    lidar = scenes['tb3_sandbox']['circle']
+    assert lidar['lidar_us_per_scan'] > 0 and 0 < lidar['lidar_us_per_step'] < lidar[
+        'lidar_us_per_scan']
 
 
 @pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
@@ -290,6 +305,58 @@ def test_the_grasp_holds_the_box_up_and_the_open_gripper_leaves_it_on_the_ground
     assert opened['box_height_m'] == pytest.approx(half_box, abs=0.002)
     # Two fingers' faces on the box; the box's face on the ground.
     assert holding['contact_points'] >= 4 and opened['contact_points'] >= 1
+
+
+def median_range(scan: LaserScan, bearing: float, half_width: float = math.radians(2)) -> float:
+    """The median range of the beams within ``half_width`` of ``bearing`` (rad, sensor frame)."""
+    ranges = [measured for index, measured in enumerate(scan.ranges)
+              if abs(math.remainder(scan.angle_min + index * scan.angle_increment - bearing,
+                                    math.tau)) <= half_width]
+    return statistics.median(ranges)
+
+
+def test_the_sandbox_robot_drives_its_circle_and_its_lidar_sees_a_pillar_and_the_wall(
+        tmp_path):
+    case = bench_scenes.tb3_sandbox(tmp_path)['circle']
+    assert case.controllers_file is None
+    assert case.watched == ('/scan', 'sensor_msgs/msg/LaserScan')
+    start = yaml.safe_load(case.parameters['initial_pose'])
+    with sim_node(paused=True, robot_description_file=str(case.description_file),
+                  world=case.parameters['world'], initial_pose=start) as sim:
+        # The world's <physics> gives the step the bench's case names.
+        assert sim.node.settings.time_step == float(case.parameters['time_step'])
+        scans = sim.collect(LaserScan, '/scan', PROBE_QUEUE)
+        odometry = sim.collect(Odometry, '/odom', PROBE_QUEUE)
+        twist = sim.probe.create_publisher(Twist, '/cmd_vel', 10)
+        sim.wait_for_subscribers('/scan')
+        sim.wait_for_subscribers('/odom')
+        assert sim.spin_until(lambda: twist.get_subscription_count() > 0)
+        sim.node.step(80)  # one lidar period (5 Hz at 3 ms) where the robot starts
+        assert sim.spin_until(lambda: scans)
+        scan = scans[-1]
+        # The lidar sits 6 cm behind the axle, heading +x.
+        lidar = (start[0] - 0.06, start[1])
+        pillar = (bench_scenes.PILLAR_GRID, 0.0)  # the nearest pillar, ahead and to the right
+        dx, dy = pillar[0] - lidar[0], pillar[1] - lidar[1]
+        assert median_range(scan, math.atan2(dy, dx)) == pytest.approx(
+            math.hypot(dx, dy) - bench_scenes.PILLAR_RADIUS, abs=0.02)
+        # Straight left (+y), past the pillars' column, the hexagon's inner face.
+        assert median_range(scan, math.pi / 2) == pytest.approx(
+            bench_scenes.HEXAGON_APOTHEM - lidar[1], abs=0.02)
+        before = sum(sim.node.commands_received.values())
+        twist.publish(case.messages['/cmd_vel'])
+        assert sim.spin_until(lambda: sum(sim.node.commands_received.values()) > before)
+        for _ in range(30):  # 9 s of sim time: most of a lap
+            sim.node.step(100)
+            sim.spin_until(lambda: False, 0.01)
+        assert sim.spin_until(lambda: len(odometry) > 20)
+    # The odometry frame starts where the robot does; the circle's centre is to its left.
+    radius = bench_scenes.SANDBOX_CIRCLE_RADIUS
+    points = [(message.pose.pose.position.x, message.pose.pose.position.y)
+              for message in odometry]
+    assert max(y for _x, y in points) > 1.8 * radius, 'it did not go round'
+    for x, y in points:
+        assert math.hypot(x, y - radius) == pytest.approx(radius, abs=0.02), (x, y)
 
 
 def test_fewer_than_one_run_is_a_usage_error():
