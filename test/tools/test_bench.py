@@ -168,14 +168,15 @@ def test_a_process_cpu_time_is_read_to_well_under_a_clock_tick_ended_threads_inc
 @pytest.mark.timeout(QUICK_TIMEOUT_S + 30)
 def test_quick_measures_the_physics_thread_at_factor_0(quick_run):
     # The thread measured is the one stepping: at factor 0 it is busy nearly all the time, so
-    # its CPU per step is most of the wall time per step (an idle thread's would be ~0).  (A
-    # quick run's bare step is too short to be a floor to hold the node's step to.)
+    # its CPU per step is a large share of the wall time per step even when another test
+    # process shares the cores (an idle thread's would be ~0).  (A quick run's bare step is
+    # too short to be a floor to hold the node's step to.)
     figures = json.loads(quick_run[0])
     measured = {**figures['factor_0'],
                 **{f'chain of {joints}': values for joints, values in figures['scaling'].items()}}
     for case, values in measured.items():
         wall_us_per_step = 1e6 / values['steps_per_s']
-        assert values['node_cpu_us_per_step'] > 0.5 * wall_us_per_step, case
+        assert values['node_cpu_us_per_step'] > 0.25 * wall_us_per_step, case
     # The chains cost more per step the more joints they step: 2, 8, 32 joints.
     raw = figures['raw']['step_us_cpu']
     chains = [figures['scaling'][joints]['node_cpu_us_per_step'] for joints in ('2', '8', '32')]
