@@ -68,15 +68,12 @@ from pan_tilt_sim.controllers.framework.base import (
 from pan_tilt_sim.controllers.framework.parameter_spec import (
     BOOL,
     DOUBLE,
-    DOUBLE_ARRAY,
     INT,
     REQUIRED,
     STRING,
     STRING_ARRAY,
     Param,
     ParameterSpec,
-    fixed_size,
-    frame_id,
     frame_id_prefix,
     gt,
     gt_eq,
@@ -85,6 +82,7 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
     unique,
 )
 from pan_tilt_sim.controllers.framework.shared_parameters import (
+    odometry_frames,
     same_frames_problem,
     velocity_limit_params,
     velocity_limiter,
@@ -110,7 +108,6 @@ from pan_tilt_sim.schedule import PeriodicSchedule
 
 LEFT, RIGHT = 'left_wheel_names', 'right_wheel_names'
 VELOCITY, POSITION = 'velocity', 'position'
-COVARIANCE_SIZE = 6
 LIMIT_GROUPS = ('linear.x', 'angular.z')
 
 
@@ -140,14 +137,7 @@ class DiffDriveController(OdometryOutputs, CommandController):
         Param('tf_frame_prefix_enable', BOOL, True, 'Prefix the frame ids with tf_frame_prefix.'),
         Param('tf_frame_prefix', STRING, '', "The frame ids' prefix; empty: the controller's "
               'namespace.', (frame_id_prefix(),)),
-        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.', (frame_id(),)),
-        Param('base_frame_id', STRING, 'base_link', "The robot's base frame, child of "
-              'odom_frame_id.', (frame_id(),)),
-        Param('pose_covariance_diagonal', DOUBLE_ARRAY, [0.0] * COVARIANCE_SIZE,
-              "Diagonal of the odometry pose's covariance (x, y, z, roll, pitch, yaw).",
-              (fixed_size(COVARIANCE_SIZE),)),
-        Param('twist_covariance_diagonal', DOUBLE_ARRAY, [0.0] * COVARIANCE_SIZE,
-              "Diagonal of the odometry twist's covariance.", (fixed_size(COVARIANCE_SIZE),)),
+        *odometry_frames(),
         Param('open_loop', BOOL, False, 'Odometry from the limited command, not the wheels.'),
         Param('position_feedback', BOOL, True, "Odometry from the wheels' positions (else "
               'their velocities).'),

@@ -66,20 +66,19 @@ from pan_tilt_sim.controllers.framework.base import (
 from pan_tilt_sim.controllers.framework.parameter_spec import (
     BOOL,
     DOUBLE,
-    DOUBLE_ARRAY,
     REQUIRED,
     STRING,
     Param,
     ParameterSpec,
-    fixed_size,
-    frame_id,
     frame_id_prefix,
     gt,
     gt_eq,
     not_empty,
 )
 from pan_tilt_sim.controllers.framework.shared_parameters import (
+    COVARIANCE_SIZE,
     UPDATE_RATE,
+    odometry_frames,
     same_frames_problem,
     update_period,
     velocity_limit_params,
@@ -93,13 +92,13 @@ from pan_tilt_sim.controllers.framework.surface import (
 )
 from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs
 from pan_tilt_sim.controllers.toolbox.rate_limiter import InvalidLimitsError
+from pan_tilt_sim.controllers.toolbox.twist_command import TwistCommand, twist_references
 from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.schedule import DUE_EPSILON, PeriodicSchedule
 
 VELOCITY = 'velocity'
 # The wheels in upstream's order of the command interfaces.
 WHEELS = ('front_left', 'front_right', 'rear_right', 'rear_left')
-COVARIANCE_SIZE = 6
 LIMIT_GROUPS = ('linear.x', 'linear.y', 'angular.z')
 # The angle (rad) between each wheel's rolling direction and its rollers' free direction in
 # the ground plane, towards the wheel's axis (see pan_tilt_sim.sim.roller_wheels): rollers
@@ -112,6 +111,8 @@ MIN_INTERVAL = 1e-4  # s: odometry updates closer together than this are skipped
 OdometrySink = Callable[[float, Transform, Sequence[float], Sequence[float]], None]
 TfSink = Callable[[float, list[tuple[str, str, Transform]]], None]
 StateSink = Callable[[float, Sequence[float], Sequence[float]], None]
+# Upstream's defaults: 0.1 on both covariance diagonals; the frames fixed once configured.
+FRAMES = odometry_frames(covariance=(0.1,) * COVARIANCE_SIZE, read_only=True)
 
 
 def frame_prefix(params: Mapping[str, Any], namespace: str) -> str:
@@ -213,18 +214,12 @@ class MecanumDriveController(OdometryOutputs, CommandController):
         Param('tf_frame_prefix_enable', BOOL, True, 'Prefix the frame ids with tf_frame_prefix.'),
         Param('tf_frame_prefix', STRING, '', "The frame ids' prefix; empty: the controller's "
               'namespace.', (frame_id_prefix(),), read_only=True),
-        Param('base_frame_id', STRING, 'base_link', "The robot's base frame.", (frame_id(),),
-              read_only=True),
-        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.', (frame_id(),),
-              read_only=True),
+        FRAMES.base,
+        FRAMES.odom,
         Param('enable_odom_tf', BOOL, True, 'Publish odom_frame_id -> base_frame_id on '
               '~/tf_odometry.'),
-        Param('twist_covariance_diagonal', DOUBLE_ARRAY, [0.1] * COVARIANCE_SIZE,
-              "Diagonal of the odometry twist's covariance.", (fixed_size(COVARIANCE_SIZE),),
-              read_only=True),
-        Param('pose_covariance_diagonal', DOUBLE_ARRAY, [0.1] * COVARIANCE_SIZE,
-              "Diagonal of the odometry pose's covariance.", (fixed_size(COVARIANCE_SIZE),),
-              read_only=True),
+        FRAMES.twist_covariance,
+        FRAMES.pose_covariance,
         UPDATE_RATE,
         *(param for group in LIMIT_GROUPS for param in velocity_limit_params(group)),
     ])
@@ -251,9 +246,7 @@ class MecanumDriveController(OdometryOutputs, CommandController):
             except InvalidLimitsError as err:
                 raise self.error(group, f'invalid limits: {err}') from None
         self._limiters = tuple(limiters)
-        names = [f'{name}/linear/x/{VELOCITY}', f'{name}/linear/y/{VELOCITY}',
-                 f'{name}/angular/z/{VELOCITY}']
-        self._references = {reference: Reference(reference) for reference in names}
+        self._references = twist_references(name)
         self._reference_list = tuple(self._references.values())
         kinematics = params['kinematics']
         for field in ('wheels_radius', 'sum_of_robot_center_projection_on_X_Y_axis'):
@@ -272,7 +265,8 @@ class MecanumDriveController(OdometryOutputs, CommandController):
         self._odometry_sink: OdometrySink | None = None
         self._tf_sink: TfSink | None = None
         self._state_sink: StateSink | None = None
-        self._problem = ''
+        self._command = TwistCommand('reference', sideways=True,
+                                     timeout_field='reference_timeout')
         self.reset()
 
     # --- what it claims and exports --------------------------------------------------------
@@ -359,7 +353,7 @@ class MecanumDriveController(OdometryOutputs, CommandController):
 
     def reset(self) -> None:
         """No reference, references NaN, limiter history zero, odometry at the origin."""
-        self._reference: StampedTwist | None = None
+        self._command.latest = None
         self._timed_out = False
         self._time = 0.0
         self._last_update: float | None = None
@@ -386,25 +380,11 @@ class MecanumDriveController(OdometryOutputs, CommandController):
 
     def set_command(self, value: StampedTwist) -> CommandResult:
         """Take a reference twist: refuse non-finite or already stale ones."""
-        linear_x, linear_y, angular = value.linear[0], value.linear[1], value.angular[2]
-        if not all(math.isfinite(part) for part in (linear_x, linear_y, angular)):
-            self._problem = (f'ignored reference (linear.x {linear_x!r}, linear.y {linear_y!r}, '
-                             f'angular.z {angular!r}): not finite numbers')
-            return CommandResult.REJECTED
-        now = self._time
-        stamp = value.stamp if value.stamp > 0.0 else now
-        timeout = self.params['reference_timeout']
-        if timeout > 0.0 and now - stamp > timeout:
-            self._problem = (f'ignored reference stamped {stamp:.4f} s: {now - stamp:.4f} s old '
-                             f'at sim time {now:.4f} s, more than reference_timeout '
-                             f'({timeout:g} s)')
-            return CommandResult.REJECTED
-        self._reference = StampedTwist(stamp, (linear_x, linear_y, 0.0), (0.0, 0.0, angular))
-        return CommandResult.ACCEPTED
+        return self._command.take(value, self._time, self.params['reference_timeout'])
 
     def command_problem(self, value: Any, result: CommandResult) -> str:
         """Describe the last refused twist."""
-        return self._problem
+        return self._command.problem(value, result)
 
     def setpoints(self) -> dict[str, float]:
         """Return each command joint's commanded velocity (rad/s)."""
@@ -468,7 +448,7 @@ class MecanumDriveController(OdometryOutputs, CommandController):
 
     def _update_references(self, time: float) -> None:
         """Write the reference while it is fresh; zeros once, then nothing, when it is stale."""
-        reference = self._reference
+        reference = self._command.latest
         if reference is None:
             return
         timeout = self.params['reference_timeout']
@@ -478,11 +458,11 @@ class MecanumDriveController(OdometryOutputs, CommandController):
                 interface.value = value
             self._timed_out = False
             if timeout == 0.0:
-                self._reference = None  # used once, as upstream's reset after each run
+                self._command.latest = None  # used once, as upstream's reset after each run
             return
         for interface in self._reference_list:
             interface.value = 0.0
-        self._reference = None
+        self._command.latest = None
         if not self._timed_out:
             self._timed_out = True
             self.notices.append(f'reference timed out ({timeout:g} s without one at sim time '

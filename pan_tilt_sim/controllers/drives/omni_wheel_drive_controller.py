@@ -63,14 +63,11 @@ from pan_tilt_sim.controllers.framework.base import (
 from pan_tilt_sim.controllers.framework.parameter_spec import (
     BOOL,
     DOUBLE,
-    DOUBLE_ARRAY,
     REQUIRED,
     STRING,
     STRING_ARRAY,
     Param,
     ParameterSpec,
-    fixed_size,
-    frame_id,
     frame_id_prefix,
     gt,
     gt_eq,
@@ -80,6 +77,7 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
 )
 from pan_tilt_sim.controllers.framework.shared_parameters import (
     UPDATE_RATE,
+    odometry_frames,
     same_frames_problem,
     update_period,
 )
@@ -90,11 +88,11 @@ from pan_tilt_sim.controllers.framework.surface import (
     StateTopic,
 )
 from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs
+from pan_tilt_sim.controllers.toolbox.twist_command import TwistCommand, twist_references
 from pan_tilt_sim.schedule import DUE_EPSILON, PeriodicSchedule
 
 WHEEL_NAMES = 'wheel_names'
 VELOCITY, POSITION = 'velocity', 'position'
-COVARIANCE_SIZE = 6
 MIN_WHEELS = 3
 OMNI_ROLLERS = math.pi / 2.0  # rad: an omni wheel's rollers roll along its axis
 MIN_INTERVAL = 1e-6  # s: odometry updates closer together than this are skipped, as upstream
@@ -204,16 +202,8 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
               read_only=True),
         Param('tf_frame_prefix', STRING, '', "The frame ids' prefix; empty: the controller's "
               'namespace.', (frame_id_prefix(),), read_only=True),
-        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.', (frame_id(),),
-              read_only=True),
-        Param('base_frame_id', STRING, 'base_link', "The robot's base frame.", (frame_id(),),
-              read_only=True),
-        Param('diagonal_covariance.pose', DOUBLE_ARRAY, [0.0] * COVARIANCE_SIZE,
-              "Diagonal of the odometry pose's covariance.", (fixed_size(COVARIANCE_SIZE),),
-              read_only=True),
-        Param('diagonal_covariance.twist', DOUBLE_ARRAY, [0.0] * COVARIANCE_SIZE,
-              "Diagonal of the odometry twist's covariance.", (fixed_size(COVARIANCE_SIZE),),
-              read_only=True),
+        *odometry_frames(pose_name='diagonal_covariance.pose',
+                         twist_name='diagonal_covariance.twist', read_only=True),
         Param('open_loop', BOOL, False, 'Odometry from the command, not the wheels.',
               read_only=True),
         Param('position_feedback', BOOL, True, "Odometry from the wheels' positions (else their "
@@ -236,9 +226,7 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
             raise self.error(WHEEL_NAMES, f'{len(self._wheel_names)} wheels: the number of '
                                           'wheels is less than 3 (name them all, or use '
                                           'another controller for this wheel layout)')
-        reference_names = [f'{name}/linear/x/{VELOCITY}', f'{name}/linear/y/{VELOCITY}',
-                           f'{name}/angular/z/{VELOCITY}']
-        self._references = {reference: Reference(reference) for reference in reference_names}
+        self._references = twist_references(name)
         self._reference_list = tuple(self._references.values())
         self._odometry = OmniOdometry(len(self._wheel_names), params['robot_radius'],
                                       params['wheel_radius'], params['wheel_offset'])
@@ -250,7 +238,8 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
         self._wheels: list[JointHandle] = []
         self._odometry_sink: OdometrySink | None = None
         self._tf_sink: TfSink | None = None
-        self._problem = ''
+        self._command = TwistCommand('cmd_vel', sideways=True, timeout_field='cmd_vel_timeout',
+                                     stale_at_timeout=True)
         self.reset()
 
     # --- what it claims and exports --------------------------------------------------------
@@ -320,7 +309,8 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
     def reset(self) -> None:
         """Forget the command (an empty one at time 0), references NaN, odometry at the origin."""
         self._time = 0.0
-        self._command = StampedTwist(0.0, (math.nan, math.nan, 0.0), (0.0, 0.0, math.nan))
+        self._command.latest = StampedTwist(0.0, (math.nan, math.nan, 0.0),
+                                            (0.0, 0.0, math.nan))
         self._timed_out = False
         for reference in self._reference_list:
             reference.value = math.nan
@@ -338,24 +328,11 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
 
     def set_command(self, value: StampedTwist) -> CommandResult:
         """Take a twist: refuse non-finite or already stale ones."""
-        linear_x, linear_y, angular = value.linear[0], value.linear[1], value.angular[2]
-        if not all(math.isfinite(part) for part in (linear_x, linear_y, angular)):
-            self._problem = (f'ignored cmd_vel (linear.x {linear_x!r}, linear.y {linear_y!r}, '
-                             f'angular.z {angular!r}): not finite numbers')
-            return CommandResult.REJECTED
-        now = self._time
-        stamp = value.stamp if value.stamp > 0.0 else now
-        timeout = self.params['cmd_vel_timeout']
-        if timeout != 0.0 and now - stamp >= timeout:
-            self._problem = (f'ignored cmd_vel stamped {stamp:.4f} s: {now - stamp:.4f} s old at '
-                             f'sim time {now:.4f} s, more than cmd_vel_timeout ({timeout:g} s)')
-            return CommandResult.REJECTED
-        self._command = StampedTwist(stamp, (linear_x, linear_y, 0.0), (0.0, 0.0, angular))
-        return CommandResult.ACCEPTED
+        return self._command.take(value, self._time, self.params['cmd_vel_timeout'])
 
     def command_problem(self, value: Any, result: CommandResult) -> str:
         """Describe the last refused twist."""
-        return self._problem
+        return self._command.problem(value, result)
 
     def setpoints(self) -> dict[str, float]:
         """Return each wheel's commanded velocity (rad/s)."""
@@ -403,7 +380,7 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
 
     def _update_references(self, time: float) -> None:
         """Write the command to the references, or zeros once it is stale (braking)."""
-        command = self._command
+        command = self._command.latest
         timeout = self.params['cmd_vel_timeout']
         if time - command.stamp > timeout:
             for reference in self._reference_list:

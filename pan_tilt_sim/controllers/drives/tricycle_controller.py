@@ -61,20 +61,18 @@ from pan_tilt_sim.controllers.framework.base import (
 from pan_tilt_sim.controllers.framework.parameter_spec import (
     BOOL,
     DOUBLE,
-    DOUBLE_ARRAY,
     INT,
     REQUIRED,
     STRING,
     Param,
     ParameterSpec,
-    fixed_size,
-    frame_id,
     gt,
     gt_eq,
     not_empty,
 )
 from pan_tilt_sim.controllers.framework.shared_parameters import (
     UPDATE_RATE,
+    odometry_frames,
     same_frames_problem,
     update_period,
 )
@@ -91,7 +89,6 @@ from pan_tilt_sim.schedule import PeriodicSchedule
 
 TRACTION, STEERING = 'traction_joint_name', 'steering_joint_name'
 VELOCITY, POSITION = 'velocity', 'position'
-COVARIANCE_SIZE = 6
 UNBOUNDED = 1000.0  # upstream's "arbitrarily big" upper bound where only a lower one is given
 ACKERMANN_MESSAGE = 'ackermann_msgs/msg/AckermannDrive'
 # Steering further than this from its command scales the wheel speed by the cosine of the
@@ -215,14 +212,7 @@ class TricycleController(OdometryOutputs, CommandController):
               '(m).', (gt(0.0),), example=0.5),
         Param('wheel_radius', DOUBLE, REQUIRED, 'Radius of the driven wheel (m).', (gt(0.0),),
               example=0.05),
-        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.', (frame_id(),)),
-        Param('base_frame_id', STRING, 'base_link', "The robot's base frame, child of "
-              'odom_frame_id.', (frame_id(),)),
-        Param('pose_covariance_diagonal', DOUBLE_ARRAY, [0.0] * COVARIANCE_SIZE,
-              "Diagonal of the odometry pose's covariance (x, y, z, roll, pitch, yaw).",
-              (fixed_size(COVARIANCE_SIZE),)),
-        Param('twist_covariance_diagonal', DOUBLE_ARRAY, [0.0] * COVARIANCE_SIZE,
-              "Diagonal of the odometry twist's covariance.", (fixed_size(COVARIANCE_SIZE),)),
+        *odometry_frames(),
         Param('open_loop', BOOL, False, 'Odometry from the command, not the joints.'),
         Param('enable_odom_tf', BOOL, False, 'Publish odom_frame_id -> base_frame_id on /tf.'),
         Param('odom_only_twist', BOOL, False, "Publish only the odometry's twist (its pose "

@@ -8,17 +8,20 @@ the pan/tilt example's controllers file writes them.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
-from typing import Any
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any, NamedTuple
 
 from pan_tilt_sim.controllers.framework.parameter_spec import (
     BOOL,
     DOUBLE,
+    DOUBLE_ARRAY,
     REQUIRED,
     STRING,
     STRING_ARRAY,
     Param,
     Validator,
+    fixed_size,
+    frame_id,
     gt_eq,
     names,
     not_empty,
@@ -40,6 +43,42 @@ JOINTS = Param('joints', STRING_ARRAY, REQUIRED, 'The joints this controller dri
 # A length or radius whose default 0 means 'not set' (upstream's convention); a negative
 # one has no meaning.
 UNSET_OR_LENGTH = (gt_eq(0.0),)
+
+
+# An odometry covariance diagonal: x, y, z, roll, pitch, yaw.
+COVARIANCE_SIZE = 6
+
+
+class OdometryFrames(NamedTuple):
+    """A drive's odometry frame and covariance entries; a spec lists them in its own order."""
+
+    odom: Param
+    base: Param
+    pose_covariance: Param
+    twist_covariance: Param
+
+
+def odometry_frames(*, covariance: Sequence[float] = (0.0,) * COVARIANCE_SIZE,
+                    pose_name: str = 'pose_covariance_diagonal',
+                    twist_name: str = 'twist_covariance_diagonal',
+                    read_only: bool = False) -> OdometryFrames:
+    """Return ``odom_frame_id``, ``base_frame_id`` and the two covariance diagonals.
+
+    ``covariance``: both diagonals' default; ``pose_name``/``twist_name``:
+    the diagonals' names (omni_wheel_drive_controller's are
+    ``diagonal_covariance.pose``/``.twist``); ``read_only``: all four fixed
+    once configured.
+    """
+    size = (fixed_size(COVARIANCE_SIZE),)
+    return OdometryFrames(
+        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.', (frame_id(),),
+              read_only=read_only),
+        Param('base_frame_id', STRING, 'base_link', "The robot's base frame, child of "
+              'odom_frame_id.', (frame_id(),), read_only=read_only),
+        Param(pose_name, DOUBLE_ARRAY, list(covariance), "Diagonal of the odometry pose's "
+              'covariance (x, y, z, roll, pitch, yaw).', size, read_only=read_only),
+        Param(twist_name, DOUBLE_ARRAY, list(covariance), "Diagonal of the odometry twist's "
+              'covariance.', size, read_only=read_only))
 
 
 def same_frames_problem(params: Mapping[str, Any]) -> str | None:

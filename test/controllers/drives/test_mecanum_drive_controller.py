@@ -176,6 +176,13 @@ def test_a_reference_stamped_longer_ago_than_the_timeout_is_refused():
     assert 'more than reference_timeout' in drive.command_problem(None, CommandResult.REJECTED)
 
 
+def test_a_reference_exactly_reference_timeout_old_is_still_taken():
+    drive, _ = controller(reference_timeout=0.25)
+    drive.update(0.5, 0.01)
+    assert drive.set_command(twist(0.2, 0.0, 0.0, stamp=0.25)) is CommandResult.ACCEPTED
+    assert drive.set_command(twist(0.2, 0.0, 0.0, stamp=0.125)) is CommandResult.REJECTED
+
+
 def test_the_velocity_limits_clamp_each_axis_before_the_kinematics():
     drive, handles = controller(linear={'y': {'max_velocity': 0.1}})
     drive.set_command(twist(0.0, 0.3, 0.0))

@@ -155,6 +155,13 @@ def test_a_twist_stamped_longer_ago_than_the_timeout_is_refused():
     assert 'more than cmd_vel_timeout' in drive.command_problem(None, CommandResult.REJECTED)
 
 
+def test_a_twist_exactly_cmd_vel_timeout_old_is_stale_too():
+    drive, _ = controller(cmd_vel_timeout=0.25)
+    drive.update(0.5, DT)
+    assert drive.set_command(twist(0.2, 0.0, 0.0, stamp=0.25)) is CommandResult.REJECTED
+    assert drive.set_command(twist(0.2, 0.0, 0.0, stamp=0.375)) is CommandResult.ACCEPTED
+
+
 def test_it_exports_three_velocity_references_and_follows_them_when_chained():
     drive, handles = controller(cmd_vel_timeout=0.1)
     references = drive.reference_interfaces()

@@ -69,20 +69,17 @@ from pan_tilt_sim.controllers.framework.base import (
 from pan_tilt_sim.controllers.framework.parameter_spec import (
     BOOL,
     DOUBLE,
-    DOUBLE_ARRAY,
     INT,
-    STRING,
     STRING_ARRAY,
     Param,
     Validator,
-    fixed_size,
-    frame_id,
     gt,
     gt_eq,
     unique,
 )
 from pan_tilt_sim.controllers.framework.shared_parameters import (
     UPDATE_RATE,
+    odometry_frames,
     same_frames_problem,
     update_period,
 )
@@ -101,8 +98,8 @@ from pan_tilt_sim.schedule import PeriodicSchedule
 VELOCITY, POSITION = 'velocity', 'position'
 TRACTION, STEERING = 'traction_joints_names', 'steering_joints_names'
 TRACTION_STATE, STEERING_STATE = 'traction_joints_state_names', 'steering_joints_state_names'
-COVARIANCE_SIZE = 6
-DEFAULT_COVARIANCE = [0.0, 7.0, 14.0, 21.0, 28.0, 35.0]  # upstream's default diagonals
+# upstream's default covariance diagonals
+FRAMES = odometry_frames(covariance=(0.0, 7.0, 14.0, 21.0, 28.0, 35.0))
 MAX_JOINTS = 4  # upstream's size_lt<5> on every joint list
 STATUS_MESSAGE = 'control_msgs/msg/SteeringControllerStatus'
 # Sinks besides the planar odometry and tf (toolbox.odometry_outputs): status(time,
@@ -155,16 +152,12 @@ def library_parameters(traction: list[str], steering: list[str]) -> tuple[Param,
               'wheels while the steering is more than 30 degrees from its command.'),
         Param('velocity_rolling_window_size', INT, 10, "Updates in the odometry twist's rolling "
               'mean.', (gt(0),)),
-        Param('base_frame_id', STRING, 'base_link', "The robot's base frame, child of "
-              'odom_frame_id.', (frame_id(),)),
-        Param('odom_frame_id', STRING, 'odom', 'The odometry frame.', (frame_id(),)),
+        FRAMES.base,
+        FRAMES.odom,
         Param('enable_odom_tf', BOOL, True, 'Publish odom_frame_id -> base_frame_id on '
               '~/tf_odometry.'),
-        Param('twist_covariance_diagonal', DOUBLE_ARRAY, DEFAULT_COVARIANCE,
-              "Diagonal of the odometry twist's covariance.", (fixed_size(COVARIANCE_SIZE),)),
-        Param('pose_covariance_diagonal', DOUBLE_ARRAY, DEFAULT_COVARIANCE,
-              "Diagonal of the odometry pose's covariance (x, y, z, roll, pitch, yaw).",
-              (fixed_size(COVARIANCE_SIZE),)),
+        FRAMES.twist_covariance,
+        FRAMES.pose_covariance,
         Param('position_feedback', BOOL, False, "Odometry from the traction joints' positions "
               '(else their velocities).'),
         UPDATE_RATE,    )
