@@ -1,4 +1,6 @@
-"""A ``controller_manager`` node in sim_node's process, so ros2_control's spawner works unchanged.
+"""The ROS ``controller_manager`` node: services over the pure controllers.framework.manager.
+
+A ``controller_manager`` node in sim_node's process, so ros2_control's spawner works unchanged.
 
 ros2_control's ``spawner`` and ``unspawner`` (jazzy) talk to a node called
 ``controller_manager`` in the robot's namespace (``/controller_manager``, or

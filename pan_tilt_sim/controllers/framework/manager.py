@@ -1,4 +1,6 @@
-"""Loaded and active controllers, as ros2_control's controller_manager keeps them.
+"""Loaded and active controllers, as ros2_control's controller_manager keeps them (no ROS).
+
+ros/controller_manager.py is the ROS node that serves this bookkeeping.
 
 ros2_control loads the controllers a launch file's spawners name, configures
 them and activates them; a controllers file may declare more (Universal
