@@ -1,7 +1,7 @@
-"""The documented import path of the ROS-free simulation loop.
+"""Re-export of :mod:`pan_tilt_sim.sim.engine`: ``from pan_tilt_sim.engine import make_simulation``.
 
-``from pan_tilt_sim.engine import make_simulation`` -- it lives in
-:mod:`pan_tilt_sim.sim.engine`.
+A documented import path of the ROS-free simulation loop, kept stable; it
+lives in :mod:`pan_tilt_sim.sim.engine`.
 """
 
 from pan_tilt_sim.sim.engine import Simulation, make_simulation

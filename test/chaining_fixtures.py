@@ -20,8 +20,8 @@ from typing import Any
 
 import pytest
 
-from pan_tilt_sim.controllers import registry
-from pan_tilt_sim.controllers.base import (
+from pan_tilt_sim.controllers.framework import registry
+from pan_tilt_sim.controllers.framework.base import (
     Actuator,
     ActuatorKind,
     CommandController,
@@ -31,8 +31,8 @@ from pan_tilt_sim.controllers.base import (
     Reference,
     is_sane_number,
 )
-from pan_tilt_sim.controllers.parameter_spec import ParameterSpec
-from pan_tilt_sim.controllers.shared_parameters import JOINTS
+from pan_tilt_sim.controllers.framework.parameter_spec import ParameterSpec
+from pan_tilt_sim.controllers.framework.shared_parameters import JOINTS
 
 CHAINABLE_TYPE = 'test_controllers/ChainableTestController'
 GAIN = 10.0  # 1/s: velocity target per metre or radian of reference error

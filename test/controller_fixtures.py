@@ -19,14 +19,14 @@ from typing import Any
 import pytest
 
 from pan_tilt_sim.controllers import JointHandle
-from pan_tilt_sim.controllers.hardware_interfaces import (
+from pan_tilt_sim.controllers.framework.hardware_interfaces import (
     NO_HARDWARE,
     GpioHandle,
     HardwareInterfaces,
     SensorHandle,
     StateInterface,
 )
-from pan_tilt_sim.controllers.manager import ControllerManager
+from pan_tilt_sim.controllers.framework.manager import ControllerManager
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.model.controller_config import ControllersConfig, ControllerSpec
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 from controller_fixtures import DT, loaded
 
 from pan_tilt_sim.controllers import JointHandle
-from pan_tilt_sim.controllers.gripper_action_controller import (
+from pan_tilt_sim.controllers.grippers.gripper_action_controller import (
     GripperActionController,
     GripperGoal,
     GripperRequest,

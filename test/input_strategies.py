@@ -28,12 +28,12 @@ from typing import Any
 import yaml
 from hypothesis import strategies as st
 
-from pan_tilt_sim.controllers.hardware_interfaces import (
+from pan_tilt_sim.controllers.framework.hardware_interfaces import (
     EXAMPLE_GPIO,
     EXAMPLE_SENSOR,
     EXAMPLE_SENSOR_INTERFACES,
 )
-from pan_tilt_sim.controllers.parameter_spec import (
+from pan_tilt_sim.controllers.framework.parameter_spec import (
     BOOL,
     DOUBLE,
     INT,
@@ -41,7 +41,7 @@ from pan_tilt_sim.controllers.parameter_spec import (
     Param,
     ParameterSpec,
 )
-from pan_tilt_sim.controllers.registry import CONTROLLER_TYPES
+from pan_tilt_sim.controllers.framework.registry import CONTROLLER_TYPES
 
 JOINTS = ('joint1', 'joint2', 'joint3', 'joint4')
 NAME = 'under_test'

@@ -55,13 +55,13 @@ def _pad(numbers: list[float], count: int) -> list[float]:
 
 def _command(controller, requests: dict) -> None:
     """Send ``controller`` the request's numbers in its command kind, and a goal if it takes one."""
-    from pan_tilt_sim.controllers.base import CommandKind
-    from pan_tilt_sim.controllers.gripper_action_controller import (
+    from pan_tilt_sim.controllers.framework.base import CommandKind
+    from pan_tilt_sim.controllers.framework.surface import StampedTwist
+    from pan_tilt_sim.controllers.grippers.gripper_action_controller import (
         GripperActionController,
         GripperRequest,
     )
-    from pan_tilt_sim.controllers.surface import StampedTwist
-    from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
+    from pan_tilt_sim.controllers.trajectory.trajectory import JointTrajectory, TrajectoryPoint
 
     numbers, stamp = requests['numbers'], requests['stamp']
     joints = tuple(getattr(controller, 'joint_names', ()) or ('joint1',))

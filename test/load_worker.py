@@ -52,7 +52,7 @@ def _finite(values) -> bool:
 
 
 def _command_all(simulation) -> None:
-    from pan_tilt_sim.controllers.multi_joint import MultiJointController
+    from pan_tilt_sim.controllers.framework.multi_joint import MultiJointController
 
     for controller in simulation.command_controllers():
         if isinstance(controller, MultiJointController):

@@ -11,10 +11,10 @@ import math
 from typing import Any
 
 from pan_tilt_sim.controllers import JointHandle
-from pan_tilt_sim.controllers.base import CommandResult
-from pan_tilt_sim.controllers.registry import create_controller
-from pan_tilt_sim.controllers.steering_controllers import SteeringController
-from pan_tilt_sim.controllers.surface import StampedTwist
+from pan_tilt_sim.controllers.drives.steering.steering_controllers import SteeringController
+from pan_tilt_sim.controllers.framework.base import CommandResult
+from pan_tilt_sim.controllers.framework.registry import create_controller
+from pan_tilt_sim.controllers.framework.surface import StampedTwist
 from pan_tilt_sim.model.robot import JointKind, JointSpec
 
 DT = 0.001

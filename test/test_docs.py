@@ -33,8 +33,8 @@ import sim_process
 import yaml
 from node_harness import sim_node
 
-from pan_tilt_sim.controllers.registry import CONTROLLER_CLASSES
-from pan_tilt_sim.controllers.surface import ActionServer, CommandTopic, StateTopic
+from pan_tilt_sim.controllers.framework.registry import CONTROLLER_CLASSES
+from pan_tilt_sim.controllers.framework.surface import ActionServer, CommandTopic, StateTopic
 from pan_tilt_sim.ros.sim_node import NODE_NAME
 from pan_tilt_sim.share import package_share
 from pan_tilt_sim.tools.controller_reference import example_controller

@@ -2,6 +2,10 @@
 
 model -> controllers -> sim -> ros -> tools; ``errors``, ``schedule`` and
 ``share`` are shared by all; viser (the browser view) only in ``ros/viewer.py``.
+Inside controllers/, each family (commands, trajectory, drives, grippers,
+broadcasters) and each plugin uses the framework and the toolbox, never
+another family or plugin; only the registry (and the manager, through it)
+knows every family.
 Read from the installed package's source with ``ast`` (every import, also
 those inside functions), and checked once more by importing: loading model/
 and controllers/ pulls in neither rclpy nor PyBullet.
@@ -30,6 +34,11 @@ ALLOWED = {
 ROS_PACKAGE_SUFFIXES = ('_msgs', '_srvs', '_interfaces')
 ROS_PACKAGES = {'rclpy', 'builtin_interfaces'}
 VIEWER_MODULE = 'pan_tilt_sim.ros.viewer'  # the browser view: an optional dependency's adapter
+CONTROLLERS = 'pan_tilt_sim.controllers'
+# Shared by every controller family and plugin: what a new one builds on.
+COMMON = {'framework', 'toolbox'}
+FAMILIES = {'commands', 'trajectory', 'drives', 'grippers', 'broadcasters'}
+REGISTRY = 'pan_tilt_sim.controllers.framework.registry'  # maps YAML types to every family
 
 
 def modules() -> dict[str, pathlib.Path]:
@@ -132,3 +141,55 @@ def test_importing_model_and_controllers_pulls_in_neither_rclpy_nor_pybullet():
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == '[]'
     assert len(names) > 20  # every module of both layers was imported
+
+
+def controller_part(module: str) -> str:
+    """Return a controllers module's part: its family folder, or its own name at the top."""
+    return module.split('.')[2] if module.startswith(CONTROLLERS + '.') else ''
+
+
+def is_plugin(module: str) -> bool:
+    """Return whether ``module`` is a Gazebo plugin (in plugins/, or still beside the families)."""
+    return (layer(module) == 'plugins'
+            or (module.startswith(CONTROLLERS + '.') and module.count('.') == 2
+                and controller_part(module) not in COMMON | FAMILIES))
+
+
+def package_imports(module: str) -> set[str]:
+    """Return the package modules ``module`` imports (a name imported from a module counts
+    as that module)."""
+    return {name if name in MODULES else name.rpartition('.')[0]
+            for name in imports(MODULES[module])
+            if name in MODULES or name.rpartition('.')[0] in MODULES} - {module}
+
+
+def test_the_controllers_are_sorted_into_family_folders():
+    folders = {path.name for path in (PACKAGE / 'controllers').iterdir()
+               if (path / '__init__.py').exists()}
+    assert folders == COMMON | FAMILIES
+    assert (PACKAGE / 'controllers' / 'drives' / 'steering' / '__init__.py').exists()
+
+
+@pytest.mark.parametrize('module', sorted(m for m in MODULES
+                                          if controller_part(m) in FAMILIES or is_plugin(m)))
+def test_families_and_plugins_use_the_framework_and_toolbox_not_each_other(module):
+    own = module.split('.')[:3]
+    for name in package_imports(module):
+        if not name.startswith(CONTROLLERS + '.'):
+            continue
+        part = controller_part(name)
+        if part in COMMON or name.split('.')[:3] == own:
+            continue  # the shared parts, or the module's own family
+        if is_plugin(module) and is_plugin(name):
+            continue  # plugins among themselves: the plugins' own rule
+        pytest.fail(f'{module} imports {name}: a family or plugin uses only '
+                    f'controllers.framework and controllers.toolbox besides itself')
+
+
+@pytest.mark.parametrize('module', sorted(m for m in MODULES if controller_part(m) in COMMON))
+def test_the_framework_and_toolbox_know_no_family_but_through_the_registry(module):
+    for name in package_imports(module):
+        if module == REGISTRY or name == REGISTRY:
+            continue
+        assert controller_part(name) not in FAMILIES and not is_plugin(name), (
+            f'{module} imports {name}')

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from pan_tilt_sim.controllers import JointHandle, create_controller
-from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
+from pan_tilt_sim.controllers.trajectory.trajectory import JointTrajectory, TrajectoryPoint
 from pan_tilt_sim.model.robot import JointKind, JointSpec
 
 JTC = 'joint_trajectory_controller/JointTrajectoryController'

@@ -13,8 +13,8 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 
-from pan_tilt_sim.controllers.base import Controller, JointHandle
-from pan_tilt_sim.controllers.surface import Endpoint, StateTopic
+from pan_tilt_sim.controllers.framework.base import Controller, JointHandle
+from pan_tilt_sim.controllers.framework.surface import Endpoint, StateTopic
 from pan_tilt_sim.model.drive_plugins import JointStatePlugin
 from pan_tilt_sim.schedule import DUE_EPSILON
 

@@ -19,8 +19,8 @@ from __future__ import annotations
 import random
 from collections.abc import Callable, Mapping
 
-from pan_tilt_sim.controllers.base import Controller, JointHandle
-from pan_tilt_sim.controllers.surface import Endpoint, StateTopic
+from pan_tilt_sim.controllers.framework.base import Controller, JointHandle
+from pan_tilt_sim.controllers.framework.surface import Endpoint, StateTopic
 from pan_tilt_sim.model.drive_plugins import P3dPlugin
 from pan_tilt_sim.model.transforms import (
     Transform,

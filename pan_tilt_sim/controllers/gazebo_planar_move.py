@@ -31,17 +31,21 @@ import math
 from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
-from pan_tilt_sim.controllers.base import (
+from pan_tilt_sim.controllers.framework.base import (
     Actuator,
     CommandController,
     CommandKind,
     CommandResult,
     JointHandle,
 )
-from pan_tilt_sim.controllers.diff_drive_controller import TfSink
+from pan_tilt_sim.controllers.framework.surface import (
+    CommandTopic,
+    Endpoint,
+    StampedTwist,
+    StateTopic,
+)
 from pan_tilt_sim.controllers.gazebo_p3d import SpatialOdometrySink
-from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs
-from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
+from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, TfSink
 from pan_tilt_sim.model.drive_plugins import ROS1, PlanarMovePlugin
 from pan_tilt_sim.model.transforms import Transform, Vector
 from pan_tilt_sim.schedule import DUE_EPSILON

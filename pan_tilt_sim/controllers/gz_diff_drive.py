@@ -33,7 +33,7 @@ import math
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
-from pan_tilt_sim.controllers.base import (
+from pan_tilt_sim.controllers.framework.base import (
     Actuator,
     ActuatorKind,
     CommandController,
@@ -41,11 +41,19 @@ from pan_tilt_sim.controllers.base import (
     CommandResult,
     JointHandle,
 )
-from pan_tilt_sim.controllers.diff_drive_controller import OdometrySink, TfSink
-from pan_tilt_sim.controllers.odometry import Odometry
-from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs
-from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError, RateLimiter, RateLimits
-from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
+from pan_tilt_sim.controllers.framework.surface import (
+    CommandTopic,
+    Endpoint,
+    StampedTwist,
+    StateTopic,
+)
+from pan_tilt_sim.controllers.toolbox.odometry import Odometry
+from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, OdometrySink, TfSink
+from pan_tilt_sim.controllers.toolbox.rate_limiter import (
+    InvalidLimitsError,
+    RateLimiter,
+    RateLimits,
+)
 from pan_tilt_sim.model.drive_plugins import GzDiffDrivePlugin
 from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.schedule import DUE_EPSILON

@@ -21,12 +21,11 @@ import math
 import random
 from collections.abc import Callable, Mapping
 
-from pan_tilt_sim.controllers.base import Controller, JointHandle
-from pan_tilt_sim.controllers.diff_drive_controller import TfSink
+from pan_tilt_sim.controllers.framework.base import Controller, JointHandle
+from pan_tilt_sim.controllers.framework.surface import Endpoint, StateTopic
 from pan_tilt_sim.controllers.gazebo_p3d import SpatialOdometrySink
 from pan_tilt_sim.controllers.gazebo_planar_move import BaseMotion, heading
-from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs
-from pan_tilt_sim.controllers.surface import Endpoint, StateTopic
+from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, TfSink
 from pan_tilt_sim.model.drive_plugins import GzOdometryPlugin
 from pan_tilt_sim.model.transforms import (
     Transform,

@@ -43,7 +43,7 @@ hardware would decide:
 
 Mixing two interfaces on a joint is refused only by the hardware above;
 two active controllers on one joint are refused whatever the hardware (see
-:mod:`pan_tilt_sim.controllers.manager`).
+:mod:`pan_tilt_sim.controllers.framework.manager`).
 """
 
 from __future__ import annotations

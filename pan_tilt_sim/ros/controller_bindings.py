@@ -2,23 +2,23 @@
 
 A controller's ROS entities exist while it is configured (inactive or
 active), as a ros2_control controller's do.  Each controller declares them
-(:meth:`~pan_tilt_sim.controllers.base.Controller.ros_surface`, see
-:mod:`pan_tilt_sim.controllers.surface`); this module creates one entity per
+(:meth:`~pan_tilt_sim.controllers.framework.base.Controller.ros_surface`, see
+:mod:`pan_tilt_sim.controllers.framework.surface`); this module creates one entity per
 declared entry from tables keyed by message and action type, never by
 controller type:
 
-* a :class:`~pan_tilt_sim.controllers.surface.CommandTopic`: a subscription
+* a :class:`~pan_tilt_sim.controllers.framework.surface.CommandTopic`: a subscription
   whose messages' values go to the controller (:data:`COMMAND_MESSAGES`);
-* a :class:`~pan_tilt_sim.controllers.surface.StateTopic`: a publisher and
+* a :class:`~pan_tilt_sim.controllers.framework.surface.StateTopic`: a publisher and
   the sink the controller hands its samples to (:data:`STATE_SINKS`; a
   message type whose interface package is not installed -- TF without
   tf2_msgs -- gets none, with an info line, and the controller takes no
   samples for it);
-* a :class:`~pan_tilt_sim.controllers.surface.Service`: a service whose
+* a :class:`~pan_tilt_sim.controllers.framework.surface.Service`: a service whose
   requests' values go to the controller and whose answers fill the
   responses (:data:`SERVICES`; none where its interface package is not
   installed, with an info line);
-* an :class:`~pan_tilt_sim.controllers.surface.ActionServer`, where its
+* an :class:`~pan_tilt_sim.controllers.framework.surface.ActionServer`, where its
   interface package is installed (:data:`ACTION_SERVERS`);
 
 
@@ -59,7 +59,7 @@ from sensor_msgs.msg import Imu, JointState, Range
 from std_srvs.srv import Empty, SetBool
 
 from pan_tilt_sim.controllers import CommandResult, Controller
-from pan_tilt_sim.controllers.surface import (
+from pan_tilt_sim.controllers.framework.surface import (
     PRIVATE,
     ActionServer,
     CommandTopic,

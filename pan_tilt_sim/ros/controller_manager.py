@@ -1,4 +1,6 @@
-"""A ``controller_manager`` node in sim_node's process, so ros2_control's spawner works unchanged.
+"""The ROS ``controller_manager`` node: services over the pure controllers.framework.manager.
+
+A ``controller_manager`` node in sim_node's process, so ros2_control's spawner works unchanged.
 
 ros2_control's ``spawner`` and ``unspawner`` (jazzy) talk to a node called
 ``controller_manager`` in the robot's namespace (``/controller_manager``, or
@@ -54,9 +56,9 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from pan_tilt_sim.controllers import CommandController
-from pan_tilt_sim.controllers.joint_state_controller import JointStateController
-from pan_tilt_sim.controllers.manager import ACTIVE, INACTIVE, ControllerManager
-from pan_tilt_sim.controllers.registry import CONTROLLER_TYPES, supported_types
+from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateController
+from pan_tilt_sim.controllers.framework.manager import ACTIVE, INACTIVE, ControllerManager
+from pan_tilt_sim.controllers.framework.registry import CONTROLLER_TYPES, supported_types
 from pan_tilt_sim.errors import ConfigurationError, ControllerConfigError, ControllerSwitchError
 from pan_tilt_sim.model.controller_config import (
     DEFAULT_UPDATE_RATE,

@@ -1,7 +1,7 @@
 """Live PID tuning: every PID gain is a node parameter, as control_toolbox's PidROS makes it.
 
 For each PID, the tunable entries of its controller's parameter spec
-(:meth:`~pan_tilt_sim.controllers.parameter_spec.ParameterSpec.tunable`) are
+(:meth:`~pan_tilt_sim.controllers.framework.parameter_spec.ParameterSpec.tunable`) are
 declared, from the gains in effect (the YAML's, or the controller's
 defaults): ``<prefix>.p``, ``.i``, ``.d``, ``.i_clamp_max``, ``.i_clamp_min``
 (doubles) and ``.antiwindup`` (bool), whatever the YAML wrote (its ``i_clamp: x`` is
@@ -15,7 +15,7 @@ gains come from (:attr:`Controller.gains_field`):
 
 ``ros2 param set /sim_node joint1_position_controller.pid.p 50`` changes the
 gain at the next physics step; the integral term is kept
-(:class:`~pan_tilt_sim.controllers.pid.Pid` stores it already multiplied by
+(:class:`~pan_tilt_sim.controllers.toolbox.pid.Pid` stores it already multiplied by
 ``i``).  Changes are checked in the node's on-set callback and applied in
 its post-set callback, so a refused change -- negative, not finite, not a
 number, or refused by another callback of the same atomic set -- changes
@@ -32,12 +32,12 @@ from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from pan_tilt_sim.controllers import parameter_spec
-from pan_tilt_sim.controllers.base import Controller
-from pan_tilt_sim.controllers.gains import PID_FIELD
-from pan_tilt_sim.controllers.parameter_spec import Param
-from pan_tilt_sim.controllers.pid import GainsError, Pid, PidGains
-from pan_tilt_sim.controllers.shared_parameters import pid_gains
+from pan_tilt_sim.controllers.framework import parameter_spec
+from pan_tilt_sim.controllers.framework.base import Controller
+from pan_tilt_sim.controllers.framework.parameter_spec import Param
+from pan_tilt_sim.controllers.framework.shared_parameters import pid_gains
+from pan_tilt_sim.controllers.toolbox.gains import PID_FIELD
+from pan_tilt_sim.controllers.toolbox.pid import GainsError, Pid, PidGains
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.ros.parameters import BOOL, DOUBLE, coerce, declare
 

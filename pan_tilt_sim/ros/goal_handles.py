@@ -15,7 +15,7 @@ from rclpy.action import CancelResponse
 from rclpy.action.server import ServerGoalHandle
 from rclpy.task import Future
 
-from pan_tilt_sim.controllers.trajectory_goal import GoalStatus
+from pan_tilt_sim.controllers.framework.surface import GoalStatus
 
 
 def end_handle(goal_handle: ServerGoalHandle, status: GoalStatus) -> None:

@@ -4,7 +4,7 @@
 ``control_msgs/action/ParallelGripperCommand``
 (:class:`ParallelGripperCommandServer`), served with rclpy's ActionServer
 on sim_node's one executor.  The goals' rules are the controller's
-(:mod:`pan_tilt_sim.controllers.gripper_action_controller`); these classes
+(:mod:`pan_tilt_sim.controllers.grippers.gripper_action_controller`); these classes
 only translate:
 
 * goal callback: an inactive controller, a goal the controller cannot
@@ -34,7 +34,7 @@ from rclpy.action.server import ServerGoalHandle
 from rclpy.node import Node
 from rclpy.task import Future
 
-from pan_tilt_sim.controllers.gripper_action_controller import (
+from pan_tilt_sim.controllers.grippers.gripper_action_controller import (
     NOT_RUNNING,
     UNLOADED_TEXT,
     GripperActionController,

@@ -15,8 +15,8 @@ from std_msgs.msg import Float64, Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage
 
 from pan_tilt_sim.controllers import CommandKind
-from pan_tilt_sim.controllers.surface import StampedTwist
-from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
+from pan_tilt_sim.controllers.framework.surface import StampedTwist
+from pan_tilt_sim.controllers.trajectory.trajectory import JointTrajectory, TrajectoryPoint
 
 try:
     from control_msgs.msg import MultiDOFCommand

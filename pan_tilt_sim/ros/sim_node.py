@@ -19,7 +19,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 
-from pan_tilt_sim.controllers.joint_state_controller import JointStateController
+from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateController
 from pan_tilt_sim.errors import ConfigurationError, ParameterError
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.controller_config import (

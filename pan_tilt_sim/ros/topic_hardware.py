@@ -22,7 +22,7 @@ actuators as the YAML controllers': each commanded joint's interface (see
 ``topic_based.command_interface`` for all) is driven by a group controller of
 that interface (``topic_based_position`` ...: the ``JointGroup*Controller``
 types, one member per joint): the ideal actuator for position and velocity
-(:mod:`pan_tilt_sim.controllers.actuator`), or a PID where
+(:mod:`pan_tilt_sim.controllers.toolbox.actuator`), or a PID where
 ``topic_based.pid_gains.<joint>.p`` (``.i``, ``.d``, ``.i_clamp``, named
 after gazebo_ros_control's ``pid_gains``) gives gains, tunable live as
 ``topic_based_<interface>.gains.<joint>.*``.
@@ -39,7 +39,7 @@ from rclpy.node import Node
 from sensor_msgs.msg import JointState
 
 from pan_tilt_sim.controllers import CommandResult, Controller
-from pan_tilt_sim.controllers.forward_command_controller import ForwardCommandController
+from pan_tilt_sim.controllers.commands.forward_command_controller import ForwardCommandController
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model.controller_config import ControllersConfig, ControllerSpec
 from pan_tilt_sim.model.description import RobotDescription

@@ -3,10 +3,10 @@
 ``control_msgs/action/FollowJointTrajectory`` (built by the standalone path,
 or a ROS install's), served with rclpy's ActionServer on sim_node's one
 executor, with ros2_controllers' semantics in sim time (the rules are the
-controller's, :mod:`pan_tilt_sim.controllers.joint_trajectory_controller`):
+controller's, :mod:`pan_tilt_sim.controllers.trajectory.joint_trajectory_controller`):
 
 * goal callback: an inactive controller, or a goal that
-  :meth:`~pan_tilt_sim.controllers.joint_trajectory_controller.JointTrajectoryController.check_goal`
+  :meth:`~pan_tilt_sim.controllers.trajectory.joint_trajectory_controller.JointTrajectoryController.check_goal`
   refuses, is REJECTED -- as ros2_controllers does, so the client sees
   ``accepted == False`` and no result; the reason, with the error code it
   stands for (INVALID_JOINTS, INVALID_GOAL, OLD_HEADER_TIMESTAMP), is logged;
@@ -39,8 +39,10 @@ from rclpy.action.server import ServerGoalHandle
 from rclpy.node import Node
 from rclpy.task import Future
 
-from pan_tilt_sim.controllers.joint_trajectory_controller import JointTrajectoryController
-from pan_tilt_sim.controllers.trajectory_goal import (
+from pan_tilt_sim.controllers.trajectory.joint_trajectory_controller import (
+    JointTrajectoryController,
+)
+from pan_tilt_sim.controllers.trajectory.trajectory_goal import (
     ERROR_NAMES,
     INVALID_GOAL,
     GoalStatus,

@@ -40,10 +40,12 @@ from sensor_msgs.msg import Image, LaserScan, PointCloud2
 from std_msgs.msg import Float64, Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from pan_tilt_sim.controllers.base import Controller
-from pan_tilt_sim.controllers.forward_command_controller import ForwardCommandController
-from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
-from pan_tilt_sim.controllers.joint_trajectory_controller import JointTrajectoryController
+from pan_tilt_sim.controllers.commands.forward_command_controller import ForwardCommandController
+from pan_tilt_sim.controllers.commands.joint_position_controller import JointPositionController
+from pan_tilt_sim.controllers.framework.base import Controller
+from pan_tilt_sim.controllers.trajectory.joint_trajectory_controller import (
+    JointTrajectoryController,
+)
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.robot import JointKind, JointSpec, RobotModel

@@ -399,7 +399,7 @@ static PyObject *stepper_call(Stepper *self, PyObject *args, PyObject *kwargs)
 /* ---- the controller laws: many steps without Python ---- */
 
 /*
- * A law row, as pan_tilt_sim.controllers.step_law lays it out (a list of
+ * A law row, as pan_tilt_sim.controllers.toolbox.step_law lays it out (a list of
  * floats); the loop reads the gains and writes the state back.  Each field
  * and each law kind is named once, in row (code) order, in the lists below:
  * they make the indices (LAW_<field>, <kind>) and the module's LAW_FIELDS,

@@ -13,7 +13,7 @@ an effort controller and a step sends PyBullet nothing but the torques (the
 pan/tilt example's case), the same extension also runs the steps between two
 broadcaster samples without returning to Python (``Stepper.run_laws``,
 driven by :meth:`pan_tilt_sim.sim.engine.Simulation.advance`): the laws of
-:mod:`pan_tilt_sim.controllers.step_law`, computed operation for operation
+:mod:`pan_tilt_sim.controllers.toolbox.step_law`, computed operation for operation
 as the Python controllers compute them, so no Python runs per step.  The
 Python controllers stay the reference; the others (trajectories,
 ideal actuators) run only in Python.
@@ -35,7 +35,7 @@ from collections.abc import Callable, Sequence
 from types import ModuleType
 from typing import Protocol
 
-from pan_tilt_sim.controllers import step_law
+from pan_tilt_sim.controllers.toolbox import step_law
 from pan_tilt_sim.sim.bullet import pybullet, quiet_native_output
 
 ENVIRONMENT_SWITCH = 'PAN_TILT_SIM_COMPILED_STEP'
@@ -96,9 +96,9 @@ def _code(code: float | None) -> str:
 _LAYOUT_MISMATCH = layout_mismatch(_compiled_step) if _compiled_step else ''
 if _LAYOUT_MISMATCH:
     warnings.warn(f'{_compiled_step.__file__} was built with another law row layout than '
-                  f'pan_tilt_sim.controllers.step_law ({_LAYOUT_MISMATCH}); the physics steps '
-                  'through Python: reinstall pan_tilt_sim to rebuild it', RuntimeWarning,
-                  stacklevel=1)  # the importer's frame would be importlib's
+                  f'pan_tilt_sim.controllers.toolbox.step_law ({_LAYOUT_MISMATCH}); '
+                  'the physics steps through Python: reinstall pan_tilt_sim to rebuild it',
+                  RuntimeWarning, stacklevel=1)  # the importer's frame would be importlib's
 
 
 class Connection(Protocol):

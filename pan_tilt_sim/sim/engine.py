@@ -7,9 +7,9 @@ controller updates (command controllers first, so broadcasters sample fresh
 efforts), the efforts and velocity targets go to PyBullet, and PyBullet
 advances one ``time_step``.  Sim time is kept as a step count, so it never
 accumulates rounding error.  Which controllers are loaded and which are
-active is the :class:`~pan_tilt_sim.controllers.manager.ControllerManager`'s
+active is the :class:`~pan_tilt_sim.controllers.framework.manager.ControllerManager`'s
 business; the active ones say how each of their joints is driven
-(:meth:`~pan_tilt_sim.controllers.base.Controller.actuators`), and a joint no
+(:meth:`~pan_tilt_sim.controllers.framework.base.Controller.actuators`), and a joint no
 active controller claims is passive -- it keeps the last effort applied.
 
 The robot's base is welded to the world unless it is mobile (see
@@ -41,17 +41,17 @@ from typing import Protocol
 import numpy
 
 from pan_tilt_sim.controllers import CommandController, Controller, JointHandle
-from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
-from pan_tilt_sim.controllers.base import Drive, idle_actuator
-from pan_tilt_sim.controllers.gains import plugin_gains
+from pan_tilt_sim.controllers.framework.base import Drive, idle_actuator
+from pan_tilt_sim.controllers.framework.manager import ControllerManager
+from pan_tilt_sim.controllers.framework.registry import drives_base
 from pan_tilt_sim.controllers.gazebo_diff_drive import GazeboDiffDrive
 from pan_tilt_sim.controllers.gazebo_joint_state_publisher import GazeboJointStatePublisher
 from pan_tilt_sim.controllers.gazebo_p3d import GazeboP3d
 from pan_tilt_sim.controllers.gazebo_planar_move import GazeboPlanarMove
 from pan_tilt_sim.controllers.gz_diff_drive import GzDiffDrive
 from pan_tilt_sim.controllers.gz_odometry_publisher import GzOdometryPublisher
-from pan_tilt_sim.controllers.manager import ControllerManager
-from pan_tilt_sim.controllers.registry import drives_base
+from pan_tilt_sim.controllers.toolbox.actuator import TRACKING_GAIN
+from pan_tilt_sim.controllers.toolbox.gains import plugin_gains
 from pan_tilt_sim.model.base_pose import FIXED_BASE, ORIGIN, BasePose
 from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription
@@ -288,7 +288,7 @@ class Simulation:
         """Give the active controllers' roller wheels their friction (a free base only).
 
         A controller says which of its wheels carry free rollers
-        (:meth:`~pan_tilt_sim.controllers.base.Controller.roller_wheels`);
+        (:meth:`~pan_tilt_sim.controllers.framework.base.Controller.roller_wheels`);
         while it is active they grip only across their rollers
         (:mod:`pan_tilt_sim.sim.roller_wheels`), the force added before every
         physics step, which therefore runs in Python.
@@ -388,7 +388,7 @@ class Simulation:
         """Run ``steps`` physics steps, updating every active controller at each.
 
         Where every controller updated each step has a compiled law
-        (:mod:`pan_tilt_sim.controllers.step_law`) and the physics can run it
+        (:mod:`pan_tilt_sim.controllers.toolbox.step_law`) and the physics can run it
         (:meth:`Physics.law_runner`), the steps between two broadcaster
         samples run in C, at least :data:`MIN_COMPILED_STEPS` at a time; a
         step at which a scheduled controller is due runs in Python.  Either

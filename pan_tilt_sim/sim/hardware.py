@@ -1,7 +1,7 @@
 """The ``<ros2_control>`` sensors and gpios, simulated: what fills their interfaces. No ROS.
 
 Every ``<sensor>`` and ``<gpio>`` of the URDF's ``<ros2_control>`` blocks
-gets its interfaces (:mod:`pan_tilt_sim.controllers.hardware_interfaces`), which the
+gets its interfaces (:mod:`pan_tilt_sim.controllers.framework.hardware_interfaces`), which the
 controllers claim by name as ros2_control's do.
 
 **Sensors** are measured in the simulation's PyBullet client with the code
@@ -26,7 +26,7 @@ at the place :func:`~pan_tilt_sim.model.control_sensors.placement` finds
   :data:`DEFAULT_MAX_RANGE`; nothing hit reads +inf.
 
 A sensor is measured only when a reader asks and someone listens (see
-:class:`~pan_tilt_sim.controllers.hardware_interfaces.SensorHandle`); a Gazebo sensor's
+:class:`~pan_tilt_sim.controllers.framework.hardware_interfaces.SensorHandle`); a Gazebo sensor's
 ``update_rate`` makes its readings change at that rate only.  The first
 reading after someone starts listening is not valid (PyBullet's joint
 feedback is switched on then, and an IMU needs an earlier velocity): the
@@ -52,7 +52,7 @@ from collections.abc import Callable
 
 import numpy
 
-from pan_tilt_sim.controllers.hardware_interfaces import (
+from pan_tilt_sim.controllers.framework.hardware_interfaces import (
     CommandInterface,
     GpioHandle,
     HardwareInterfaces,

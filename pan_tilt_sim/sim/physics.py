@@ -45,7 +45,7 @@ Each joint is driven one of two ways (:meth:`Physics.set_drives`):
   with the velocity gain ``d dt / (J + d dt)``.  A joint coupled by a mimic
   gear always takes the first form; a joint with neither damping nor
   friction has no motor at all.
-* **velocity** (the ideal actuator, :mod:`pan_tilt_sim.controllers.actuator`):
+* **velocity** (the ideal actuator, :mod:`pan_tilt_sim.controllers.toolbox.actuator`):
   a velocity motor drives the joint to the target the controllers ask for,
   with at most the joint's URDF effort limit, or the lower force a step
   asks for (a gripper's ``max_effort``); the torque it applied is read
@@ -441,7 +441,7 @@ class Physics:
 
         ``run(steps, dt, efforts, laws, states) -> (before_last, last)`` runs
         ``steps`` steps in C, each law being ``(effort slot, state slot,
-        row)`` with the row of :mod:`pan_tilt_sim.controllers.step_law`; see
+        row)`` with the row of :mod:`pan_tilt_sim.controllers.toolbox.step_law`; see
         ``_compiled_step.c``.  None without the compiled step, or when a step
         sends PyBullet more than the efforts (velocity motors, implicit
         damping): those steps stay in Python.  Valid until the next

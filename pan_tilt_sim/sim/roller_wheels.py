@@ -7,7 +7,7 @@ ground plane -- the *free* direction -- and grips like an ordinary wheel
 only along the perpendicular one -- the *traction* direction.  With ``d``
 the wheel's rolling direction (its axis crossed with the contact normal)
 and ``a`` its axis, both in the ground plane, and the rollers' angle
-``gamma`` (:meth:`pan_tilt_sim.controllers.base.Controller.roller_wheels`:
+``gamma`` (:meth:`pan_tilt_sim.controllers.framework.base.Controller.roller_wheels`:
 pi / 2 for an omni wheel, +-pi / 4 for a mecanum wheel)::
 
     free     f = cos(gamma) d + sin(gamma) a

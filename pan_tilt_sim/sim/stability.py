@@ -36,7 +36,7 @@ import math
 import pathlib
 from collections.abc import Sequence
 
-from pan_tilt_sim.controllers.base import ActuatorKind, Drive, JointHandle
+from pan_tilt_sim.controllers.framework.base import ActuatorKind, Drive, JointHandle
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.robot import JointKind, RobotModel

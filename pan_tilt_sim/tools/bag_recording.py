@@ -23,9 +23,9 @@ from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage
 from trajectory_msgs.msg import JointTrajectoryPoint
 
 from pan_tilt_sim.controllers import CommandController
-from pan_tilt_sim.controllers.base import CommandKind
-from pan_tilt_sim.controllers.surface import PRIVATE, StateTopic
-from pan_tilt_sim.controllers.trajectory import JointTrajectory
+from pan_tilt_sim.controllers.framework.base import CommandKind
+from pan_tilt_sim.controllers.framework.surface import PRIVATE, StateTopic
+from pan_tilt_sim.controllers.trajectory.trajectory import JointTrajectory
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.ros.controller_bindings import STATE_SINKS
 from pan_tilt_sim.ros.recording import Recorder

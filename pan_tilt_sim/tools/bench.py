@@ -121,7 +121,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
 from pan_tilt_sim.controllers import create_controller
-from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
+from pan_tilt_sim.controllers.commands.joint_position_controller import JointPositionController
 from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.controller_config import load_controllers_config

@@ -47,7 +47,7 @@ import yaml
 from geometry_msgs.msg import Twist, TwistStamped
 from std_msgs.msg import Float64, Float64MultiArray
 
-from pan_tilt_sim.controllers.surface import StampedTwist
+from pan_tilt_sim.controllers.framework.surface import StampedTwist
 from pan_tilt_sim.model.world_file import world_from_parameter
 from pan_tilt_sim.sim.bullet import pybullet
 from pan_tilt_sim.sim.engine import make_simulation

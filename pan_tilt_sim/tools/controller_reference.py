@@ -18,11 +18,11 @@ import sys
 from collections.abc import Sequence
 
 from pan_tilt_sim.controllers import JointHandle
-from pan_tilt_sim.controllers.base import Controller
-from pan_tilt_sim.controllers.hardware_interfaces import example_hardware
-from pan_tilt_sim.controllers.parameter_spec import Param
-from pan_tilt_sim.controllers.registry import CONTROLLER_CLASSES
-from pan_tilt_sim.controllers.surface import (
+from pan_tilt_sim.controllers.framework.base import Controller
+from pan_tilt_sim.controllers.framework.hardware_interfaces import example_hardware
+from pan_tilt_sim.controllers.framework.parameter_spec import Param
+from pan_tilt_sim.controllers.framework.registry import CONTROLLER_CLASSES
+from pan_tilt_sim.controllers.framework.surface import (
     ActionServer,
     CommandTopic,
     Endpoint,

@@ -37,7 +37,7 @@ import time
 from collections.abc import Iterator, Mapping, Sequence
 
 from pan_tilt_sim.controllers import CommandController, Controller
-from pan_tilt_sim.controllers.pid import PidGains
+from pan_tilt_sim.controllers.toolbox.pid import PidGains
 from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.model.controller_config import (
     ControllersConfig,

@@ -54,10 +54,12 @@ from collections.abc import Sequence
 from typing import Any
 
 from pan_tilt_sim.controllers import CommandController, CommandResult
-from pan_tilt_sim.controllers.forward_command_controller import ForwardCommandController
-from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
-from pan_tilt_sim.controllers.joint_trajectory_controller import JointTrajectoryController
-from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
+from pan_tilt_sim.controllers.commands.forward_command_controller import ForwardCommandController
+from pan_tilt_sim.controllers.commands.joint_position_controller import JointPositionController
+from pan_tilt_sim.controllers.trajectory.joint_trajectory_controller import (
+    JointTrajectoryController,
+)
+from pan_tilt_sim.controllers.trajectory.trajectory import JointTrajectory, TrajectoryPoint
 from pan_tilt_sim.errors import ConfigurationError, ControllerSwitchError
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.controller_config import (

@@ -48,7 +48,7 @@ import random
 import sys
 from collections.abc import Callable, Mapping, Sequence
 
-from pan_tilt_sim.controllers.pid import PidGains
+from pan_tilt_sim.controllers.toolbox.pid import PidGains
 from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.model.variation import Payload, PhysicalVariation
 from pan_tilt_sim.tools import tune

@@ -51,7 +51,7 @@ import tempfile
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 
-from pan_tilt_sim.controllers.pid import PidGains
+from pan_tilt_sim.controllers.toolbox.pid import PidGains
 from pan_tilt_sim.errors import ConfigurationError, ControllerConfigError
 from pan_tilt_sim.model.controller_config import (
     load_controllers_config,

@@ -80,7 +80,7 @@ from world_truth import (
     quaternion_matrix,
 )
 
-from pan_tilt_sim.controllers.surface import StampedTwist
+from pan_tilt_sim.controllers.framework.surface import StampedTwist
 from pan_tilt_sim.model.world_file import read_world_file
 from pan_tilt_sim.sim.engine import Simulation, make_simulation
 from pan_tilt_sim.sim.entities import Entities, spawn_world_objects

@@ -20,9 +20,9 @@ from mobile_fixtures import (
 )
 
 from pan_tilt_sim.controllers import JointHandle
-from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult
+from pan_tilt_sim.controllers.framework.base import ActuatorKind, CommandResult
+from pan_tilt_sim.controllers.framework.surface import CommandTopic, StampedTwist, StateTopic
 from pan_tilt_sim.controllers.gazebo_diff_drive import GazeboDiffDrive
-from pan_tilt_sim.controllers.surface import CommandTopic, StampedTwist, StateTopic
 from pan_tilt_sim.model.robot import JointKind, JointSpec
 from pan_tilt_sim.model.urdf import parse_urdf
 

@@ -5,8 +5,8 @@ import pathlib
 import pytest
 from mobile_fixtures import WHEEL_RADIUS, WHEEL_SEPARATION, rover_urdf
 
-from pan_tilt_sim.controllers.base import CommandKind
-from pan_tilt_sim.controllers.diff_drive_controller import DiffDriveController
+from pan_tilt_sim.controllers.drives.diff_drive_controller import DiffDriveController
+from pan_tilt_sim.controllers.framework.base import CommandKind
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.model import ros1_diff_drive
 from pan_tilt_sim.model.urdf import parse_urdf

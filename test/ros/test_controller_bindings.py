@@ -7,8 +7,8 @@ from node_harness import sim_node
 from rcl_interfaces.msg import Log
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile
 
-from pan_tilt_sim.controllers.registry import CONTROLLER_CLASSES
-from pan_tilt_sim.controllers.surface import CommandTopic, StateTopic
+from pan_tilt_sim.controllers.framework.registry import CONTROLLER_CLASSES
+from pan_tilt_sim.controllers.framework.surface import CommandTopic, StateTopic
 from pan_tilt_sim.ros.controller_bindings import (
     STATE_SINKS,
     DofStateSink,

@@ -7,7 +7,7 @@ import pytest
 from node_harness import sim_node
 from rclpy.parameter import Parameter
 
-from pan_tilt_sim.controllers.pid import GainsError, PidGains
+from pan_tilt_sim.controllers.toolbox.pid import GainsError, PidGains
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.ros.gain_parameters import FIELDS, apply_fields, field_values
 

@@ -10,7 +10,7 @@ from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage
 from trajectory_msgs.msg import JointTrajectoryPoint
 
 from pan_tilt_sim.controllers import CommandKind
-from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
+from pan_tilt_sim.controllers.trajectory.trajectory import JointTrajectory, TrajectoryPoint
 from pan_tilt_sim.ros.ros_interfaces import (
     COMMAND_MESSAGES,
     GROUP_VALUES,

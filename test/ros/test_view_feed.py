@@ -19,7 +19,7 @@ from sensor_msgs.msg import Image, LaserScan, PointCloud2
 from std_msgs.msg import Float64, Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
-from pan_tilt_sim.controllers.registry import create_controller
+from pan_tilt_sim.controllers.framework.registry import create_controller
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model.description import load_description
 from pan_tilt_sim.model.robot import JointKind, JointSpec

@@ -27,8 +27,8 @@ from gripper_fixtures import (
 )
 from mobile_fixtures import CONTROLLER, WHEEL_RADIUS, write_rover
 
-from pan_tilt_sim.controllers.gripper_action_controller import GripperRequest
-from pan_tilt_sim.controllers.surface import StampedTwist
+from pan_tilt_sim.controllers.framework.surface import StampedTwist
+from pan_tilt_sim.controllers.grippers.gripper_action_controller import GripperRequest
 from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.sim.bullet import pybullet
 from pan_tilt_sim.sim.engine import make_simulation

@@ -17,9 +17,9 @@ from robot_fixtures import (
     write_text,
 )
 
-from pan_tilt_sim.controllers.base import ActuatorKind, Drive
-from pan_tilt_sim.controllers.joint_state_controller import JointStateController
-from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
+from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateController
+from pan_tilt_sim.controllers.framework.base import ActuatorKind, Drive
+from pan_tilt_sim.controllers.trajectory.trajectory import JointTrajectory, TrajectoryPoint
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.sim.engine import make_simulation
 

@@ -18,11 +18,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from robot_fixtures import JointDef, write_star_robot, write_text
 
-from pan_tilt_sim.controllers import step_law
-from pan_tilt_sim.controllers.base import JointHandle
-from pan_tilt_sim.controllers.joint_effort_controller import JointEffortController
-from pan_tilt_sim.controllers.joint_position_controller import JointPositionController
-from pan_tilt_sim.controllers.joint_velocity_controller import JointVelocityController
+from pan_tilt_sim.controllers.commands.joint_effort_controller import JointEffortController
+from pan_tilt_sim.controllers.commands.joint_position_controller import JointPositionController
+from pan_tilt_sim.controllers.commands.joint_velocity_controller import JointVelocityController
+from pan_tilt_sim.controllers.framework.base import JointHandle
+from pan_tilt_sim.controllers.toolbox import step_law
 from pan_tilt_sim.model.description import load_description
 from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
 from pan_tilt_sim.sim import compiled_step

@@ -14,7 +14,7 @@ from types import SimpleNamespace
 
 import pytest
 
-from pan_tilt_sim.controllers import step_law
+from pan_tilt_sim.controllers.toolbox import step_law
 from pan_tilt_sim.model.description import load_description
 from pan_tilt_sim.sim import _compiled_step, compiled_step
 from pan_tilt_sim.sim.physics import Physics, pybullet

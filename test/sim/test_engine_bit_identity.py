@@ -18,7 +18,7 @@ import hashlib
 import pytest
 from robot_fixtures import JointDef, write_star_robot, write_text
 
-from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
+from pan_tilt_sim.controllers.trajectory.trajectory import JointTrajectory, TrajectoryPoint
 from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
 from pan_tilt_sim.sim import compiled_step
 from pan_tilt_sim.sim.engine import make_simulation

@@ -138,7 +138,7 @@ def test_the_robot_pushes_an_object():
         simulation.advance(500)
         before = entities.state('box').pose.translation
         controller = simulation.controller('arm_controller')
-        from pan_tilt_sim.controllers.trajectory import JointTrajectory, TrajectoryPoint
+        from pan_tilt_sim.controllers.trajectory.trajectory import JointTrajectory, TrajectoryPoint
         controller.set_command(JointTrajectory(
             ('shoulder_joint', 'extend_joint', 'wrist_joint'),
             (TrajectoryPoint(3.0, (1.5, 0.1, 0.0)),)))

@@ -14,7 +14,7 @@ import pytest
 from mobile_fixtures import CONTROLLER, REST_HEIGHT, drive_parameters, write_rover
 from robot_fixtures import JointDef, Log, ros2_control_yaml, write_star_robot, write_text
 
-from pan_tilt_sim.controllers.surface import StampedTwist
+from pan_tilt_sim.controllers.framework.surface import StampedTwist
 from pan_tilt_sim.model.base_pose import ORIGIN, BasePose
 from pan_tilt_sim.sim.bullet import pybullet
 from pan_tilt_sim.sim.engine import make_simulation

@@ -23,8 +23,8 @@ from gripper_fixtures import (
     write_gripper_arm,
 )
 
-from pan_tilt_sim.controllers.gripper_action_controller import GripperRequest
-from pan_tilt_sim.controllers.trajectory_goal import GoalStatus
+from pan_tilt_sim.controllers.grippers.gripper_action_controller import GripperRequest
+from pan_tilt_sim.controllers.trajectory.trajectory_goal import GoalStatus
 from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.sim.bullet import pybullet

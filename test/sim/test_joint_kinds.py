@@ -5,7 +5,7 @@ import math
 import pytest
 from robot_fixtures import LINK_MASS, JointDef, star_robot_urdf, write_text
 
-from pan_tilt_sim.controllers.joint_state_controller import JointStateController
+from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateController
 from pan_tilt_sim.errors import ControllerConfigError, DescriptionError
 from pan_tilt_sim.sim.engine import make_simulation
 

@@ -21,7 +21,7 @@ import numpy
 import pytest
 import yaml
 
-from pan_tilt_sim.controllers.surface import StampedTwist
+from pan_tilt_sim.controllers.framework.surface import StampedTwist
 from pan_tilt_sim.model.world_file import read_world_file
 from pan_tilt_sim.sim.engine import LEANING_TILT, TIPPED_TILT, make_simulation
 from pan_tilt_sim.sim.entities import Entities, spawn_world_objects

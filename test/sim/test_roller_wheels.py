@@ -22,7 +22,7 @@ from roller_fixtures import (
     write_omni,
 )
 
-from pan_tilt_sim.controllers.surface import StampedTwist
+from pan_tilt_sim.controllers.framework.surface import StampedTwist
 from pan_tilt_sim.sim.bullet import pybullet
 from pan_tilt_sim.sim.engine import make_simulation
 

@@ -2,8 +2,10 @@
 
 import dataclasses
 
-from pan_tilt_sim.controllers.joint_trajectory_controller import JointTrajectoryController
-from pan_tilt_sim.controllers.registry import CONTROLLER_CLASSES
+from pan_tilt_sim.controllers.framework.registry import CONTROLLER_CLASSES
+from pan_tilt_sim.controllers.trajectory.joint_trajectory_controller import (
+    JointTrajectoryController,
+)
 from pan_tilt_sim.tools import controller_reference
 
 

@@ -5,7 +5,7 @@ import math
 
 import pytest
 
-from pan_tilt_sim.controllers.pid import PidGains
+from pan_tilt_sim.controllers.toolbox.pid import PidGains
 from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.model.variation import PhysicalVariation
 from pan_tilt_sim.sim.engine import make_simulation

@@ -84,7 +84,7 @@ def test_a_grid_is_every_combination():
 
 
 def test_percentages_become_factors_and_gains():
-    from pan_tilt_sim.controllers.pid import PidGains
+    from pan_tilt_sim.controllers.toolbox.pid import PidGains
 
     variation = sweep.variation_of({'mass': -20.0, 'friction': -100.0, 'payload': 1.5},
                                    'tilt_link', (0.0, 0.0, 0.1))

@@ -13,7 +13,7 @@ import types
 
 import pytest
 
-from pan_tilt_sim.controllers.pid import PidGains
+from pan_tilt_sim.controllers.toolbox.pid import PidGains
 from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.model.controller_config import load_controllers_config
 from pan_tilt_sim.model.robot import JointKind, JointSpec

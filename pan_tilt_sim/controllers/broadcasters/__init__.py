@@ -1,0 +1,1 @@
+"""Broadcasters: joint states and the semantic sensors (IMU, force/torque, range, pose)."""

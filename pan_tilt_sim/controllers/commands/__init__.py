@@ -1,0 +1,1 @@
+"""Command controllers: forward/group commands, single joints, GPIO and the PID controller."""

@@ -1,0 +1,1 @@
+"""Mobile-base drive controllers: diff drive, mecanum, omni wheel and tricycle."""

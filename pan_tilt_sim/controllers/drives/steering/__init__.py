@@ -1,0 +1,1 @@
+"""Steering controllers (ackermann, bicycle, tricycle steering) and their kinematics."""

@@ -1,0 +1,1 @@
+"""The controller framework: base classes, parameter specs, ROS surfaces, registry, manager."""

@@ -1,0 +1,1 @@
+"""Gripper action controllers: position, parallel and effort grippers."""

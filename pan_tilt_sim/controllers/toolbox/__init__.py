@@ -1,0 +1,1 @@
+"""Shared by controller families and plugins: PID, gains, limits, rate limiter, odometry."""

@@ -1,0 +1,63 @@
+"""Per-step controller updates written as data, for a compiled stepping loop.
+
+A controller's :meth:`~pan_tilt_sim.controllers.framework.base.Controller.update` is
+the reference: Python, run every physics step.  Where the per-step update of
+every active controller is one of the laws below, the stepping loop may run
+many steps in compiled code instead (:mod:`pan_tilt_sim.sim.compiled_step`)
+and must get the same results to the last bit, operation for operation.  A
+controller offers its law with ``step_law()`` -- its joint's handle and a
+row of floats laid out as below -- and takes the row back, with the state
+the compiled steps left in it, with ``absorb_step_law(row)``.
+
+The laws (``KIND``):
+
+* ``POSITION_PID`` (``JointPositionController`` with gains, alone or as a
+  group's member): the setpoint ramps toward the command at most
+  ``max_velocity * dt`` per step; a :class:`~.pid.Pid` on the position
+  error, with the measured velocity as the rate, gives the effort, clamped
+  to the effort limit;
+* ``VELOCITY_PID`` (``JointVelocityController`` with gains): a Pid on the
+  velocity error, the rate being the finite difference of the measured
+  velocity (``last_measurement`` NaN before the first step), the effort
+  clamped to the effort limit;
+* ``EFFORT`` (``JointEffortController``): the command is the effort.
+
+A row has every field; a law reads the ones it needs (the gains are a
+Pid's, the antiwindup flag as 0.0 / 1.0).
+
+The compiled loop has its own copy of this layout; :data:`FIELDS` and
+:data:`KINDS` name it for :mod:`pan_tilt_sim.sim.compiled_step`, which
+compares the two before it runs a step in C.  A change here is a change to
+``_compiled_step.c`` too.
+"""
+
+from __future__ import annotations
+
+# The fields' names in row order: FIELDS[index] names the constant equal to index.
+FIELDS = ('KIND', 'P_GAIN', 'I_GAIN', 'D_GAIN', 'I_CLAMP_MIN', 'I_CLAMP_MAX', 'ANTIWINDUP',
+          'MAX_VELOCITY', 'EFFORT_LIMIT', 'SETPOINT', 'COMMAND', 'INTEGRAL', 'OUTPUT',
+          'LAST_MEASUREMENT')
+ROW_SIZE = len(FIELDS)
+(KIND, P_GAIN, I_GAIN, D_GAIN, I_CLAMP_MIN, I_CLAMP_MAX, ANTIWINDUP, MAX_VELOCITY, EFFORT_LIMIT,
+ SETPOINT, COMMAND, INTEGRAL, OUTPUT, LAST_MEASUREMENT) = range(ROW_SIZE)
+
+POSITION_PID, VELOCITY_PID, EFFORT = 0.0, 1.0, 2.0
+# Each law kind's name and its code in a row's KIND field.
+KINDS = {'POSITION_PID': POSITION_PID, 'VELOCITY_PID': VELOCITY_PID, 'EFFORT': EFFORT}
+_UNUSED = 0.0
+
+
+def pid_row(kind: float, pid_values: list[float], max_velocity: float, effort_limit: float,
+            setpoint: float, command: float) -> list[float]:
+    """Return a PID law's row from :meth:`~.pid.Pid.law_values` and the controller's state."""
+    p, i, d, i_min, i_max, antiwindup, integral, output, last = pid_values
+    return [kind, p, i, d, i_min, i_max, antiwindup, max_velocity, effort_limit, setpoint,
+            command, integral, output, last]
+
+
+def effort_row(command: float) -> list[float]:
+    """Return the effort law's row."""
+    row = [_UNUSED] * ROW_SIZE
+    row[KIND] = EFFORT
+    row[COMMAND] = command
+    return row

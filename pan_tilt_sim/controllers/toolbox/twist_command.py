@@ -1,0 +1,74 @@
+"""A drive's body-twist command: taken from its topic, refused when not finite or stale.
+
+Drive controllers (mecanum, omni wheel) and the Gazebo diff-drive plugins take
+a ``geometry_msgs`` twist on a command topic.  :class:`TwistCommand` keeps the
+last accepted one, planar and stamped, and says why the last refused one was
+refused (the command topic's problem callback).  :func:`twist_references`
+makes the ``<name>/linear/x/velocity`` ... reference interfaces a chainable
+drive exports.  Pure Python.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from pan_tilt_sim.controllers.framework.base import CommandResult, Reference
+from pan_tilt_sim.controllers.framework.surface import StampedTwist
+
+# The reference interfaces of a chainable drive, in upstream's order.
+TWIST_AXES = ('linear/x', 'linear/y', 'angular/z')
+
+
+def twist_references(controller: str) -> dict[str, Reference]:
+    """Return ``<controller>/linear/x/velocity``, ``.../linear/y/...``, ``.../angular/z/...``."""
+    names = [f'{controller}/{axis}/velocity' for axis in TWIST_AXES]
+    return {name: Reference(name) for name in names}
+
+
+class TwistCommand:
+    """The last accepted twist of one command topic, and why the last refused one was refused.
+
+    ``topic``: how refusals name the topic (``cmd_vel``, ``reference``);
+    ``sideways``: ``linear.y`` counts (holonomic bases), else it is dropped;
+    ``timeout_field``: the parameter named when a stale twist is refused;
+    ``stale_at_timeout``: a twist exactly ``timeout`` old is stale too.
+    """
+
+    def __init__(self, topic: str, *, sideways: bool = False, timeout_field: str = '',
+                 stale_at_timeout: bool = False) -> None:
+        self.topic = topic
+        self.sideways = sideways
+        self.timeout_field = timeout_field
+        self.stale_at_timeout = stale_at_timeout
+        # (stamp s, (x, y, 0) m/s, (0, 0, z) rad/s); None: none taken since the last reset.
+        self.latest: StampedTwist | None = None
+        self._problem = ''
+
+    def take(self, value: StampedTwist, now: float = 0.0, timeout: float = 0.0) -> CommandResult:
+        """Keep ``value``, or refuse it and say why.
+
+        Refused: a counted part not finite, or, with ``timeout`` > 0 (s of sim
+        time), a stamp that long before ``now``.  An unstamped twist gets ``now``.
+        """
+        linear_x, linear_y, angular = value.linear[0], value.linear[1], value.angular[2]
+        parts = (linear_x, linear_y, angular) if self.sideways else (linear_x, angular)
+        if not all(math.isfinite(part) for part in parts):
+            sideways = f'linear.y {linear_y!r}, ' if self.sideways else ''
+            self._problem = (f'ignored {self.topic} (linear.x {linear_x!r}, {sideways}'
+                             f'angular.z {angular!r}): not finite numbers')
+            return CommandResult.REJECTED
+        stamp = value.stamp if value.stamp > 0.0 else now
+        age = now - stamp
+        if timeout > 0.0 and (age >= timeout if self.stale_at_timeout else age > timeout):
+            self._problem = (f'ignored {self.topic} stamped {stamp:.4f} s: {age:.4f} s old at '
+                             f'sim time {now:.4f} s, more than {self.timeout_field} '
+                             f'({timeout:g} s)')
+            return CommandResult.REJECTED
+        self.latest = StampedTwist(stamp, (linear_x, linear_y if self.sideways else 0.0, 0.0),
+                                   (0.0, 0.0, angular))
+        return CommandResult.ACCEPTED
+
+    def problem(self, value: Any, result: CommandResult) -> str:
+        """Describe the last refused twist (the command topic's problem callback)."""
+        return self._problem

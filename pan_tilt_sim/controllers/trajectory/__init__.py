@@ -1,0 +1,1 @@
+"""The joint trajectory controller, its trajectories and its FollowJointTrajectory goals."""
