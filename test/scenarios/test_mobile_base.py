@@ -1,6 +1,6 @@
 """A DiffBot-style robot on sim_node: cmd_vel in, odom and TF out, the base free on the ground.
 
-The rover of test/mobile_fixtures.py runs in-process, paused, at
+The rover of test/support/mobile_fixtures.py runs in-process, paused, at
 real_time_factor 0; each test drives it closed loop from the probe: it
 reads ``/base_controller/odom``, decides the next ``cmd_vel``, and steps
 the physics one odometry period (``node.step``) -- so the loop's delay is

@@ -1,6 +1,6 @@
 """A mecanum base on sim_node: ~/reference in; ~/odometry, ~/tf_odometry, ~/controller_state out.
 
-The mecanum base of test/roller_fixtures.py runs in-process, paused, at
+The mecanum base of test/support/roller_fixtures.py runs in-process, paused, at
 real_time_factor 0; each test drives it closed loop from the probe: it
 reads ``/base_controller/odometry``, decides the next reference and steps
 the physics one controller update (10 steps at 100 Hz) at a time.  The

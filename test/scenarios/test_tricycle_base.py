@@ -1,6 +1,6 @@
 """A tricycle on sim_node: tricycle_controller drives its steered front wheel; odometry vs truth.
 
-The tricycle of test/steering_fixtures.py (one front wheel that steers and
+The tricycle of test/support/steering_fixtures.py (one front wheel that steers and
 drives, two rear wheels rolling freely) runs in-process, paused, at
 real_time_factor 0; each test drives it closed loop from the probe one
 controller update (10 ms) at a time.  The true pose comes from

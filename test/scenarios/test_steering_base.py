@@ -1,6 +1,6 @@
 """Steered robots on sim_node: reference in, odometry out, the front wheels steering on the ground.
 
-The robots of test/steering_fixtures.py run in-process, paused, at
+The robots of test/support/steering_fixtures.py run in-process, paused, at
 real_time_factor 0; each test drives one closed loop from the probe: it
 reads ``/steering_controller/odometry``, decides the next reference, and
 steps the physics one period (``node.step``).  The true pose comes from

@@ -1,6 +1,6 @@
 """An omni base on sim_node: ~/cmd_vel in; ~/odom and /tf out, the base free on the ground.
 
-The three-wheel omni base of test/roller_fixtures.py runs in-process,
+The three-wheel omni base of test/support/roller_fixtures.py runs in-process,
 paused, at real_time_factor 0; each test drives it closed loop from the
 probe: it reads ``/base_controller/odom``, decides the next command and
 steps the physics one controller update (10 steps at 100 Hz) at a time.
