@@ -1,5 +1,9 @@
 """simulation_interfaces for sim_node: the standard way to control a simulator from tests and tools.
 
+Every answer fills ``result`` and says why in ``error_message``; a refused request changes
+nothing.  The services act between batches of physics steps; a spawn's object is read and
+tried in a thread of its own, and loaded in the executor's turn.
+
 Design notes: docs/design/ros.md#simulation_servicespy.
 """
 

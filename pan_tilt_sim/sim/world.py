@@ -1,5 +1,9 @@
 """Scenery for the camera: a ground plane and a few coloured targets, a ground alone, or nothing.
 
+Built from PyBullet primitives in the simulation's own client.  The ground is the plane
+z = 0; it becomes a collision body only when an object or a free robot needs it, and the
+links of a fixed robot that start touching it never collide with it.
+
 Design notes: docs/design/sim.md#worldpy.
 """
 
