@@ -26,10 +26,16 @@ _prefixes = [p for p in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep
 if sys.prefix not in _prefixes:
     os.environ['AMENT_PREFIX_PATH'] = os.pathsep.join([sys.prefix, *_prefixes])
 
+REPO_ROOT = pathlib.Path(__file__).resolve().parents[1]
+# The helpers every test folder shares (harnesses, clients, URDF/YAML builders) live in
+# test/support/ and are imported by their bare names (`from node_harness import sim_node`)
+# from any folder; a helper that serves one folder sits beside its tests instead.
+SUPPORT = REPO_ROOT / 'test' / 'support'
+if str(SUPPORT) not in sys.path:
+    sys.path.insert(0, str(SUPPORT))
+
 # PAN_TILT_SIM_RECORD_FAILED=<folder> keeps the bags of failed tests (see record_failed.py).
 pytest_plugins = ['record_failed']
-
-REPO_ROOT = pathlib.Path(__file__).resolve().parents[1]
 ORIGINAL_EXAMPLES = REPO_ROOT / 'test' / 'data' / 'original_examples'
 
 

@@ -41,8 +41,14 @@ from pan_tilt_sim.tools.controller_reference import example_controller
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 THIS_FILE = pathlib.Path(__file__).resolve()
-DOCS = (REPO / 'README.md', *sorted((REPO / 'docs').glob('*.md')))
+DOCS = (REPO / 'README.md', *sorted((REPO / 'docs').rglob('*.md')))
 PACKAGE = 'pan_tilt_sim'
+
+
+def doc_id(path: pathlib.Path) -> str:
+    """A doc's test id: its name, or its path under docs/ (docs/design/ reuses names)."""
+    return str(path.relative_to(REPO / 'docs')) if REPO / 'docs' in path.parents else path.name
+
 BIN = pathlib.Path(sys.executable).parent
 RUN_BUDGET_S = 90.0
 STOP_BUDGET_S = 10.0
@@ -138,7 +144,7 @@ def broken_links(path: pathlib.Path) -> list[str]:
     return broken
 
 
-@pytest.mark.parametrize('doc', DOCS, ids=lambda path: path.name)
+@pytest.mark.parametrize('doc', DOCS, ids=doc_id)
 def test_every_relative_link_names_a_file_and_heading_that_exist(doc):
     assert broken_links(doc) == []
 
@@ -645,7 +651,7 @@ def check_ros2(command: Command, setup: Setup, words: tuple[str, ...],
     pytest.fail(f'{command.where}: no check for ros2 {verb}')
 
 
-@pytest.mark.parametrize('doc', DOCS, ids=lambda path: path.name)
+@pytest.mark.parametrize('doc', DOCS, ids=doc_id)
 def test_every_command_in_the_docs_runs_or_matches_the_code(doc, tmp_path):
     setup = Setup()  # each file starts from the default sim_node
     for command in commands(doc):

@@ -92,7 +92,7 @@ SPIN_SLICE_S = 0.05
 BUDGET_S = 30.0
 # Fast DDS may call a service ready before the server has matched the
 # client's response reader and then drops the response; a request still
-# unanswered after this long is sent again (test/node_harness.py does the same).
+# unanswered after this long is sent again (test/support/node_harness.py does the same).
 RESEND_AFTER_S = 2.0
 
 

@@ -1,4 +1,4 @@
-"""test/launch_stand_in.py carries out a launch file as ROS 2's launch would.
+"""test/support/launch_stand_in.py carries out a launch file as ROS 2's launch would.
 
 test/data/gz_shaped/arm_sim_control.launch.py is written in the shape of
 Universal Robots' gz simulation launch (an OpaqueFunction building the nodes,

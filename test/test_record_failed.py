@@ -15,7 +15,7 @@ import sys
 import yaml
 from record_failed import RECORD_FAILED, bag_folder_of
 
-TEST_DIR = pathlib.Path(__file__).resolve().parent
+SUPPORT = pathlib.Path(__file__).resolve().parent / 'support'
 INNER_TESTS = '''
 from node_harness import sim_node
 
@@ -39,7 +39,7 @@ def test_only_the_failed_tests_bag_is_kept(tmp_path):
     (inner / 'test_inner.py').write_text(INNER_TESTS)
     bags = tmp_path / 'bags'
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(
-        filter(None, [str(TEST_DIR), os.environ.get('PYTHONPATH')])))
+        filter(None, [str(SUPPORT), os.environ.get('PYTHONPATH')])))
     env[RECORD_FAILED] = str(bags)
     result = subprocess.run(
         [sys.executable, '-m', 'pytest', '-q', '-p', 'no:cacheprovider', '-p', 'no:xdist',

@@ -2,29 +2,10 @@
 
 Not a ros2_control controller: the simulation creates one per system the
 URDF declares (:mod:`pan_tilt_sim.model.drive_plugins`) and updates it every
-physics step, before the controllers; it is always active.  As the system:
+physics step, before the controllers; it is always active.
+It does what the system does (see the design notes).
 
-* **Command**: ``gz.msgs.Twist`` on ``topic`` -- here the
-  ``geometry_msgs/msg/Twist`` ros_gz_bridge would carry on the same name
-  (no bridge process needed); ``linear.x`` (m/s) and ``angular.z`` (rad/s)
-  count and the last one holds (the system has no timeout).  A twist with a
-  NaN or infinite value is refused (a throttled warning names it).
-* **Limits**: every step the linear and angular velocity go through the
-  system's speed limiter: jerk, acceleration, velocity, each bounded to
-  ``[min, max]`` (an absent ``min``/``max``: unbounded that way).
-* **Wheels**: every step each left wheel's velocity target is ``(v - w *
-  wheel_separation / 2) / wheel_radius`` rad/s and each right one's ``(v +
-  ...)``, reached by the ideal velocity actuator within the joint's effort
-  limit.
-* **Odometry**: from the first left and first right wheels' positions
-  (:class:`~.odometry.Odometry`, its twist a rolling mean of 10 updates, as
-  gz-math's DiffDriveOdometry), updated and published every ``1 /
-  odom_publish_frequency`` s of sim time: ``gz.msgs.Odometry`` on
-  ``odom_topic`` (``nav_msgs/msg/Odometry``, ``frame_id`` ->
-  ``child_frame_id``, no covariance) and the same transform as
-  ``gz.msgs.Pose_V`` on ``tf_topic`` (``tf2_msgs/msg/TFMessage``).
-
-A reset drops the command and puts the odometry back at the origin.  Pure Python.
+Design notes: docs/design/plugins.md#gz_diff_drivepy.
 """
 
 from __future__ import annotations

@@ -10,40 +10,9 @@ alone) asks no component.
 
 The simulator drives every joint with its own physics, whatever the block's
 ``<plugin>`` says.  What it refuses is decided by that plugin, as the
-hardware would decide:
+hardware would decide (see the design notes).
 
-* ``mock_components/GenericSystem`` with ``<param name="calculate_dynamics">``
-  true: each joint that the switch starts an interface of must start
-  exactly one of ``position``, ``velocity`` and ``acceleration`` ("Got
-  multiple (2) starting interfaces for joint 'joint1' - this is not
-  supported!"; a joint started on ``effort`` alone "has to have 'position',
-  'velocity', or 'acceleration' interface!").  Without
-  ``calculate_dynamics`` it accepts any combination.
-* ``ros2_control_demo_example_3/RRBotSystemMultiInterfaceHardware`` (the
-  RRBot with multiple interfaces of ros2_control_demos' example 3): a
-  switch touching its interfaces must start one of ``position``,
-  ``velocity`` and ``acceleration`` on every one of its joints at once, the
-  same on all, and leave none of them in use by a controller the switch
-  does not stop.  So a controller on one of its two joints
-  (``forward_illegal1_controller``), one command mode on one joint and
-  another on the other, or deactivating its controller without starting
-  another in the same switch, are refused -- while that controller and
-  its twin on the other joint, activated in one switch, are accepted, as
-  that hardware accepts them.
-* Any other plugin, and joints outside every block (the simulator's own
-  system), accept any combination, including ``position`` and ``velocity``
-  active on one joint at once.  gz_ros2_control's ``GazeboSimSystem`` does
-  not override ``prepare_command_mode_switch`` (ros2_control's default
-  accepts everything) and its ``perform_command_mode_switch`` sets one flag
-  per started interface on the joint; the simulator stands in for it, so a
-  controllers file that runs in Gazebo runs here.  (How such a joint
-  moves is the controller's business: a trajectory controller follows its
-  desired position.)  A real robot's driver may refuse more, but its rules
-  are not known here: ros2_control's default stands for it.
-
-Mixing two interfaces on a joint is refused only by the hardware above;
-two active controllers on one joint are refused whatever the hardware (see
-:mod:`pan_tilt_sim.controllers.framework.manager`).
+Design notes: docs/design/model.md#command_modespy.
 """
 
 from __future__ import annotations

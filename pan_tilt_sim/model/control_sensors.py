@@ -15,16 +15,7 @@ components give them:
 * ``range`` -- the distance along the sensor frame's +x to the first thing
   hit.
 
-Other interface names are not simulated: they keep their ``initial_value``
-(NaN where none is given), as mock hardware's sensor interfaces do, and a
-start-up warning names them.
-
-Where the sensor is (:func:`placement`): a Gazebo ``<sensor>`` of the same
-name (gz_ros2_control pairs them by name: its link, joint, pose, noise and
-rate), else the ``<sensor>``'s ``<param name="frame_id">`` naming a link, else
-a link of the sensor's own name.  A sensor none of these places waits for a
-broadcaster whose ``frame_id`` names a link (Universal Robots' ``tcp_fts_sensor``
-has only the broadcaster's ``frame_id: tool0``).
+Design notes: docs/design/model.md#control_sensorspy.
 """
 
 from __future__ import annotations

@@ -11,51 +11,7 @@ ROS 1 style (``rosparam load``), as in both examples::
         joint: pan_joint
         pid: {p: 100.0, i: 0.01, d: 10.0}
 
-A single top-level key whose value holds the controllers is the robot's
-namespace, as ``rosparam load`` inside ``ns=...`` would make it.  Beside the
-controllers, gazebo_ros_control's own PID gains for a joint's position or
-velocity interface, ``gazebo_ros_control: {pid_gains: {<joint>: {p, i, d}}}``,
-are kept as written (:attr:`ControllersConfig.pid_gains`).
-
-ros2_control style (a ROS 2 parameter file), recognised by its
-``ros__parameters`` keys::
-
-    controller_manager:
-      ros__parameters:
-        update_rate: 100
-        arm_controller:
-          type: joint_trajectory_controller/JointTrajectoryController
-    arm_controller:
-      ros__parameters:
-        joints: [shoulder_joint, elbow_joint]
-        gains: {shoulder_joint: {p: 100.0, i: 0.01, d: 10.0}}
-
-The controllers are the entries with a ``type`` under any node's
-``ros__parameters`` (normally the controller_manager's); each takes the
-``ros__parameters`` of the node of its name.  Node keys may carry a
-namespace (``/robot/arm_controller``, or nested mappings), which is
-ignored -- the last name token is the node -- and wildcard keys such as
-``/**`` give parameters to every node they match, under the node's own
-(the node's own win).  Dotted names (``gains.shoulder_joint.p: 100.0``)
-mean the same as nested mappings, as in ROS 2.  As in ros2_control, every
-controller's ``update_rate`` defaults to the controller_manager's, which
-defaults to 100 Hz.  The file gives no namespace: the robot's namespace
-comes from the node, the ``robot_namespace`` parameter or the URDF plugin.
-
-A ROS 1 file may also hold one controller and nothing else (``type`` at the
-top level, as ``rosparam load head.yaml ns=head`` expects): the controller is
-named after the file (``head``).
-
-Launch substitutions are expanded before the YAML is read, as a launch
-file's ``ParameterFile(..., allow_substs=True)`` does: ``$(var name)`` (and
-ROS 1's ``$(arg name)``) from the ``controllers_args`` mappings, ``$(env
-NAME)``, ``$(optenv NAME)`` and ``$(find-pkg-share PKG)``; one left
-unexpanded is an error naming it.
-
-Which file: the ``controllers_file`` parameter, else the files the URDF's
-gz_ros2_control / gazebo_ros2_control plugin names in ``<parameters>``, else
--- for the shipped pan/tilt model only -- the shipped pan/tilt controllers
-(:func:`controllers_files_for`).
+Design notes: docs/design/model.md#controller_configpy.
 """
 
 from __future__ import annotations

@@ -3,74 +3,9 @@
 ``libgazebo_ros_diff_drive.so`` drives a differential base from a
 ``geometry_msgs/Twist`` and publishes its odometry and the odom -> base
 transform.  Both gazebo_plugins generations are read, each with its own
-element names and defaults (from the plugins' sources):
+element names and defaults (from the plugins' sources) (see the design notes).
 
-==========================  ========================  ===============================
-what                        ROS 2 (gazebo_ros)        ROS 1 (gazebo_plugins)
-==========================  ========================  ===============================
-wheels                      ``left_joint`` /          ``leftJoint`` / ``rightJoint``
-                            ``right_joint`` (one per  (one pair)
-                            pair, ``num_wheel_pairs``
-                            pairs, default 1)
-separation (m)              ``wheel_separation`` 0.34 ``wheelSeparation`` 0.34
-diameter (m)                ``wheel_diameter`` 0.15   ``wheelDiameter`` 0.15
-wheel torque (N m)          ``max_wheel_torque`` 5    ``wheelTorque`` 5
-wheel acceleration (m/s^2)  ``max_wheel_acceleration``  ``wheelAcceleration`` 0
-                            0 (0: none)
-update rate (Hz)            ``update_rate`` 100       ``updateRate`` 100
-command topic               ``cmd_vel`` (remappable)  ``commandTopic`` cmd_vel
-odometry topic              ``odom`` (remappable)     ``odometryTopic`` odom
-odometry frame              ``odometry_frame`` odom   ``odometryFrame`` odom
-base frame                  ``robot_base_frame``      ``robotBaseFrame``
-                            base_footprint            base_footprint
-odometry source             ``odometry_source`` 1     ``odometrySource`` world
-                            (0 encoder, 1 world)      (encoder / world)
-publish odometry            ``publish_odom`` false    ``publishTf`` true
-publish odom -> base TF     ``publish_odom_tf`` false ``publishOdomTF`` true
-covariance (x, y, yaw)      ``covariance_x``,         fixed: 1e-5, 1e-5, 1e-3
-                            ``covariance_y`` 1e-5,
-                            ``covariance_yaw`` 1e-3
-==========================  ========================  ===============================
-
-``libgazebo_ros_p3d.so`` publishes a link's true pose and twist as
-``nav_msgs/Odometry`` (ground truth): ROS 2 ``body_name`` (required),
-``frame_name`` (world), ``xyz_offsets``, ``rpy_offsets`` (0 0 0),
-``gaussian_noise`` (0), ``update_rate`` (0: every step), topic ``odom`` of
-its node; ROS 1 ``bodyName``, ``frameName``, ``xyzOffsets``, ``rpyOffsets``,
-``gaussianNoise``, ``updateRate``, ``topicName`` in ``robotNamespace``.
-
-``libgazebo_ros_joint_state_publisher.so`` publishes the named joints'
-``sensor_msgs/JointState``: ROS 2 ``joint_name`` (one element per joint,
-required), ``update_rate`` (100 Hz), topic ``joint_states`` of its node;
-ROS 1 ``jointName`` (comma-separated), ``updateRate`` (100 Hz) in
-``robotNamespace``.
-
-``libgazebo_ros_planar_move.so`` sets the base's planar velocity from a
-``geometry_msgs/Twist``: ROS 2 ``update_rate`` (20 Hz), ``publish_rate``
-(20 Hz), ``publish_odom`` / ``publish_odom_tf`` (true), ``odometry_frame``,
-``robot_base_frame``, ``covariance_x|y|yaw``; ROS 1 ``commandTopic``,
-``odometryTopic``, ``odometryFrame``, ``robotBaseFrame``, ``odometryRate``
-(20 Hz), ``publishOdometryTf`` (true), ``cmdTimeout`` (-1: none).
-
-gz-sim's DiffDrive, OdometryPublisher and JointStatePublisher systems are
-known by their file (``gz-sim-*-system``, ``ignition-gazebo-*-system``, with
-or without ``lib``/``.so``) or name (``gz::sim::systems::*``,
-``ignition::gazebo::systems::*``), their elements and defaults as in their
-sources (:func:`read_gz_plugins`); their topics are gz-transport names, as
-ros_gz_bridge would carry them under the same name.
-
-Topic names resolve as each generation resolves them: ROS 2 in a node named
-after the plugin in ``<ros><namespace>`` with its ``<remapping>``s; ROS 1
-in ``robotNamespace`` -- absent: the root (as spawn_model sets it), given
-empty: the robot's name, as gazebo_plugins' GazeboRos takes it (see
-:mod:`pan_tilt_sim.model.sensors`).  A wheel
-the robot does not have, a wheel that is a fixed or ``<mimic>`` joint or
-another wheel's joint too, a number that is not one, a separation,
-diameter, torque or rate that is not positive (or a rate whose period
-overflows), an odometry or base frame that is no valid frame id, or one
-frame for both, ends start-up (:class:`~pan_tilt_sim.errors.DescriptionError`
-naming the file, the plugin and the element) -- the checks a driving
-controller makes.
+Design notes: docs/design/plugins.md#drive_pluginspy.
 """
 
 from __future__ import annotations

@@ -8,29 +8,9 @@ module reads it with the robot's own parser (:mod:`pan_tilt_sim.model.urdf`)
 and makes PyBullet's copy the same way (:mod:`pan_tilt_sim.model.resources`),
 but an object may have no movable joint at all (a box).  Every failure is an
 :class:`EntityResourceError` whose :attr:`~EntityResourceError.problem` says
-which of the standard's result codes it is:
+which of the standard's result codes it is (see the design notes).
 
-* ``NOT_FOUND``: the URI names no file (or an unknown package);
-* ``UNSUPPORTED_FORMAT``: neither URDF nor SDF (a ``.usd`` file, another root element);
-* ``PARSE_ERROR``: not well-formed XML, or a URDF the parser refuses;
-* ``MISSING_ASSETS``: a mesh it names does not exist;
-* ``UNSUPPORTED_ASSETS``: a mesh PyBullet cannot be given (unknown format, garbage);
-* ``TOO_LARGE``: beyond the :class:`EntityLimits` (the standard has no code of its own for
-  it: the service answers ``RESULT_OPERATION_FAILED``).
-
-**Limits.**  What one object may be is bounded, so that reading, trying and
-loading it take well under a second and the world keeps stepping at a usable
-rate afterwards (docs/simulator-control.md gives the measurements):
-:data:`MAX_ENTITY_BYTES` of URDF text (a file's size is checked before it is
-read, xacro's output after it is made), :data:`MAX_ENTITY_LINKS` links and
-:data:`MAX_ENTITY_JOINTS` joints, counted right after the XML is parsed,
-before anything else looks at it.  The links and joints are PyBullet's own
-bound: it loads a body of more, but cannot report its state (every
-``getBasePositionAndOrientation``, ``getJointStates`` and ``getLinkState``
-of a body past 127 joints fails), and a body's cost per step grows faster
-than linearly with its joints.
-
-Nothing here touches a simulation, so a refused resource leaves it as it was.
+Design notes: docs/design/model.md#entity_resourcepy.
 """
 
 from __future__ import annotations
@@ -65,7 +45,7 @@ MAX_ENTITY_LINKS = MAX_ENTITY_JOINTS + 1  # a tree of that many joints
 
 @dataclasses.dataclass(frozen=True)
 class EntityLimits:
-    """The most one object to spawn may be (see the module docstring)."""
+    """The most one object to spawn may be (see the module's design notes)."""
 
     max_bytes: int = MAX_ENTITY_BYTES
     max_links: int = MAX_ENTITY_LINKS

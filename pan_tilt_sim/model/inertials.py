@@ -14,10 +14,7 @@ cannot be accelerated.  Its child link gets a negligible mass and inertia
 instead, so that an actuator can move it, and a warning says so (Gazebo
 classic drops such joints).
 
-A free (mobile) base needs the same: PyBullet welds a body whose root link
-has no mass, and mobile robots often hang everything on a massless
-``base_footprint``.  :func:`with_massive_root` gives it the same negligible
-mass and inertia.
+Design notes: docs/design/model.md#inertialspy.
 """
 
 from __future__ import annotations

@@ -13,21 +13,9 @@ a user cannot see (PyBullet 3.2.7, DIRECT mode):
   the process (SIGSEGV) in the visual and in the collision role.
 
 So every mesh is checked here first, and what PyBullet cannot be trusted
-with is converted into a binary STL in a cache folder:
+with is converted into a binary STL in a cache folder (see the design notes).
 
-- binary STL: size must be 84 + 50 x triangle count, vertices finite;
-  handed over as it is (with trailing bytes: converted);
-- ASCII STL: parsed and converted;
-- OBJ: faces must have 3+ corners naming existing vertices; handed over
-  as it is (PyBullet's own OBJ reader keeps its materials);
-- DAE (Collada 1.4/1.5): parsed by :func:`read_collada` and converted, in
-  both roles, so PyBullet's crash-prone Collada reader is never used.
-
-PyBullet reads the URDF ``scale`` attribute itself, for every format and both
-roles (``scale="0.001 0.001 0.001"`` on a 1 m box gives a 1 mm
-collision hull, ``"2 3 4"`` a 2 x 3 x 4 m one; ``test/dependencies/test_pybullet_meshes.py``
-pins it), so ``scale`` stays on the
-``<mesh>`` element and converted files keep the file's own units.
+Design notes: docs/design/model.md#resourcespy.
 """
 
 from __future__ import annotations
@@ -176,7 +164,7 @@ def localize_meshes(robot: ET.Element, base_dir: pathlib.Path,
 
     For each ``robot/link/{visual,collision}/geometry/mesh``: resolve
     ``filename`` with :func:`resolve_resource` (relative paths against
-    ``base_dir``), check the file (see the module docstring), convert it into
+    ``base_dir``), check the file (see the module's design notes), convert it into
     ``cache_dir`` when PyBullet cannot load it as it is, and rewrite
     ``filename`` to the absolute path of the loadable file.  ``scale`` is
     checked (three finite, non-zero numbers, as urdfdom requires) and left in

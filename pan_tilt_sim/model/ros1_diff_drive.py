@@ -4,28 +4,9 @@ A gazebo_ros_control YAML (ROS 1 layout) names the wheels ``left_wheel`` /
 ``right_wheel`` (a string or a list) where jazzy has ``left_wheel_names`` /
 ``right_wheel_names``; that is how its layout is told apart
 (:func:`is_ros1_layout`).  :func:`jazzy_params` maps the noetic
-controller's parameters onto jazzy's, with noetic's defaults:
+controller's parameters onto jazzy's, with noetic's defaults (see the design notes).
 
-* ``wheel_separation``, ``wheel_radius``: as given; absent, from the URDF
-  as noetic reads them (:func:`with_urdf_geometry`): the distance between
-  the first left and first right wheel joint's origins, and the radius of
-  the first left wheel link's collision cylinder or sphere;
-* ``wheel_radius_multiplier`` (1): the default of both
-  ``left_wheel_radius_multiplier`` and ``right_wheel_radius_multiplier``;
-* ``publish_cmd``: jazzy's ``publish_limited_velocity``;
-* ``linear/x`` and ``angular/z``: ``has_velocity_limits``,
-  ``has_acceleration_limits``, ``has_jerk_limits`` default to false; a
-  group turned on bounds to ``[min, max]`` with ``max`` default 0 and
-  ``min`` default ``-max``.  noetic clamps an acceleration to
-  ``[min_acceleration, max_acceleration]`` whichever way the robot moves,
-  so ``min_acceleration`` becomes jazzy's ``max_deceleration`` and
-  ``max_acceleration_reverse``;
-* frame ids are not prefixed (noetic has no ``tf_frame_prefix``).
-
-The command is an unstamped ``geometry_msgs/Twist`` on ``<controller>/cmd_vel``
-and the odometry ``<controller>/odom`` (the controller's own topics).
-``allow_multiple_cmd_vel_publishers`` and
-``publish_wheel_joint_controller_state`` are read and not simulated.
+Design notes: docs/design/model.md#ros1_diff_drivepy.
 """
 
 from __future__ import annotations

@@ -12,12 +12,7 @@ Two places hand sim_node such arguments as data rather than through rcl:
   arguments of the controller's own node: remaps of its topic names, ``-p``
   parameters, ``--params-file`` files.
 
-Names follow rcl: a remap rule ``[node:]from:=to`` applies to the node named
-``node`` (to every node without it); ``from`` and ``to`` are expanded in the
-node's namespace (``~`` is ``<namespace>/<node>``, a relative name is in the
-namespace, ``{node}`` and ``{ns}`` are substituted), and a topic whose
-expanded name equals the expanded ``from`` is renamed to the expanded ``to``.
-Pure Python: no rclpy.
+Design notes: docs/design/model.md#ros_argumentspy.
 """
 
 from __future__ import annotations

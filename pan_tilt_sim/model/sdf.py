@@ -3,45 +3,9 @@
 An SDF robot (``<sdf><model>``) becomes a URDF that says the same thing, which
 the one URDF parser (:mod:`pan_tilt_sim.model.urdf`) then reads, so the
 controllers, sensors, plugins, TF, the view and recording see an SDF robot as
-they see a URDF one.  What is read (SDFormat 1.4 to 1.11):
+they see a URDF one.  What is read (SDFormat 1.4 to 1.11) (see the design notes).
 
-* ``<model>``, nested ``<model>`` and ``<include>`` (their links and joints
-  named ``nested::link``, as gz-sim names them), ``<frame>``;
-* ``<link>`` with ``<pose relative_to>``, ``<inertial>`` (its pose, mass,
-  inertia; a link without one weighs 1 kg with a unit inertia, SDFormat's
-  default), ``<collision>`` and ``<visual>`` with box, cylinder, sphere,
-  capsule, ellipsoid (a mesh made here), plane (a 1 cm slab under it) and
-  mesh (``model://``, ``package://``, ``file://`` and relative URIs,
-  ``<scale>``), a visual's ``<material><diffuse>`` colour;
-* ``<joint>`` revolute (continuous when it has no finite limits),
-  continuous, prismatic, fixed and ball (PyBullet's spherical joint: three
-  free degrees of freedom), with ``<axis><xyz expressed_in>``
-  (``use_parent_model_frame`` in 1.5/1.6; the model frame in 1.4),
-  ``<limit>`` and ``<dynamics>``;
-* ``<surface><friction><ode><mu>/<mu2>`` and ``<contact><ode><kp>/<kd>``,
-  which become the link's ``<gazebo reference>`` tags (the smaller of its
-  collisions' values);
-* ``<sensor>`` of a link or joint, which becomes a ``<gazebo reference>``
-  sensor with its pose in the URDF link's frame, and the model's
-  ``<plugin>`` elements, which become ``<gazebo>`` plugins: from there on
-  the URDF path's rules apply (topics, frames, supported kinds);
-* ``<static>``, which becomes ``<gazebo><static>``.
-
-Frames: a URDF joint's child frame is its child link's frame, where an SDF
-joint may sit anywhere in the child link.  Each URDF link frame therefore
-has the SDF link's orientation and the origin of the joint that moves it
-(the root link keeps its SDF frame); the link's collisions, visuals,
-inertial and sensors are moved into it, so that everything is where the SDF
-puts it and each joint turns about its own axis line.  Where a joint sits
-at its child link's origin (the usual case) the two frames are one.
-
-Errors end start-up (:class:`~pan_tilt_sim.errors.DescriptionError`) with
-one line naming the file, the element and the problem: malformed XML, a
-root that is not ``<sdf>``, a version outside 1.4-1.11, no model or several,
-a joint naming a missing link or of a type not simulated, a pose that is not
-six numbers, a ``model://`` URI no model path has, a collision mesh that
-does not exist.  A visual mesh that does not exist is a warning and the
-visual is left out.  Material scripts are ignored.
+Design notes: docs/design/model.md#sdfpy.
 """
 
 from __future__ import annotations

@@ -16,10 +16,7 @@ What is read from ``<sdf><world>``:
   whose work the simulator does itself: accepted, with nothing to do.  Any other
   world plugin, and actors, populations and roads, get one warning each.
 
-A model that cannot be found (a ``model://`` URI in no model path, a Fuel
-model not in the cache) or not read is one warning and the world loads
-without it.  A malformed file, a root that is not ``<sdf>``, a version not
-supported or no ``<world>`` end start-up (:class:`SdfWorldError`).
+Design notes: docs/design/model.md#sdf_worldpy.
 """
 
 from __future__ import annotations

@@ -12,14 +12,7 @@ command interface, in joint order -- so with uniform interfaces an array is
 one value per name, and with mixed ones it is shorter (packed).  A
 hand-written publisher may send any joints by name with index-aligned arrays.
 
-:class:`CommandReader` turns such a message into one command per joint: an
-array as long as ``name`` is read index-aligned; a shorter one is unpacked
-onto the named joints that declare that interface (the plugin's packing);
-anything else is refused with the reason.  Each commanded joint takes one
-interface (:func:`command_interface`): position if its ``<ros2_control>``
-entry declares one, else velocity, else effort (so a joint a trajectory
-controller drives through position and velocity follows the position); a
-value for another interface of that joint is ignored, with the reason.
+Design notes: docs/design/model.md#topic_basedpy.
 """
 
 from __future__ import annotations

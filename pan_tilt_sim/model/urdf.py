@@ -9,40 +9,9 @@ and the attribute.  Elements the simulator does not use are not checked.
 The robot, every spawned object and every world file's object is read here
 before PyBullet sees it, and nothing PyBullet crashes on or cannot integrate
 gets through (test/dependencies/test_pybullet_limits.py shows what PyBullet
-does with each):
+does with each) (see the design notes).
 
-* **A tree**: unique link and joint names, one root link, each other link
-  the child of exactly one joint, no joint whose parent is its own child,
-  no cycle.  PyBullet's importer follows the joints without checking: it
-  crashes (a segmentation fault) on most of these, and on a cycle its root
-  does not reach it silently loads a robot without the cycle's links.
-* **Names** of the robot, its links and joints of at most
-  :data:`MAX_NAME_BYTES` bytes in UTF-8: PyBullet hands them out in
-  1024-byte buffers with their terminating NUL, and a longer one overruns
-  them -- the name comes back wrong or the process dies.
-* **Joint types PyBullet simulates**: revolute, continuous, prismatic and
-  fixed.  A ``floating`` joint PyBullet silently makes fixed; a ``planar``
-  one it moves in three degrees of freedom that it reports as no joint
-  state, and its mass matrix and inverse dynamics (which the start-up
-  checks and the damping use) have no planar joints.
-* **Axes with a direction**: a moving joint's ``<axis>`` must be longer than
-  :data:`MIN_AXIS_LENGTH` (SDFormat's test for a zero axis) and is
-  normalized, as URDF, KDL and Gazebo take it.  PyBullet would not
-  normalize it: a revolute joint then moves with the wrong dynamics and a
-  prismatic one reports its position in units of the axis length; a zero
-  axis makes every state NaN at the first step.
-* **Masses and inertias** finite, masses >= 0 (0: a massless frame) and at
-  most :data:`MAX_MASS`, every inertia component at most
-  :data:`MAX_INERTIA` in magnitude.  A negative mass breaks PyBullet's mass
-  matrix; gravity on a mass near 1e308 kg overflows to infinity and every
-  state is NaN.  The bounds are physical -- a thousand tonnes, and that mass
-  ten metres from its centre of mass, beyond any robot link or object a
-  robot handles -- and far inside where PyBullet fails: its ground contact
-  stops holding a body some orders of magnitude heavier (the body sinks
-  through the plane).  An inertia tensor that is no rigid body's (a negative
-  principal moment, one larger than the other two together) is PyBullet's
-  business: it sets the link's inertia to zero and says so, which start-up
-  logs as a warning.
+Design notes: docs/design/model.md#urdfpy.
 """
 
 from __future__ import annotations

@@ -16,12 +16,7 @@ the variation:
   body (mass added, centre of mass moved, inertia by the parallel-axis
   theorem), expressed in the link frame.
 
-A variation that takes a link beyond the parser's bounds on mass and inertia
-(:mod:`pan_tilt_sim.model.urdf`) is refused, as the parser would refuse it.
-
-A link without ``<inertial>`` has no mass to scale (PyBullet then applies
-its own default); a payload on it becomes its whole inertial.  The URDF as
-the user wrote it (``urdf_xml``, what robot_description publishes) is kept.
+Design notes: docs/design/model.md#variationpy.
 """
 
 from __future__ import annotations

@@ -5,39 +5,9 @@ A scenery name is one of :data:`SCENERIES`: ``empty`` (nothing), ``ground``
 Anything else is a world file -- a path, ``file://`` or ``package://`` URI:
 an SDF world (``.sdf``, ``.world``, ``.sdf.xacro``; :mod:`pan_tilt_sim.model.sdf_world`),
 or YAML, one entry per object, each what a ``SpawnEntity`` request would
-give::
+give (see the design notes).
 
-    scenery: ground            # empty | ground | targets (default: ground)
-    entities:
-      - name: box              # default: the URDF's <robot name>
-        uri: package://pan_tilt_sim/urdf/objects/box.urdf   # or a path (relative
-                               # to this file), file://..., or resource_string: <robot ...>
-        pose:
-          position: [0.5, 0.3, 0.25]        # m, world frame (default 0 0 0)
-          orientation: [0, 0, 0, 1]         # quaternion x y z w, or rpy: [r, p, y] (rad)
-        description: a box to push          # optional, for GetEntityInfo
-        tags: [pushable]                    # optional, for GetEntities' tag filter
-      - name: north_wall       # a simple shape instead of a URDF
-        shape: box             # box | cylinder | sphere
-        size: [0.1, 4.0, 0.5]  # m: box [x, y, z]; cylinder [radius, length]; sphere [radius]
-        colour: [0.8, 0.8, 0.8, 1.0]        # rgba (or rgb), each 0..1 (default grey)
-        static: true           # fixed where it is (default); false: free, of ``mass`` kg (1)
-        pose: {position: [2.0, 0.0, 0.25]}  # its centre
-
-A shape becomes a one-link URDF (:func:`shape_urdf`), its collision and
-visual the same shape, a cylinder's axis along z; cameras and lidars see
-it, robots touch it.
-
-A world file lists at most :data:`MAX_WORLD_ENTITIES` objects, each within
-the limits of one spawned object
-(:class:`~pan_tilt_sim.model.entity_resource.EntityLimits`): start-up takes
-under 2 ms per object and every object costs each physics step
-something (docs/simulator-control.md gives the measurements).
-
-Every problem ends start-up with one line naming the file and the field
-(:class:`WorldFileError`), or the parameter when its value names nothing
-(:class:`~pan_tilt_sim.errors.ParameterError`).  Reading the objects' URDFs is the entity
-resource module's business; this module only checks the file's shape.
+Design notes: docs/design/model.md#world_filepy.
 """
 
 from __future__ import annotations

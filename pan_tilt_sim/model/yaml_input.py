@@ -13,14 +13,7 @@ arguments) goes through here.  The limits:
 * an alias that refers to its own anchor (``a: &a [*a]``) is refused: the
   data would contain itself.
 
-Composition is checked before anything is constructed, and the check walks
-the node graph without recursion, so no input can reach Python's recursion
-limit.  Problems are :class:`YamlInputError`, whose text says what is wrong
-without the file's name: callers add it (``<file>: <what>``).
-
-PyYAML's C parser is used for the syntax when PyYAML has it (the pure-Python
-one otherwise); either way the nodes are composed by PyYAML's Python
-composer, which is where the depth is bounded.
+Design notes: docs/design/model.md#yaml_inputpy.
 """
 
 from __future__ import annotations

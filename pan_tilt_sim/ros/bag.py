@@ -2,31 +2,9 @@
 
 A :class:`BagWriter` makes the folder ``<folder>/`` with ``<name>_0.mcap``
 (``<name>`` is the folder's own name) and, when closed, ``metadata.yaml``,
-as ``ros2 bag record -s mcap -o <folder>`` does:
+as ``ros2 bag record -s mcap -o <folder>`` does (see the design notes).
 
-* the MCAP file has the ``ros2`` profile; a schema per message type, named
-  ``pkg/msg/Type``, encoding ``ros2msg``, holding the type's ``.msg`` text
-  followed by every type it uses, nested types included, each after a line
-  of 80 ``=`` and ``MSG: pkg/Type`` -- the text rosbag2's local message
-  definition source builds from the installed interface packages
-  (``share/<pkg>/msg/*.msg``, found through the ament index); a channel per
-  topic, message encoding ``cdr``, with the ``offered_qos_profiles`` and
-  ``topic_type_hash`` metadata rosbag2 reads back; a ``rosbag2`` metadata
-  record holding the serialized bag metadata;
-* ``metadata.yaml`` is rosbag2_storage's ``BagMetadata`` at version 9
-  (jazzy): QoS policies as words, the topics with their message counts and
-  REP-2011 type hashes (from the packages' ``msg/*.json``).
-
-Messages arrive already serialized (CDR, as rclpy's ``serialize_message``
-gives them) with their time in nanoseconds; the writer never decodes them.
-Writing is the ``mcap`` package's (an optional dependency: ``pip install
-mcap``); nothing here imports rclpy.
-
-Bad input and a full disk: a folder that cannot be made or written is a
-:class:`~pan_tilt_sim.errors.ConfigurationError` when the writer is made (the
-programs exit with code 2); an ``OSError`` while writing (a full disk, a
-quota) stops the recording -- later messages are dropped, the
-``on_failure`` callback is told once -- and never reaches the caller.
+Design notes: docs/design/ros.md#bagpy.
 """
 
 from __future__ import annotations

@@ -11,14 +11,7 @@ now; the image is stamped with the sim time and published in the
 ``camera.fov_deg`` and the image size.  A reset of the simulation starts the
 schedule again (:meth:`CameraPublisher.reset`).
 
-Rendering runs on the physics thread, between batches of steps: a
-TinyRenderer frame costs milliseconds (``scripts/camera_benchmark.py``
-measures it), and PyBullet holds the GIL while it renders, so a Python
-thread would not run it in parallel.  Sim time is not affected
-(every frame shows the state at its stamp); wall-time pacing absorbs the
-cost at real_time_factor 1, and at real_time_factor 0 frames take their
-share of the machine.  Like Gazebo's camera plugin, nothing is rendered
-while nobody subscribes to ``image_raw``, so the camera then costs nothing.
+Design notes: docs/design/ros.md#camera_publisherpy.
 """
 
 from __future__ import annotations

@@ -11,18 +11,7 @@ the command subscriptions alone, takes every message that arrived, and runs
 their callbacks in their turn -- between two batches of steps, as the
 executor would have run them.
 
-The subscriptions are ordinary rclpy subscriptions (``ros2 topic info``
-sees them as any other) in a callback group that no executor executes
-(:class:`ReaderGroup`), so the executor leaves them out of its wait set.
-A callback that raises stops the reader and is handed to the executor,
-which raises it, as it would its own callback's exception.
-
-rclpy has no public wait set: :func:`wait_and_take` is the one place that
-uses its private one (``WaitSet`` and the subscription handles'
-``take_message``).  :func:`available` tries it out; where it does not work
-(another rclpy), sim_node makes no reader and its executor reads the command
-topics like any other, in their turn: the same behaviour, at more CPU per
-message.
+Design notes: docs/design/ros.md#command_readerpy.
 """
 
 from __future__ import annotations
@@ -57,7 +46,7 @@ def wait_and_take(subscriptions: list[Subscription], guard: GuardCondition, cont
     Returns (subscription, message) pairs, in the order of ``subscriptions``
     and, for each, of arrival; subscriptions destroyed meanwhile are skipped.
     ``timeout_ns`` < 0 waits without end.  Built on rclpy's private API
-    (see the module's docstring): AttributeError or TypeError where rclpy
+    (see the module's design notes): AttributeError or TypeError where rclpy
     changed it.
     """
     with contextlib.ExitStack() as held:

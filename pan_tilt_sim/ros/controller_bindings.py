@@ -5,44 +5,9 @@ active), as a ros2_control controller's do.  Each controller declares them
 (:meth:`~pan_tilt_sim.controllers.framework.base.Controller.ros_surface`, see
 :mod:`pan_tilt_sim.controllers.framework.surface`); this module creates one entity per
 declared entry from tables keyed by message and action type, never by
-controller type:
+controller type (see the design notes).
 
-* a :class:`~pan_tilt_sim.controllers.framework.surface.CommandTopic`: a subscription
-  whose messages' values go to the controller (:data:`COMMAND_MESSAGES`);
-* a :class:`~pan_tilt_sim.controllers.framework.surface.StateTopic`: a publisher and
-  the sink the controller hands its samples to (:data:`STATE_SINKS`; a
-  message type whose interface package is not installed -- TF without
-  tf2_msgs -- gets none, with an info line, and the controller takes no
-  samples for it);
-* a :class:`~pan_tilt_sim.controllers.framework.surface.Service`: a service whose
-  requests' values go to the controller and whose answers fill the
-  responses (:data:`SERVICES`; none where its interface package is not
-  installed, with an info line);
-* an :class:`~pan_tilt_sim.controllers.framework.surface.ActionServer`, where its
-  interface package is installed (:data:`ACTION_SERVERS`);
-
-
-each where its interface package is installed (an optional one may not be);
-plus its tunable PID gains as sim_node parameters (:mod:`.gain_parameters`).
-A topic whose message type's interface package is not installed (control_msgs
-for the gpio controller, where the venv lacks it) is left out with one warning;
-the controller still runs.
-A command controller's commands are ignored while it is inactive, or in
-chained mode (then the controller before it in the chain writes its
-references) unless the topic is taken ``while_chained``.  Given a
-:class:`~pan_tilt_sim.ros.command_reader.CommandReader` (the sim_node
-program), the command subscriptions are read by it rather than by the
-executor.
-
-:class:`ControllerBindings` creates them for the controllers configured at
-start-up, and :meth:`~ControllerBindings.load`,
-:meth:`~ControllerBindings.configure`, :meth:`~ControllerBindings.cleanup`,
-:meth:`~ControllerBindings.unload` and :meth:`~ControllerBindings.switch`
-change the simulation's controllers (the controller_manager services call
-these, and nothing else touches the simulation's controllers) and keep the
-entities in step.  The URDF's Gazebo drive plugins
-(:attr:`~pan_tilt_sim.sim.engine.Simulation.plugins`) get their entities the
-same way, once, and always take commands.  Each is one short call, made between physics steps.
+Design notes: docs/design/ros.md#controller_bindingspy.
 """
 
 from __future__ import annotations

@@ -10,37 +10,9 @@ services, then call ``load_controller``, ``configure_controller`` and
 ``switch_controller`` (STRICT), and treat ``ok == false`` as failure.
 :class:`ControllerManagerNode` offers every service of
 ``controller_manager_msgs`` (older spawners wait until all of them exist on
-that node) and answers them with ros2_control's rules:
+that node) and answers them with ros2_control's rules (see the design notes).
 
-* ``load_controller``: the type is the node's ``<name>.type`` parameter (the
-  controllers file's types are declared at start-up, so ``spawner <name>``
-  needs no ``-p``); the parameters are the controllers file's section for
-  ``<name>`` with the sections of ``<name>.params_file`` (a string or a
-  string list, read as ``--params-file`` would be) over it.  A missing type,
-  a type this simulator does not have, a name already loaded or parameters
-  the controller refuses: ``ok`` false, with one error line saying why.
-* ``configure_controller`` / ``cleanup_controller`` / ``unload_controller``:
-  an active controller is refused; configuring an inactive one configures it
-  afresh.  The controller's topics and action exist from configure on.
-* ``switch_controller``: STRICT refuses the whole switch on any problem,
-  BEST_EFFORT (and 0, AUTO, FORCE_AUTO, as upstream) leaves the controllers
-  concerned out; two active controllers on one joint, or an interface the
-  URDF's ``<ros2_control>`` block does not give a joint, are refused in
-  both.  The switch happens at once, between physics steps -- also while
-  the simulation is paused (upstream's switch waits for its update loop,
-  and times out while a simulator is paused) -- so ``activate_asap`` and
-  ``timeout`` change nothing.
-* the lists: controllers with their lifecycle state, type, claimed and
-  required interfaces, and their chains (``is_chainable``, ``is_chained``,
-  the ``reference_interfaces`` a chainable controller exports, and for a
-  preceding controller one ``chain_connections`` entry per controller it
-  feeds, with the reference interfaces it claims of it -- what
-  ``ros2 control list_controllers`` and ``view_controller_chains`` show);
-  the types this simulator has; one hardware component per
-  ``<ros2_control>`` block, always active; the joints' interfaces.
-
-All its callbacks run on sim_node's executor; changes to the simulation go
-through :class:`~pan_tilt_sim.ros.controller_bindings.ControllerBindings`.
+Design notes: docs/design/ros.md#controller_managerpy.
 """
 
 from __future__ import annotations

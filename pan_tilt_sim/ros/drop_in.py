@@ -4,27 +4,9 @@ A ros2_control launch file (ros2_control_demos' style) starts
 ``ros2_control_node`` (the node ``controller_manager``), robot_state_publisher
 (which publishes the xacro output on ``robot_description``) and spawners.
 Started there instead, as ``Node(package='pan_tilt_sim', executable='sim_node',
-name='controller_manager', parameters=[...])``, sim_node is that node:
+name='controller_manager', parameters=[...])``, sim_node is that node (see the design notes).
 
-* without ``robot_description_file`` it takes the robot from the
-  ``robot_description`` topic as the jazzy controller_manager does -- a
-  relative name (so ``<namespace>/robot_description``, and the node's remap
-  rules apply), transient local, depth 1 -- and waits for it, saying so in
-  one info line; the simulation starts when it arrives (a later one is
-  ignored with a warning, as upstream ignores it);
-* its parameters mean what they mean to ros2_control_node: ``update_rate``;
-  ``<controller>.type`` (and ``.params_file``, ``.node_options_args``,
-  ``.fallback_controllers``), given in the controller manager's own YAML
-  layout or set by a spawner; ``hardware_components_initial_state``;
-* each controller's parameters are its section of the parameter files the
-  node was started with, as ros2_control passes the controller_manager's
-  ``--params-file`` arguments on to every controller node;
-* nothing is active until a spawner activates it (joints held), and the
-  controllers' topics are in the node's namespace;
-* robot_state_publisher publishes TF, so sim_node does not by default.
-
-The controller_manager's services run on sim_node itself
-(:class:`~pan_tilt_sim.ros.controller_manager.ControllerManagerServices`).
+Design notes: docs/design/ros.md#drop_inpy.
 """
 
 from __future__ import annotations

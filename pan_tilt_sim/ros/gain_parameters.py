@@ -13,13 +13,7 @@ gains come from (:attr:`Controller.gains_field`):
 * ``<controller>.gains.<joint>`` for each joint of a multi-joint controller
   (ros2_controllers style, as ``arm_controller.gains.shoulder_joint.p``).
 
-``ros2 param set /sim_node joint1_position_controller.pid.p 50`` changes the
-gain at the next physics step; the integral term is kept
-(:class:`~pan_tilt_sim.controllers.toolbox.pid.Pid` stores it already multiplied by
-``i``).  Changes are checked in the node's on-set callback and applied in
-its post-set callback, so a refused change -- negative, not finite, not a
-number, or refused by another callback of the same atomic set -- changes
-nothing.  Integers are accepted for the doubles.
+Design notes: docs/design/ros.md#gain_parameterspy.
 """
 
 from __future__ import annotations

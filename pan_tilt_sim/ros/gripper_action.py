@@ -4,23 +4,10 @@
 ``control_msgs/action/ParallelGripperCommand``
 (:class:`ParallelGripperCommandServer`), served with rclpy's ActionServer
 on sim_node's one executor.  The goals' rules are the controller's
-(:mod:`pan_tilt_sim.controllers.grippers.gripper_action_controller`); these classes
-only translate:
+(:mod:`pan_tilt_sim.controllers.gripper_action_controller`); these classes
+only translate (see the design notes).
 
-* goal callback: an inactive controller, a goal the controller cannot
-  run, or (parallel) a command without exactly one position is REJECTED,
-  the reason logged;
-* accepted callback: the controller starts the goal at once (the goal it
-  preempts ends ABORTED), then the goal executes;
-* execute callback: a coroutine awaiting a Future that :meth:`poll`
-  completes on the executor once a batch of physics steps has ended the goal
-  (:meth:`needs_attention` is asked after every batch, also from sim_node's
-  physics thread, and the node then wakes the executor); it sets the
-  terminal state and returns the result message built from the goal's result;
-* cancel callback: the running goal is canceled at once (the joint holds
-  where it is) and ACCEPTED; a goal that has already ended is REJECTED.
-
-Upstream sends no feedback for these actions, and neither does this server.
+Design notes: docs/design/ros.md#gripper_actionpy.
 """
 
 from __future__ import annotations

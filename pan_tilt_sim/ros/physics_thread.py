@@ -9,16 +9,7 @@ between ticks, and the executor wakes only for messages, services and
 parameters (the command topics have a reader of their own:
 :mod:`pan_tilt_sim.ros.command_reader`).
 
-Both still take turns, as when a timer drove the physics: every callback
-runs between two batches of steps, never during one.  :class:`Turns` is
-that lock; a callback waiting for its turn goes before the next batch, so
-at real_time_factor 0 a command waits at most for the batch in progress
-(``FAST_TICK_S`` of wall time).  :class:`TurnTakingExecutor` is rclpy's SingleThreadedExecutor
-with each callback run inside its turn; the callbacks ready at once share one
-turn (up to :data:`CALLBACK_TURN_S`), so that a queue of requests is not
-served one per batch of steps.  If the physics thread fails, it
-wakes the executor, which raises its exception, so the program ends with
-the traceback -- the executor never has to poll for it.
+Design notes: docs/design/ros.md#physics_threadpy.
 """
 
 from __future__ import annotations

@@ -12,20 +12,7 @@ Sensor topics (camera, depth, lidar, IMU, force-torque) are recorded only
 with ``record_sensors:=true``: their messages are large and each costs a
 rendering or a ray cast that nobody may want.
 
-Cost: a message is serialized once (rclpy's ``serialize_message``); the
-same bytes go to the bag and, when somebody subscribes, to DDS
-(``publish`` of serialized bytes).  A recorded publisher counts the bag as
-one more subscriber, so the node builds the message even when nobody else
-listens; it skips DDS then, as it did before.
-
-Stamps are sim time: a message is logged at its own stamp (``header.stamp``,
-a Clock's ``clock``, the first transform's stamp of a TF message), else --
-commands, robot_description -- at the sim time it was published or received.
-A reset that sets sim time back to 0 starts the stamps over.
-
-A full disk stops the recording (see :mod:`pan_tilt_sim.ros.bag`): one
-warning, the publishers go back to counting only real subscribers, and the
-simulation goes on.
+Design notes: docs/design/ros.md#recordingpy.
 """
 
 from __future__ import annotations

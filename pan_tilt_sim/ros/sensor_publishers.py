@@ -16,8 +16,7 @@ Topic names and frames follow the plugin conventions of
 default frame, the sensor's name) gets a ``/tf_static`` from the sensor's
 link, so every message's frame is in the TF tree.
 
-Every publisher keeps the wall time it spent per message (measure, build,
-publish): :attr:`SensorPublisher.cost_per_message` -- the benchmark prints it.
+Design notes: docs/design/ros.md#sensor_publisherspy.
 """
 
 from __future__ import annotations

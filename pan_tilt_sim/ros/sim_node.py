@@ -308,7 +308,7 @@ class SimNode(Node):
         self.get_logger().info(f'viewer: open {self.viewer.url} in a browser')
 
     def create_publisher(self, *args, **kwargs):
-        """Create a publisher without rclpy's default QoS-event handler (see below).
+        """Create a publisher without rclpy's default QoS-event handler (see the design notes).
 
         While recording, the publisher is teed into the bag (a
         :class:`~pan_tilt_sim.ros.recording.RecordedPublisher`).

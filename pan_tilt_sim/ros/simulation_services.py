@@ -1,25 +1,10 @@
 """simulation_interfaces for sim_node: the standard way to control a simulator from tests and tools.
 
-Serves ROS 2's ``simulation_interfaces`` (1.5, Jazzy), as Gazebo (ros_gz_sim), Isaac
-Sim and O3DE do, where the package is installed; without it these services are off
-and everything else runs.  The services live under the
-``simulation_interfaces.namespace`` parameter (``~``, the node's own name, by
-default; ``''`` gives Isaac Sim's root names, and then ResetSimulation takes
-``reset_simulation`` from gazebo_ros's Empty service).  States and transitions follow
-O3DE's table; StepSimulation (at most :data:`MAX_STEP_SIMULATION_STEPS`) and the
-SimulateSteps action run only while paused, through :mod:`pan_tilt_sim.ros.stepping`;
-ResetSimulation's scope bits TIME, STATE and SPAWNED are served, others are
-FEATURE_UNSUPPORTED.  Entities (:mod:`pan_tilt_sim.sim.entities`) are the robot, the
-targets and URDF objects, their states in the world frame stamped with sim time.  Every
-answer fills ``result`` and says why in ``error_message``; a refused request changes
-nothing.  The services act between batches of physics steps.  A spawn's slow part --
-reading, checking and trying the object (:meth:`Entities.prepare
-<pan_tilt_sim.sim.entities.Entities.prepare>`) -- runs in a thread of its own
-(:class:`Preparations`), one object at a time, while /clock, the topics and the other
-services go on; PyBullet's load follows in the executor's turn, between two batches of
-steps.  An object beyond the limits of :mod:`pan_tilt_sim.model.entity_resource` is
-refused with RESULT_OPERATION_FAILED and one line saying which limit.
-docs/simulator-control.md is the user's reference.
+Every answer fills ``result`` and says why in ``error_message``; a refused request changes
+nothing.  The services act between batches of physics steps; a spawn's object is read and
+tried in a thread of its own, and loaded in the executor's turn.
+
+Design notes: docs/design/ros.md#simulation_servicespy.
 """
 
 from __future__ import annotations
@@ -188,7 +173,7 @@ def service_name(namespace: str, leaf: str) -> str:
 
 
 class SimulationServices:
-    """simulation_interfaces' services and action on a SimNode (see the module docstring)."""
+    """simulation_interfaces' services and action on a SimNode (see the module's design notes)."""
 
     def __init__(self, node: Node, interfaces: types.SimpleNamespace, namespace: str,
                  gazebo_services: list[Service]) -> None:

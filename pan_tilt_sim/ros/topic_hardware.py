@@ -13,19 +13,7 @@ on the far side of two topics (see :mod:`pan_tilt_sim.model.topic_based`):
   Hz of sim time: every movable joint (or ``topic_based.joints``), with name,
   position, velocity and effort aligned, stamped with sim time.
 
-The mode is on with ``topic_based.enabled``, whose default is true when the
-URDF's ``<ros2_control>`` hardware is TopicBasedSystem; the topics then
-default to that block's ``joint_commands_topic`` / ``joint_states_topic``
-params, else to the plugin's defaults.  The commands go through the same
-actuators as the YAML controllers': each commanded joint's interface (see
-:func:`~pan_tilt_sim.model.topic_based.command_interface`, or
-``topic_based.command_interface`` for all) is driven by a group controller of
-that interface (``topic_based_position`` ...: the ``JointGroup*Controller``
-types, one member per joint): the ideal actuator for position and velocity
-(:mod:`pan_tilt_sim.controllers.toolbox.actuator`), or a PID where
-``topic_based.pid_gains.<joint>.p`` (``.i``, ``.d``, ``.i_clamp``, named
-after gazebo_ros_control's ``pid_gains``) gives gains, tunable live as
-``topic_based_<interface>.gains.<joint>.*``.
+Design notes: docs/design/ros.md#topic_hardwarepy.
 """
 
 from __future__ import annotations

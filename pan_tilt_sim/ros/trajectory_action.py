@@ -3,30 +3,9 @@
 ``control_msgs/action/FollowJointTrajectory`` (built by the standalone path,
 or a ROS install's), served with rclpy's ActionServer on sim_node's one
 executor, with ros2_controllers' semantics in sim time (the rules are the
-controller's, :mod:`pan_tilt_sim.controllers.trajectory.joint_trajectory_controller`):
+controller's, :mod:`pan_tilt_sim.controllers.joint_trajectory_controller`) (see the design notes).
 
-* goal callback: an inactive controller, or a goal that
-  :meth:`~pan_tilt_sim.controllers.trajectory.joint_trajectory_controller.JointTrajectoryController.check_goal`
-  refuses, is REJECTED -- as ros2_controllers does, so the client sees
-  ``accepted == False`` and no result; the reason, with the error code it
-  stands for (INVALID_JOINTS, INVALID_GOAL, OLD_HEADER_TIMESTAMP), is logged;
-* accepted callback: the controller starts the goal at once (which aborts
-  the one running: preempted), then the goal executes;
-* execute callback: a coroutine that awaits a Future, so it never blocks
-  the executor; once a batch of physics steps has ended the goal
-  (:meth:`TrajectoryActionServer.needs_attention`, asked after every batch,
-  also in sim_node's physics thread), the node wakes the executor with a
-  guard condition and :meth:`TrajectoryActionServer.poll` completes the
-  Future there; the coroutine then sets the terminal state and returns the
-  result.  Callbacks that end a goal themselves (cancel, preemption, a
-  switch) poll at once;
-* cancel callback: the running goal is canceled at once (the joints hold
-  where they are) and ACCEPTED; a goal that has already ended is REJECTED;
-* feedback (desired, actual, error) goes out at the controller's
-  ``action_monitor_rate`` (20 Hz) of sim time, at most once per batch of steps.
-
-Every access to the simulation is one short call into the controller; none
-waits for the physics.
+Design notes: docs/design/ros.md#trajectory_actionpy.
 """
 
 from __future__ import annotations

@@ -16,9 +16,7 @@ command topic of the active controller that drives the joint's position
 ``JointTrajectory`` on ``~/joint_trajectory``), and the node's own
 subscriptions store it as any other command.
 
-The sensors' data are what the node publishes: :class:`SensorTaps`
-subscribes to the lidars' and cameras' topics only while a browser shows
-them, so, as for any subscriber, a sensor is measured only while watched.
+Design notes: docs/design/ros.md#view_feedpy.
 """
 
 from __future__ import annotations

@@ -14,11 +14,7 @@ square, so ``fx = fy = (width / 2) / tan(fov / 2)``, and the principal
 point is the image centre in OpenCV's convention (pixel centres at integer
 coordinates): ``cx = (width - 1) / 2``, ``cy = (height - 1) / 2``.
 
-:class:`Renderer` renders in the simulation's own PyBullet client -- one
-client per simulation -- between batches of physics steps, so every frame
-shows the robot (and anything else in the world) exactly as the physics has
-it.  Rendering only reads the world; the scenery it shows
-(:mod:`pan_tilt_sim.sim.world`) is visual only and never touches the physics.
+Design notes: docs/design/sim.md#camerapy.
 """
 
 from __future__ import annotations

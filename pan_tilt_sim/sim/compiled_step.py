@@ -8,23 +8,7 @@ statistics per step that nobody reads.  ``_compiled_step`` (C, built by
 through PyBullet's C API, without that parsing and that dict.  The results
 are the same to the last bit.
 
-Where every controller updated each step is a position or velocity PID or
-an effort controller and a step sends PyBullet nothing but the torques (the
-pan/tilt example's case), the same extension also runs the steps between two
-broadcaster samples without returning to Python (``Stepper.run_laws``,
-driven by :meth:`pan_tilt_sim.sim.engine.Simulation.advance`): the laws of
-:mod:`pan_tilt_sim.controllers.toolbox.step_law`, computed operation for operation
-as the Python controllers compute them, so no Python runs per step.  The
-Python controllers stay the reference; the others (trajectories,
-ideal actuators) run only in Python.
-
-The C side gets its PyBullet client the documented way, as a PyBullet
-plugin (:func:`pybullet.loadPlugin` on the extension's own file).  It is
-used only with the PyBullet C API version it was written against
-(:data:`API_VERSION`) and only when the law row layout it was built with is
-step_law's (:func:`layout_mismatch`, checked at import); otherwise, without
-the extension, or with ``PAN_TILT_SIM_COMPILED_STEP=0`` in the environment,
-the physics steps through PyBullet's Python module.
+Design notes: docs/design/sim.md#compiled_steppy.
 """
 
 from __future__ import annotations

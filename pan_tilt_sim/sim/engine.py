@@ -16,18 +16,7 @@ The robot's base is welded to the world unless it is mobile (see
 :func:`base_is_fixed` and :mod:`pan_tilt_sim.model.base_pose`); a free base
 starts resting on the ground and a reset puts it back there.
 
-A robot PyBullet cannot integrate -- whose joint states are not finite within
-the first steps with no effort -- ends start-up
-(:func:`~pan_tilt_sim.sim.stability.check_startup_stability`).  Otherwise, at
-start-up the simulation says, through the logger it is given, whether the
-base is free and why, which actuator drives each joint and why, where each
-joint starts, what PyBullet said while loading the robot, and which PID
-gains are too high for their joint's inertia at this time step
-(:mod:`pan_tilt_sim.sim.stability`).
-While running, a joint at PyBullet's speed cap or with a non-finite state
-gets a warning (at most one per joint per second), and so does a free base
-that tipped over or fell below the ground plane; a free base that leans (on
-its nose, say: its sensors tilted with it) gets one warning per lean.
+Design notes: docs/design/sim.md#enginepy.
 """
 
 from __future__ import annotations

@@ -2,51 +2,9 @@
 
 :class:`Entities` keeps one record per entity of one simulation and does
 what ``simulation_interfaces`` asks of them, in the simulation's own PyBullet
-client:
+client (see the design notes).
 
-* **the robot** (named after its URDF ``<robot name>``; fixed to the world,
-  or -- a mobile robot -- free on the ground: then the ground plane is a
-  collision body from the start and every link of the robot meets it, and
-  the robot's state has a twist);
-* **the targets** of the ``targets`` scenery (``target_red``...; static);
-* **objects** from a world file or spawned at run time: any URDF, loaded as a
-  free-floating PyBullet body with the URDF's inertia.  They fall under
-  gravity, land on the ground plane (added with the first object, see
-  :func:`~pan_tilt_sim.sim.world.add_ground_plane`; the robot's links that
-  touch the ground in the initial pose never meet it), collide with the robot
-  and the targets, can be pushed and grasped, and the cameras and lidars see
-  them -- they are ordinary bodies in the client those render in.  An object
-  whose URDF says ``<gazebo><static>true</static></gazebo>`` is fixed where
-  it is spawned; one whose base link has no mass (no ``<inertial>``) is
-  static too (PyBullet's rule).  PyBullet's hidden drag is off, as for the
-  robot.  Its joints are passive (PyBullet's default motors off; URDF
-  friction as a velocity motor capped at the friction, as for the robot).
-  Its links' ``<gazebo reference>`` ``<mu1>``/``<mu2>`` set their surface
-  friction, as the robot's do (:func:`~pan_tilt_sim.sim.physics.apply_surface_friction`),
-  and its contacts hold by static friction from one step to the next
-  (PyBullet's friction anchor): a box held between fingers stays put.
-
-Poses are those of an entity's URDF root link frame in the world (PyBullet
-itself reports the base's centre of mass; the difference is converted here),
-twists are the velocity of that frame's origin and the angular velocity, both
-in world axes.  Bounds are PyBullet's axis-aligned boxes (with its 1 mm
-margin), over all links.
-
-Spawning checks everything before PyBullet is touched, so a refused request
-leaves the simulation as it was; :class:`SpawnError` says which of the
-standard's result codes applies (:class:`SpawnProblem`).  An object is tried
-alone in a PyBullet client of its own first
-(:class:`~pan_tilt_sim.sim.stability.ObjectTrials`): one whose state is not
-finite within the first steps never enters the world (RESOURCE_PARSE_ERROR).
-One beyond the :class:`~pan_tilt_sim.model.entity_resource.EntityLimits` is
-refused before it is read further (TOO_LARGE).
-
-A spawn is three steps: :meth:`Entities.check_request` (cheap: the name
-space, the pose, the frame), :meth:`Entities.prepare` (the slow part --
-reading, checking and trying the object -- which touches neither the
-simulation's client nor the records, so it may run in another thread, one
-preparation at a time) and :meth:`Entities.add` (PyBullet's load into the
-world, which must not overlap a step).  :meth:`Entities.spawn` does all three.
+Design notes: docs/design/sim.md#entitiespy.
 """
 
 from __future__ import annotations
@@ -223,7 +181,7 @@ class EntityState:
 
 
 class Entities:
-    """The named bodies of one simulation (see the module docstring)."""
+    """The named bodies of one simulation (see the module's design notes)."""
 
     def __init__(self, physics: Physics, robot_name: str, *, targets: dict[str, int] | None = None,
                  ground: bool = True, limits: EntityLimits = DEFAULT_LIMITS) -> None:

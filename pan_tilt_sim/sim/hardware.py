@@ -7,42 +7,9 @@ controllers claim by name as ros2_control's do.
 **Sensors** are measured in the simulation's PyBullet client with the code
 that measures the URDF's Gazebo sensors (:mod:`pan_tilt_sim.sim.sensors`),
 at the place :func:`~pan_tilt_sim.model.control_sensors.placement` finds
-(see that module for which interface names mean what):
+(see that module for which interface names mean what) (see the design notes).
 
-* the wrench is the reaction of the joint above the sensor's link -- what
-  the link and everything beyond it load it with -- by default in the
-  link's frame, about its origin, child on parent (SDF's default: a mass
-  hanging below reads its weight, along gravity).  A Gazebo force_torque
-  sensor of the same name brings its ``<frame>``, ``<measure_direction>``,
-  noise and rate.  A broadcaster whose ``frame_id`` names another link gets
-  the same wrench expressed there (axes and moment point);
-* the IMU reads as the Gazebo IMU does (:mod:`.sensors.imu`), its
-  acceleration the mean over the steps since its previous reading;
-* the pose is the sensor frame's, in the broadcaster's ``frame_id`` when
-  that is a link, else in the world;
-* the range is one ray along the sensor frame's +x (:mod:`.sensors.lidar`),
-  from a Gazebo ray sensor's range limits and noise, else the ``<sensor>``'s
-  ``min_range`` / ``max_range`` parameters, else 0 to
-  :data:`DEFAULT_MAX_RANGE`; nothing hit reads +inf.
-
-A sensor is measured only when a reader asks and someone listens (see
-:class:`~pan_tilt_sim.controllers.framework.hardware_interfaces.SensorHandle`); a Gazebo sensor's
-``update_rate`` makes its readings change at that rate only.  The first
-reading after someone starts listening is not valid (PyBullet's joint
-feedback is switched on then, and an IMU needs an earlier velocity): the
-broadcaster skips it.  Noise draws from its own generator per sensor
-(:func:`~pan_tilt_sim.sim.sensors.noise.generator`, indices from
-:data:`NOISE_STREAM_OFFSET` on, apart from the Gazebo sensors').
-
-**Gpios** behave as mock_components' GenericSystem: a command is echoed into
-the state interface of the same name; a state interface without a command
-keeps its ``initial_value`` (NaN where none is given).  With the hardware
-parameter ``mock_gpio_commands`` true, every gpio state interface also has a
-command interface, as that parameter makes mock hardware export.
-
-What cannot be simulated -- an interface name that means nothing here, a
-sensor nothing places, a wrench above the root link, a gpio input -- is said
-once, in :meth:`SimulatedHardware.startup_report`.
+Design notes: docs/design/sim.md#hardwarepy.
 """
 
 from __future__ import annotations

@@ -6,60 +6,7 @@ loaded with the URDF's inertia (links without ``<inertial>`` come massless,
 see :mod:`pan_tilt_sim.model.inertials`); what PyBullet says while loading
 goes to the log, one line per message.
 
-The base is welded to the world (``fixed_base``, the default; placed at
-``initial_pose`` if one is given) or free (a mobile robot, see
-:mod:`pan_tilt_sim.model.base_pose`): a free base starts at rest with its
-lowest collision point ``initial_pose.z`` above the ground plane z = 0 (0:
-standing on it), and :meth:`Physics.reset_base` puts it back there; the
-plane (:attr:`Physics.ground`) is then part of the physics from the start.  A free
-robot's URDF cylinders are PyBullet's exact cylinder shapes, not the
-polygon hulls it makes of them otherwise, so that wheels roll round, and
-each of its links' contact friction is the URDF's ``<gazebo reference>``
-``mu1``/``mu2`` (the smaller; Gazebo's 1 by default), and its contact spring
-the ``kp``/``kd`` where the URDF gives them (:mod:`pan_tilt_sim.model.surfaces`);
-the ground plane's friction is 1 (as under objects, see
-:func:`~pan_tilt_sim.sim.world.add_ground_plane`), so that on it a link's own
-coefficient decides, as on Gazebo's high-friction ground (PyBullet multiplies
-the two coefficients, Gazebo takes the smaller).  A welded robot keeps
-PyBullet's contacts, as before.
-PyBullet's hidden drag on every link (linear and angular damping 0.04,
-not in the URDF, not in Gazebo) is switched off, and its speed cap
-(``maxJointVelocity``, 100 rad/s) raised to twice the fastest URDF velocity
-limit, so that only an unstable joint ever reaches it.
-
-Each joint is driven one of two ways (:meth:`Physics.set_drives`):
-
-* **effort**: the joint gets the effort the controllers ask for, plus its
-  URDF damping and Coulomb friction (a velocity motor held at zero speed
-  whose force is capped at the friction: static friction included).
-  PyBullet applies damping explicitly, which diverges once ``damping *
-  time_step`` exceeds twice the joint's effective inertia ``J = 1 /
-  (M^-1)_ii``; it is kept only where it is twenty times inside that bound
-  (``d dt <= 0.1 J`` at every pose checked: there explicit and implicit
-  Euler are equally accurate, and it costs nothing per step -- the pan/tilt
-  example).  Elsewhere damping is implicit, stable at any time step: the
-  zero-speed motor resists with at most the force that damping and
-  friction give at the speed the joint would have at the end of the step
-  (implicit Euler of ``J v' = tau + g - d v - f sgn v``, with the passive
-  torque ``g`` read back from the previous step), or, for damping alone,
-  with the velocity gain ``d dt / (J + d dt)``.  A joint coupled by a mimic
-  gear always takes the first form; a joint with neither damping nor
-  friction has no motor at all.
-* **velocity** (the ideal actuator, :mod:`pan_tilt_sim.controllers.toolbox.actuator`):
-  a velocity motor drives the joint to the target the controllers ask for,
-  with at most the joint's URDF effort limit, or the lower force a step
-  asks for (a gripper's ``max_effort``); the torque it applied is read
-  back as the joint's effort.  URDF damping and friction are not applied.
-
-A ``<mimic>`` joint is held at ``multiplier * leader + offset`` by a gear
-constraint (see :mod:`pan_tilt_sim.model.mimic`).
-
-A link with ``<gazebo reference>`` ``<mu1>``/``<mu2>`` (robot or spawned
-object, :func:`apply_surface_friction`) gets the smaller of the two as
-PyBullet's lateral friction -- PyBullet's friction is the same in every
-direction.  At a contact PyBullet multiplies the two surfaces' coefficients
-where Gazebo takes the smaller one; a surface without the tags keeps
-PyBullet's 0.5.
+Design notes: docs/design/sim.md#physicspy.
 """
 
 from __future__ import annotations
@@ -234,7 +181,7 @@ class Physics:
     :attr:`~pan_tilt_sim.model.robot.JointSpec.initial_position`) is where
     the joints start and where :meth:`reset_joints` without arguments puts
     them.  ``fixed_base`` welds the root link to the world; ``initial_pose``
-    places the base (see the module docstring).  ``warn`` receives
+    places the base (see the module's design notes).  ``warn`` receives
     PyBullet's load messages, one line each.
     """
 

@@ -13,30 +13,7 @@ pi / 2 for an omni wheel, +-pi / 4 for a mecanum wheel)::
     free     f = cos(gamma) d + sin(gamma) a
     traction u = sin(gamma) d - cos(gamma) a
 
-PyBullet's friction is the same in every direction, and its anisotropic
-friction scales the friction directions in the link's own frame, which
-spins with the wheel: a mecanum wheel's free direction (45 degrees between
-rolling direction and axis) would turn with it.  So a roller wheel's
-PyBullet friction is 0 -- Bullet still computes the normal force -- and
-before every step :meth:`RollerWheels.apply` adds the friction across the
-rollers: from the velocity of the wheel's rim point at the contact (the
-link's velocity plus its spin about the contact's lever arm, so the
-motor-driven spin counts), its component ``s`` along ``u`` is opposed by
-``F = -clamp(k s, mu N) u`` at the contact point, ``N`` the normal force
-of the last step's contact (summed over the wheel's contact points, applied
-at their force-weighted mean), ``mu`` the wheel link's friction times the
-other surface's (as PyBullet combines them).  ``k`` is a quarter of the
-robot's mass per roller wheel divided by the time step: the slip decays
-within a few steps, and the explicit force stays far from the bound where
-it would overshoot.  Along ``f`` there is no force at all (no roller
-rolling resistance).  The force acts on the wheel link, so the wheel's
-motor feels it and the base moves only through the contact, never by
-being placed.
-
-Limits: the other body at the contact is taken as at rest (the ground
-plane; a moving object under a wheel does not carry it along); static
-friction is a stiff damper, so on a slope a standing base creeps slowly;
-the rollers' own inertia and the bumps between them are not modelled.
+Design notes: docs/design/sim.md#roller_wheelspy.
 """
 
 from __future__ import annotations
@@ -74,7 +51,7 @@ def _rotate(q: tuple[float, float, float, float],
 
 
 class RollerWheels:
-    """The roller friction of some wheels of ``physics``' robot (see the module docstring).
+    """The roller friction of some wheels of ``physics``' robot (see the module's design notes).
 
     ``angles``: the roller angle (rad) of each wheel, by the name of the
     joint whose child link is the wheel.  Building it sets those links'

@@ -14,20 +14,7 @@ world (:class:`ObjectTrials`).
 
 **The gains.**
 
-A PID on effort is explicit: PyBullet applies the torque computed from the
-state at the start of the step.  For a position loop ``tau = -p q - d v``
-on a joint of effective inertia ``J`` (``1 / (M^-1)_ii``: what a torque on
-that joint alone accelerates while the others move freely), PyBullet's
-semi-implicit Euler step is stable exactly while
-
-    d * dt / 2 + p * dt^2 / 4 < J
-
-(from the eigenvalues of one step's map; with p = 0 it is the familiar
-``d dt < 2 J``).  A velocity loop ``tau = p (v_cmd - v)`` is stable while
-``p * dt / 2 < J``.  ``J`` depends on the arm's pose, so the check takes the
-smallest over a few poses: the start, the middle of the limits, and a
-quarter of the range in from either limit.  A joint that fails gets one
-warning naming it, the gain and the largest stable value.
+Design notes: docs/design/sim.md#stabilitypy.
 """
 
 from __future__ import annotations

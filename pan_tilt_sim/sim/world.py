@@ -1,38 +1,10 @@
 """Scenery for the camera: a ground plane and a few coloured targets, a ground alone, or nothing.
 
-The world is built from PyBullet primitives (no ``pybullet_data`` files)
-and lives in the simulation's PyBullet client, where the cameras render (see
-:mod:`pan_tilt_sim.sim.camera`) and a GUI window shows it.  The targets are
-static bodies (mass 0) with box collision shapes, so lidars and anything
-else that casts rays hits them, as in Gazebo.  They are made with maximal
-coordinates (a static btRigidBody each), not as multibodies: a static
-multibody, even a visual-only one, joins PyBullet's articulated-body pass
-every step, a static rigid body with a collision shape only the broadphase,
-which costs next to nothing.  Cameras, depth cameras and lidars meet the
-ground plane analytically.  Objects spawned into the world
-(:mod:`pan_tilt_sim.sim.entities`) land on it: :func:`add_ground_plane`
-adds the plane as a collision body when the first object arrives -- so a
-world without objects pays nothing for it.  A free (mobile) robot stands
-on the plane, which is then a collision body from the start and touches
-every link.  The links of a robot fixed to the world that touch the ground
-or reach below it in the initial pose (:func:`grounded_links`: the pan/tilt
-example's base and its pan link, whose collision cylinder reaches below z = 0; a base
-sunk into the floor) never collide with the plane: they would be held by
-it (a wheel half in the ground turns 0 rad/s instead of 42 under the same
-torque).  Every other
-link meets the ground as any object does: a gripper cannot go through it.
+Built from PyBullet primitives in the simulation's own client.  The ground is the plane
+z = 0; it becomes a collision body only when an object or a free robot needs it, and the
+links of a fixed robot that start touching it never collide with it.
 
-The ground is the plane z = 0.  TinyRenderer's cost grows with the pixels it
-shades, and a ground body covers half of every horizontal view, so the camera
-does not render a ground body: it paints the ground into the background pixels
-whose viewing ray points down (exact for an infinite plane, which a plane
-lit by a directional light shows in one flat colour).  ``build_world(...,
-ground=True)`` adds a ground box for the GUI window.
-
-Targets stand on the ground around the origin, one per compass direction,
-each a different colour, their centres at the height of the pan/tilt
-example's camera when the tilt is horizontal.  With the pan/tilt the camera looks
-along world -x at pan 0, so pan = azimuth - pi faces a target.
+Design notes: docs/design/sim.md#worldpy.
 """
 
 from __future__ import annotations
@@ -110,7 +82,7 @@ def build_world(name: str, client: int, *, ground: bool = False) -> dict[str, in
 
     The names are the targets' entity names (``target_red``...).  The ground
     plane becomes a body only with ``ground`` (for a GUI window); the camera
-    paints it instead (see the module docstring).
+    paints it instead (see the module's design notes).
     """
     check_world(name)
     if name == EMPTY:

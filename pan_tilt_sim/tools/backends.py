@@ -9,17 +9,7 @@ every back end.  ``shared`` is what all calls of one map have in common
 processes get it pickled with each call (a few tens of kB, against
 ~0.2 s of simulation per call).
 
-* :class:`InProcess` -- a plain loop (``--workers 0``; the reference).
-* :class:`LocalProcesses` -- ``concurrent.futures.ProcessPoolExecutor`` with
-  the *spawn* start method (no inherited PyBullet clients or locks), each
-  worker building its own simulations.
-* :class:`RayCluster` -- each call a Ray task (``num_cpus=1``) on the cluster
-  at ``address`` (``auto``: the one the local machine belongs to; ``ray://host:10001``:
-  a remote cluster through Ray Client; ``host:6379``: the head's GCS), or on
-  the Ray instance this process already started.  Connecting to a cluster
-  ships this ``pan_tilt_sim`` package to its workers (Ray ``runtime_env``
-  ``py_modules``), so they run exactly the driver's code; PyBullet (and
-  PyYAML, xacro) must be installed on the cluster's nodes.
+Design notes: docs/design/tools.md#backendspy.
 """
 
 from __future__ import annotations
@@ -42,7 +32,7 @@ class BackendError(RuntimeError):
 
 
 class Backend(abc.ABC):
-    """Runs evaluations; see the module docstring."""
+    """Runs evaluations; see the module's design notes."""
 
     name: str = ''
 
@@ -120,7 +110,7 @@ class LocalProcesses(Backend):
 
 
 class RayCluster(Backend):
-    """Evaluations as Ray tasks; see the module docstring for ``address``."""
+    """Evaluations as Ray tasks; ``address``: see the module's design notes."""
 
     name = 'Ray'
 

@@ -4,93 +4,9 @@
 runs the pan/tilt example and prints, measured in one run so that
 ratios hold on a noisy machine (CPU figures come from the processes' and
 threads' own CPU clocks, which other work on the machine distorts far less
-than wall time):
+than wall time) (see the design notes).
 
-* ``raw``: PyBullet alone on the physics the node runs (same model, time
-  step, friction motors, the efforts the node's controllers applied,
-  replayed, positional calls): ``step_us_cpu``, the thread CPU microseconds
-  of one ``stepSimulation`` (median over windows), the ``steps_per_s`` that
-  allows, ``calls_us_cpu`` for the three calls the engine makes per step
-  (set efforts, step, read states) made as the engine makes them,
-  ``compiled_step`` (whether that is from C: :mod:`pan_tilt_sim.sim.compiled_step`),
-  and ``wall_steps_per_s``: bare ``stepSimulation`` calls per wall second,
-  beside them;
-* ``factor_0``: sim_node at real_time_factor 0, both position controllers
-  moving, in four cases, one after the other: ``no_subscriber``,
-  ``clock_subscriber`` (a reliable /clock subscriber in its own process, as
-  ``ros2 topic echo /clock`` makes; rclpy's use_sim_time TimeSource makes a
-  best-effort one), ``joint_state_subscriber`` (a reliable JointState
-  subscriber in its own process) and ``recording`` (no subscriber, the run
-  recorded with ``record:=<folder>``; absent without the mcap package).
-  Each gives ``steps_per_s`` (sim time over wall time between two
-  JointStates the probe takes at the ends of the window, subscribing only
-  for them), ``ratio_to_raw`` (over
-  ``raw.steps_per_s``), ``node_cpu_us_per_step`` (the thread that used
-  the most CPU over the window: the one stepping the physics) and, with a subscriber,
-  ``subscriber_cpu_percent`` (% of one core);
-* ``factor_1``: at real_time_factor 1 with a /clock subscriber:
-  ``cpu_percent`` (the node process, % of one core, while nobody reads
-  JointState), ``cpu_percent_with_joint_states`` (while the probe reads
-  JointState too), ``cpu_percent_recording`` (a second node, recording the
-  run, nobody reading JointState; absent without the mcap package),
-  ``clock_subscriber_cpu_percent``, JointState inter-arrival
-  ``joint_states_p50_ms`` / ``joint_states_p99_ms`` and ``rtf_error``
-  (|sim/wall - 1|, the slope of JointState stamps against arrival times);
-* ``startup_s``: process start to the first JointState at the probe, median
-  of ``STARTUP_RUNS``; ``startup_floor_s``: the same for a bare rclpy
-  JointState publisher (:mod:`pan_tilt_sim.tools.bare_publisher`), run by
-  run in turn with sim_node -- what Python, rclpy and DDS discovery alone
-  take on the machine;
-* ``scaling``: serial chains of 2, 8 and 32 revolute joints, each with a
-  position controller, at real_time_factor 0 with no subscriber:
-  ``steps_per_s`` and ``node_cpu_us_per_step`` (keys are the joint counts).
-* ``scenes`` (:mod:`pan_tilt_sim.tools.bench_scenes`): two scenes with contacts,
-  each in two cases that differ in what touches: ``driving_base``
-  (``on_ground``: the rover driving a circle in the room on its wheels and
-  caster, its lidar unwatched; ``base_fixed``: the same with
-  ``fixed_base:=true``, its wheels touching nothing) and ``grasp``
-  (``holding``: the fingers squeezing a box the lift holds up; ``open``: the
-  fingers open, the box on the ground).  Per case, at real_time_factor 0
-  with no subscriber: ``steps_per_s``, ``node_cpu_us_per_step``,
-  ``real_time_multiple`` (sim seconds per wall second), ``contact_points``
-  (PyBullet's per step, the case run in this process) and, for the grasp,
-  ``box_height_m`` (the box's centre, which says whether it is held).
-  And ``tb3_sandbox.circle``: an SDF robot of a TurtleBot3 waffle's sizes
-  driving a circle in an SDF world of nine cylinders and a hexagonal mesh
-  wall, at the world's own ``max_step_size`` (3 ms), ``/scan`` read by a
-  subscriber process: ``steps_per_s``, ``node_cpu_us_per_step``,
-  ``real_time_multiple``, ``subscriber_cpu_percent`` and, from the robot run
-  in this process, ``lidar_us_per_scan`` and ``lidar_us_per_step``.
-* ``service_round_trip``: sim_node at real_time_factor 1 (the default) answering
-  ``SERVICE_CALLERS`` callers of its simulation_interfaces services
-  (``get_entity_state`` and ``get_simulation_state``, half each) from one process
-  (this one, on loopback), each with one call in flight, for ``Plan.services_s``
-  wall seconds and at most ``SERVICE_MAX_CALLS`` calls: ``p50_ms`` / ``p99_ms``
-  of the round trips, ``answers_per_s`` and ``unanswered`` (calls with no answer
-  within ``SERVICE_CALL_TIMEOUT_S``); absent without simulation_interfaces.
-* ``sensor_us_per_message``: wall microseconds sim_node spends per message
-  of each sensor of ``urdf/pan_tilt_sensors.xacro`` with every topic watched
-  (:mod:`pan_tilt_sim.tools.sensor_cost`, in this process).
-
-``--tune`` measures something else instead: evaluations per second of
-``tune``/``sweep`` on each back end (:mod:`pan_tilt_sim.tools.tune_bench`);
-``--load``: what spawned objects and world files cost to read, load and step
-(:mod:`pan_tilt_sim.tools.bench_load`); ``--test-session``: a user's pytest
-session, go-to-goal tests each on a fresh ``sim`` fixture, in one process and
-under ``-n 2`` (:mod:`pan_tilt_sim.tools.bench_test_session`; the domain and
-the next one).
-
-If the two raw rates (thread CPU, wall) are more than ``RAW_AGREEMENT``
-apart, a warning on stderr says the run's ratios are not to be trusted.
-
-``--runs N`` repeats everything and prints the median of each figure;
-``--quick`` is a smoke run of a few seconds (every key present, no timing
-meaningful).
-
-Every sim_node runs as a child process with ``ROS_AUTOMATIC_DISCOVERY_RANGE=
-LOCALHOST`` and the bench's ROS domain: ``--domain-id``, else the
-environment's ``ROS_DOMAIN_ID``, else one derived from the bench's process id.
-The children's output goes to log files, so stdout carries only the JSON.
+Design notes: docs/design/tools.md#benchpy.
 """
 
 from __future__ import annotations

@@ -4,26 +4,9 @@
 measures, in this process, without ROS, on the pan/tilt example at the default
 time step, the figures the limits on spawned objects and world files come from
 (:mod:`pan_tilt_sim.model.entity_resource`, :mod:`pan_tilt_sim.model.world_file`).
-CPU seconds of this process (its only thread does the work):
+CPU seconds of this process (its only thread does the work) (see the design notes).
 
-* ``chains``: serial chains of revolute joints (0.1 kg links), keyed by their
-  number of links: ``read_s`` (reading and checking the URDF, as SpawnEntity
-  does, the limits lifted), ``pybullet_load_s`` (one ``loadURDF`` into an
-  empty client), ``state_reported`` (whether PyBullet can give the body's base
-  pose afterwards) and, for chains PyBullet can report, ``trial_s`` (the
-  object's trial, alone), ``add_s`` (the load into the world) and
-  ``step_us`` (node physics per step with the chain in the world, less the
-  world's own).  Past :data:`STEPPED_LINKS` links a step takes seconds, so
-  only ``first_step_s`` (one step, alone, in its own client) is given, up to
-  :data:`FIRST_STEP_LINKS`.
-* ``world``: world files of 1,000 and 10,000 static boxes (0.2 m boxes on a
-  0.5 m grid, clear of the robot), keyed by count: ``read_s`` (reading
-  the YAML file), ``spawn_s`` (spawning every object), ``startup_ms_per_entity``
-  (both, per object) and ``step_us`` / ``step_us_per_entity`` (physics per
-  step with them, less the world's own).  The limit on world files is lifted
-  to measure 10,000.
-
-``--quick`` runs small cases only (every key present, timing meaningless).
+Design notes: docs/design/tools.md#bench_loadpy.
 """
 
 from __future__ import annotations
@@ -116,7 +99,7 @@ class World:
 
 def chain_figures(links: int, share: pathlib.Path, folder: pathlib.Path,
                   window: int) -> dict[str, float | bool]:
-    """Measure the ``chains`` figures of one chain (see the module docstring)."""
+    """Measure the ``chains`` figures of one chain (see the module's design notes)."""
     text = chain_urdf(links)
     read_s, resource = cpu_s(lambda: read_entity_resource(resource_string=text,
                                                           limits=UNLIMITED))
@@ -160,7 +143,7 @@ def chain_figures(links: int, share: pathlib.Path, folder: pathlib.Path,
 
 def world_figures(count: int, share: pathlib.Path, folder: pathlib.Path,
                   window: int) -> dict[str, float]:
-    """Measure the ``world`` figures of ``count`` static boxes (see the module docstring)."""
+    """Measure the ``world`` figures of ``count`` static boxes (see the module's design notes)."""
     path = folder / f'world_{count}.yaml'
     path.write_text(world_yaml(count), encoding='utf-8')
     read_s, world_file = cpu_s(lambda: read_world_file(path, max_entities=count))

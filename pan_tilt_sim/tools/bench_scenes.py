@@ -3,36 +3,9 @@
 Each scene is a robot and a world written into the bench's folder from
 package files (the bench runs from an installed package, so it makes its
 own files, as it does its chains), run in two cases that differ only in the
-contacts PyBullet has to solve:
+contacts PyBullet has to solve (see the design notes).
 
-* ``driving_base``: the shipped ``urdf/diff_drive_rover.urdf`` with its Gazebo
-  drive plugins replaced by a ``<ros2_control>`` block and a
-  ``diff_drive_controller/DiffDriveController`` (``base_controller``), in
-  ``config/worlds/room.yaml``, its lidar present and nobody subscribed to
-  ``/scan``.  ``on_ground``: the base free, driving a circle of
-  :data:`CIRCLE_RADIUS` on its wheels and caster; ``base_fixed``: the same
-  robot, commands and world with ``fixed_base:=true``, which welds the base
-  frame at the origin: the wheels and the caster reach into the ground, and
-  links that do when welded never collide with it, so the wheels spin
-  touching nothing (the room's ball resting on the ground is the one contact
-  left in both cases).
-* ``grasp``: a lift arm with a parallel gripper (two prismatic fingers, the
-  right one a mimic of the left, as Franka's hand) and a 4 cm, 0.2 kg box
-  between the fingers, spawned from a world file.  ``holding``: the fingers
-  squeeze the box with :data:`GRIP_N` and the lift holds it
-  :data:`LIFT_M` above the ground; ``open``: the fingers pushed open, the
-  lift at the same height, the box resting on the ground.
-* ``tb3_sandbox``: an SDF robot of the TurtleBot3 waffle's sizes and masses
-  (two driven wheels, two ball casters, a 360-beam 5 Hz lidar, gz-sim's
-  DiffDrive and JointStatePublisher) in an SDF world like Nav2's
-  ``tb3_sandbox`` (a ground plane, nine static cylinders on a
-  :data:`PILLAR_GRID` grid, a hexagonal wall given as a static concave OBJ
-  mesh, ``max_step_size`` :data:`SANDBOX_STEP`), all written here.
-  ``circle``: the robot driving a circle between four cylinders, ``/scan``
-  watched.
-
-:func:`contact_points` counts, in this process, the contact points PyBullet
-reports per step in each case (the same files, commands and world).
+Design notes: docs/design/tools.md#bench_scenespy.
 """
 
 from __future__ import annotations

@@ -11,19 +11,9 @@ A fresh simulation per evaluation, and the targets always in the same
 order, make the result a function of the case alone: the same case gives
 the same numbers on any worker, in any order.
 
-What is measured (``step_response``'s metrics, plus):
+What is measured (``step_response``'s metrics, plus) (see the design notes).
 
-* ``itae`` -- the cost: integral of ``t * |setpoint(t) - position(t)|`` over
-  the record, divided by the size of the step (s^2).  The setpoint is the
-  one the controller follows: the target, ramped at the URDF velocity limit
-  when the joint has one, so the unavoidable part of the error (the ramp
-  itself) does not drown what the gains change.
-* ``final_error`` -- the largest ``|target - position|`` over the last
-  ``FINAL_WINDOW_S`` of the record (``step_response`` reports the last
-  sample; the window keeps a joint that still hunts from passing).
-* ``saturated_s`` -- how long the effort sat at the URDF effort limit.
-* ``stable`` -- every position finite and the joint slower than PyBullet's
-  joint speed cap (a joint that hits the cap is being thrown around).
+Design notes: docs/design/tools.md#evaluationpy.
 """
 
 from __future__ import annotations

@@ -12,14 +12,7 @@ Installed with the package and inert until a test asks for its fixtures:
 * ``sim_process``: the same helpers for sim_node started as a program
   (:mod:`pan_tilt_sim.tools.sim_process_handle`).
 
-In a session whose tests use these fixtures, DDS stays on loopback unless
-``ROS_AUTOMATIC_DISCOVERY_RANGE`` says otherwise, and under pytest-xdist each
-worker gets a ROS domain of its own: ``ROS_DOMAIN_ID`` = the base
-(``--ros-domain-base``, else the controller's ``ROS_DOMAIN_ID``, else 0) +
-the worker's number.  Other sessions are left as they are.  With
-``--sim-record-failed=<folder>`` or ``PAN_TILT_SIM_RECORD_FAILED=<folder>``
-every simulation records its run as a rosbag2 bag; the bags of passing
-tests are removed, a failing test's report names its bags.
+Design notes: docs/design/tools.md#pytest_pluginpy.
 """
 
 from __future__ import annotations

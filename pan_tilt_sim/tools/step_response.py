@@ -9,36 +9,7 @@ rclpy), commands the joint to ``--target`` at t = 0 through the controller
 that drives it by position, records position, setpoint and effort every
 physics step for ``--duration`` seconds of sim time, and prints JSON.
 
-Any controller that takes position commands will do: a position controller
-(its command), a forward-command group on the position interface (the
-joint's element, the other joints holding their setpoints), or a joint
-trajectory controller (a one-point trajectory due at once, the other joints
-holding).  ``--controller`` picks one; by default the active controller of
-the joint is used when it takes positions, else the first that does.  The
-controllers file is read as sim_node reads it (``--controllers``, else the
-file the URDF's control plugin names; ``--controllers-args`` for its
-``$(var ...)``); ``--active-controllers`` chooses the active set, else every
-controller is activated that claims no joint an earlier one claims (the
-stepping controller first).  The metrics:
-
-* ``rise_time_s`` -- 10 % to 90 % of the step (linear interpolation between samples);
-* ``overshoot_percent`` -- how far past the target the joint went, in % of the step;
-* ``settling_time_s`` -- from the step until the position stays within 2 % of the step
-  around the target (null if it never does within the run);
-* ``steady_state_error`` -- target minus the final position (rad or m);
-* ``peak_effort`` -- the largest absolute effort applied (N*m or N);
-* ``velocity_limit_active`` -- whether the URDF velocity limit ramped the setpoint
-  (joint_limits_interface), and ``setpoint_reached_s``, when the ramp reached the target;
-* ``actuator`` -- what drives the joint (a position PID on effort, or the ideal
-  actuator when the YAML gives no gains) and ``gains`` (null for the ideal actuator).
-
-``--plot FILE`` writes a PNG (matplotlib, Agg backend): position and setpoint
-over time, the effort on a second axis, the metrics in the legend.
-``--record FOLDER`` writes the run as a rosbag2 bag (MCAP storage), the
-topics sim_node's ``record:=`` would hold (:mod:`.bag_recording`; only then
-are rclpy's message serialization and the mcap package loaded).  Errors in
-the arguments or files (a bag folder that exists or cannot be made
-included): one line on stderr, exit code 2.
+Design notes: docs/design/tools.md#step_responsepy.
 """
 
 from __future__ import annotations

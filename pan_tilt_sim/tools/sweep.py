@@ -11,28 +11,9 @@ Each ``--vary NAME=VALUES`` is an axis; the sweep runs every combination
 (a grid) or, with ``--samples N``, N random combinations (seeded by
 ``--seed``).  VALUES is a list (``-20,0,20``) or ``LOW:HIGH:COUNT`` (COUNT
 evenly spaced values; with ``--samples``, ``LOW:HIGH`` is a uniform range).
-The axes:
+The axes (see the design notes).
 
-* ``mass``, ``inertia``, ``friction``, ``damping`` -- change in % of every
-  link's mass (with its inertia), every inertia tensor, every joint's URDF
-  friction or damping (-100 = none);
-* ``payload`` -- kg added at ``--payload-link`` (default: the child link of
-  the last ``--joint``), ``--payload-offset X Y Z`` m in that link's frame;
-* ``time_step`` -- the physics step, s;
-* ``p``, ``i``, ``d`` -- change in % of the stepped joint's own PID gains.
-
-Physical variations go through :mod:`pan_tilt_sim.model.variation` (the
-robot model and PyBullet's URDF together); each combination and joint is one
-evaluation (:mod:`pan_tilt_sim.tools.evaluation`) on the same back ends as
-``tune``: ``--workers`` local processes or, with ``--address``, Ray tasks.
-Every step is checked against the same specification as ``tune``'s
-(``--max-overshoot``, ``--max-settling``, ``--max-error``, effort never at the
-URDF limit).  ``--report`` gets one row per combination, joint and target
-(CSV, or JSON for a ``.json`` name): the axis values, pass or fail, the
-constraints missed and the metrics; ``--heatmap`` a PNG of the share of
-failing steps over two axes (``--heatmap-axes X Y``; default the first two),
-the other axes folded in.  Exit code 0 when the sweep ran (failures are
-results), 2 for errors in the arguments or files.
+Design notes: docs/design/tools.md#sweeppy.
 """
 
 from __future__ import annotations

@@ -6,38 +6,7 @@ r"""tune: search PID gains that meet a step-response specification, in parallel.
         --max-error 0.002 --max-settling 15 --out tuned.yaml --plot tune.png
     ros2 run pan_tilt_sim tune ... --address auto          # the same on a Ray cluster
 
-For each ``--joint`` (one after another; a joint tuned earlier keeps its new
-gains while the next is tuned), Optuna's TPE sampler (seeded with
-``--seed``, constrained by the specification) proposes PID gains -- p, i, d
-and a symmetric integral clamp, log-uniform around the YAML's gains -- in
-batches of ``--batch``; each candidate is evaluated by stepping the joint
-from its initial position to every ``--target`` in a fresh simulation
-(:mod:`pan_tilt_sim.tools.evaluation`), on ``--workers`` local processes or,
-with ``--address``, as Ray tasks.  Results are told to the optimiser in the
-order they were asked for, never in the order they finish, so a seed gives
-the same gains with 1 worker, 2 workers or a Ray cluster.  The YAML's own
-gains are the first candidate.
-
-The specification: overshoot at most ``--max-overshoot`` % of the step,
-settled within 2 % of the step by ``--max-settling`` s, ``|target -
-position|`` at most ``--max-error`` over the last 0.5 s, and the effort never
-at the URDF effort limit.  Among the candidates that meet it, the one with
-the lowest cost wins: ITAE, the integral of ``t * |setpoint - position|``
-over the record, per unit of step, summed over the targets (see
-``evaluation``).
-
-Then it prints a before/after table of every metric for every target,
-writes ``--plot`` (one PNG: both step responses of every target),
-``--record`` (the after steps as rosbag2 bags, ``FOLDER/<joint>_<n>`` for
-the n-th target, the topics sim_node's ``record:=`` would hold) and, if
-every joint met the specification, ``--out``: the controllers YAML with
-only the gains' values changed, in the file's own style (ROS 1 ``pid:`` or
-ros2_control ``gains:``, flow or block, comments and order untouched).  When
-no candidate meets it, it says which constraint binds for the best one and,
-where the URDF's limits make the bound impossible (a velocity limit that
-ramps the setpoint too slowly for the settling time, an effort limit below
-the joint's friction), says so; exit code 1, and the YAML is not written.
-Errors in the arguments or files: one line, exit code 2.
+Design notes: docs/design/tools.md#tunepy.
 """
 
 from __future__ import annotations

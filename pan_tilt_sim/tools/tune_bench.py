@@ -4,50 +4,9 @@
 times the unit of work of ``tune`` and ``sweep`` -- one evaluation: the
 pan/tilt example's pan stepped 0 -> 1 rad with its own gains, 15 s of sim time at
 1 ms, in a fresh simulation (:func:`pan_tilt_sim.tools.evaluation.evaluate`)
--- and prints one JSON object:
+-- and prints one JSON object (see the design notes).
 
-* ``cpu_s_per_evaluation`` -- CPU seconds of one evaluation in this process
-  (median): the core-seconds an evaluation costs wherever it runs, and
-  ``worker_cpu_s_per_evaluation``, the same measured inside each back end's
-  workers (it should match: the work is the same everywhere);
-* ``evaluations_per_s`` -- throughput of ``in_process`` (a loop here),
-  ``local_1`` and ``local_2`` (1 and 2 spawned worker processes) and
-  ``ray_2_nodes`` (Ray tasks on a two-node cluster started on the local machine:
-  a head node and a second node, one CPU each, all on 127.0.0.1);
-* ``worker_busy_share`` -- per back end, the share of its workers' wall time
-  spent evaluating (their CPU time over wall time x parallelism): 1 on an
-  idle machine with no overhead; on a shared machine it shows how much of a
-  core the workers actually got;
-* ``overhead_ms_per_evaluation`` -- per back end, wall time per evaluation
-  times the back end's parallelism, less ``cpu_s_per_evaluation``: what
-  running it there costs beyond the simulation itself (dispatch,
-  serialisation, scheduling, and on a shared machine, waiting for a core);
-* ``dispatch_ms_per_task`` -- per back end, the wall time per call of a task
-  that does nothing but receive the same payload (the robot) and return:
-  the back end's own cost, with no simulation to hide it;
-* ``ray_submit_ms_per_task`` -- the driver's own cost of submitting one Ray
-  task (``.remote()`` alone, not waiting for it): one driver keeps at most
-  about ``cpu_s_per_evaluation / submit`` cores busy;
-* ``tpe_ms_per_trial`` -- ``tune``'s driver cost per candidate: Optuna's TPE
-  ask + tell with 64 and 512 candidates already known (keys), the same
-  sampler, space and constraints, cheap made-up costs;
-* ``ray_cluster_start_s`` and ``ray_connect_s`` -- starting the two nodes,
-  and connecting a driver to them (which ships this package to the cluster);
-* ``load_average_1min`` before and after, and ``cpu_count``: how quiet the
-  machine was.
-
-Every figure is the median over ``--runs`` rounds; in each round the back
-ends run one after the other on the same cases (after a warm-up batch that
-starts their workers), so they see the same machine.  ``--quick`` is a smoke
-run of a few seconds (1 s of sim time per evaluation; timing meaningless).
-
-The Ray nodes: on Linux ``ray start`` resolves 127.0.0.1 to the machine's
-network address (Ray expects nodes to reach each other over the network),
-so the bench starts its two nodes with Ray's own multi-node-on-one-machine
-tool, ``ray.cluster_utils.Cluster``, in a child process with
-``RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER=0``, which keeps every Ray address on
-loopback; the child is stopped (and with it every Ray process it started)
-at the end.  Without Ray installed, the Ray figures are null.
+Design notes: docs/design/tools.md#tune_benchpy.
 """
 
 from __future__ import annotations
@@ -83,7 +42,7 @@ CLUSTER_START_TIMEOUT_S = 120.0
 CLUSTER_STOP_TIMEOUT_S = 30.0
 NODE_OBJECT_STORE_BYTES = 100 * 1024 * 1024
 LOOPBACK = '127.0.0.1'
-# Keeps every Ray address on 127.0.0.1 (see the module docstring).
+# Keeps every Ray address on 127.0.0.1 (see the module's design notes).
 RAY_LOOPBACK_ENV = {'RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER': '0', 'RAY_USAGE_STATS_ENABLED': '0'}
 MILLISECONDS = 1e3
 # Optuna's cost per trial is measured with this many trials already told.
@@ -233,7 +192,7 @@ def cpu_per_evaluation(scenario: Scenario, case: Case, count: int) -> tuple[floa
 
 def run(*, quick: bool = False, runs: int = 1,
         log: Callable[[str], None] = lambda text: None) -> dict:
-    """Measure every figure ``runs`` times; return the medians (see the module docstring)."""
+    """Measure every figure ``runs`` times; return the medians (see the module's design notes)."""
     scenario = pan_scenario()
     case = Case(JOINT, (TARGET,), duration=QUICK_DURATION_S if quick else None)
     evaluations = QUICK_EVALUATIONS if quick else FULL_EVALUATIONS

@@ -4,7 +4,7 @@ examples/launch/arm_ros2_control.launch.py is written in ros2_control_demos'
 shape (control node with the controllers YAML, robot_state_publisher with
 the xacro output, spawners with ``--param-file`` and ``--controller-ros-args``
 chained by OnProcessExit); a stand-in of the launch API carries it out
-(test/launch_stand_in.py: sim_node and a stand-in robot_state_publisher as
+(test/support/launch_stand_in.py: sim_node and a stand-in robot_state_publisher as
 processes, spawners in-process as jazzy's spawner calls).
 test/data/gz_shaped/arm_sim_control.launch.py is a Gazebo launch in UR's shape
 (its nodes made by an OpaqueFunction) with the spawn step swapped for sim_node.

@@ -1,7 +1,7 @@
 """The browser view in a real browser: sim_node with viewer:=true, rendered by headless Chromium.
 
 The program serves the view on a free port (it logs the URL); Chromium opens
-it and takes screenshots over the DevTools protocol (``test/browser.py``).
+it and takes screenshots over the DevTools protocol (``test/end_to_end/browser.py``).
 The page must show the pan/tilt: its blue pan link and its red tilt link on
 the 3D canvas; after a pan command from the test process, the red link's
 pixels must have moved.  Where Chromium cannot be had, the test skips saying

@@ -1,6 +1,6 @@
 """A free base on the ground: when the base is free, where it starts, and how it meets the ground.
 
-The rover (test/mobile_fixtures.py) stands on two wheels and a frictionless
+The rover (test/support/mobile_fixtures.py) stands on two wheels and a frictionless
 caster; its diff drive controller makes it mobile, so ``fixed_base`` None
 (sim_node's ``auto``) frees it.  Driven by the controller's own command, the
 wheels' traction moves the base over the ground plane.

@@ -1,6 +1,6 @@
 """The <ros2_control> sensors and gpios, simulated, against the truth of the sensor arm.
 
-See test/hardware_fixtures.py: a payload of known mass below a force-torque
+See test/support/hardware_fixtures.py: a payload of known mass below a force-torque
 sensor, an IMU at rest, a range ray looking down at the ground, a pose, a
 gpio, and entries the simulator cannot produce.
 """

@@ -1,6 +1,6 @@
 """Fuzzing what users hand sim_node: parameters, plugin and sensor tags, run-time requests.
 
-Whatever test/input_strategies.py draws -- any registered controller type
+Whatever test/sim/input_strategies.py draws -- any registered controller type
 with hostile parameters generated from its own spec, a Gazebo drive plugin,
 lidar or camera with hostile tags, and hostile commands and goals -- starting
 it as sim_node does either ends in a ConfigurationError of one line (sim_node's
@@ -8,8 +8,8 @@ exit 2), or it runs: one scan and image per sensor, every command and goal
 sent, a few hundred steps, and no exception, NaN joint state, NaN base pose,
 NaN range or depth.
 
-The examples run in a child process (test/input_worker.py, driven by
-test/worker_process.py): a crash or a hang is a failing example.  The default
+The examples run in a child process (test/sim/input_worker.py, driven by
+test/sim/worker_process.py): a crash or a hang is a failing example.  The default
 run draws :data:`EXAMPLES` (a few seconds); the opt-in ``fuzz`` marker's test
 draws :data:`SLOW_EXAMPLES`, only with ``PAN_TILT_SIM_SLOW=1``::
 
@@ -38,7 +38,7 @@ EXAMPLES = 24
 SLOW_EXAMPLES = 3000
 SLOW_BUDGET_S = 4 * 3600  # the suite's 600 s per test is far too little for thousands
 STEPS = 100  # physics steps each accepted input runs
-WORKER = pathlib.Path(__file__).resolve().parents[1] / 'input_worker.py'
+WORKER = pathlib.Path(__file__).resolve().parent / 'input_worker.py'
 OUTCOMES = ('refused', 'ran')
 SETTINGS = {'deadline': None, 'suppress_health_check': [HealthCheck.too_slow,
                                                          HealthCheck.data_too_large]}

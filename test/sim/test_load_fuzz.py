@@ -9,7 +9,7 @@ still finite after a few hundred steps -- or ends in a ConfigurationError
 hang or a NaN.
 
 PyBullet segfaults on some inputs, so the examples run in a child process
-(test/load_worker.py, run by test/worker_process.py), one after another: a
+(test/sim/load_worker.py, run by test/sim/worker_process.py), one after another: a
 crash or a hang there is a failing example here, and the next example gets a
 fresh child.  CI runs
 :data:`EXAMPLES` examples; ``PAN_TILT_SIM_SLOW=1`` runs :data:`SLOW_EXAMPLES`.
@@ -31,7 +31,7 @@ SLOW_ENV = 'PAN_TILT_SIM_SLOW'
 EXAMPLES = 100
 SLOW_EXAMPLES = 2000
 STEPS = 300  # physics steps each loaded robot and spawned object runs
-WORKER = pathlib.Path(__file__).resolve().parents[1] / 'load_worker.py'
+WORKER = pathlib.Path(__file__).resolve().parent / 'load_worker.py'
 ROBOT_OUTCOMES = ('refused', 'loaded')
 OBJECT_OUTCOMES = ('refused', 'spawned')
 

@@ -1,6 +1,6 @@
 """Wheels with free rollers on the ground: the base moves by contact forces, as the rollers allow.
 
-The mecanum base of test/roller_fixtures.py stands free on its four wheels,
+The mecanum base of test/support/roller_fixtures.py stands free on its four wheels,
 the omni base on its three; their controllers' wheel speeds are the only
 thing driving them, and the roller friction
 (pan_tilt_sim/sim/roller_wheels.py) is the only grip the wheels have.

@@ -1,4 +1,4 @@
-"""URDF sensors in the simulation, against the truth of the rig (see test/sensor_fixtures.py)."""
+"""URDF sensors in the simulation, against the rig's truth (test/support/sensor_fixtures.py)."""
 
 import math
 import pathlib

@@ -11,44 +11,7 @@ messages stamped with sim time:
   ``publish_dynamic_joint_states`` is false; the node publishes it where
   control_msgs is installed).
 
-With ``use_local_topics`` both are in the controller's namespace
-(``~/joint_states``), as joint_state_broadcaster's are.  A sample's lists
-are reused from call to call; a sink must copy them.  Only a connected sink
-costs anything: a topic nobody listens to takes no sample (see
-:class:`~pan_tilt_sim.controllers.framework.surface.StateTopic`).
-
-Which interfaces, as joint_state_broadcaster (jazzy) chooses them:
-
-* A joint's state interfaces are position, velocity and effort -- the
-  physics measures them -- then the other ``<state_interface>`` entries its
-  ``<ros2_control>`` block declares (see
-  :class:`~pan_tilt_sim.controllers.framework.base.JointHandle`).  Nothing measures
-  those: they are published with the value they hold, their
-  ``initial_value`` or else NaN, which is what ros2_control's mock hardware
-  reports for a state interface nothing writes (gz_ros2_control would not
-  offer them at all; leaving them out would drop what the URDF declares).
-* ``joints`` and ``interfaces`` both given: the interfaces named, of the
-  joints named, in the order given; a pair the robot lacks is left out with
-  a warning, and no pair at all is an error.  Either one empty: every state
-  interface of every movable joint, in the description's order (the other
-  list is ignored, with a warning).
-* ``map_interface_to_joint_state.<field>`` names the interface published
-  as JointState's ``<field>``; a joint without it publishes its own
-  ``<field>`` interface there if selected, else NaN.  A mapping is ignored
-  when ``interfaces`` names the field itself, as upstream.  A mapped
-  interface no published joint has gets one warning (upstream is silent).  In the dynamic
-  message every interface keeps its own name (upstream files a mapped one
-  under the field's name, where it can collide with the joint's own
-  interface of that name).
-* ``extra_joints``: names published after the joints with position,
-  velocity and effort 0, in both messages; a name already published is
-  skipped.
-
-The rate is ``publish_rate`` when given (ROS 1 style); otherwise
-``update_rate``, since ROS 2's joint_state_broadcaster publishes at every
-update of its controller_manager (a ros2_control-style file gives every
-controller the controller_manager's rate, 100 Hz by default); otherwise
-50 Hz, the pan/tilt example's rate.
+Design notes: docs/design/controllers.md#joint_state_controllerpy.
 """
 
 from __future__ import annotations
@@ -204,7 +167,7 @@ class JointStateController(Controller):
         return dict(self._selected)
 
     def configure(self, joints: Mapping[str, JointHandle]) -> None:
-        """Choose the joints and interfaces published (see the module's docstring)."""
+        """Choose the joints and interfaces published (see the module's design notes)."""
         handles, self._selected = self._select(joints)
         sources = self._field_sources
         self.names, self.dynamic_names, self.dynamic_interfaces = [], [], []

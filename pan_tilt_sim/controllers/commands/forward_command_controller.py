@@ -5,42 +5,9 @@ interface, ``interface_name``, and takes ``std_msgs/msg/Float64MultiArray``
 commands on ``<controller>/commands``: element k is the command of the k-th
 joint.  Each joint behaves exactly like the one-joint controller of its
 interface (limits, ramp, actuator), which it is built from, with gains from
-``gains: {<joint>: {p, i, d, i_clamp}}``:
+``gains: {<joint>: {p, i, d, i_clamp}}`` (see the design notes).
 
-* position and velocity: a joint with gains (there, or in
-  ``gazebo_ros_control/pid_gains``) is driven by a PID on effort; one
-  without by the ideal actuator (see :mod:`~pan_tilt_sim.controllers.toolbox.actuator`),
-  as Gazebo does.  A PID is stable while (for the position loop)
-  ``d * time_step / 2 + p * time_step^2 / 4`` stays below the joint's
-  effective inertia -- at the default 1 ms step and the pan/tilt example's p 100, d 10,
-  inertias above 0.005 kg m^2 (or 5 g on a prismatic joint); the simulation
-  warns at start-up about any joint that is too light for its gains.
-* effort: the command is the effort;
-* acceleration: the command is integrated into the velocity target of the
-  ideal velocity actuator, as ros2_control's mock hardware integrates it
-  (:mod:`~pan_tilt_sim.controllers.commands.joint_acceleration_controller`).
-
-ros2_control lets a ``<ros2_control>`` block name any command interface, so
-any ``interface_name`` is taken when the file is read.  One the simulator
-cannot drive (``pid_gain``, say): configuring the controller refuses it,
-naming the joint, unless the joint's ``<ros2_control>`` entry declares it --
-then the controller configures, as upstream's does, and the
-:mod:`~pan_tilt_sim.controllers.framework.manager` refuses to activate it
-(:meth:`ForwardCommandController.undrivable_interfaces`).  Whether the
-joint's block gives it the interface, and whether the block's hardware
-accepts it beside the others, is also the manager's question at activation.
-
-An entry of ``joints`` may instead name a chainable controller's degree of
-freedom, ``<controller>/<dof>``, as ros2_control's chained controllers do: the
-controller then claims that controller's reference interface
-``<controller>/<dof>/<interface_name>`` and writes its command there every
-step, unchanged -- no limits, ramp, PID or actuator, since a reference is
-not a joint: the following controller decides what it means.  Before the
-first command nothing is written.
-
-A command of the wrong length, or with a NaN or infinite element, is
-rejected whole and nothing changes.  The ``JointGroup*Controller`` types
-are this controller with the interface fixed.
+Design notes: docs/design/controllers.md#forward_command_controllerpy.
 """
 
 from __future__ import annotations

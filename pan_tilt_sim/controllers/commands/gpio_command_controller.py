@@ -6,20 +6,7 @@ claims of each, ``state_interfaces.<gpio>.interfaces`` the state interfaces
 it publishes -- all of every listed gpio's when no gpio lists any, as
 upstream reads them from the URDF.  With neither it refuses to configure.
 
-At every update (the controller_manager's rate) it publishes the states on
-``~/gpio_states`` and then writes the latest command taken on ``~/commands``
-(subscribed only when it claims command interfaces) -- both
-``control_msgs/msg/DynamicInterfaceGroupValues``: one entry of
-``interface_groups`` per gpio, with its ``interface_names`` and ``values``.
-A command is checked whole when it arrives: a group or interface it does not
-claim, names and values of different lengths, or a value that is not a
-finite number reject it with a warning, and nothing changes.  Activated again
-after a deactivation it starts without a command, as upstream resets it (the
-interfaces keep their values).
-
-The simulation echoes a gpio command into the state interface of the same
-name, as mock hardware does; a state without a command keeps its
-``initial_value`` (NaN where none is given).
+Design notes: docs/design/controllers.md#gpio_command_controllerpy.
 """
 
 from __future__ import annotations

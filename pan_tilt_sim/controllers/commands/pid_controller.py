@@ -7,60 +7,7 @@ it commands through ``command_interface``, and ``reference_and_state_dof_names``
 reads, through the one or two ``reference_and_state_interfaces`` (the second
 is the first derivative of the first: ``[position, velocity]``).
 
-References.  For every interface and reference DoF the controller exports
-the reference interface ``<controller>/<dof>/<interface>`` (all DoFs of the
-first interface, then of the second).  In chained mode the preceding
-controller writes them; otherwise ``~/reference``
-(``control_msgs/msg/MultiDOFCommand``) does: ``values`` are the first
-interface's references, ``values_dot`` the second's, by ``dof_names`` (or in
-order when the message names none); a NaN leaves that reference as it is.
-The state is the joints' state interfaces, or with
-``use_external_measured_states`` the last ``~/measured_state`` message (also
-a MultiDOFCommand, in order).
-
-Every update, for each DoF whose first reference and state are finite (see
-upstream's ``update_and_write_commands``):
-
-* ``error = reference - state`` (wrapped into [-pi, pi] with
-  ``angle_wraparound``);
-* the derivative term acts on ``reference_dot - state_dot`` when there are
-  two interfaces and both are finite, else on the finite difference of the
-  error (the previous error being 0 after activation, as control_toolbox's);
-* the PID (control_toolbox's "legacy" anti-windup: ``i_clamp_min`` /
-  ``i_clamp_max``, ``antiwindup``), its output within
-  [``u_clamp_min``, ``u_clamp_max``];
-* in feed-forward mode (``enable_feedforward``, or
-  ``~/set_feedforward_control``) plus ``feedforward_gain`` times the second
-  interface's reference (two interfaces; nothing while it is NaN) or the
-  first's (one).
-
-The sum is the command.  Where reference or state is not finite nothing is
-written and the command keeps its value.  On a joint the simulator applies
-it as the interface's hardware would be:
-
-* ``effort``: the physics applies it, within the joint's effort limit;
-* ``velocity``: the ideal actuator's velocity target, within the velocity
-  limit (:mod:`pan_tilt_sim.controllers.toolbox.actuator`);
-* ``position``: the ideal actuator's position path, as a
-  JointPositionController without gains drives it: the command, within the
-  position limits, is reached within the velocity and acceleration limits.
-
-A ``dof_names`` entry ``<controller>/<dof>`` names a reference interface of
-a chainable controller instead: the command is written there unchanged.
-
-On activation the references are the present state
-(``set_current_state_as_first_setpoint``; NaN otherwise, or with external
-states, until a reference comes), the PIDs restart keeping their integral
-term (``save_i_term``), and until the first command each joint gets none:
-no effort, zero velocity, or held where it is.
-
-``~/controller_state`` (``control_msgs/msg/MultiDOFStateStamped``) carries
-every update's reference, feedback, error, time step and command per
-reference DoF while someone subscribes.  The gains ``p``, ``i``, ``d``,
-``i_clamp_*`` and ``antiwindup`` are live-tunable node parameters
-(``<controller>.gains.<dof>.p``); the other per-DoF entries are read when
-the controller is configured.  Exported state interfaces (upstream's, for
-following chained controllers to read) are not simulated.
+Design notes: docs/design/controllers.md#pid_controllerpy.
 """
 
 from __future__ import annotations

@@ -1,53 +1,8 @@
 """``diff_drive_controller/DiffDriveController``: a twist in, wheel velocities out, odometry back.
 
-As ros2_controllers' (jazzy), parameters by their names there:
+As ros2_controllers' (jazzy), parameters by their names there (see the design notes).
 
-* **Command**: ``~/cmd_vel`` (``geometry_msgs/msg/TwistStamped``); only
-  ``linear.x`` (m/s) and ``angular.z`` (rad/s) count.  A twist whose
-  ``linear.x`` or ``angular.z`` is NaN or infinite is refused (a throttled
-  warning); an unstamped one is stamped with the sim time it arrives at, and
-  one already older than ``cmd_vel_timeout`` is refused.  Once the newest
-  command is older than ``cmd_vel_timeout`` (s of sim time; 0: never) the
-  robot brakes to a stop.  Until the first command the wheels are not
-  commanded; the odometry is published all the same (upstream waits for a
-  command), so that odom and its TF exist from the start.
-* **Limits**: ``linear.x.*`` and ``angular.z.*`` velocity, acceleration
-  (forward, deceleration, and the reverse pair) and jerk limits, NaN = off
-  (see :mod:`.rate_limiter`); the deprecated ``has_*_limits: false`` turns a
-  group off.  ``publish_limited_velocity``: the limited twist on
-  ``~/cmd_vel_out`` (at ``update_rate``, else ``publish_rate``).
-* **Wheels**: ``left_wheel_names`` and ``right_wheel_names`` (as many on
-  each side), driven through their ``velocity`` command interface by the
-  ideal velocity actuator at ``(v -+ w * separation / 2) / radius`` rad/s,
-  with ``wheel_separation``, ``wheel_radius`` and their multipliers.
-* **Odometry**: from the wheels' mean position per side
-  (``position_feedback``, the default), their mean velocity, or the limited
-  command (``open_loop``); see :mod:`.odometry`.  ``~/odom``
-  (``nav_msgs/msg/Odometry``, ``odom_frame_id`` -> ``base_frame_id``, the
-  covariance diagonals) and, with ``enable_odom_tf``, the same transform on
-  ``/tf``, at ``publish_rate`` Hz of sim time.  Frame ids get
-  ``tf_frame_prefix`` (empty: the controller's namespace, without its
-  leading slash) when ``tf_frame_prefix_enable``.
-* **Chaining**: it exports ``<name>/linear/velocity`` and
-  ``<name>/angular/velocity``; in chained mode the preceding controller
-  writes them and ``~/cmd_vel`` (and its timeout) is not used.  A wheel
-  name ``<controller>/<dof>`` (ros2_control_demos' example 16:
-  ``pid_controller_left_wheel_joint/left_wheel_joint``) is that chainable
-  controller's reference ``<controller>/<dof>/velocity``: the wheel velocity
-  (rad/s) is written there instead of to a joint.  Its feedback is the state
-  that controller exports for ``<dof>``, which for a pid_controller reading
-  its joint is the joint's own state: so ``<dof>`` must be a joint of the
-  robot unless ``open_loop`` needs no feedback.
-
-A ROS 1 (gazebo_ros_control) YAML's controller -- ``left_wheel`` /
-``right_wheel`` instead of the ``*_names`` -- is read with noetic's names
-and defaults (:mod:`pan_tilt_sim.model.ros1_diff_drive`) and takes an
-unstamped ``geometry_msgs/msg/Twist`` on ``~/cmd_vel``.
-
-Its type frees the robot's base (``drives_base``): with sim_node's
-``fixed_base:=auto`` a robot with one active stands on the ground.  A reset
-(activation, ``reset_simulation``) puts the odometry back at the origin;
-upstream keeps it across a deactivation.
+Design notes: docs/design/controllers.md#diff_drive_controllerpy.
 """
 
 from __future__ import annotations

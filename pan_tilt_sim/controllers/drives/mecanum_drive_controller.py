@@ -1,51 +1,8 @@
 """``mecanum_drive_controller/MecanumDriveController``: a body twist in, four wheel speeds out.
 
-As ros2_controllers' (jazzy), parameters by their names there:
+As ros2_controllers' (jazzy), parameters by their names there (see the design notes).
 
-* **Reference**: ``~/reference`` (``geometry_msgs/msg/TwistStamped``);
-  ``linear.x``, ``linear.y`` (m/s) and ``angular.z`` (rad/s) count, in the
-  base frame.  A twist with a NaN or infinite one of them is refused (a
-  throttled warning; upstream lets infinities through).  An unstamped one
-  is stamped with the sim time it arrives at; one older than
-  ``reference_timeout`` (s of sim time) is refused.  The reference is used
-  while it is at most ``reference_timeout`` old, then the wheels are
-  commanded to stop; with ``reference_timeout`` 0 (the default) each
-  reference is used for one update only, as upstream.
-* **Limits**: ``linear.x.*``, ``linear.y.*`` and ``angular.z.*`` velocity,
-  acceleration and jerk limits (NaN = off, see :mod:`.rate_limiter`),
-  applied before the inverse kinematics.
-* **Wheels**: ``front_left_wheel_command_joint_name`` ... (four), driven
-  through their ``velocity`` command interface by the ideal velocity
-  actuator -- or a following controller's references
-  (``<controller>/<joint>``, its ``velocity`` reference), as upstream.
-  With ``l`` = ``kinematics.sum_of_robot_center_projection_on_X_Y_axis``
-  and ``r`` = ``kinematics.wheels_radius``: front left ``(vx - vy - l w) / r``,
-  front right ``(vx + vy + l w) / r``, rear right ``(vx - vy + l w) / r``,
-  rear left ``(vx + vy - l w) / r`` rad/s, the twist first moved from the
-  base frame to the wheels' centre by ``kinematics.base_frame_offset``.
-  The ``*_wheel_state_joint_name`` (default: the command joint) are read
-  through their ``velocity`` state interface; they name the wheels when a
-  following controller takes the commands.
-* **Odometry**: the forward kinematics of the measured wheel velocities,
-  integrated at every update (Euler, heading first), twist raw (no rolling
-  mean), as upstream.  ``~/odometry`` (``nav_msgs/msg/Odometry``,
-  ``odom_frame_id`` -> ``base_frame_id``, the covariance diagonals),
-  ``~/tf_odometry`` (``tf2_msgs/msg/TFMessage``, with ``enable_odom_tf``)
-  and ``~/controller_state`` (``control_msgs/msg/MecanumDriveControllerState``:
-  the measured wheel velocities and the reference).  Frame ids get
-  ``tf_frame_prefix`` (empty: the controller's namespace) when
-  ``tf_frame_prefix_enable``.
-* **Chaining**: it exports ``<name>/linear/x/velocity``,
-  ``<name>/linear/y/velocity`` and ``<name>/angular/z/velocity``; they are
-  read at each update and set back to NaN after it, so a preceding
-  controller writes them every update.
-
-The controller updates every ``1 / update_rate`` s of sim time (the
-controller_manager's rate, 100 Hz by default); the wheels keep their speed
-in between, as on hardware.  Its type frees the robot's base
-(``drives_base``), and it tells the simulation that its four wheels carry
-free rollers at 45 degrees (:meth:`MecanumDriveController.roller_wheels`):
-see :mod:`pan_tilt_sim.sim.roller_wheels`.
+Design notes: docs/design/controllers.md#mecanum_drive_controllerpy.
 """
 
 from __future__ import annotations

@@ -1,42 +1,8 @@
 """``omni_wheel_drive_controller/OmniWheelDriveController``: a twist in, n omni wheel speeds out.
 
-As ros2_controllers' (jazzy branch), parameters by their names there:
+As ros2_controllers' (jazzy branch), parameters by their names there (see the design notes).
 
-* **Wheels**: ``wheel_names`` (at least three), given anticlockwise from
-  the wheel at ``wheel_offset`` rad from the base's x axis; wheel ``i``
-  sits at angle ``theta_i = 2 pi i / n + wheel_offset``, ``robot_radius``
-  (m) from the centre, its axis pointing away from it, and is driven
-  through its ``velocity`` command interface by the ideal velocity
-  actuator at ``(sin(theta_i) vx - cos(theta_i) vy - robot_radius wz) /
-  wheel_radius`` rad/s.
-* **Command**: ``~/cmd_vel`` (``geometry_msgs/msg/TwistStamped``);
-  ``linear.x``, ``linear.y`` (m/s) and ``angular.z`` (rad/s) count.  A
-  twist with a NaN or infinite one is refused (a throttled warning;
-  upstream keeps it and warns at each update).  An unstamped one is
-  stamped with the sim time it arrives at; one at least ``cmd_vel_timeout``
-  old is refused (0: none is).  Once the newest command is older than
-  ``cmd_vel_timeout`` the wheels brake to a stop -- with 0, as upstream,
-  right after the update it arrived at.  Until the first command (and
-  while the initial, empty one is younger than the timeout) nothing is
-  commanded and no odometry is published, as upstream.
-* **Odometry**: from the wheels' positions (``position_feedback``, the
-  default), their velocities, or the command (``open_loop``): the
-  least-squares twist of the wheel speeds, integrated exactly along an arc.
-  ``~/odom`` (``nav_msgs/msg/Odometry``, ``odom_frame_id`` ->
-  ``base_frame_id``, ``diagonal_covariance.pose``/``.twist``) and, with
-  ``enable_odom_tf``, the same transform on ``/tf``, once per update.
-  Frame ids get ``tf_frame_prefix`` (empty: the controller's namespace)
-  when ``tf_frame_prefix_enable``.
-* **Chaining**: it exports ``<name>/linear/x/velocity``,
-  ``<name>/linear/y/velocity`` and ``<name>/angular/z/velocity``; in
-  chained mode the preceding controller writes them and ``~/cmd_vel`` is
-  not used.
-
-It updates every ``1 / update_rate`` s of sim time (the controller_manager's
-rate, 100 Hz by default).  Its type frees the robot's base (``drives_base``)
-and tells the simulation that its wheels are omni wheels, free along their
-axes (:meth:`OmniWheelDriveController.roller_wheels`, see
-:mod:`pan_tilt_sim.sim.roller_wheels`).
+Design notes: docs/design/controllers.md#omni_wheel_drive_controllerpy.
 """
 
 from __future__ import annotations

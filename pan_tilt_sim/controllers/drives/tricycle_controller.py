@@ -1,42 +1,8 @@
 """``tricycle_controller/TricycleController``: one wheel that steers and drives.
 
-As ros2_controllers' (jazzy), parameters by their names there:
+As ros2_controllers' (jazzy), parameters by their names there (see the design notes).
 
-* **Command**: ``~/cmd_vel`` (``geometry_msgs/msg/TwistStamped``); only
-  ``linear.x`` (m/s) and ``angular.z`` (rad/s) count.  An unstamped twist is
-  stamped with the sim time it arrives at; a twist whose ``linear.x`` or
-  ``angular.z`` is NaN or infinite is refused (a throttled warning).  While
-  the newest command is older than ``cmd_vel_timeout`` (ms of sim time) --
-  and before the first -- the command is zero: the wheel stops and steers
-  straight.
-* **Kinematics**: the steered wheel ``wheelbase`` ahead of the middle of the
-  rear axle turns to ``alpha = atan(omega * wheelbase / v)`` (0 where ``v``
-  or ``omega`` is 0; +-90 degrees for a turn on the spot) and rolls at
-  ``v / (wheel_radius * cos(alpha))`` rad/s (``|omega| * wheelbase /
-  wheel_radius`` on the spot).  While the steering is more than 30 degrees
-  from its command the speed is scaled by the cosine of the difference
-  (0.01 beyond 90 degrees).  ``traction_joint_name`` is driven through its
-  ``velocity`` interface (the ideal velocity actuator),
-  ``steering_joint_name`` through ``position`` (a setpoint within the
-  joint's limits, tracked every physics step).
-* **Limits**: ``traction.*`` (the wheel's rad/s: velocity, acceleration,
-  deceleration, jerk) and ``steering.*`` (rad: position, velocity,
-  acceleration), NaN = off, each a magnitude applied in both directions; a
-  ``min_*`` is a floor on the magnitude, as upstream.
-* **Odometry**: from the wheel's velocity and the steering angle (``Vx = Vs
-  cos(alpha)``, ``omega = Vs sin(alpha) / wheelbase``), or from the command
-  (``open_loop``); ``~/odom`` (``nav_msgs/msg/Odometry``; ``odom_only_twist``
-  leaves its pose at zero) and, with ``enable_odom_tf``, ``/tf``.
-  ``~/reset_odometry`` (``std_srvs/srv/Empty``) puts it back at the origin.
-  With ``publish_ackermann_command``, the limited command on
-  ``~/cmd_ackermann`` (``ackermann_msgs/msg/AckermannDrive``: wheel speed in
-  rad/s as upstream writes it, steering angle in rad).
-
-Everything but the steering's tracking runs at ``update_rate`` (the
-controller_manager's), as upstream.  Its type frees the robot's base
-(``drives_base``).  A reset (activation, ``reset_simulation``) puts the
-odometry back at the origin; deactivation stops the wheel and steers it
-straight (upstream's halt).
+Design notes: docs/design/controllers.md#tricycle_controllerpy.
 """
 
 from __future__ import annotations

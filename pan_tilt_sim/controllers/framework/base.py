@@ -16,15 +16,7 @@ each of its joints' handles which :class:`Actuator` drives it:
   ``max_effort``), and the simulation writes the effort it applied back into
   ``handle.effort`` (an acceleration command is integrated into that target).
 
-Controllers can be chained, as ros2_control's chainable controllers are: a
-*chainable* controller exports reference interfaces (:class:`Reference`),
-named ``<controller>/<reference>``, which a *preceding* controller claims
-and writes as it would a joint's command interface; the following
-controller reads them in the same step (the manager updates preceding
-controllers first).  While an active controller uses its references the
-chainable controller is in chained mode (:attr:`Controller.is_chained`).
-
-Controllers never touch PyBullet or rclpy.
+Design notes: docs/design/controllers.md#basepy.
 """
 
 from __future__ import annotations

@@ -5,20 +5,9 @@ ros2_control names every interface ``<component>/<interface>``
 state interfaces to read and command interfaces to write.  Here each is a
 small object holding one value (a double; NaN until something sets it),
 shared by the simulation and the controllers as joints share
-:class:`~pan_tilt_sim.controllers.framework.base.JointHandle`:
+:class:`~pan_tilt_sim.controllers.base.JointHandle` (see the design notes).
 
-* a :class:`SensorHandle` groups a sensor's state interfaces.  The
-  simulation writes them when a reader asks (:meth:`SensorHandle.refresh`,
-  from a broadcaster's update when a sample is due and someone listens), so
-  an unwatched sensor costs nothing; the simulation attaches its
-  :class:`SensorSource` to the handle;
-* a :class:`GpioHandle` holds a gpio's command and state interfaces.  A
-  command interface with a state interface of the same name is echoed into
-  it as it is written (:meth:`CommandInterface.write`), as mock_components'
-  GenericSystem mirrors gpio commands into their states.
-
-:class:`HardwareInterfaces` is the set of them the controller manager hands
-each controller before it is configured.  Pure Python: no PyBullet, no ROS.
+Design notes: docs/design/controllers.md#hardware_interfacespy.
 """
 
 from __future__ import annotations

@@ -7,69 +7,12 @@ them and activates them; a controllers file may declare more (Universal
 Robots' declares a trajectory controller and two forward command
 controllers on the same six joints), and only one controller may claim a
 joint's command interface at a time.  :class:`ControllerManager` does the
-same with the controllers of one :class:`ControllersConfig`:
+same with the controllers of one :class:`ControllersConfig`: which are active,
+which interfaces each may claim, the lifecycle states (:data:`UNCONFIGURED`,
+:data:`INACTIVE`, :data:`ACTIVE`), atomic switches and chaining follow
+controller_manager's rules (see the design notes).
 
-* ``active`` unset: every controller is active (the ROS 1 examples' way), and two
-  controllers claiming one joint is an error naming both and the parameter
-  that chooses between them.
-* ``active`` given: those are active; every other controller of a type the
-  simulator has is loaded and configured but inactive -- it runs no update
-  and takes no command.  One that cannot be loaded (a joint the robot lacks,
-  say) is skipped with its reason, as ros2_control never loads what no
-  spawner names.
-* A type the simulator does not have (a vendor controller) is skipped with
-  its reason when it is not active.  Listed as active, or -- with ``active``
-  unset -- when no controller of the file that commands joints is of a known
-  type, it ends start-up, listing the supported types.
-* A controller may claim only command interfaces that the URDF's
-  ``<ros2_control>`` block gives its joints (joints outside every block are
-  not checked), or its ``<gpio>`` entries' command interfaces
-  (``<gpio>/<interface>``), each by one active controller at a time.  The
-  robot's sensors and gpios (:mod:`.hardware_interfaces`) are handed to every
-  controller before it is configured.
-* A controller on a command interface the joint's block declares but the
-  simulation cannot drive (example 13's ``pid_gain``) loads and configures,
-  as upstream's does; its activation is refused with one line naming the
-  joint and the interface, in controller_manager's words.  With ``active``
-  unset it stays inactive, that line in :attr:`ControllerManager.refused`;
-  listed in ``active``, it ends start-up.
-* The block's hardware may refuse a combination of command interfaces --
-  two on one joint, different command modes on its joints -- as its
-  ``prepare_command_mode_switch`` does; which hardware refuses what, and
-  why the simulator follows it, is in :mod:`pan_tilt_sim.model.command_modes`.
-  The start-up active set is asked as one switch that starts all of them
-  (as one spawner activating them as a group).
-
-:meth:`ControllerManager.switch` activates and deactivates controllers at run
-time, atomically, under the same rules.  An activated controller starts from
-the joints' present state (a position loop holds where the joint is); a
-deactivated one holds nothing: its joints keep the last command applied to
-them (the last effort), as a ros2_control command interface keeps its last
-value when its controller stops writing it.
-
-Controllers chain as controller_manager chains them.  A claimed command
-interface whose first name part is a loaded controller's name
-(``pid/joint1/position``) is one of that controller's reference interfaces:
-the claiming controller *precedes* it, which *follows*.  A controller can be
-configured only against references a loaded controller exports; it can be
-activated only if every controller it precedes is chainable and active or
-activated in the same switch (and not being deactivated); a following
-controller cannot be deactivated while an active preceding controller stays
-active.  A chainable controller is in chained mode while an active
-controller claims its references; an active one whose chained mode changes
-is restarted (deactivated and activated again), as upstream.  Activation
-runs following controllers first, deactivation preceding ones first, and
-every step updates preceding controllers before those they feed, so a
-reference written in a step is used in that step.
-
-Each loaded controller has ros2_control's lifecycle state
-(:data:`UNCONFIGURED`, :data:`INACTIVE`, :data:`ACTIVE`): :meth:`load`,
-:meth:`configure`, :meth:`cleanup`, :meth:`unload` and :meth:`switch`
-follow controller_manager's rules, so that its services can be served from
-here.  With ``autostart`` false nothing is loaded at start-up -- as with
-gz_ros2_control, whose controller_manager waits for spawners -- and the
-file's controllers are only :attr:`ControllerManager.declared`, for
-:meth:`load` to take their type and parameters from.
+Design notes: docs/design/controllers.md#managerpy.
 """
 
 from __future__ import annotations

@@ -13,18 +13,7 @@ uses them:
   warning, with the closest known name ("did you mean 'wheel_separation'?");
 * the defaults of parameters not given are filled in.
 
-Names are dotted paths (``constraints.goal_time``).  A path segment
-``__map_<list>`` stands for each entry of the string-list parameter
-``<list>``, as generate_parameter_library's ``__map_`` keys do:
-``gains.__map_joints.p`` is ``gains.<joint>.p`` for every joint in
-``joints``; over a string parameter it stands for that one string
-(``gains.__map_joint.p``: ``gains.<joint>.p`` for the one ``joint``).
-A default of None means "optional, absent when not given".
-
-Types are ROS 2 parameter types by their generate_parameter_library names:
-``bool``, ``int``, ``double``, ``string`` and the ``*_array`` of each.  An
-integer is taken where a double is expected; doubles must be finite unless
-the entry says otherwise.  Pure Python: no rclpy.
+Design notes: docs/design/controllers.md#parameter_specpy.
 """
 
 from __future__ import annotations

@@ -7,46 +7,9 @@ action controllers do.  The node serves the action on ``~/gripper_cmd``
 (:mod:`pan_tilt_sim.ros.gripper_action`); the rules live here, in
 :class:`GripperActionController` and its :class:`GripperGoal`, which the
 effort type (:mod:`.effort_gripper_action_controller`) and the parallel
-type (:mod:`.parallel_gripper_action_controller`) build on:
+type (:mod:`.parallel_gripper_action_controller`) build on (see the design notes).
 
-* a goal is accepted whenever the controller is active (one whose position
-  or ``max_effort`` is not a finite number, or whose ``max_effort`` (or
-  a parallel gripper's velocity) is negative, is refused with a throttled
-  warning: upstream would send it to the hardware, and a negative cap has
-  no meaning); it replaces the command at once and the goal it
-  preempts ends ABORTED with an empty result (GripperCommand's fields all
-  zero and false, ParallelGripperCommand's ``state`` without entries).
-  Upstream asks for CANCELED there, a transition ROS 2's goal state machine
-  refuses from EXECUTING (the goal would never end); ros2_controllers' own
-  trajectory controller aborts a goal it drops, and so does this one;
-* every update compares the command with the measured position: closer
-  than ``goal_tolerance`` (strictly), the goal SUCCEEDED with
-  ``reached_goal``; otherwise, once the joint has moved no faster than
-  ``stall_velocity_threshold`` for more than ``stall_timeout`` seconds of
-  sim time since the goal began or last moved, it is ``stalled`` and
-  SUCCEEDED with ``allow_stalling``, else ABORTED;
-* the result carries the measured ``position`` and the ``effort`` of the
-  last command (below); after the goal ends the joint is still driven to
-  the goal's position with its ``max_effort`` -- a grasp goes on squeezing;
-* a cancel of the running goal holds the joint where it is now, with the
-  ``max_effort`` parameter, and ends the goal CANCELED with an empty result;
-* until the first goal, from every activation on, the joint holds the
-  position it had then, with the ``max_effort`` parameter.
-
-How the command reaches the joint: the ideal actuator
-(:mod:`pan_tilt_sim.controllers.toolbox.actuator`), a velocity motor that tracks the
-commanded position (``position_proportional_gain`` of the error per step,
-within the URDF velocity limit) with at most ``|max_effort|`` -- 0: the
-URDF effort limit.  Upstream's position adapter hands the hardware the
-position alone and reports ``max_effort`` as the result's effort; here, as
-a real gripper's driver would, it also bounds the force on the fingers.
-The result's ``effort`` is upstream's: the ``max_effort`` in force.
-
-Beyond upstream, which leaves a goal pending while the controller is
-inactive: deactivation, or a reset of the simulation, ends the running goal
-ABORTED with the present position, and a goal sent to an inactive
-controller is rejected.  ``action_monitor_rate`` is accepted;
-results go out after the batch of physics steps in which the goal ended.
+Design notes: docs/design/controllers.md#gripper_action_controllerpy.
 """
 
 from __future__ import annotations

@@ -6,26 +6,9 @@ finger, and any linkage, follow the commanded ``joint`` as ``<mimic>``
 joints).  It serves control_msgs' ``ParallelGripperCommand`` on
 ``~/gripper_cmd`` (the node does, :mod:`pan_tilt_sim.ros.gripper_action`)
 and runs goals exactly as :mod:`.gripper_action_controller` describes --
-tolerance, stall, preemption, cancel -- with these differences, upstream's:
+tolerance, stall, preemption, cancel -- with these differences, upstream's (see the design notes).
 
-* a goal's ``command`` is a JointState with exactly one ``position`` (any
-  other number is rejected); its optional ``velocity[0]`` and ``effort[0]``
-  are used only when ``max_velocity_interface`` / ``max_effort_interface``
-  name a command interface to write them to, else the ``max_velocity`` /
-  ``max_effort`` parameters are;
-* the controller claims ``<joint>/position`` and those two interfaces when
-  given (``<joint>/<interface>``: the URDF's ``<ros2_control>`` block must
-  give the joint such a command interface, as the hardware must export it);
-* the result is a JointState ``state`` with one position and one effort.
-
-How it moves the joint: the ideal actuator tracks the commanded position.
-Where the hardware would get a max effort (``max_effort_interface``), the
-actuator's force is at most that effort, and where it would get a max
-velocity (``max_velocity_interface``), its speed is at most that velocity --
-0 leaves the joint's own URDF limit; without the interfaces the hardware
-hears of neither, and the joint moves with its URDF effort and velocity
-limits.  The result's effort is the one the actuator applied at the end
-(upstream leaves it unset).
+Design notes: docs/design/controllers.md#parallel_gripper_action_controllerpy.
 """
 
 from __future__ import annotations

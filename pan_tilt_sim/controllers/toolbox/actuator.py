@@ -4,25 +4,9 @@ Gazebo does not put a PID between a position interface and the joint unless
 it is given gains: gazebo_ros_control sets the joint's position, and
 gz_ros2_control turns the position error into a joint velocity command
 (``position_proportional_gain`` 0.1 per step) that the physics enforces with
-at most the joint's effort limit.  Here, likewise:
+at most the joint's effort limit.  Here, likewise (see the design notes).
 
-* a **position** command becomes a setpoint that moves toward it within the
-  joint's velocity limit and :data:`SETPOINT_ACCELERATION` (a trapezoidal
-  profile: a step command on a big arm would otherwise make every joint
-  jump to its speed limit at once, and their reaction torques would make
-  the neighbours overshoot); the joint's velocity target is the setpoint's
-  rate plus :data:`TRACKING_GAIN` of the remaining error per step, within
-  the velocity limit;
-* a **velocity** command (within the limit) is the velocity target;
-* a trajectory controller's sampled position and velocity are the setpoint
-  and its rate (trajectories are smooth already).
-
-The physics (:mod:`pan_tilt_sim.sim.physics`) drives the joint to the target
-with a PyBullet velocity motor -- a constraint, stable for any mass at any
-step -- whose force is capped at the URDF effort limit, so the joint holds
-against gravity, never pushes harder than the limit, and the effort it
-applied is what JointState reports.  The joint's URDF damping and friction
-are not felt (Gazebo's ideal modes ignore them too).
+Design notes: docs/design/controllers.md#actuatorpy.
 """
 
 from __future__ import annotations

@@ -14,10 +14,7 @@ Three places, the first that gives gains for a joint wins:
 * gazebo_ros_control's own ``gazebo_ros_control/pid_gains/<joint>`` (read
   into each joint's handle, see :func:`plugin_gains`).
 
-Where none gives gains, a position or velocity interface gets the ideal
-actuator (see :mod:`pan_tilt_sim.controllers.toolbox.actuator`); an effort
-controller's PID (``effort_controllers/*``, a trajectory controller on the
-effort interface) falls back to its defaults.
+Design notes: docs/design/controllers.md#gainspy.
 """
 
 from __future__ import annotations

@@ -9,26 +9,9 @@ controller offers its law with ``step_law()`` -- its joint's handle and a
 row of floats laid out as below -- and takes the row back, with the state
 the compiled steps left in it, with ``absorb_step_law(row)``.
 
-The laws (``KIND``):
+The laws (``KIND``) (see the design notes).
 
-* ``POSITION_PID`` (``JointPositionController`` with gains, alone or as a
-  group's member): the setpoint ramps toward the command at most
-  ``max_velocity * dt`` per step; a :class:`~.pid.Pid` on the position
-  error, with the measured velocity as the rate, gives the effort, clamped
-  to the effort limit;
-* ``VELOCITY_PID`` (``JointVelocityController`` with gains): a Pid on the
-  velocity error, the rate being the finite difference of the measured
-  velocity (``last_measurement`` NaN before the first step), the effort
-  clamped to the effort limit;
-* ``EFFORT`` (``JointEffortController``): the command is the effort.
-
-A row has every field; a law reads the ones it needs (the gains are a
-Pid's, the antiwindup flag as 0.0 / 1.0).
-
-The compiled loop has its own copy of this layout; :data:`FIELDS` and
-:data:`KINDS` name it for :mod:`pan_tilt_sim.sim.compiled_step`, which
-compares the two before it runs a step in C.  A change here is a change to
-``_compiled_step.c`` too.
+Design notes: docs/design/controllers.md#step_lawpy.
 """
 
 from __future__ import annotations

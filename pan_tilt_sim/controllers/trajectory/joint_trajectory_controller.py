@@ -7,59 +7,7 @@ upstream, it reports its state on ``<controller>/controller_state`` every
 update (:meth:`JointTrajectoryController.connect_state`) and answers
 ``<controller>/query_state`` (:meth:`~JointTrajectoryController.query_state`).
 
-* The message names every joint of the controller, in any order (partial
-  goals are rejected); points need increasing ``time_from_start``, finite
-  positions (clamped to the joints' limits) and velocities in every point
-  or in none.  Accelerations are not used.
-* A trajectory starts at its ``header.stamp`` in sim time; a zero stamp
-  means now.  Until then the previous trajectory goes on; from then on the
-  new one replaces it.  From the desired state at that moment the joints go
-  to the first point still in the future -- points already past are
-  skipped -- by cubic Hermite interpolation when the points carry
-  velocities, linearly otherwise, and hold the last point after the end.
-* A joint with PID gains -- ``gains: {<joint>: {p, i, d, i_clamp,
-  ff_velocity_scale}}``, else ``gazebo_ros_control/pid_gains/<joint>`` -- is
-  driven by effort from a PID on the position error whose derivative acts
-  on the velocity error (desired minus measured velocity), plus
-  ``ff_velocity_scale`` times the desired velocity, as in ros2_controllers.
-* ``command_interfaces`` are those ros2_controllers allows: ``position``,
-  ``velocity`` or ``effort`` alone, or ``position`` with ``velocity``,
-  ``acceleration`` or both, or with ``effort``.  Each joint follows the desired
-  position whatever the list; an ``acceleration`` interface is claimed (the
-  hardware may refuse it beside the others, see
-  :mod:`pan_tilt_sim.model.command_modes`) but adds nothing.
-* A joint without gains is driven by the ideal actuator (see
-  :mod:`~pan_tilt_sim.controllers.toolbox.actuator`): a velocity motor capped at the
-  effort limit tracks the desired position, with the desired velocity as
-  feed-forward -- what gz_ros2_control does for a position (or velocity)
-  command interface.  Only on the ``effort`` command interface (which has
-  no ideal actuator) does a joint without gains fall back to the position
-  controller's default PID (p 100, i 0.01, d 10).
-* Before the first trajectory every joint holds its position at start.
-
-FollowJointTrajectory goals (:meth:`JointTrajectoryController.check_goal`,
-:meth:`~JointTrajectoryController.start_goal`,
-:meth:`~JointTrajectoryController.cancel_goal`) run as in ros2_controllers:
-
-* a goal is checked before it is accepted (:meth:`check_goal` returns the
-  result code and text of the first problem) -- ros2_controllers rejects such
-  a goal, so the code only reaches the log;
-* while it runs, every step compares desired and measured state with the
-  goal's tolerances (:mod:`~pan_tilt_sim.controllers.trajectory.trajectory_goal`): a path
-  tolerance broken before the last point aborts it (PATH_TOLERANCE_VIOLATED)
-  and the joints hold where they are; past the last point it succeeds once
-  every goal tolerance holds (then the last point is held), or is aborted
-  (GOAL_TOLERANCE_VIOLATED) once ``goal_time_tolerance`` (if not 0) has
-  passed, holding where they are;
-* a new goal aborts the running one (INVALID_GOAL, "Current goal preempted by
-  new incoming action."), a topic trajectory replaces its trajectory and the
-  goal goes on against it, a cancel holds the joints where they are, and
-  deactivation or a reset of the simulation aborts it (INVALID_GOAL).
-
-The velocity error is measured, as upstream, only with a ``velocity`` state
-interface and a ``velocity`` or ``effort`` command interface; the defaults
-are ``state_interfaces: [position, velocity]``.  Topic trajectories are held
-to the YAML ``constraints`` too (a violation holds the joints where they are).
+Design notes: docs/design/controllers.md#joint_trajectory_controllerpy.
 """
 
 from __future__ import annotations

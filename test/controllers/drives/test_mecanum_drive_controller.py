@@ -3,7 +3,7 @@
 The controller runs against joint handles the tests turn themselves (ideal
 wheels: each turns exactly as commanded), at its update rate of 100 Hz, so
 every figure follows from the kinematics alone.  Geometry of
-test/roller_fixtures.py: wheel radius 0.05 m, lx + ly = 0.32 m.
+test/support/roller_fixtures.py: wheel radius 0.05 m, lx + ly = 0.32 m.
 """
 
 from __future__ import annotations

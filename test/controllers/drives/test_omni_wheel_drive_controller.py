@@ -2,7 +2,7 @@
 
 The controller runs against joint handles the tests turn themselves (ideal
 wheels: each turns exactly as commanded), at its update rate of 100 Hz.
-Geometry of test/roller_fixtures.py: three wheels at 0, 120 and 240
+Geometry of test/support/roller_fixtures.py: three wheels at 0, 120 and 240
 degrees, robot radius 0.15 m, wheel radius 0.05 m.
 """
 

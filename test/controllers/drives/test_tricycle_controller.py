@@ -1,6 +1,6 @@
 """tricycle_controller/TricycleController on its own: kinematics, limits, timeout, odometry.
 
-The tricycle of test/steering_fixtures.py: its front wheel steers and
+The tricycle of test/support/steering_fixtures.py: its front wheel steers and
 drives, 0.3 m ahead of the rear axle, radius 0.05 m.  A twist of 0.2 m/s and
 0.2 rad/s (a circle of 1 m about the rear axle's middle) steers it to
 atan(0.3) and rolls it at 0.2 / (0.05 cos(atan(0.3))) = 4 sqrt(1.09) rad/s.

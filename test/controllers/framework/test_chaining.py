@@ -1,7 +1,7 @@
 """Controller chaining, as ros2_control's controller_manager chains controllers.
 
 A forward position group whose ``joints`` entry is ``pid/joint1`` precedes
-``pid``, a chainable controller (test/chaining_fixtures.py) exporting the
+``pid``, a chainable controller (test/support/chaining_fixtures.py) exporting the
 reference interface ``pid/joint1/position``: the group writes its command
 there and ``pid`` drives joint1 toward it.  The manager accepts the claim,
 activates and deactivates the chain in order, refuses what would break it,

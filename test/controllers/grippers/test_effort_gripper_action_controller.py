@@ -9,7 +9,7 @@ URDF effort limit; the result's effort is the last one computed.
 
 import pytest
 from controller_fixtures import DT, raises_naming
-from gripper_controller_fixtures import EFFORT_LIMIT, EFFORT_TYPE, FINGER, HandMovedGripper
+from hand_moved_gripper import EFFORT_LIMIT, EFFORT_TYPE, FINGER, HandMovedGripper
 
 from pan_tilt_sim.controllers import JointHandle, create_controller
 from pan_tilt_sim.controllers.trajectory.trajectory_goal import GoalStatus

@@ -16,7 +16,7 @@ import math
 
 import pytest
 from controller_fixtures import DT, raises_naming
-from gripper_controller_fixtures import (
+from hand_moved_gripper import (
     EFFORT_LIMIT,
     EFFORT_TYPE,
     FINGER,

@@ -9,7 +9,7 @@ This file has those parts for the three-joint arm (urdf/three_joint_arm.xacro,
 whose gazebo_ros2_control plugin names its controllers file), with the gz
 include dropped and the spawn step replaced by sim_node named
 ``controller_manager``, as docs/launch-files.md shows.  The tests run it
-through test/launch_stand_in.py.
+through test/support/launch_stand_in.py.
 """
 
 # ruff: noqa: I001 -- this repository's launch/ folder makes ruff take `launch` for first-party

@@ -4,47 +4,9 @@ The Ackermann, bicycle and tricycle steering controllers
 (:mod:`.ackermann_steering_controller`, :mod:`.bicycle_steering_controller`,
 :mod:`.tricycle_steering_controller`) differ only in their geometry
 parameters and their kinematics (:mod:`.steering_odometry`); the rest is
-here, parameters by their upstream names:
+here, parameters by their upstream names (see the design notes).
 
-* **Reference**: ``~/reference`` (``geometry_msgs/msg/TwistStamped``; jazzy
-  has no unstamped variant); only ``linear.x`` (m/s) and ``angular.z``
-  (rad/s) count.  An unstamped twist is stamped with the sim time it
-  arrives at; one older than ``reference_timeout`` (s of sim time) is
-  refused, and a twist whose ``linear.x`` or ``angular.z`` is NaN or
-  infinite is refused (both a throttled warning; upstream takes the latter
-  and then commands nothing).  Once the reference is older than
-  ``reference_timeout`` it is dropped: the traction wheels are commanded to
-  0 and the steering stays where it was.  ``reference_timeout: 0`` uses each
-  reference for one update only.
-* **Joints**: ``traction_joints_names`` through their ``velocity`` command
-  interface (rad/s, the ideal velocity actuator) and ``steering_joints_names``
-  through ``position`` (rad: a setpoint that moves within the joint's limits,
-  tracked by the ideal position actuator), each pair right then left.  The
-  state comes from ``traction_joints_state_names`` /
-  ``steering_joints_state_names`` where given, else from the commanded joints:
-  the traction wheels' ``position`` (``position_feedback``) or ``velocity``
-  (the default), the steering joints' ``position``.  The deprecated
-  ``front_wheels_names`` / ``rear_wheels_names`` (and ``*_state_names``) are
-  mapped by ``front_steering`` as upstream maps them, with a warning.
-* **Odometry**: from that feedback, or from the reference (``open_loop``);
-  ``~/odometry`` (``nav_msgs/msg/Odometry``, ``odom_frame_id`` ->
-  ``base_frame_id``, the covariance diagonals), the same transform on
-  ``~/tf_odometry`` (``tf2_msgs/msg/TFMessage``, with ``enable_odom_tf``; remap
-  it to ``/tf``), and ``~/controller_state``
-  (``control_msgs/msg/SteeringControllerStatus``), all at every update.
-* **Rate**: the kinematics, odometry and messages run at ``update_rate`` (the
-  controller_manager's, 100 Hz unless the file says otherwise), as upstream;
-  the steering joints' setpoints are tracked at every physics step, as
-  gz_ros2_control tracks a position command.
-* **Chaining**: it exports ``<name>/linear/velocity`` and
-  ``<name>/angular/velocity``; in chained mode the preceding controller
-  writes them and ``~/reference`` is not used.  They are reset to NaN after
-  every update, as upstream: a preceding controller writes them each time.
-
-Its types free the robot's base (``drives_base``).  A reset (activation,
-``reset_simulation``) puts the odometry back at the origin; deactivation
-stops the traction wheels and holds the steering where it is (upstream
-writes NaN to both).
+Design notes: docs/design/controllers.md#steering_controllerspy.
 """
 
 from __future__ import annotations

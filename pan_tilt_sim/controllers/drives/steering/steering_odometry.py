@@ -8,20 +8,7 @@ Three configurations, by their number of steering and traction joints:
 * **Ackermann**: two steering joints on an axle of ``steering_track`` and
   two traction wheels (each pair right, then left).
 
-The body twist is ``v`` (m/s, along x) and ``omega`` (rad/s, about z),
-``wheelbase`` the distance between the axles (m), ``radius`` the traction
-wheels' (m).  Inverse kinematics (:meth:`SteeringKinematics.commands`):
-``phi = atan(omega * wheelbase / v)`` (0 where that is not finite: no
-motion), the traction wheels turn at ``v / radius`` rad/s, and on a
-two-wheel axle at ``(R +- track / 2) / R`` of it, ``R = wheelbase /
-tan(phi)`` the turning radius -- with the *measured* steering angle in
-closed loop, as upstream.  Ackermann's wheels steer to ``atan(wheelbase /
-(R +- steering_track / 2))`` (right: +, the outer wheel of a left turn).
-Forward kinematics (the odometry) inverts these from the measured wheel
-velocities (or position differences) and steering angles; the pose is
-integrated exactly along an arc (second-order Runge-Kutta when the turn is
-below 1e-6 rad), and the reported twist is a rolling mean.  Units: m, rad,
-s.  Pure Python.
+Design notes: docs/design/controllers.md#steering_odometrypy.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """ackermann_steering_controller/AckermannSteeringController: its kinematics, by hand.
 
-The car of test/steering_fixtures.py: wheelbase 0.3 m, track 0.25 m, wheel
+The car of test/support/steering_fixtures.py: wheelbase 0.3 m, track 0.25 m, wheel
 radius 0.05 m.  A twist of 0.2 m/s and 0.2 rad/s turns about a centre 1 m to
 the left of the rear axle's middle: the centre steering angle is atan(0.3),
 the right (outer) wheel steers to atan(0.3 / 1.125) and the left to

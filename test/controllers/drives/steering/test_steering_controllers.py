@@ -3,7 +3,7 @@
 References and their timeout, refused twists, chaining, the update rate,
 the joints' claims and errors, the steering joints' tracking, the ROS
 surface -- shown on the bicycle and Ackermann types of
-test/steering_fixtures.py, with ideal joints (steering_harness.py) where the
+test/support/steering_fixtures.py, with ideal joints (steering_harness.py) where the
 kinematics is not the point.
 """
 

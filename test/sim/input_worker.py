@@ -1,7 +1,7 @@
 """A child process that starts fuzzed inputs and drives them, one per request.
 
 Run as ``python input_worker.py``: each line on stdin is a JSON request drawn
-by test/input_strategies.py (``urdf``, ``controllers`` or null, ``requests``,
+by test/sim/input_strategies.py (``urdf``, ``controllers`` or null, ``requests``,
 ``steps``); each answer is one JSON line on the stdout the process started
 with (PyBullet's own prints go to stderr).
 
@@ -18,7 +18,7 @@ base's pose and every range and depth stayed finite (``inf`` is a lidar's
 "no return", so a range may be infinite but never NaN).
 
 A segmentation fault, an abort or a hang is this process dying or falling
-silent: the parent (test/worker_process.py) sees it.
+silent: the parent (test/sim/worker_process.py) sees it.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Steered robots on sim_node: reference in, odometry out, the front wheels steering on the ground.
 
-The robots of test/steering_fixtures.py run in-process, paused, at
+The robots of test/support/steering_fixtures.py run in-process, paused, at
 real_time_factor 0; each test drives one closed loop from the probe: it
 reads ``/steering_controller/odometry``, decides the next reference, and
 steps the physics one period (``node.step``).  The true pose comes from
@@ -13,16 +13,13 @@ import contextlib
 import math
 import re
 import time
-from collections.abc import Iterator
 
 import pytest
 import sim_process
 from control_msgs.msg import SteeringControllerStatus
-from geometry_msgs.msg import TwistStamped
-from nav_msgs.msg import Odometry
+from mobile_base_harness import BaseKind, MobileBase, base_on_sim_node, heading
 from node_harness import PROBE_QUEUE, sim_node
 from rcl_interfaces.msg import Log
-from sim_interfaces_client import SimInterfaces, position
 from steering_fixtures import (
     ACKERMANN,
     BICYCLE,
@@ -32,75 +29,24 @@ from steering_fixtures import (
     steering_parameters,
     write_steered,
 )
-from tf2_msgs.msg import TFMessage
 
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.ros.controller_bindings import WARNING_THROTTLE_S
 
-TIME_STEP = 0.001
-PERIOD_STEPS = 10  # one controller update (100 Hz): one odometry message per period
 ROBOT = 'car'
 ODOMETRY = f'/{CONTROLLER}/odometry'
+# One controller update (100 Hz, 10 steps): one odometry message per period.
+CAR = BaseKind(ROBOT, CONTROLLER, ODOMETRY, update_steps=10, tf=f'/{CONTROLLER}/tf_odometry',
+               state=(SteeringControllerStatus, f'/{CONTROLLER}/controller_state'))
 BAD_COUNT = 20
 EXIT_CONFIGURATION_ERROR = 2
 
 
-class Car:
-    """A steered robot on sim_node, driven from the probe one period at a time."""
-
-    def __init__(self, sim) -> None:
-        self.sim = sim
-        self.node = sim.node
-        self.odometry: list[Odometry] = sim.collect(Odometry, ODOMETRY)
-        self.tf: list[TFMessage] = sim.collect(TFMessage, f'/{CONTROLLER}/tf_odometry')
-        self.status: list[SteeringControllerStatus] = sim.collect(
-            SteeringControllerStatus, f'/{CONTROLLER}/controller_state')
-        self.interfaces = SimInterfaces(sim)
-        sim.wait_for_subscribers(ODOMETRY)
-
-    def command(self, linear: float, angular: float) -> None:
-        """Publish an unstamped twist on ``~/reference``; return once the controller took it."""
-        message = TwistStamped()
-        message.twist.linear.x, message.twist.angular.z = linear, angular
-        self.sim.command(CONTROLLER, message)
-
-    def period(self) -> Odometry:
-        """Step one period; return the newest odometry."""
-        count = len(self.odometry)
-        self.node.step(PERIOD_STEPS)
-        assert self.sim.spin_until(lambda: len(self.odometry) > count), 'no odometry came'
-        return self.odometry[-1]
-
-    def true_speed(self) -> float:
-        """Return the base's true speed over the ground (m/s; the twist is in the world frame)."""
-        linear = self.interfaces.entity_state(ROBOT).twist.linear
-        return math.hypot(linear.x, linear.y)
-
-    def true_yaw_rate(self) -> float:
-        """Return the base's true rate of turn (rad/s, GetEntityState)."""
-        return self.interfaces.entity_state(ROBOT).twist.angular.z
-
-    def true_pose(self) -> tuple[tuple[float, float, float], float, float]:
-        """Return the base's true position, heading and forward speed (GetEntityState)."""
-        state = self.interfaces.entity_state(ROBOT)
-        q = state.pose.orientation
-        return position(state), 2.0 * math.atan2(q.z, q.w), state.twist.linear.x
-
-
-def heading(odometry: Odometry) -> float:
-    """Return the heading of an odometry message's pose."""
-    q = odometry.pose.pose.orientation
-    return 2.0 * math.atan2(q.z, q.w)
-
-
-@contextlib.contextmanager
-def running(folder, type_name: str = ACKERMANN, **overrides) -> Iterator[Car]:
+def running(folder, type_name: str = ACKERMANN,
+            **overrides) -> contextlib.AbstractContextManager[MobileBase]:
     """Run the robot ``type_name`` drives on sim_node, its controller given ``overrides``."""
-    description, controllers = write_steered(
-        folder, type_name, steering_parameters(type_name, **overrides))
-    with sim_node(paused=True, time_step=TIME_STEP, robot_description_file=str(description),
-                  controllers_file=str(controllers), world='ground') as sim:
-        yield Car(sim)
+    return base_on_sim_node(CAR, *write_steered(
+        folder, type_name, steering_parameters(type_name, **overrides)))
 
 
 def test_the_base_is_free_and_stands_on_its_wheels_with_its_topics(tmp_path):
@@ -120,13 +66,13 @@ def test_the_base_is_free_and_stands_on_its_wheels_with_its_topics(tmp_path):
 def test_one_metre_straight_at_0_2_m_s_the_odometry_agrees_with_the_true_pose(
         tmp_path, type_name):
     with running(tmp_path, type_name) as car:
-        odometry = car.period()
+        odometry = car.update()
         while odometry.pose.pose.position.x < 1.0:
             car.command(0.2, 0.0)
-            odometry = car.period()
+            odometry = car.update()
         car.command(0.0, 0.0)
         for _ in range(10):
-            odometry = car.period()
+            odometry = car.update()
         where, yaw, speed = car.true_pose()
         assert where[0] == pytest.approx(1.0, rel=0.02)
         assert odometry.pose.pose.position.x == pytest.approx(where[0], rel=0.02)
@@ -142,21 +88,21 @@ def test_one_metre_straight_at_0_2_m_s_the_odometry_agrees_with_the_true_pose(
 @pytest.mark.parametrize('type_name', [ACKERMANN, TRICYCLE, BICYCLE])
 def test_an_arc_of_one_metre_radius_the_odometry_and_the_truth_agree(tmp_path, type_name):
     with running(tmp_path, type_name) as car:
-        odometry = car.period()
+        odometry = car.update()
         radius = None
         while heading(odometry) < math.pi / 2:  # a quarter circle: 1.57 m at 0.2 m/s
             car.command(0.2, 0.2)
-            odometry = car.period()
+            odometry = car.update()
             if radius is None and heading(odometry) > math.pi / 4:  # turning steadily
                 radius = car.true_speed() / car.true_yaw_rate()
         car.sim.drain()
-        status = car.status[-1]  # turning: the steering stands where it was sent
+        status = car.states[-1]  # turning: the steering stands where it was sent
         assert status.steer_positions[0] == pytest.approx(status.steering_angle_command[0],
                                                           abs=0.01)
         assert status.steering_angle_command[0] > 0.2
         car.command(0.0, 0.0)
         for _ in range(10):
-            odometry = car.period()
+            odometry = car.update()
         where, yaw, speed = car.true_pose()
         assert radius == pytest.approx(1.0, rel=0.02)
         assert yaw == pytest.approx(math.pi / 2, rel=0.02)
@@ -170,10 +116,10 @@ def test_the_car_stops_once_the_reference_times_out(tmp_path):
     with running(tmp_path, reference_timeout=0.2) as car:
         car.command(0.2, 0.0)
         for _ in range(10):  # 0.1 s: still within the timeout
-            car.period()
+            car.update()
         assert car.true_pose()[2] == pytest.approx(0.2, rel=0.05)
         for _ in range(50):
-            car.period()
+            car.update()
         where, yaw, speed = car.true_pose()
         assert abs(speed) < 1e-3
         assert where[0] < 0.2 * 0.4
@@ -183,14 +129,14 @@ def test_a_twist_that_is_not_finite_is_refused_with_a_throttled_warning(tmp_path
     with running(tmp_path) as car:
         log = car.sim.collect(Log, '/rosout', PROBE_QUEUE)
         car.command(0.2, 0.0)
-        car.period()
+        car.update()
         start = time.monotonic()
         for _ in range(BAD_COUNT):
             car.command(math.nan, 0.0)
             car.command(0.2, math.inf)
         elapsed = time.monotonic() - start
         for _ in range(5):
-            car.period()
+            car.update()
         assert car.true_pose()[2] == pytest.approx(0.2, rel=0.05)  # the last good one holds
         car.sim.drain()
         warnings = [entry.msg for entry in log if entry.level == Log.WARN and

@@ -1,6 +1,6 @@
 """An omni base on sim_node: ~/cmd_vel in; ~/odom and /tf out, the base free on the ground.
 
-The three-wheel omni base of test/roller_fixtures.py runs in-process,
+The three-wheel omni base of test/support/roller_fixtures.py runs in-process,
 paused, at real_time_factor 0; each test drives it closed loop from the
 probe: it reads ``/base_controller/odom``, decides the next command and
 steps the physics one controller update (10 steps at 100 Hz) at a time.
@@ -12,66 +12,25 @@ from __future__ import annotations
 import contextlib
 import math
 import time
-from collections.abc import Iterator
 
 import pytest
 import sim_process
-from geometry_msgs.msg import TwistStamped
-from nav_msgs.msg import Odometry
-from node_harness import PROBE_QUEUE, sim_node
+from mobile_base_harness import BaseKind, MobileBase, base_on_sim_node
 from rcl_interfaces.msg import Log
 from roller_fixtures import CONTROLLER, REST_HEIGHT, omni_parameters, write_omni
-from sim_interfaces_client import SimInterfaces, position
-from tf2_msgs.msg import TFMessage
 
-TIME_STEP = 0.001
-UPDATE_STEPS = 10  # one controller update at the controller_manager's 100 Hz
 ROBOT = 'omni'
 ODOM = f'/{CONTROLLER}/odom'
 EXIT_CONFIGURATION_ERROR = 2
 WARNING_THROTTLE_S = 1.0
 FLOOD_COUNT = 50
+# One controller update at the controller_manager's 100 Hz: 10 steps.
+OMNI = BaseKind(ROBOT, CONTROLLER, ODOM, update_steps=10, holonomic=True, tf='/tf', log=True)
 
 
-class Base:
-    """The omni base on sim_node, driven from the probe one update at a time."""
-
-    def __init__(self, sim) -> None:
-        self.sim = sim
-        self.node = sim.node
-        self.odometry: list[Odometry] = sim.collect(Odometry, ODOM)
-        self.tf: list[TFMessage] = sim.collect(TFMessage, '/tf')
-        self.log: list[Log] = sim.collect(Log, '/rosout', PROBE_QUEUE)
-        self.interfaces = SimInterfaces(sim)
-        sim.wait_for_subscribers(ODOM)
-
-    def command(self, vx: float, vy: float, wz: float) -> None:
-        """Publish an unstamped twist; return once the controller took it."""
-        message = TwistStamped()
-        message.twist.linear.x, message.twist.linear.y, message.twist.angular.z = vx, vy, wz
-        self.sim.command(CONTROLLER, message)
-
-    def update(self) -> Odometry:
-        """Step one controller update; return the odometry it published."""
-        count = len(self.odometry)
-        self.node.step(UPDATE_STEPS)
-        assert self.sim.spin_until(lambda: len(self.odometry) > count), 'no odometry came'
-        return self.odometry[-1]
-
-    def true_pose(self) -> tuple[tuple[float, float, float], float]:
-        """Return the base's true position and heading (GetEntityState)."""
-        state = self.interfaces.entity_state(ROBOT)
-        q = state.pose.orientation
-        return position(state), 2.0 * math.atan2(q.z, q.w)
-
-
-@contextlib.contextmanager
-def running_base(folder, **drive) -> Iterator[Base]:
+def running_base(folder, **drive) -> contextlib.AbstractContextManager[MobileBase]:
     """Run the omni base on sim_node, its controller given ``drive`` parameters."""
-    description, controllers = write_omni(folder, omni_parameters(**drive))
-    with sim_node(paused=True, time_step=TIME_STEP, robot_description_file=str(description),
-                  controllers_file=str(controllers), world='ground') as sim:
-        yield Base(sim)
+    return base_on_sim_node(OMNI, *write_omni(folder, omni_parameters(**drive)))
 
 
 @pytest.fixture
@@ -83,7 +42,7 @@ def base(tmp_path):
 
 def test_the_base_is_free_and_the_topics_are_upstreams(base):
     assert not base.node.simulation.physics.fixed_base
-    where, _ = base.true_pose()
+    where, _, _ = base.true_pose()
     assert where == pytest.approx((0.0, 0.0, REST_HEIGHT), abs=1e-6)
     published, subscribed = base.sim.own_topics()
     assert subscribed[f'/{CONTROLLER}/cmd_vel'] == 'geometry_msgs/msg/TwistStamped'
@@ -100,7 +59,7 @@ def test_one_metre_sideways_the_odometry_agrees_with_the_true_pose(base):
     base.command(0.0, 0.0, 0.0)
     for _ in range(50):
         odometry = base.update()
-    where, yaw = base.true_pose()
+    where, yaw, _ = base.true_pose()
     assert where[1] == pytest.approx(1.0, rel=0.02)
     assert odometry.pose.pose.position.y == pytest.approx(where[1], rel=0.02)
     assert abs(odometry.pose.pose.position.x) < 0.02 and abs(yaw) < 0.02
@@ -121,7 +80,7 @@ def test_the_base_stops_once_cmd_vel_times_out(tmp_path):
         for _ in range(60):
             base.update()
         assert base.odometry[-1].twist.twist.linear.x == pytest.approx(0.0, abs=1e-3)
-        where, _ = base.true_pose()
+        where, _, _ = base.true_pose()
         assert where[0] < 0.2 * 0.4
 
 

@@ -13,7 +13,7 @@
   every command (the worker shapes them into each controller's command
   kind) and a gripper goal.
 
-Each draw is a JSON-able request for test/input_worker.py.  The robot
+Each draw is a JSON-able request for test/sim/input_worker.py.  The robot
 (:data:`ROBOT_URDF`) has the joints, sensor and gpio the specs' examples
 name: four continuous wheels ``joint1`` to ``joint4`` on a free base with
 position, velocity and effort interfaces, ``sensor1`` with every sensor

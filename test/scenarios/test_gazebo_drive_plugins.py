@@ -1,6 +1,6 @@
 """A robot driven by Gazebo's drive plugins on sim_node: cmd_vel, odom and TF, no controllers.
 
-The rover of test/mobile_fixtures.py with a ``libgazebo_ros_diff_drive.so``
+The rover of test/support/mobile_fixtures.py with a ``libgazebo_ros_diff_drive.so``
 plugin (or planar move, or gz-sim's DiffDrive system), a
 ``libgazebo_ros_p3d.so`` on ``/ground_truth`` and a lidar,
 in-process, paused, at real_time_factor 0; each test drives it closed loop

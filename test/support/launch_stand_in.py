@@ -16,9 +16,9 @@ actions carried out in its place; then the nodes, as launch_ros would start them
   __node:=<name>`` and its parameters as ``--params-file`` arguments (a dict
   written to a file under ``/**``, as launch_ros writes one);
 * ``robot_state_publisher`` as the stand-in program of
-  test/robot_state_publisher_stand_in.py, with its parameters so;
+  test/support/robot_state_publisher_stand_in.py, with its parameters so;
 * ``controller_manager``'s ``spawner`` in-process, playing jazzy's spawner
-  (test/spawner_client.py), and each OnProcessExit's actions once it ended.
+  (test/support/spawner_client.py), and each OnProcessExit's actions once it ended.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """A fuzzing worker in a child process: one JSON request a line in, one answer a line out.
 
-:class:`WorkerProcess` runs a worker script (test/load_worker.py,
-test/input_worker.py) and hands it requests one after another.  A crash
+:class:`WorkerProcess` runs a worker script (test/sim/load_worker.py,
+test/sim/input_worker.py) and hands it requests one after another.  A crash
 (a signal, an exit) or a hang there is a failing example here -- with the
 child's last output -- and the next request gets a fresh child.
 """

@@ -1,6 +1,6 @@
 """A ROS 1 (gazebo_ros_control) diff drive YAML on sim_node: Twist in, odom out, as noetic.
 
-The rover of test/mobile_fixtures.py without ``<ros2_control>``: wheels
+The rover of test/support/mobile_fixtures.py without ``<ros2_control>``: wheels
 with ROS 1 transmissions and a gazebo_ros_control plugin, its controllers in
 a ROS 1 layout YAML (``left_wheel``/``right_wheel``, no ``wheel_radius``:
 noetic reads it from the wheel's collision cylinder).  In-process, paused;

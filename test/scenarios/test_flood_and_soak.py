@@ -2,7 +2,7 @@
 
 Minutes long, so off by default; run them with
 
-    PAN_TILT_SIM_SLOW=1 scripts/run_tests.sh -m soak -s test/ros/test_flood_and_soak.py
+    PAN_TILT_SIM_SLOW=1 scripts/run_tests.sh -m soak -s test/scenarios/test_flood_and_soak.py
 
 (``-s`` shows the figures each test prints).  sim_node runs in its own
 process, so its RSS is its own; the test process is the probe.
@@ -47,7 +47,7 @@ pytestmark = [
 NS = '/ex_urdf_pan_tilt'
 PAN_COMMAND = f'{NS}/joint1_position_controller/command'
 TILT_COMMAND = f'{NS}/joint2_position_controller/command'
-FLOOD_SCRIPT = pathlib.Path(__file__).resolve().parents[1] / 'flood_publisher.py'
+FLOOD_SCRIPT = pathlib.Path(__file__).resolve().parent / 'flood_publisher.py'
 MEGABYTE = 1024 * 1024
 STARTUP_BUDGET_S = 30.0
 STOP_BUDGET_S = 2.0

@@ -1,6 +1,6 @@
 """ros2_control_demos' example 16 on sim_node: diff drive chained into two wheel PIDs.
 
-The rover of test/mobile_fixtures.py (velocity command interfaces on both
+The rover of test/support/mobile_fixtures.py (velocity command interfaces on both
 wheels) with a controllers file in example 16's shape (jazzy's
 ``diffbot_chained_controllers.yaml``): a broadcaster, one
 ``pid_controller/PidController`` per wheel (velocity reference and state,

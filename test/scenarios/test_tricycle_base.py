@@ -1,6 +1,6 @@
 """A tricycle on sim_node: tricycle_controller drives its steered front wheel; odometry vs truth.
 
-The tricycle of test/steering_fixtures.py (one front wheel that steers and
+The tricycle of test/support/steering_fixtures.py (one front wheel that steers and
 drives, two rear wheels rolling freely) runs in-process, paused, at
 real_time_factor 0; each test drives it closed loop from the probe one
 controller update (10 ms) at a time.  The true pose comes from
@@ -11,86 +11,38 @@ from __future__ import annotations
 
 import contextlib
 import math
-from collections.abc import Iterator
 
 import pytest
-from geometry_msgs.msg import TwistStamped
-from nav_msgs.msg import Odometry
-from node_harness import sim_node
-from sim_interfaces_client import SimInterfaces, position
+from mobile_base_harness import BaseKind, MobileBase, base_on_sim_node, heading
 from std_srvs.srv import Empty
 from steering_fixtures import REST_HEIGHT, TRICYCLE_NAME, write_tricycle
 
 from pan_tilt_sim.ros import controller_bindings
 
-PERIOD_STEPS = 10  # one controller update at 100 Hz: one odometry message per period
 ROBOT = 'trike'
 ODOM = f'/{TRICYCLE_NAME}/odom'
 BAD_COUNT = 20
+# One controller update at 100 Hz (10 steps): one odometry message per period.
+TRIKE = BaseKind(ROBOT, TRICYCLE_NAME, ODOM, update_steps=10)
 
 
-class Trike:
-    """The tricycle on sim_node, driven from the probe one period at a time."""
-
-    def __init__(self, sim) -> None:
-        self.sim = sim
-        self.node = sim.node
-        self.odometry: list[Odometry] = sim.collect(Odometry, ODOM)
-        self.interfaces = SimInterfaces(sim)
-        sim.wait_for_subscribers(ODOM)
-
-    def command(self, linear: float, angular: float) -> None:
-        """Publish an unstamped twist on ``~/cmd_vel``; return once the controller took it."""
-        message = TwistStamped()
-        message.twist.linear.x, message.twist.angular.z = linear, angular
-        self.sim.command(TRICYCLE_NAME, message)
-
-    def period(self) -> Odometry:
-        """Step one period; return the newest odometry."""
-        count = len(self.odometry)
-        self.node.step(PERIOD_STEPS)
-        assert self.sim.spin_until(lambda: len(self.odometry) > count), 'no odometry came'
-        return self.odometry[-1]
-
-    def true_pose(self) -> tuple[tuple[float, float, float], float]:
-        """Return the base's true position and heading (GetEntityState)."""
-        state = self.interfaces.entity_state(ROBOT)
-        q = state.pose.orientation
-        return position(state), 2.0 * math.atan2(q.z, q.w)
-
-    def true_radius(self) -> float:
-        """Return the true radius of the turn (m): speed over the ground / rate of turn."""
-        twist = self.interfaces.entity_state(ROBOT).twist
-        return math.hypot(twist.linear.x, twist.linear.y) / twist.angular.z
-
-
-def heading(odometry: Odometry) -> float:
-    """Return the heading of an odometry message's pose."""
-    q = odometry.pose.pose.orientation
-    return 2.0 * math.atan2(q.z, q.w)
-
-
-@contextlib.contextmanager
-def running(folder, **params) -> Iterator[Trike]:
+def running(folder, **params) -> contextlib.AbstractContextManager[MobileBase]:
     """Run the tricycle on sim_node, its controller given ``params``."""
-    description, controllers = write_tricycle(folder, params)
-    with sim_node(paused=True, time_step=0.001, robot_description_file=str(description),
-                  controllers_file=str(controllers), world='ground') as sim:
-        yield Trike(sim)
+    return base_on_sim_node(TRIKE, *write_tricycle(folder, params))
 
 
 def test_one_metre_straight_at_0_2_m_s_the_odometry_agrees_with_the_true_pose(tmp_path):
     with running(tmp_path) as trike:
         assert not trike.node.simulation.physics.fixed_base
         assert trike.true_pose()[0] == pytest.approx((0.0, 0.0, REST_HEIGHT), abs=1e-3)
-        odometry = trike.period()
+        odometry = trike.update()
         while odometry.pose.pose.position.x < 1.0:
             trike.command(0.2, 0.0)
-            odometry = trike.period()
+            odometry = trike.update()
         trike.command(0.0, 0.0)
         for _ in range(10):
-            odometry = trike.period()
-        where, yaw = trike.true_pose()
+            odometry = trike.update()
+        where, yaw, _ = trike.true_pose()
         assert where[0] == pytest.approx(1.0, rel=0.02)
         assert odometry.pose.pose.position.x == pytest.approx(where[0], rel=0.02)
         assert odometry.pose.pose.position.y == pytest.approx(where[1], abs=0.02)
@@ -99,17 +51,17 @@ def test_one_metre_straight_at_0_2_m_s_the_odometry_agrees_with_the_true_pose(tm
 
 def test_an_arc_of_one_metre_radius_the_odometry_and_the_truth_agree(tmp_path):
     with running(tmp_path) as trike:
-        odometry = trike.period()
+        odometry = trike.update()
         radius = None
         while heading(odometry) < math.pi / 2:
             trike.command(0.2, 0.2)
-            odometry = trike.period()
+            odometry = trike.update()
             if radius is None and heading(odometry) > math.pi / 4:  # turning steadily
-                radius = trike.true_radius()
+                radius = trike.true_speed() / trike.true_yaw_rate()
         trike.command(0.0, 0.0)
         for _ in range(10):
-            odometry = trike.period()
-        where, yaw = trike.true_pose()
+            odometry = trike.update()
+        where, yaw, _ = trike.true_pose()
         assert radius == pytest.approx(1.0, rel=0.02)
         assert yaw == pytest.approx(math.pi / 2, rel=0.02)
         assert heading(odometry) == pytest.approx(yaw, rel=0.02)
@@ -122,11 +74,11 @@ def test_it_stops_once_cmd_vel_times_out(tmp_path):
     with running(tmp_path, cmd_vel_timeout=200) as trike:
         trike.command(0.2, 0.0)
         for _ in range(15):  # 0.15 s: within the timeout, the rolling mean full
-            trike.period()
+            trike.update()
         assert trike.odometry[-1].twist.twist.linear.x == pytest.approx(0.2, rel=0.05)
         for _ in range(50):
-            trike.period()
-        where, yaw = trike.true_pose()
+            trike.update()
+        where, yaw, _ = trike.true_pose()
         assert trike.odometry[-1].twist.twist.linear.x == pytest.approx(0.0, abs=1e-3)
         assert where[0] < 0.2 * 0.4
 
@@ -134,11 +86,11 @@ def test_it_stops_once_cmd_vel_times_out(tmp_path):
 def test_a_twist_that_is_not_finite_is_refused_with_a_throttled_warning(tmp_path, capfd):
     with running(tmp_path) as trike:
         trike.command(0.2, 0.0)
-        trike.period()
+        trike.update()
         for _ in range(BAD_COUNT):
             trike.command(math.nan, 0.0)
         for _ in range(15):
-            trike.period()
+            trike.update()
         assert trike.odometry[-1].twist.twist.linear.x == pytest.approx(0.2, rel=0.05)
     lines = [line for line in capfd.readouterr().err.splitlines()
              if f'{TRICYCLE_NAME}: ignored cmd_vel' in line]
@@ -152,7 +104,7 @@ def test_reset_odometry_puts_the_odometry_back_at_the_origin(tmp_path):
         assert published['/tf'] == 'tf2_msgs/msg/TFMessage'
         trike.command(0.2, 0.0)
         for _ in range(20):
-            trike.period()
+            trike.update()
         controller = trike.node.simulation.controller(TRICYCLE_NAME)
         assert controller.odometry.x > 0.02
         client = trike.sim.probe.create_client(Empty, f'/{TRICYCLE_NAME}/reset_odometry')
@@ -172,7 +124,7 @@ def test_without_ackermann_msgs_cmd_ackermann_is_left_out_with_one_warning(
         assert f'/{TRICYCLE_NAME}/cmd_ackermann' not in published
         trike.command(0.2, 0.0)
         for _ in range(20):
-            trike.period()
+            trike.update()
         assert trike.odometry[-1].twist.twist.linear.x == pytest.approx(0.2, rel=0.05)
     lines = [line for line in capfd.readouterr().err.splitlines()
              if f'{TRICYCLE_NAME}: no topic' in line]

@@ -1,6 +1,6 @@
 """A controller on an interface the robot declares but the simulation cannot drive.
 
-ros2_control_demos' example 13 in small (test/ros2_control_fixtures.py): its
+ros2_control_demos' example 13 in small (test/support/ros2_control_fixtures.py): its
 ThreeDofBot's mock hardware declares a ``pid_gain`` command interface on each
 joint, and a ForwardCommandController claims it.  Upstream loads and
 configures that controller and refuses to activate it; so does sim_node,

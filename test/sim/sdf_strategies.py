@@ -34,7 +34,7 @@ class FuzzSdf:
     text: str
 
     def request(self, steps: int) -> dict:
-        """Return the request test/load_worker.py takes (an SDF where it takes a URDF)."""
+        """Return the request test/sim/load_worker.py takes (an SDF where it takes a URDF)."""
         return {'urdf': self.text, 'controllers': CONTROLLERS, 'steps': steps}
 
 

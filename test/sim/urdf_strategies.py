@@ -7,7 +7,7 @@ length around PyBullet's buffer (and beyond); every URDF joint type and a
 few that are none; axes of every length down to zero; masses and inertias
 from zero and tiny through the physical to the absurd, negative ones too;
 origins out to where their squares overflow.  Its :meth:`FuzzRobot.request`
-is what test/load_worker.py takes: the URDF and a controllers file giving
+is what test/sim/load_worker.py takes: the URDF and a controllers file giving
 every movable joint a controller (a PID on effort, the ideal actuator, or
 plain effort) and a joint_state broadcaster.
 """
@@ -121,7 +121,7 @@ class FuzzRobot:
         return '\n'.join(lines) + '\n'
 
     def request(self, steps: int) -> dict:
-        """Return the request test/load_worker.py takes."""
+        """Return the request test/sim/load_worker.py takes."""
         return {'urdf': self.urdf(), 'controllers': self.controllers_yaml(), 'steps': steps}
 
 

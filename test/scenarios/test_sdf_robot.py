@@ -1,6 +1,6 @@
 """An SDF robot in an SDF world on sim_node: gz-sim's topics, driving, and a lidar that sees.
 
-The rover of test/sdf_fixtures.py (gz-sim's DiffDrive and JointStatePublisher,
+The rover of test/support/sdf_fixtures.py (gz-sim's DiffDrive and JointStatePublisher,
 a gpu_lidar, an IMU, a ball caster) in an SDF world of a ground plane and
 static cylinders, in-process, paused, at real_time_factor 0.
 """

@@ -1,6 +1,6 @@
 """A robot's own ros2_control setup starts unchanged, given only what its launch file would give.
 
-The fixture robot (test/ros2_control_fixtures.py) is shaped like Universal
+The fixture robot (test/support/ros2_control_fixtures.py) is shaped like Universal
 Robots' and ros2_control_demos' setups: a xacro with a ``prefix`` argument, a
 ``<ros2_control>`` block, a gz_ros2_control plugin naming its controllers
 file, and a controllers file with three controllers on the same joints,

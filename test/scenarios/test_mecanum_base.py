@@ -1,6 +1,6 @@
 """A mecanum base on sim_node: ~/reference in; ~/odometry, ~/tf_odometry, ~/controller_state out.
 
-The mecanum base of test/roller_fixtures.py runs in-process, paused, at
+The mecanum base of test/support/roller_fixtures.py runs in-process, paused, at
 real_time_factor 0; each test drives it closed loop from the probe: it
 reads ``/base_controller/odometry``, decides the next reference and steps
 the physics one controller update (10 steps at 100 Hz) at a time.  The
@@ -12,69 +12,28 @@ from __future__ import annotations
 import contextlib
 import math
 import time
-from collections.abc import Iterator
 
 import pytest
 import sim_process
 from control_msgs.msg import MecanumDriveControllerState
-from geometry_msgs.msg import TwistStamped
-from nav_msgs.msg import Odometry
-from node_harness import PROBE_QUEUE, sim_node
+from mobile_base_harness import BaseKind, MobileBase, base_on_sim_node, heading
 from rcl_interfaces.msg import Log
 from roller_fixtures import CONTROLLER, REST_HEIGHT, mecanum_parameters, write_mecanum
-from sim_interfaces_client import SimInterfaces, position
-from tf2_msgs.msg import TFMessage
 
-TIME_STEP = 0.001
-UPDATE_STEPS = 10  # one controller update at the controller_manager's 100 Hz
 ROBOT = 'mecanum'
 ODOMETRY = f'/{CONTROLLER}/odometry'
 EXIT_CONFIGURATION_ERROR = 2
 WARNING_THROTTLE_S = 1.0
 FLOOD_COUNT = 50
+# One controller update at the controller_manager's 100 Hz: 10 steps.
+MECANUM = BaseKind(ROBOT, CONTROLLER, ODOMETRY, update_steps=10, holonomic=True,
+                   tf=f'/{CONTROLLER}/tf_odometry', log=True,
+                   state=(MecanumDriveControllerState, f'/{CONTROLLER}/controller_state'))
 
 
-class Base:
-    """The mecanum base on sim_node, driven from the probe one update at a time."""
-
-    def __init__(self, sim) -> None:
-        self.sim = sim
-        self.node = sim.node
-        self.odometry: list[Odometry] = sim.collect(Odometry, ODOMETRY)
-        self.tf: list[TFMessage] = sim.collect(TFMessage, f'/{CONTROLLER}/tf_odometry')
-        self.states: list[MecanumDriveControllerState] = sim.collect(
-            MecanumDriveControllerState, f'/{CONTROLLER}/controller_state')
-        self.log: list[Log] = sim.collect(Log, '/rosout', PROBE_QUEUE)
-        self.interfaces = SimInterfaces(sim)
-        sim.wait_for_subscribers(ODOMETRY)
-
-    def command(self, vx: float, vy: float, wz: float) -> None:
-        """Publish an unstamped reference; return once the controller took it."""
-        message = TwistStamped()
-        message.twist.linear.x, message.twist.linear.y, message.twist.angular.z = vx, vy, wz
-        self.sim.command(CONTROLLER, message)
-
-    def update(self) -> Odometry:
-        """Step one controller update; return the odometry it published."""
-        count = len(self.odometry)
-        self.node.step(UPDATE_STEPS)
-        assert self.sim.spin_until(lambda: len(self.odometry) > count), 'no odometry came'
-        return self.odometry[-1]
-
-    def true_pose(self) -> tuple[tuple[float, float, float], float]:
-        """Return the base's true position and heading (GetEntityState)."""
-        state = self.interfaces.entity_state(ROBOT)
-        q = state.pose.orientation
-        return position(state), 2.0 * math.atan2(q.z, q.w)
-
-
-@contextlib.contextmanager
-def running_base(folder, **drive) -> Iterator[Base]:
+def running_base(folder, **drive) -> contextlib.AbstractContextManager[MobileBase]:
     """Run the mecanum base on sim_node, its controller given ``drive`` parameters."""
-    description, controllers = write_mecanum(folder, mecanum_parameters(**drive))
-    with sim_node(paused=True, time_step=TIME_STEP, robot_description_file=str(description),
-                  controllers_file=str(controllers), world='ground') as sim:
-        yield Base(sim)
+    return base_on_sim_node(MECANUM, *write_mecanum(folder, mecanum_parameters(**drive)))
 
 
 @pytest.fixture
@@ -86,7 +45,7 @@ def base(tmp_path):
 
 def test_the_base_is_free_and_the_topics_are_upstreams(base):
     assert not base.node.simulation.physics.fixed_base
-    where, _ = base.true_pose()
+    where, _, _ = base.true_pose()
     assert where == pytest.approx((0.0, 0.0, REST_HEIGHT), abs=1e-6)
     published, subscribed = base.sim.own_topics()
     assert subscribed[f'/{CONTROLLER}/reference'] == 'geometry_msgs/msg/TwistStamped'
@@ -104,7 +63,7 @@ def test_one_metre_sideways_the_odometry_agrees_with_the_true_pose(base):
     base.command(0.0, 0.0, 0.0)
     for _ in range(50):
         odometry = base.update()
-    where, yaw = base.true_pose()
+    where, yaw, _ = base.true_pose()
     assert where[1] == pytest.approx(1.0, rel=0.02)
     assert odometry.pose.pose.position.y == pytest.approx(where[1], rel=0.02)
     assert abs(odometry.pose.pose.position.x) < 0.02 and abs(yaw) < 0.02
@@ -119,10 +78,6 @@ def test_one_metre_sideways_the_odometry_agrees_with_the_true_pose(base):
 
 
 def test_a_quarter_turn_on_the_spot_the_odometry_agrees_with_the_true_heading(base):
-    def heading(odometry: Odometry) -> float:
-        q = odometry.pose.pose.orientation
-        return 2.0 * math.atan2(q.z, q.w)
-
     odometry = base.update()
     while heading(odometry) < math.pi / 2:
         base.command(0.0, 0.0, 0.5)
@@ -130,7 +85,7 @@ def test_a_quarter_turn_on_the_spot_the_odometry_agrees_with_the_true_heading(ba
     base.command(0.0, 0.0, 0.0)
     for _ in range(50):
         odometry = base.update()
-    _, yaw = base.true_pose()
+    _, yaw, _ = base.true_pose()
     assert yaw == pytest.approx(math.pi / 2, rel=0.02)
     assert heading(odometry) == pytest.approx(yaw, rel=0.02)
 
@@ -144,7 +99,7 @@ def test_the_base_stops_once_the_reference_times_out(tmp_path):
         for _ in range(60):
             base.update()
         assert base.odometry[-1].twist.twist.linear.x == pytest.approx(0.0, abs=1e-3)
-        where, _ = base.true_pose()
+        where, _, _ = base.true_pose()
         assert where[0] < 0.2 * 0.4
 
 

@@ -1,6 +1,6 @@
 """A DiffBot-style robot on sim_node: cmd_vel in, odom and TF out, the base free on the ground.
 
-The rover of test/mobile_fixtures.py runs in-process, paused, at
+The rover of test/support/mobile_fixtures.py runs in-process, paused, at
 real_time_factor 0; each test drives it closed loop from the probe: it
 reads ``/base_controller/odom``, decides the next ``cmd_vel``, and steps
 the physics one odometry period (``node.step``) -- so the loop's delay is
@@ -12,70 +12,26 @@ from __future__ import annotations
 
 import contextlib
 import math
-from collections.abc import Iterator
 
 import pytest
-from geometry_msgs.msg import Twist, TwistStamped
+from geometry_msgs.msg import Twist
+from mobile_base_harness import BaseKind, MobileBase, base_on_sim_node, heading
 from mobile_fixtures import CONTROLLER, REST_HEIGHT, drive_parameters, write_rover
-from nav_msgs.msg import Odometry
 from node_harness import sim_node
-from sim_interfaces_client import OK, SimInterfaces, msg, pose, position, srv
-from tf2_msgs.msg import TFMessage
+from sim_interfaces_client import OK, msg, pose, srv
 
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.ros import controller_bindings
 
-TIME_STEP = 0.001
-PERIOD_STEPS = 20  # one odometry period at the default publish_rate of 50 Hz
 ROBOT = 'rover'
 ODOM = f'/{CONTROLLER}/odom'
+# One odometry period at the default publish_rate of 50 Hz: 20 steps.
+ROVER = BaseKind(ROBOT, CONTROLLER, ODOM, update_steps=20, tf='/tf', wait_for_tf=True)
 
 
-class Rover:
-    """The rover on sim_node, driven from the probe one odometry period at a time."""
-
-    def __init__(self, sim) -> None:
-        self.sim = sim
-        self.node = sim.node
-        self.odometry: list[Odometry] = sim.collect(Odometry, ODOM)
-        self.tf: list[TFMessage] = sim.collect(TFMessage, '/tf')
-        self.interfaces = SimInterfaces(sim)
-        sim.wait_for_subscribers(ODOM)
-        sim.wait_for_subscribers('/tf')
-
-    def command(self, linear: float, angular: float) -> None:
-        """Publish an unstamped twist on ``cmd_vel``; return once the controller took it."""
-        message = TwistStamped()
-        message.twist.linear.x, message.twist.angular.z = linear, angular
-        self.sim.command(CONTROLLER, message)
-
-    def period(self) -> Odometry:
-        """Step one odometry period; return the odometry it published."""
-        count = len(self.odometry)
-        self.node.step(PERIOD_STEPS)
-        assert self.sim.spin_until(lambda: len(self.odometry) > count), 'no odometry came'
-        return self.odometry[-1]
-
-    def true_pose(self) -> tuple[tuple[float, float, float], float, float]:
-        """Return the base's true position, heading and forward speed (GetEntityState)."""
-        state = self.interfaces.entity_state(ROBOT)
-        q = state.pose.orientation
-        return position(state), 2.0 * math.atan2(q.z, q.w), state.twist.linear.x
-
-
-def heading(odometry: Odometry) -> float:
-    """Return the heading of an odometry message's pose."""
-    q = odometry.pose.pose.orientation
-    return 2.0 * math.atan2(q.z, q.w)
-
-
-@contextlib.contextmanager
-def running_rover(folder, **drive) -> Iterator[Rover]:
+def running_rover(folder, **drive) -> contextlib.AbstractContextManager[MobileBase]:
     """Run the rover on sim_node, its controller given ``drive`` parameters."""
-    description, controllers = write_rover(folder, drive_parameters(**drive))
-    with sim_node(paused=True, time_step=TIME_STEP, robot_description_file=str(description),
-                  controllers_file=str(controllers), world='ground') as sim:
-        yield Rover(sim)
+    return base_on_sim_node(ROVER, *write_rover(folder, drive_parameters(**drive)))
 
 
 @pytest.fixture
@@ -96,13 +52,13 @@ def test_the_base_is_free_and_stands_on_its_wheels_where_it_started(rover):
 
 
 def test_one_metre_straight_at_0_2_m_s_the_odometry_agrees_with_the_true_pose(rover):
-    odometry = rover.period()
+    odometry = rover.update()
     while odometry.pose.pose.position.x < 1.0:
         rover.command(0.2, 0.0)
-        odometry = rover.period()
+        odometry = rover.update()
     rover.command(0.0, 0.0)
     for _ in range(10):
-        odometry = rover.period()
+        odometry = rover.update()
     where, yaw, speed = rover.true_pose()
     assert where[0] == pytest.approx(1.0, rel=0.02)
     assert odometry.pose.pose.position.x == pytest.approx(where[0], rel=0.02)
@@ -116,13 +72,13 @@ def test_one_metre_straight_at_0_2_m_s_the_odometry_agrees_with_the_true_pose(ro
 
 
 def test_a_quarter_turn_on_the_spot_the_odometry_agrees_with_the_true_heading(rover):
-    odometry = rover.period()
+    odometry = rover.update()
     while heading(odometry) < math.pi / 2:
         rover.command(0.0, 0.5)
-        odometry = rover.period()
+        odometry = rover.update()
     rover.command(0.0, 0.0)
     for _ in range(10):
-        odometry = rover.period()
+        odometry = rover.update()
     where, yaw, speed = rover.true_pose()
     assert yaw == pytest.approx(math.pi / 2, rel=0.02)
     assert heading(odometry) == pytest.approx(yaw, rel=0.02)
@@ -133,14 +89,14 @@ def test_the_robot_stops_once_cmd_vel_times_out(tmp_path):
         stops_after_the_timeout(rover)
 
 
-def stops_after_the_timeout(rover: Rover) -> None:
+def stops_after_the_timeout(rover: MobileBase) -> None:
     """Command once; check the robot moves within the timeout and stands after it."""
     rover.command(0.2, 0.0)
     for _ in range(5):  # 0.1 s: still within the timeout
-        rover.period()
+        rover.update()
     assert rover.true_pose()[2] == pytest.approx(0.2, rel=0.05)
     for _ in range(20):
-        rover.period()
+        rover.update()
     where, yaw, speed = rover.true_pose()
     assert abs(speed) < 1e-3
     assert rover.odometry[-1].twist.twist.linear.x == pytest.approx(0.0, abs=1e-3)
@@ -153,12 +109,12 @@ def test_the_acceleration_limit_shapes_the_ramp(tmp_path):
         ramps_at_half_a_metre_per_second_squared(rover)
 
 
-def ramps_at_half_a_metre_per_second_squared(rover: Rover) -> None:
+def ramps_at_half_a_metre_per_second_squared(rover: MobileBase) -> None:
     """Command 0.2 m/s from rest; check the true speed follows a 0.5 m/s^2 ramp."""
     rover.command(0.2, 0.0)
     speeds = []
     for _ in range(25):  # 0.5 s
-        rover.period()
+        rover.update()
         speeds.append(rover.true_pose()[2])
     # 0.5 m/s^2: 0.1 m/s after 0.2 s (10 periods), the full 0.2 m/s from 0.4 s on.
     assert speeds[9] == pytest.approx(0.1, abs=0.01)
@@ -169,7 +125,7 @@ def ramps_at_half_a_metre_per_second_squared(rover: Rover) -> None:
 def test_reset_simulation_puts_the_base_back_and_set_entity_state_moves_it(rover):
     rover.command(0.2, 0.3)
     for _ in range(25):
-        rover.period()
+        rover.update()
     assert rover.true_pose()[0][0] > 0.05
     result = rover.interfaces.reset(srv.ResetSimulation.Request.SCOPE_ALL)
     assert result.result == OK, result.error_message
@@ -184,7 +140,7 @@ def test_reset_simulation_puts_the_base_back_and_set_entity_state_moves_it(rover
     where, yaw, speed = rover.true_pose()
     assert where == pytest.approx((2.0, -1.0, REST_HEIGHT), abs=1e-6)
     assert yaw == pytest.approx(1.0)
-    rover.period()  # it stands where it was put
+    rover.update()  # it stands where it was put
     assert rover.true_pose()[0] == pytest.approx((2.0, -1.0, REST_HEIGHT), abs=1e-3)
     info = rover.interfaces.call('get_entity_info', srv.GetEntityInfo.Request(entity=ROBOT))
     assert info.info.category.category == msg.EntityCategory.CATEGORY_ROBOT
@@ -192,10 +148,10 @@ def test_reset_simulation_puts_the_base_back_and_set_entity_state_moves_it(rover
 
 def test_a_twist_that_is_not_finite_leaves_the_robot_as_it_was(rover):
     rover.command(0.2, 0.0)
-    rover.period()
+    rover.update()
     rover.command(math.nan, 0.0)
     for _ in range(5):
-        rover.period()
+        rover.update()
     assert rover.true_pose()[2] == pytest.approx(0.2, rel=0.05)
 
 

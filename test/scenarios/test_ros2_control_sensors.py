@@ -1,4 +1,4 @@
-"""The sensor arm's <ros2_control> sensors and gpio through sim_node (test/hardware_fixtures.py).
+"""The sensor arm's <ros2_control> sensors and gpio through sim_node (support/hardware_fixtures.py).
 
 Its broadcasters publish what the simulation measures -- the payload's weight,
 gravity on the IMU, the pose -- on their upstream topics, the gpio controller

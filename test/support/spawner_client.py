@@ -1,7 +1,7 @@
 """A test client that calls controller_manager the way jazzy's spawner.py does.
 
 :class:`Spawner` works on anything with ``call``, ``probe`` and
-``spin_until`` (test/node_harness.py's NodeHarness and SimUnderTest).
+``spin_until`` (test/support/node_harness.py's NodeHarness and SimUnderTest).
 """
 
 from __future__ import annotations
