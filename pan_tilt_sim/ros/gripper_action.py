@@ -4,7 +4,7 @@
 ``control_msgs/action/ParallelGripperCommand``
 (:class:`ParallelGripperCommandServer`), served with rclpy's ActionServer
 on sim_node's one executor.  The goals' rules are the controller's
-(:mod:`pan_tilt_sim.controllers.gripper_action_controller`); these classes
+(:mod:`pan_tilt_sim.controllers.grippers.gripper_action_controller`); these classes
 only translate (see the design notes).
 
 Design notes: docs/design/ros.md#gripper_actionpy.

@@ -5,7 +5,7 @@ ros2_control names every interface ``<component>/<interface>``
 state interfaces to read and command interfaces to write.  Here each is a
 small object holding one value (a double; NaN until something sets it),
 shared by the simulation and the controllers as joints share
-:class:`~pan_tilt_sim.controllers.base.JointHandle` (see the design notes).
+:class:`~pan_tilt_sim.controllers.framework.base.JointHandle` (see the design notes).
 
 Design notes: docs/design/controllers.md#hardware_interfacespy.
 """
