@@ -85,6 +85,14 @@ class LaunchContext:
         self.launch_configurations = launch_configurations
 
 
+class LaunchDescription(list):
+    """launch.LaunchDescription: its actions, in order; ``add_action`` appends one."""
+
+    def add_action(self, action: Any) -> None:
+        """Append ``action``, as launch's does."""
+        self.append(action)
+
+
 class Node(Recorded):
     """launch_ros.actions.Node."""
 
@@ -219,7 +227,7 @@ def generate_controllers_spawner_launch_description(
 def modules() -> dict[str, types.ModuleType]:
     """Return the stand-in modules, by name."""
     made = {name: types.ModuleType(name) for name in STAND_IN_MODULES}
-    made['launch'].LaunchDescription = list
+    made['launch'].LaunchDescription = LaunchDescription
     made['launch.actions'].RegisterEventHandler = RegisterEventHandler
     made['launch.actions'].DeclareLaunchArgument = DeclareLaunchArgument
     made['launch.actions'].OpaqueFunction = OpaqueFunction
@@ -283,6 +291,8 @@ def perform(value: Any, arguments: dict[str, str]) -> Any:
         holds = truth(text(value.args[0], arguments))
         return text(value.kwargs['if_value' if holds else 'else_value'], arguments)
     if isinstance(value, LaunchConfiguration):
+        if value.args[0] not in arguments and 'default' in value.kwargs:
+            return text(_as_text(value.kwargs['default']), arguments)
         return arguments[value.args[0]]
     if isinstance(value, FindExecutable):
         name = text(value.kwargs['name'], arguments)
@@ -300,6 +310,11 @@ def perform(value: Any, arguments: dict[str, str]) -> Any:
     if isinstance(value, dict):
         return {key: perform(item, arguments) for key, item in value.items()}
     return value
+
+
+def _as_text(value: Any) -> Any:
+    """A plain default (``True``, ``1.5``) as the text launch makes of it."""
+    return str(value) if isinstance(value, bool | int | float) else value
 
 
 def text(value: Any, arguments: dict[str, str]) -> str:

@@ -8,7 +8,9 @@ with it: its plugins, its controller manager (``<ros2_control>`` with a
 gz_ros2_control plugin), its sensors, at the request's pose and namespace.  The
 answer follows once it is built, so ``create`` exits when the robot is in.  The
 service stays: later requests go to the simulation services' SpawnEntity (objects),
-whose own server of that name it replaces.  docs/launch-files.md is the reference.
+whose own server of that name it replaces.  A robot is built once the bridge stand-ins
+that announced themselves have handed over their entries (:mod:`.bridged_topics`), at
+most :data:`BRIDGE_WAIT_S` later.  docs/launch-files.md is the reference.
 """
 
 from __future__ import annotations
