@@ -74,3 +74,18 @@ def test_a_rename_after_the_robot_is_in_is_refused_naming_the_topic():
             '--ros-args', '-r', '__ns:=/robot1'))
         assert code == 2
         assert "'/model/rover/odometry' exists already" in output, output
+
+
+def test_image_bridge_hands_its_image_topics_over_and_without_topics_prints_its_usage():
+    code, output = finish(None, start('image_bridge'))
+    assert code == 255 and 'image_bridge <topic> <topic>' in output
+    with world_only() as (harness, node):
+        process = start('image_bridge', '/camera/image_raw')
+        try:
+            assert harness.spin_until(lambda: '/ros_gz_image' in node.bridged_topics._sources,
+                                      BUDGET_S), 'image_bridge never handed over'
+            assert process.poll() is None
+        finally:
+            process.send_signal(signal.SIGINT)
+            code, output = finish(harness, process)
+        assert code == 0, output
