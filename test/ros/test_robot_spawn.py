@@ -27,6 +27,7 @@ pytestmark = pytest.mark.skipif(
     reason='simulation_interfaces or controller_manager_msgs is not installed')
 
 WAITING = 'No robot yet: waiting for one on'
+BUILD_S = 10.0
 BOX = ('<robot name="box"><link name="box"><inertial><mass value="1"/><inertia ixx="0.01" '
        'iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry>'
        '<box size="0.1 0.1 0.1"/></geometry></collision></link></robot>')
@@ -93,3 +94,20 @@ def test_the_robot_starts_at_the_requested_pose_and_a_world_objects_name_is_take
         assert (response.result.result, response.entity_name) == (1, 'rover_1')
         (x, y, heading), _twist = node.simulation.base_state()
         assert (x, y, heading) == pytest.approx((1.0, -0.5, 0.3), abs=1e-3)
+
+
+def test_a_robot_that_reads_but_cannot_be_built_is_refused_then_ends_it():
+    from mobile_fixtures import rover_urdf
+
+    from pan_tilt_sim.errors import ConfigurationError
+
+    with world_only() as (harness, _node):
+        client = harness.probe.create_client(srv().SpawnEntity, SERVICE)
+        assert harness.spin_until(client.service_is_ready)
+        # <ros2_control> with no controllers file and no plugin: nothing could drive it.
+        future = client.call_async(srv().SpawnEntity.Request(resource_string=rover_urdf()))
+        with pytest.raises(ConfigurationError, match='no controllers file'):
+            harness.spin_for(BUILD_S)  # the one line ends sim_node's spin
+        assert harness.spin_until(future.done)  # answered all the same
+        assert future.result().result.result == 4  # RESULT_OPERATION_FAILED
+        assert 'no controllers file' in future.result().result.error_message
