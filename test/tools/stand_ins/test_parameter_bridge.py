@@ -89,3 +89,23 @@ def test_image_bridge_hands_its_image_topics_over_and_without_topics_prints_its_
             process.send_signal(signal.SIGINT)
             code, output = finish(harness, process)
         assert code == 0, output
+
+
+def test_ros_names_are_the_bridge_nodes_and_gz_names_absolute_unless_expanded():
+    from node_harness import NodeHarness
+    from rclpy.node import Node
+
+    from pan_tilt_sim.model.gz_bridge import GZ_TO_ROS, BridgeEntry
+    from pan_tilt_sim.tools.stand_ins.bridging import absolute
+
+    harness = NodeHarness()
+    try:
+        node = Node('ros_gz_bridge', namespace='/robot1', context=harness.context)
+        entry = BridgeEntry('odom', 'odom', 'nav_msgs/msg/Odometry', 'gz.msgs.Odometry',
+                            GZ_TO_ROS)
+        plain, expanded = absolute(node, entry, False), absolute(node, entry, True)
+        assert (plain.ros_topic, plain.gz_topic) == ('/robot1/odom', '/odom')
+        assert (expanded.ros_topic, expanded.gz_topic) == ('/robot1/odom', '/robot1/odom')
+        node.destroy_node()
+    finally:
+        harness.close()
