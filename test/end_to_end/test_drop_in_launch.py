@@ -2,11 +2,10 @@
 
 examples/launch/arm_ros2_control.launch.py is written in ros2_control_demos'
 shape (pan_tilt_sim's ros2_control_node, unnamed, with the controllers YAML,
-robot_state_publisher with
-the xacro output, spawners with ``--param-file`` and ``--controller-ros-args``
-chained by OnProcessExit); a stand-in of the launch API carries it out
-(test/launch_stand_in.py: sim_node and a stand-in robot_state_publisher as
-processes, spawners in-process as jazzy's spawner calls).
+robot_state_publisher with the xacro output, spawners with ``--param-file``
+and ``--controller-ros-args`` chained by OnProcessExit); a stand-in of the
+launch API carries it out (test/launch_stand_in.py: sim_node and a stand-in
+robot_state_publisher as processes, spawners in-process as jazzy's spawner calls).
 test/data/gz_shaped/arm_sim_control.launch.py is a Gazebo launch in UR's shape
 (its nodes made by an OpaqueFunction) with the spawn step swapped for sim_node.
 With nobody publishing robot_description, the program says so once and waits idle.
