@@ -31,6 +31,12 @@ EXECUTABLES = {
     'tune': 'pan_tilt_sim.tools.tune:main',
     'sweep': 'pan_tilt_sim.tools.sweep:main',
 }
+# The Gazebo-side stand-ins (create, parameter_bridge, ...; pan_tilt_sim.tools.stand_ins):
+# launchers in lib/pan_tilt_sim/ only, all running one console script of an unmistakable
+# name, so that their generic names never land on PATH.
+STAND_INS = ('create', 'parameter_bridge', 'image_bridge', 'spawn_entity.py',
+             'ros2_control_node')
+STAND_IN_SCRIPT = 'pan_tilt_sim_stand_in'
 HERE = os.path.dirname(os.path.abspath(__file__))
 SHARE = os.path.join('share', PACKAGE)
 
@@ -65,7 +71,8 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + PACKAGE]),
         (SHARE, ['package.xml']),
-        ('lib/' + PACKAGE, ['resource/ros2_run/' + name for name in EXECUTABLES]),
+        ('lib/' + PACKAGE, ['resource/ros2_run/' + name for name in EXECUTABLES]
+         + ['resource/stand_ins/' + name for name in STAND_INS]),
         *_files('urdf'),
         *_files('config', ('.yaml', '.yml')),
         *_files('launch', ('.launch.py',)),
@@ -86,7 +93,8 @@ setup(
     license='Apache-2.0',
     python_requires='>=3.10',
     entry_points={
-        'console_scripts': [f'{name} = {target}' for name, target in EXECUTABLES.items()],
+        'console_scripts': [f'{name} = {target}' for name, target in EXECUTABLES.items()]
+        + [f'{STAND_IN_SCRIPT} = {PACKAGE}.tools.stand_ins:main'],
         # The sim fixtures for users' tests (inert unless a test asks for them).
         'pytest11': ['pan_tilt_sim = pan_tilt_sim.tools.pytest_plugin'],
     },

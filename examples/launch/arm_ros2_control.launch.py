@@ -6,7 +6,7 @@ robot_state_publisher with the xacro output, a spawner for the broadcaster
 and, once it has finished, one for the arm with ``--param-file`` and
 ``--controller-ros-args``.  Against real hardware the control node would be
 ``Node(package='controller_manager', executable='ros2_control_node', ...)``;
-here it is sim_node under the same name -- the one line that changes::
+here its package is pan_tilt_sim -- the one word that changes::
 
     ros2 launch examples/launch/arm_ros2_control.launch.py
     ros2 topic pub --once /arm/joint_trajectory trajectory_msgs/msg/JointTrajectory \
@@ -33,7 +33,7 @@ def generate_launch_description():
     robot_description = Command(['xacro ', PathJoinSubstitution([share, 'urdf',
                                                                  'three_joint_arm.xacro'])])
     control_node = Node(
-        package='pan_tilt_sim', executable='sim_node', name='controller_manager',
+        package='pan_tilt_sim', executable='ros2_control_node',
         parameters=[controllers],
         output='both',
     )

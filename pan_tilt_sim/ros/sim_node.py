@@ -32,10 +32,12 @@ from pan_tilt_sim.model.controller_config import (
 from pan_tilt_sim.model.description import RobotDescription, load_description
 from pan_tilt_sim.model.ros_arguments import parse_ros_arguments
 from pan_tilt_sim.ros import (
+    bridged_topics,
     command_reader,
     drop_in,
     optional_interfaces,
     parameters,
+    robot_spawn,
     services,
     simulation_services,
     topic_hardware,
@@ -120,6 +122,8 @@ class SimNode(Node):
         # teed into the bag (see create_publisher, create_subscription).
         self.recorder: Recorder | None = None
         self.viewer = None  # the browser view (viewer:=true), a pan_tilt_sim.ros.viewer.Viewer
+        # ros_gz_bridge entries' names and types for the robot's topics (robot_from_spawn).
+        self.bridged_topics: bridged_topics.BridgedTopics | None = None
         super().__init__(NODE_NAME, **kwargs)
         # Named controller_manager (launch's name='controller_manager'), sim_node stands
         # in for ros2_control_node: see the module pan_tilt_sim.ros.drop_in.
@@ -159,6 +163,13 @@ class SimNode(Node):
             view_feed.check_viewer(self._viewer_settings)
         # With a physics thread, callbacks take turns with it (the executor needs them now).
         self.turns: Turns | None = Turns() if physics_thread else None
+        if robot_spawn.declare(self):  # the world now, the robot from a spawn request
+            self.bridged_topics = bridged_topics.BridgedTopics(self)
+            self._robot_spawn = robot_spawn.RobotSpawnService(
+                self, lambda description, spawn: self._build_spawned(
+                    physics_thread, description, spawn),
+                taken=(entity.name for entity in self._world.entities if entity.name))
+            return
         if self.settings.robot_description_file:
             self._build(physics_thread, load_description(
                 self.settings.robot_description_file, self.settings.xacro_args))
@@ -166,6 +177,14 @@ class SimNode(Node):
         self._description_subscription = drop_in.wait_for_description(
             self, lambda description: self._build(physics_thread, description,
                                                   from_topic=True))
+
+    def _build_spawned(self, physics_thread: bool, description: RobotDescription,
+                       spawn: robot_spawn.Spawn) -> None:
+        """Build for a spawned robot: its pose and namespace as the parameters would give them."""
+        self.settings = dataclasses.replace(
+            self.settings, initial_pose=spawn.pose,
+            robot_namespace=spawn.namespace or self.settings.robot_namespace)
+        self._build(physics_thread, description, from_topic=True)
 
     def _build(self, physics_thread: bool, description: RobotDescription, *,
                from_topic: bool = False) -> None:
@@ -314,6 +333,8 @@ class SimNode(Node):
         :class:`~pan_tilt_sim.ros.recording.RecordedPublisher`).
         """
         kwargs.setdefault('event_callbacks', PublisherEventCallbacks(use_default_callbacks=False))
+        if self.bridged_topics is not None and len(args) >= 2:
+            args = (*self.bridged_topics.publisher(args[0], args[1]), *args[2:])
         publisher = super().create_publisher(*args, **kwargs)
         return publisher if self.recorder is None else self.recorder.tee_publisher(publisher)
 
@@ -333,6 +354,8 @@ class SimNode(Node):
         """
         kwargs.setdefault('event_callbacks',
                           SubscriptionEventCallbacks(use_default_callbacks=False))
+        if self.bridged_topics is not None and len(args) >= 3:
+            args = (*self.bridged_topics.subscription(args[0], args[1], args[2]), *args[3:])
         subscription = super().create_subscription(*args, **kwargs)
         if self.recorder is not None:  # the messages received are recorded too
             self.recorder.tee_subscription(subscription)

@@ -1,11 +1,11 @@
 """A ros2_control launch file run with sim_node as its control node, and sim_node left waiting.
 
 examples/launch/arm_ros2_control.launch.py is written in ros2_control_demos'
-shape (control node with the controllers YAML, robot_state_publisher with
-the xacro output, spawners with ``--param-file`` and ``--controller-ros-args``
-chained by OnProcessExit); a stand-in of the launch API carries it out
-(test/support/launch_stand_in.py: sim_node and a stand-in robot_state_publisher as
-processes, spawners in-process as jazzy's spawner calls).
+shape (pan_tilt_sim's ros2_control_node, unnamed, with the controllers YAML,
+robot_state_publisher with the xacro output, spawners with ``--param-file``
+and ``--controller-ros-args`` chained by OnProcessExit); a stand-in of the
+launch API carries it out (test/support/launch_stand_in.py: sim_node and a stand-in
+robot_state_publisher as processes, spawners in-process as jazzy's spawner calls).
 test/data/gz_shaped/arm_sim_control.launch.py is a Gazebo launch in UR's shape
 (its nodes made by an OpaqueFunction) with the spawn step swapped for sim_node.
 With nobody publishing robot_description, the program says so once and waits idle.
@@ -51,8 +51,9 @@ def test_the_launch_file_swaps_only_the_control_node(repo_root, monkeypatch):
     actions = launch_stand_in.load(repo_root.joinpath(*LAUNCH_FILE), monkeypatch)
     nodes = [action for action in actions if isinstance(action, launch_stand_in.Node)]
     control = nodes[0]
+    # ros2_control_node, unnamed as in ros2_control_demos: only its package differs.
     assert (control.kwargs['package'], control.kwargs['executable'],
-            control.kwargs['name']) == ('pan_tilt_sim', 'sim_node', 'controller_manager')
+            control.kwargs.get('name')) == ('pan_tilt_sim', 'ros2_control_node', None)
     assert [(node.kwargs['package'], node.kwargs['executable']) for node in nodes[1:]] == [
         ('robot_state_publisher', 'robot_state_publisher'), ('controller_manager', 'spawner')]
 
@@ -74,7 +75,7 @@ def test_the_launch_file_starts_the_simulation_spawns_and_the_arm_follows_its_co
     finally:
         harness.close()
         errors = launch.close()
-    log = errors['sim_node']
+    log = errors['ros2_control_node']
     assert log.count(WAITING) <= 1, log
     assert "Received robot description from topic '/robot_description'" in log
 

@@ -21,6 +21,10 @@ from ament_index_python.packages import get_package_prefix, get_package_share_di
 
 PACKAGE = 'pan_tilt_sim'
 EXECUTABLES = ('sim_node', 'bench', 'step_response', 'tune', 'sweep')
+# The Gazebo-side stand-ins: in lib/pan_tilt_sim/ only, run by one console script.
+STAND_INS = ('create', 'parameter_bridge', 'image_bridge', 'spawn_entity.py',
+             'ros2_control_node')
+STAND_IN_SCRIPT = 'pan_tilt_sim_stand_in'
 # What setup.py installs from; copied into the colcon workspace.
 PACKAGE_SOURCES = ('setup.py', 'setup.cfg', 'package.xml', 'resource', PACKAGE,
                    'urdf', 'config', 'launch')
@@ -139,10 +143,26 @@ def test_ros2_run_sees_exactly_the_entry_points(prefix):
     # sim_node starts through the runner, which installs its signal handlers
     # before rclpy and PyBullet are imported (a Ctrl-C during start-up is clean).
     expected['sim_node'] = f'{PACKAGE}.__main__:main'
+    expected[STAND_IN_SCRIPT] = f'{PACKAGE}.tools.stand_ins:main'
     assert entry_points == expected
     # `ros2 run` offers every executable file in lib/<package>/.
     lib = prefix / 'lib' / PACKAGE
-    assert {p.name for p in lib.iterdir() if _is_executable_file(p)} == set(EXECUTABLES)
+    assert {p.name for p in lib.iterdir() if _is_executable_file(p)} == {
+        *EXECUTABLES, *STAND_INS}
+
+
+@pytest.mark.parametrize('name', STAND_INS)
+def test_stand_ins_are_in_lib_only_never_on_path(prefix, name):
+    assert _is_executable_file(prefix / 'lib' / PACKAGE / name)
+    assert not (prefix / 'bin' / name).exists(), f'{name} is on PATH'
+
+
+def test_a_stand_in_launcher_runs_its_stand_in(prefix):
+    # parameter_bridge with no argument prints its usage and exits 255, as ros_gz_bridge's.
+    done = subprocess.run([str(prefix / 'lib' / PACKAGE / 'parameter_bridge')],
+                          capture_output=True, text=True, timeout=60, check=False)
+    assert done.returncode == 255 and 'parameter_bridge [<topic@ROS2_type@Ign_type>' in (
+        done.stdout), done
 
 
 def test_source_launchers_are_one_script(repo_root):

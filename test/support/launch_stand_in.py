@@ -5,7 +5,10 @@
 RegisterEventHandler + OnProcessExit, Command, PathJoinSubstitution, PathSubstitution,
 FindPackageShare, FindExecutable, LaunchConfiguration, IfElseSubstitution,
 DeclareLaunchArgument with its choices, IfCondition, UnlessCondition, OpaqueFunction,
-ParameterFile; IncludeLaunchDescription is recorded and refused when it would run;
+ParameterFile, Shutdown, launch.logging; IncludeLaunchDescription of pan_tilt_sim's own
+launch files -- the Gazebo stand-ins, gz_sim.launch.py and gazebo.launch.py -- is followed
+(their actions carried out in its place, with its launch_arguments), any other is recorded and
+refused when it would run;
 controller_manager.launch_utils' generate_controllers_spawner_launch_description, whose
 LaunchDescription is carried out in its place), and :class:`StandInLaunch` carries it out as
 launch would: the arguments declared (a default performed, a value outside ``choices``
@@ -17,13 +20,17 @@ actions carried out in its place; then the nodes, as launch_ros would start them
   written to a file under ``/**``, as launch_ros writes one);
 * ``robot_state_publisher`` as the stand-in program of
   test/support/robot_state_publisher_stand_in.py, with its parameters so;
+* ``pan_tilt_sim``'s Gazebo-side stand-ins (``create``, ``parameter_bridge``,
+  ``ros2_control_node``, ...) as processes, with the node's ``arguments``;
 * ``controller_manager``'s ``spawner`` in-process, playing jazzy's spawner
-  (test/support/spawner_client.py), and each OnProcessExit's actions once it ended.
+  (test/support/spawner_client.py), and each OnProcessExit's actions once it ended --
+  a spawner's, or a stand-in process's (``create`` exits once the robot is in).
 """
 
 from __future__ import annotations
 
 import importlib.util
+import logging
 import os
 import pathlib
 import re
@@ -31,6 +38,7 @@ import shlex
 import shutil
 import subprocess
 import sys
+import time
 import types
 from collections.abc import Iterable, Iterator
 from typing import Any
@@ -41,10 +49,15 @@ from spawner_client import spawner_main
 
 HERE = pathlib.Path(__file__).resolve().parent
 STAND_IN_MODULES = ('launch', 'launch.actions', 'launch.conditions', 'launch.event_handlers',
-                    'launch.launch_description_sources', 'launch.substitutions', 'launch_ros',
+                    'launch.launch_description_sources', 'launch.logging',
+                    'launch.substitutions', 'launch_ros',
                     'launch_ros.actions', 'launch_ros.parameter_descriptions',
                     'launch_ros.substitutions', 'controller_manager',
                     'controller_manager.launch_utils')
+# pan_tilt_sim's executables that run as processes here (sim_node has its own start).
+STAND_IN_EXECUTABLES = ('create', 'parameter_bridge', 'image_bridge', 'spawn_entity.py',
+                        'ros2_control_node')
+PROCESS_EXIT_WAIT_S = 120.0  # for a process an OnProcessExit waits on (create: the robot in)
 SUBSTITUTION = re.compile(r'\$\(var ([A-Za-z0-9_]+)\)')
 # The texts launch reads as a true or false condition (any case); any other is an error.
 TRUE_TEXTS, FALSE_TEXTS = ('true', '1'), ('false', '0')
@@ -72,6 +85,14 @@ class LaunchContext:
         self.launch_configurations = launch_configurations
 
 
+class LaunchDescription(list):
+    """launch.LaunchDescription: its actions, in order; ``add_action`` appends one."""
+
+    def add_action(self, action: Any) -> None:
+        """Append ``action``, as launch's does."""
+        self.append(action)
+
+
 class Node(Recorded):
     """launch_ros.actions.Node."""
 
@@ -82,6 +103,10 @@ class RegisterEventHandler(Recorded):
 
 class OnProcessExit(Recorded):
     """launch.event_handlers.OnProcessExit."""
+
+
+class Shutdown(Recorded):
+    """launch.actions.Shutdown (a Node's ``on_exit``; recorded only)."""
 
 
 class Command(Substitution):
@@ -152,6 +177,10 @@ class IncludeLaunchDescription(Recorded):
     ``launch_arguments`` (name-value pairs, or a dict's items).
     """
 
+    def path(self, arguments: dict[str, str]) -> pathlib.Path:
+        """Return the included file, performed."""
+        return pathlib.Path(text(self.args[0].args[0], arguments))
+
     def describe(self, arguments: dict[str, str]) -> str:
         """Return the included file's name and its launch arguments, performed."""
         names = [part for part in _strings(self.args[0].args[0]) if part.strip('/')]
@@ -198,10 +227,13 @@ def generate_controllers_spawner_launch_description(
 def modules() -> dict[str, types.ModuleType]:
     """Return the stand-in modules, by name."""
     made = {name: types.ModuleType(name) for name in STAND_IN_MODULES}
-    made['launch'].LaunchDescription = list
+    made['launch'].LaunchDescription = LaunchDescription
     made['launch.actions'].RegisterEventHandler = RegisterEventHandler
     made['launch.actions'].DeclareLaunchArgument = DeclareLaunchArgument
     made['launch.actions'].OpaqueFunction = OpaqueFunction
+    made['launch.actions'].Shutdown = Shutdown
+    made['launch.logging'].get_logger = logging.getLogger
+    made['launch'].logging = made['launch.logging']
     made['launch.conditions'].IfCondition = IfCondition
     made['launch.conditions'].UnlessCondition = UnlessCondition
     made['launch.actions'].IncludeLaunchDescription = IncludeLaunchDescription
@@ -232,6 +264,15 @@ def load(path: pathlib.Path, monkeypatch) -> list:
     return module.generate_launch_description()
 
 
+def _load_file(path: pathlib.Path) -> list:
+    """The actions of an included launch file (the stand-in modules are in place already)."""
+    spec = importlib.util.spec_from_file_location(f'included_{path.stem.replace(".", "_")}',
+                                                  path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.generate_launch_description()
+
+
 def perform(value: Any, arguments: dict[str, str]) -> Any:
     """Return the text a substitution stands for (lists and dicts element by element)."""
     if isinstance(value, FindPackageShare):
@@ -250,6 +291,8 @@ def perform(value: Any, arguments: dict[str, str]) -> Any:
         holds = truth(text(value.args[0], arguments))
         return text(value.kwargs['if_value' if holds else 'else_value'], arguments)
     if isinstance(value, LaunchConfiguration):
+        if value.args[0] not in arguments and 'default' in value.kwargs:
+            return text(_as_text(value.kwargs['default']), arguments)
         return arguments[value.args[0]]
     if isinstance(value, FindExecutable):
         name = text(value.kwargs['name'], arguments)
@@ -267,6 +310,11 @@ def perform(value: Any, arguments: dict[str, str]) -> Any:
     if isinstance(value, dict):
         return {key: perform(item, arguments) for key, item in value.items()}
     return value
+
+
+def _as_text(value: Any) -> Any:
+    """A plain default (``True``, ``1.5``) as the text launch makes of it."""
+    return str(value) if isinstance(value, bool | int | float) else value
 
 
 def text(value: Any, arguments: dict[str, str]) -> str:
@@ -310,6 +358,8 @@ class StandInLaunch:
         self.arguments = dict(arguments or {})
         self.actions = self._carry_out(actions)
         self.processes: dict[str, subprocess.Popen] = {}
+        self._process_of: dict[int, subprocess.Popen] = {}  # by id() of the Node action
+        self._logs: dict[str, pathlib.Path] = {}
         self.spawner_exits: list[tuple[list[str], int]] = []
         self._files = 0
 
@@ -332,6 +382,9 @@ class StandInLaunch:
             package, executable = node.kwargs['package'], node.kwargs['executable']
             if (package, executable) == ('pan_tilt_sim', 'sim_node'):
                 self.processes['sim_node'] = sim_process.start(*self._ros_args(node))
+                self._process_of[id(node)] = self.processes['sim_node']
+            elif package == 'pan_tilt_sim' and executable in STAND_IN_EXECUTABLES:
+                self._start_stand_in(node)
             elif package == 'robot_state_publisher':
                 command = [sys.executable, str(HERE / 'robot_state_publisher_stand_in.py'),
                            '--ros-args', *self._ros_args(node)]
@@ -339,10 +392,45 @@ class StandInLaunch:
                     command, env=sim_process.environment(), stdout=subprocess.DEVNULL,
                     stderr=subprocess.PIPE, text=True)
 
+    def _start_stand_in(self, node: Node) -> None:
+        """Start a pan_tilt_sim stand-in as launch_ros would: its arguments, then its ROS ones.
+
+        Its output goes to a file in the folder (``<name>.log``): read by :meth:`output`.
+        """
+        executable = node.kwargs['executable']
+        name = executable
+        number = 1
+        while name in self.processes:
+            number += 1
+            name = f'{executable}_{number}'
+        arguments = [str(item) for item in perform(node.kwargs.get('arguments', []),
+                                                  self.arguments)]
+        command = [sys.executable, '-m', 'pan_tilt_sim.tools.stand_ins', executable,
+                   *arguments, '--ros-args', *self._ros_args(node)]
+        log = (self.folder / f'{name}.log').open('w')
+        self.processes[name] = subprocess.Popen(
+            command, env=sim_process.environment(), stdout=log, stderr=subprocess.STDOUT,
+            text=True)
+        self._process_of[id(node)] = self.processes[name]
+        self._logs[name] = self.folder / f'{name}.log'
+
+    def output(self, name: str) -> str:
+        """What the stand-in process ``name`` wrote so far (stdout and stderr)."""
+        return self._logs[name].read_text()
+
+    def wait_for_exit(self, name: str, timeout: float = PROCESS_EXIT_WAIT_S) -> int | None:
+        """Wait up to ``timeout`` s for the process ``name`` to end; its exit code or None."""
+        try:
+            return self.processes[name].wait(timeout)
+        except subprocess.TimeoutExpired:
+            return None
+
     def run_spawners(self, harness) -> list[int]:
         """Run the spawners in order, each OnProcessExit's spawners after its target; exits.
 
         A RegisterEventHandler whose condition does not hold registers nothing.
+        The handlers of a stand-in process (``create``) run first, once it
+        has ended (within :data:`PROCESS_EXIT_WAIT_S`; else AssertionError).
         """
         handlers = {}
         for action in self.actions:
@@ -352,7 +440,18 @@ class StandInLaunch:
                 handlers[id(handler.kwargs['target_action'])] = (
                     on_exit if isinstance(on_exit, list | tuple) else [on_exit])
         codes = []
-        queue = self._spawners(self.nodes())
+        queue = []
+        for target, actions in handlers.items():
+            process = self._process_of.get(target)
+            if process is None:
+                continue
+            deadline = time.monotonic() + PROCESS_EXIT_WAIT_S
+            while process.poll() is None and time.monotonic() < deadline:
+                harness.spin_until(lambda ended=process: ended.poll() is not None)
+            assert process.poll() is not None, (
+                f'{process.args[4:6]} did not exit within {PROCESS_EXIT_WAIT_S} s')
+            queue.extend(self._spawners(actions))
+        queue.extend(self._spawners(self.nodes()))
         while queue:
             spawner = queue.pop(0)
             arguments = [str(item) for item in perform(spawner.kwargs.get('arguments', []),
@@ -370,25 +469,51 @@ class StandInLaunch:
         return codes
 
     def close(self) -> dict[str, str]:
-        """Stop every process (SIGINT); return what each wrote on stderr."""
+        """Stop every process (SIGINT); return what each wrote on stderr (a stand-in: all)."""
         errors = {}
         for name, process in self.processes.items():
             _ended, errors[name] = sim_process.stop(process, 10.0)
+            if name in self._logs:
+                errors[name] = self.output(name)
         return errors
 
     def _carry_out(self, actions: list) -> list:
-        """Declare the arguments and run the OpaqueFunctions in order; return the actions left."""
+        """Declare the arguments and run the OpaqueFunctions in order; return the actions left.
+
+        An include of pan_tilt_sim's own launch files (its condition holding) is
+        followed: its launch_arguments set, as launch sets them, and its actions
+        carried out in its place.
+        """
         left = []
         for action in actions:
             if isinstance(action, DeclareLaunchArgument):
                 action.declare(self.arguments)
-            if isinstance(action, OpaqueFunction):
+            if isinstance(action, IncludeLaunchDescription) and self._is_own(action):
+                if self._holds(action):
+                    for name, value in action.kwargs.get('launch_arguments', []):
+                        self.arguments[text(name, self.arguments)] = text(value, self.arguments)
+                    left += self._carry_out(_load_file(action.path(self.arguments)))
+            elif isinstance(action, OpaqueFunction):
                 left += self._carry_out(action.run(self.arguments))
             elif isinstance(action, list):  # a LaunchDescription among the actions
                 left += self._carry_out(action)
             else:
                 left.append(action)
         return left
+
+    def _is_own(self, action: IncludeLaunchDescription) -> bool:
+        """Whether the include names a launch file of pan_tilt_sim's installed share."""
+        from ament_index_python.packages import (
+            PackageNotFoundError,
+            get_package_share_directory,
+        )
+
+        share = pathlib.Path(get_package_share_directory('pan_tilt_sim')).resolve()
+        try:
+            included = action.path(self.arguments)
+        except PackageNotFoundError:  # another package's (ros_gz_sim's, not installed here)
+            return False
+        return share in included.resolve().parents
 
     def _holds(self, action: Recorded) -> bool:
         """Whether the action's condition (if any) holds."""
@@ -409,7 +534,8 @@ class StandInLaunch:
             args += ['--params-file', str(self._parameter_file(parameters))]
         for source, target in node.kwargs.get('remappings', []):
             args += ['-r', f'{source}:={target}']
-        return args
+        return args + [str(item) for item in perform(node.kwargs.get('ros_arguments', []),
+                                                      self.arguments)]
 
     def _parameter_file(self, parameters: Any) -> pathlib.Path:
         """A file name stays; a dict is written under ``/**``, as launch_ros writes it."""

@@ -1,0 +1,139 @@
+"""What ros_gz_bridge entries do to sim_node's topics: the ROS names and types they give.
+
+sim_node publishes and subscribes its robot's gz topics on ROS under their gz names
+(as an identity bridge would).  The ``parameter_bridge`` and ``image_bridge``
+stand-ins set the ``gz_bridge`` parameter (entries of
+:mod:`pan_tilt_sim.model.gz_bridge`); a topic created afterwards whose name is an
+entry's gz topic is created under the entry's ROS name, and a subscription under its
+ROS type where sim_node's converts (TwistStamped and Twist).  A spawned robot is
+built once every bridge announced on :data:`ANNOUNCE_TOPIC` has handed over (see
+:mod:`.robot_spawn`); entries that would rename or retype a topic that exists
+already are refused.  No message is copied: the simulation's own endpoints move.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from typing import Any
+
+from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+from pan_tilt_sim.model.gz_bridge import BridgeEntry, BridgeError, decode
+
+PARAMETER = 'gz_bridge'
+# Each bridge stand-in publishes on this hidden topic from its start, so that sim_node
+# knows a bridge is coming and builds a spawned robot only once it has handed over.
+ANNOUNCE_TOPIC = '/_pan_tilt_sim/gz_bridge'
+TWIST, TWIST_STAMPED = 'geometry_msgs/msg/Twist', 'geometry_msgs/msg/TwistStamped'
+
+
+def type_name(message_type: type) -> str:
+    """``geometry_msgs/msg/Twist`` of the class."""
+    package, kind, _module = message_type.__module__.split('.')[:3]
+    return f'{package}/{kind}/{message_type.__name__}'
+
+
+def message_class(name: str) -> type:
+    """Return the class of ``package/msg/Name``."""
+    package, kind, leaf = name.split('/')
+    return getattr(importlib.import_module(f'{package}.{kind}'), leaf)
+
+
+def _converter(ros_type: str, sim_type: str) -> Callable[[Any], Any] | None:
+    """Return a function from a ``ros_type`` message to a ``sim_type`` one, if one exists."""
+    if (ros_type, sim_type) == (TWIST_STAMPED, TWIST):
+        return lambda message: message.twist
+    if (ros_type, sim_type) == (TWIST, TWIST_STAMPED):
+        stamped = message_class(TWIST_STAMPED)
+        return lambda message: stamped(twist=message)
+    return None
+
+
+class BridgedTopics:
+    """The ``gz_bridge`` parameter and the topic routes it gives (see the module)."""
+
+    def __init__(self, node: Node) -> None:
+        self._node = node
+        self._entries: dict[str, BridgeEntry] = {}  # by gz topic, absolute
+        self._created: dict[str, str] = {}  # topic as sim_node names it -> its type name
+        self._sources: set[str] = set()  # the bridges that handed their entries over
+        node.declare_parameter(PARAMETER, Parameter.Type.STRING_ARRAY, ParameterDescriptor(
+            description="ros_gz_bridge entries ('gz_topic|ros_topic|ros_type|gz_type|"
+            "direction', after the bridge node's name), set by pan_tilt_sim's parameter_bridge "
+            "and image_bridge: the ROS names and types of the simulation's gz topics."))
+        node.add_on_set_parameters_callback(self._check)
+        node.add_post_set_parameters_callback(self._apply)
+
+    def publisher(self, message_type: type, topic: str) -> tuple[type, str]:
+        """Return the type and name to create sim_node's publisher of ``topic`` with."""
+        resolved = self._resolve(topic)
+        self._created[resolved] = type_name(message_type)
+        entry = self._entries.get(resolved)
+        if entry is None or not entry.to_ros:
+            return message_type, topic
+        if entry.ros_type != type_name(message_type):
+            self._node.get_logger().warning(
+                f"gz_bridge: '{entry.gz_topic}' is published as {type_name(message_type)}, "
+                f'not {entry.ros_type}: the type stays')
+        return message_type, entry.ros_topic
+
+    def subscription(self, message_type: type, topic: str,
+                     callback: Callable) -> tuple[type, str, Callable]:
+        """Return the type, name and callback to create sim_node's subscription with."""
+        resolved = self._resolve(topic)
+        self._created[resolved] = type_name(message_type)
+        entry = self._entries.get(resolved)
+        if entry is None or not entry.from_ros:
+            return message_type, topic, callback
+        if entry.ros_type == type_name(message_type):
+            return message_type, entry.ros_topic, callback
+        convert = _converter(entry.ros_type, type_name(message_type))
+        if convert is None:
+            self._node.get_logger().warning(
+                f"gz_bridge: '{entry.gz_topic}' is read as {type_name(message_type)}, not "
+                f'{entry.ros_type}: the type stays')
+            return message_type, entry.ros_topic, callback
+        return (message_class(entry.ros_type), entry.ros_topic,
+                lambda message: callback(convert(message)))
+
+    def _resolve(self, topic: str) -> str:
+        return self._node.resolve_topic_name(topic)
+
+    def pending(self) -> list[str]:
+        """Return the bridge stand-ins in the graph that have not handed their entries over."""
+        bridges = {f"{info.node_namespace.rstrip('/')}/{info.node_name}"
+                   for info in self._node.get_publishers_info_by_topic(ANNOUNCE_TOPIC)}
+        return sorted(bridges - self._sources)
+
+    def _entries_of(self, changed: list[Parameter]) -> list[BridgeEntry] | None:
+        for parameter in changed:
+            if parameter.name == PARAMETER:
+                return decode(list(parameter.value or ()))[1]
+        return None
+
+    def _check(self, changed: list[Parameter]) -> SetParametersResult:
+        try:
+            entries = self._entries_of(changed)
+        except BridgeError as err:
+            return SetParametersResult(successful=False, reason=str(err))
+        for entry in entries or ():
+            created = self._created.get(entry.gz_topic)
+            renamed = entry.ros_topic != entry.gz_topic or (
+                entry.ros_type != created and _converter(entry.ros_type, created) is not None)
+            if created is not None and renamed:
+                return SetParametersResult(successful=False, reason=(
+                    f"'{entry.gz_topic}' exists already as {created}: it cannot become "
+                    f"'{entry.ros_topic}' ({entry.ros_type}) now; start the bridge before the "
+                    'robot is spawned'))
+        return SetParametersResult(successful=True)
+
+    def _apply(self, changed: list[Parameter]) -> None:
+        for parameter in changed:
+            if parameter.name == PARAMETER:
+                source, entries = decode(list(parameter.value or ()))
+                self._sources.add(source)
+                for entry in entries:
+                    self._entries[entry.gz_topic] = entry

@@ -1,0 +1,264 @@
+"""A world without a robot yet: the first SpawnEntity request brings THE robot.
+
+With ``robot_from_spawn`` true (what the ros_gz_sim and gazebo_ros stand-ins start
+sim_node with) sim_node loads its world and waits, serving simulation_interfaces'
+``SpawnEntity`` where the simulation services will be (``~/spawn_entity``).  The
+first request's description becomes the robot, as if sim_node had been started
+with it: its plugins, its controller manager (``<ros2_control>`` with a
+gz_ros2_control plugin), its sensors, at the request's pose and namespace.  The
+answer follows once it is built, so ``create`` exits when the robot is in.  The
+service stays: later requests go to the simulation services' SpawnEntity (objects),
+whose own server of that name it replaces.  A robot is built once the bridge stand-ins
+that announced themselves have handed over their entries (:mod:`.bridged_topics`), at
+most :data:`BRIDGE_WAIT_S` later.  docs/launch-files.md is the reference.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import pathlib
+import time
+from collections.abc import Callable, Iterable
+
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.node import Node
+from rclpy.task import Future
+
+from pan_tilt_sim.errors import ConfigurationError, ParameterError
+from pan_tilt_sim.model import naming
+from pan_tilt_sim.model.base_pose import BasePose
+from pan_tilt_sim.model.description import (
+    RobotDescription,
+    description_from_text,
+    load_description,
+)
+from pan_tilt_sim.model.resources import resolve_resource
+from pan_tilt_sim.ros import parameters as params
+from pan_tilt_sim.ros.ros_interfaces import SERVICE_QOS
+from pan_tilt_sim.ros.simulation_services import interfaces
+
+PARAMETER = 'robot_from_spawn'
+SERVICE = '~/spawn_entity'  # where simulation_services' default namespace puts it
+WORLD_FRAMES = ('', 'world')
+TILT_TOLERANCE = 1e-6  # rad of roll or pitch taken as none
+# Wall seconds a spawn waits for announced bridges to hand over (their start-up is ~1 s).
+BRIDGE_WAIT_S = 10.0
+BRIDGE_POLL_S = 0.1
+
+
+@dataclasses.dataclass(frozen=True)
+class Spawn:
+    """What a spawn request asks of the robot besides its description."""
+
+    name: str
+    pose: BasePose
+    namespace: str  # '' = the description's own (its plugins')
+
+
+def declare(node: Node) -> bool:
+    """Declare ``robot_from_spawn``; return whether the robot comes from a spawn request."""
+    return params.declare(
+        node, PARAMETER, params.BOOL, False,
+        'true: start with the world only; the first simulation_interfaces SpawnEntity '
+        "request on '~/spawn_entity' (ros_gz_sim's create, gazebo_ros's spawn_entity.py) "
+        "brings the robot, with its plugins and controller manager.")
+
+
+def yaw_of(x: float, y: float, z: float, w: float) -> tuple[float, float]:
+    """Return (yaw, tilt) of a quaternion: its heading and how far it leans off vertical (rad)."""
+    norm = math.sqrt(x * x + y * y + z * z + w * w)
+    if not math.isfinite(norm) or norm < 1e-9:
+        raise ValueError('the orientation is not a rotation (zero or non-finite quaternion)')
+    x, y, z, w = x / norm, y / norm, z / norm, w / norm
+    yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    # The body's z axis in the world: its angle from vertical is the tilt.
+    up_z = 1.0 - 2.0 * (x * x + y * y)
+    return yaw, math.acos(max(-1.0, min(1.0, up_z)))
+
+
+def free_name(wanted: str, taken: Iterable[str], allow_renaming: bool) -> str | None:
+    """Return ``wanted``, or with ``allow_renaming`` the first free ``wanted_N``; None if taken."""
+    taken = set(taken)
+    if wanted not in taken:
+        return wanted
+    if not allow_renaming:
+        return None
+    number = 1
+    while f'{wanted}_{number}' in taken:
+        number += 1
+    return f'{wanted}_{number}'
+
+
+def renamed(description: RobotDescription, name: str) -> RobotDescription:
+    """Return ``description`` with the robot called ``name``."""
+    if name == description.name:
+        return description
+    return dataclasses.replace(description, model=dataclasses.replace(description.model,
+                                                                      name=name))
+
+
+class RobotSpawnService:
+    """Serves SpawnEntity until the robot is in; ``build(description, spawn)`` builds it.
+
+    ``taken`` are the world's entity names (a robot may not take one, unless
+    renamed).  A request refused (no resource, bad description, taken name,
+    bad pose) leaves sim_node waiting; one whose robot cannot be built ends
+    sim_node with that error after the answer, as a bad description file does.
+    """
+
+    def __init__(self, node: Node, build: Callable[[RobotDescription, Spawn], None],
+                 taken: Iterable[str] = ()) -> None:
+        found = interfaces()
+        if found is None:
+            raise ParameterError(
+                f"parameter '{PARAMETER}' is true, but simulation_interfaces is not installed: "
+                'nothing could spawn the robot (scripts/build_interfaces.sh builds it)')
+        self._node, self._build, self._taken = node, build, tuple(taken)
+        self._srv = found.srv.SpawnEntity
+        self._result = found.msg.Result
+        self._built = False
+        self._busy = False  # a request is waiting for the bridges
+        self._failure: ConfigurationError | None = None
+        self._objects: Callable | None = None  # the simulation services' handler, once built
+        # Reentrant: an object's spawn awaits its preparation, which other callbacks finish.
+        self.service = node.create_service(self._srv, SERVICE, self._spawn,
+                                           qos_profile=SERVICE_QOS,
+                                           callback_group=ReentrantCallbackGroup())
+        node.get_logger().info(
+            f"No robot yet: waiting for one on '{node.resolve_service_name(SERVICE)}' "
+            "(ros_gz_sim's create, "
+            "gazebo_ros's spawn_entity.py, or a SpawnEntity request); the simulation starts "
+            'with it')
+
+    async def _spawn(self, request, response):
+        if self._objects is not None:
+            return await self._objects(request, response)
+        if self._built or self._busy:  # being built, or it failed (sim_node is ending)
+            return self._refuse(response, self._result.RESULT_OPERATION_FAILED,
+                                'the robot is in or being loaded: spawn objects through the '
+                                'simulation services')
+        self._busy = True
+        try:
+            await self._bridges_handed_over()
+            return self._spawn_robot(request, response)
+        finally:
+            self._busy = False
+
+    async def _bridges_handed_over(self) -> None:
+        """Wait (at most BRIDGE_WAIT_S) for the bridges in the graph to give their entries."""
+        bridges = getattr(self._node, 'bridged_topics', None)
+        if bridges is None:
+            return
+        deadline = time.monotonic() + BRIDGE_WAIT_S
+        pending = bridges.pending()
+        if pending:
+            self._node.get_logger().info(
+                f"waiting for {', '.join(pending)} to hand over its topics before the robot "
+                'is built')
+        while pending and time.monotonic() < deadline:
+            await self._pause(BRIDGE_POLL_S)
+            pending = bridges.pending()
+        if pending:
+            self._node.get_logger().warning(
+                f"{', '.join(pending)} did not hand over its topics within {BRIDGE_WAIT_S:g} s: "
+                'the robot is built without them')
+
+    def _pause(self, seconds: float) -> Future:
+        """Return a Future done after ``seconds`` of wall time (a one-shot timer completes it)."""
+        future = Future()
+
+        def done() -> None:
+            self._node.destroy_timer(timer)
+            future.set_result(None)
+
+        timer = self._node.create_timer(seconds, done)
+        return future
+
+    def _spawn_robot(self, request, response):
+        codes = self._srv.Response
+        if not request.uri and not request.resource_string:
+            return self._refuse(response, codes.NO_RESOURCE,
+                                'neither uri nor resource_string is set')
+        if request.entity_namespace and not naming.is_valid_namespace(
+                naming.normalize(request.entity_namespace)):
+            return self._refuse(response, codes.NAMESPACE_INVALID,
+                                f"entity_namespace '{request.entity_namespace}' is not a valid "
+                                f'ROS namespace ({naming.NAMESPACE_RULE})')
+        pose = request.initial_pose
+        if pose.header.frame_id not in WORLD_FRAMES:
+            return self._refuse(response, codes.INVALID_POSE,
+                                f"initial_pose frame '{pose.header.frame_id}': with no robot "
+                                "in the world yet, only '' or 'world'")
+        position, orientation = pose.pose.position, pose.pose.orientation
+        try:
+            yaw, tilt = yaw_of(orientation.x, orientation.y, orientation.z, orientation.w)
+        except ValueError as err:
+            return self._refuse(response, codes.INVALID_POSE, f'initial_pose: {err}')
+        if not all(math.isfinite(value) for value in (position.x, position.y, position.z)):
+            return self._refuse(response, codes.INVALID_POSE,
+                                'initial_pose: the position is not finite')
+        try:
+            description = self._description(request)
+        except ConfigurationError as err:
+            code = (self._result.RESULT_NOT_FOUND if 'no such file' in str(err)
+                    or 'unknown package' in str(err) else codes.RESOURCE_PARSE_ERROR)
+            return self._refuse(response, code, str(err))
+        name = free_name(request.name or description.name, self._taken, request.allow_renaming)
+        if name is None:
+            return self._refuse(response, codes.NAME_NOT_UNIQUE,
+                                f"entity named '{request.name or description.name}' already "
+                                'exists (allow_renaming is false)')
+        if tilt > TILT_TOLERANCE:
+            self._node.get_logger().warning(
+                f"spawning '{name}' upright: its initial roll and pitch ({tilt:.3g} rad off "
+                'vertical) are not simulated, only its yaw')
+        self._built = True
+        try:
+            self._build(renamed(description, name), Spawn(
+                name, BasePose(position.x, position.y, position.z, yaw),
+                naming.normalize(request.entity_namespace)))
+        except ConfigurationError as err:
+            # As for a description file: sim_node ends with this line, after the answer.
+            self._failure = err
+            self._once(self._fail)
+            return self._refuse(response, self._result.RESULT_OPERATION_FAILED, str(err))
+        self._take_over()
+        response.result.result = self._result.RESULT_OK
+        response.entity_name = name
+        return response
+
+    def _description(self, request) -> RobotDescription:
+        if request.uri:
+            return load_description(resolve_resource(request.uri, pathlib.Path.cwd()))
+        return description_from_text(request.resource_string, '<SpawnEntity resource_string>')
+
+    def _refuse(self, response, code: int, message: str):
+        self._node.get_logger().error(f'SpawnEntity refused: {message}')
+        response.result.result = code
+        response.result.error_message = message
+        return response
+
+    def _once(self, action: Callable[[], None]) -> None:
+        """Run ``action`` once, in the executor's next turn (after this answer is sent)."""
+        def run() -> None:
+            self._node.destroy_timer(timer)
+            action()
+
+        timer = self._node.create_timer(0.0, run)
+
+    def _take_over(self) -> None:
+        """Serve the simulation services' SpawnEntity in place of their own server."""
+        simulation = getattr(self._node, 'simulation_interfaces', None)
+        theirs = None if simulation is None else simulation.services.get('spawn_entity')
+        if theirs is None:
+            return
+        if (self._node.resolve_service_name(theirs.srv_name)
+                != self._node.resolve_service_name(self.service.srv_name)):
+            return  # elsewhere (simulation_interfaces.namespace): both stay
+        self._objects = theirs.callback
+        self._node.destroy_service(theirs)
+        simulation.services['spawn_entity'] = self.service
+
+    def _fail(self) -> None:
+        raise self._failure

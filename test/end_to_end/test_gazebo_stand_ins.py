@@ -1,0 +1,137 @@
+"""Gazebo launch files with only package names changed run on sim_node (one robot per world).
+
+Each fixture is written in an upstream shape with ``pan_tilt_sim`` where the Gazebo-side
+package was (test/data/gz_shaped/, test/data/classic_shaped/); the launch stand-in
+(test/launch_stand_in.py) follows their includes into pan_tilt_sim's gz_sim.launch.py and
+gazebo.launch.py and starts the stand-ins (create, parameter_bridge, spawn_entity.py) as
+processes, the spawners in-process once create or spawn_entity.py has exited.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import pathlib
+
+import launch_stand_in
+import pytest
+from builtin_interfaces.msg import Duration
+from geometry_msgs.msg import TwistStamped
+from mobile_fixtures import GZ_DIFF_DRIVE, plugin_rover_urdf
+from nav_msgs.msg import Odometry
+from node_harness import PROBE_QUEUE, NodeHarness
+from sensor_msgs.msg import JointState
+from spawner_client import Spawner
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+
+pytestmark = pytest.mark.skipif(
+    importlib.util.find_spec('controller_manager_msgs') is None
+    or importlib.util.find_spec('simulation_interfaces') is None,
+    reason='controller_manager_msgs or simulation_interfaces is not installed')
+
+DATA = pathlib.Path(__file__).resolve().parents[1] / 'data'
+GZ_ARM = DATA / 'gz_shaped' / 'arm_gz_spawn.launch.py'
+GZ_ROVER = DATA / 'gz_shaped' / 'rover_gz_bridge.launch.py'
+ROVER_BRIDGE = DATA / 'gz_shaped' / 'rover_bridge.yaml'
+CLASSIC_ARM = DATA / 'classic_shaped' / 'arm_classic.launch.py'
+ARM_JOINTS = ['shoulder_joint', 'extend_joint', 'wrist_joint']
+TARGET = [0.5, 0.1, 0.3]
+REACHED_RAD = 0.02
+MOVE_BUDGET_S = 30.0
+EXIT_BUDGET_S = 60.0
+DRIVE_SPEED = 0.3  # m/s
+
+
+def _arm_follows(harness: NodeHarness, states: list[JointState], topic: str) -> None:
+    publisher = harness.probe.create_publisher(JointTrajectory, topic, 10)
+    assert harness.spin_until(lambda: publisher.get_subscription_count() > 0)
+    publisher.publish(JointTrajectory(joint_names=ARM_JOINTS, points=[JointTrajectoryPoint(
+        positions=TARGET, time_from_start=Duration(sec=1))]))
+
+    def reached() -> bool:
+        if not states:
+            return False
+        positions = dict(zip(states[-1].name, states[-1].position, strict=True))
+        return all(abs(positions[joint] - target) < REACHED_RAD
+                   for joint, target in zip(ARM_JOINTS, TARGET, strict=True))
+
+    assert harness.spin_until(reached, MOVE_BUDGET_S), (
+        f'the arm did not reach {TARGET}: last {states[-1] if states else None}')
+
+
+def _run_arm(monkeypatch, tmp_path, launch_file: pathlib.Path, spawn_step: str):
+    """Run an arm launch file; return (spawner exits, spawn step's exit, outputs)."""
+    launch = launch_stand_in.StandInLaunch(launch_stand_in.load(launch_file, monkeypatch),
+                                           tmp_path)
+    harness = NodeHarness()
+    states: list[JointState] = []
+    harness.probe.create_subscription(JointState, '/joint_states', states.append, PROBE_QUEUE)
+    try:
+        launch.start_processes()
+        codes = launch.run_spawners(harness)
+        spawned = launch.processes[spawn_step].returncode
+        listed = {name: c.state for name, c in Spawner(harness).controllers().items()}
+        assert listed == {'joint_state_broadcaster': 'active', 'arm_controller': 'active'}
+        _arm_follows(harness, states, '/arm_controller/joint_trajectory')
+        alive = {name: process.poll() is None for name, process in launch.processes.items()}
+    finally:
+        harness.close()
+        outputs = launch.close()
+    return codes, spawned, alive, outputs
+
+
+def test_a_gz_launch_file_spawns_with_create_and_its_spawners_run_on_creates_exit(
+        monkeypatch, tmp_path):
+    codes, spawned, alive, outputs = _run_arm(monkeypatch, tmp_path, GZ_ARM, 'create')
+    assert codes == [0, 0] and spawned == 0, outputs.get('create')
+    # sim_node (gz_sim.launch.py's) and the bridge keep running; create has ended.
+    assert alive == {'sim_node': True, 'create': False, 'parameter_bridge': True,
+                     'robot_state_publisher': True}
+    assert 'Entity creation successfull.' in outputs['create']
+    assert 'No robot yet: waiting for one on' in outputs['sim_node']
+    assert "simulating 'three_joint_arm'" in outputs['sim_node']
+    assert 'parameter_bridge' in outputs and 'refused' not in outputs['parameter_bridge']
+
+
+def test_a_classic_launch_file_spawns_with_spawn_entity_py(monkeypatch, tmp_path):
+    codes, spawned, _alive, outputs = _run_arm(monkeypatch, tmp_path, CLASSIC_ARM,
+                                               'spawn_entity.py')
+    assert codes == [0, 0] and spawned == 0, outputs.get('spawn_entity.py')
+    assert "simulating 'arm'" in outputs['sim_node']  # -entity names it
+
+
+def test_a_bridge_config_gives_the_robots_gz_topics_their_ros_names_and_types(
+        monkeypatch, tmp_path):
+    urdf = tmp_path / 'rover.urdf'
+    urdf.write_text(plugin_rover_urdf(GZ_DIFF_DRIVE))
+    launch = launch_stand_in.StandInLaunch(
+        launch_stand_in.load(GZ_ROVER, monkeypatch), tmp_path,
+        {'description_file': str(urdf), 'bridge_config': str(ROVER_BRIDGE)})
+    harness = NodeHarness()
+    odometry: list[Odometry] = []
+    harness.probe.create_subscription(Odometry, '/odom', odometry.append, PROBE_QUEUE)
+    try:
+        launch.start_processes()
+        assert launch.wait_for_exit('create', EXIT_BUDGET_S) == 0, launch.output('create')
+        # The gz names are not on ROS: the bridge gave them others.
+        names = dict(harness.probe.get_topic_names_and_types())
+        assert '/model/rover/odometry' not in names and '/model/rover/cmd_vel' not in names
+        assert harness.spin_until(lambda: odometry), 'no /odom'
+        command = harness.probe.create_publisher(TwistStamped, '/cmd_vel', 10)
+        assert harness.spin_until(lambda: command.get_subscription_count() > 0), (
+            'nobody reads /cmd_vel as TwistStamped')
+
+        def driving() -> bool:
+            message = TwistStamped()
+            message.twist.linear.x = DRIVE_SPEED
+            command.publish(message)
+            return bool(odometry) and odometry[-1].twist.twist.linear.x > 0.8 * DRIVE_SPEED
+
+        assert harness.spin_until(driving, MOVE_BUDGET_S), (
+            f'the rover did not drive: {odometry[-1].twist.twist if odometry else None}')
+        alive = launch.processes['parameter_bridge'].poll() is None
+    finally:
+        harness.close()
+        outputs = launch.close()
+    assert alive, outputs['parameter_bridge']
+    assert 'to hand over its topics' in outputs['sim_node'] or (
+        'bridged by' in outputs['parameter_bridge'])

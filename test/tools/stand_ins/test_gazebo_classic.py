@@ -1,0 +1,50 @@
+"""gazebo_ros's gazebo.launch.py arguments, read as sim_node's start (Gazebo classic)."""
+
+import pytest
+
+from pan_tilt_sim.tools.stand_ins.gazebo_classic import ARGUMENTS, server
+from pan_tilt_sim.tools.stand_ins.gz_sim import GzArgsError
+
+
+def launch_arguments(**given: str) -> dict[str, str]:
+    """The launch arguments as the launch file performs them: defaults, then ``given``."""
+    return {**ARGUMENTS, **given}
+
+
+def test_the_defaults_are_gzservers_empty_world_playing_and_quiet():
+    started = server(launch_arguments(), environ={})
+    assert started.run and started.warnings == []
+    assert started.parameters == {'world': 'ground', 'robot_from_spawn': True, 'paused': False,
+                                  'autostart_controllers': False, 'publish_tf': False}
+    assert started.ros_arguments == ['--log-level', 'warn']
+
+
+def test_pause_verbose_and_extra_gazebo_args():
+    assert server(launch_arguments(pause='true'), environ={}).parameters['paused'] is True
+    started = server(launch_arguments(extra_gazebo_args='-u --verbose -s libfoo.so'),
+                     environ={})
+    assert started.parameters['paused'] is True and started.ros_arguments == []
+    assert started.warnings == ["extra_gazebo_args: '-s' is not honoured by sim_node",
+                                "extra_gazebo_args: 'libfoo.so' is not honoured by sim_node"]
+
+
+def test_arguments_given_a_value_sim_node_does_not_honour_are_named():
+    started = server(launch_arguments(physics='bullet', seed='4'), environ={})
+    assert started.warnings == [
+        "gazebo.launch.py: physics:='bullet' is not honoured by sim_node",
+        "gazebo.launch.py: seed:='4' is not honoured by sim_node"]
+
+
+def test_a_world_on_the_resource_path_and_one_that_is_nowhere(tmp_path):
+    (tmp_path / 'worlds').mkdir()
+    world = tmp_path / 'worlds' / 'room.world'
+    world.write_text('<sdf version="1.6"><world name="room"/></sdf>')
+    found = server(launch_arguments(world='worlds/room.world'),
+                   environ={'GAZEBO_RESOURCE_PATH': str(tmp_path)}, cwd=tmp_path / 'worlds')
+    assert found.parameters['world'] == str(world)
+    with pytest.raises(GzArgsError, match="world 'cafe.world' not found"):
+        server(launch_arguments(world='cafe.world'), environ={}, cwd=tmp_path)
+
+
+def test_server_false_starts_nothing():
+    assert not server(launch_arguments(server='false'), environ={}).run

@@ -1,0 +1,57 @@
+"""gz_sim.launch.py's gz_args, read as `gz sim` reads them, make sim_node's start."""
+
+import pathlib
+
+import pytest
+
+from pan_tilt_sim.tools.stand_ins.gz_sim import GzArgsError, server
+
+
+def test_run_verbosity_and_the_built_in_empty_world():
+    started = server(' -r -v 3 empty.sdf', environ={})
+    assert started.run
+    assert started.parameters == {'world': 'ground', 'robot_from_spawn': True, 'paused': False,
+                                  'autostart_controllers': False, 'publish_tf': False}
+    assert started.ros_arguments == ['--log-level', 'info'] and started.warnings == []
+
+
+def test_without_r_it_starts_paused_as_gz_sim_does_and_no_world_is_the_empty_one():
+    started = server('-s --headless-rendering', environ={})
+    assert started.parameters['paused'] is True
+    assert started.parameters['world'] == 'ground' and started.warnings == []
+
+
+@pytest.mark.parametrize(('level', 'ros'), [('0', 'fatal'), ('1', 'error'), ('2', 'warn'),
+                                            ('4', 'info')])
+def test_verbosity_levels_map_to_log_levels(level, ros):
+    assert server(f'-v {level}', environ={}).ros_arguments == ['--log-level', ros]
+
+
+def test_a_world_file_is_found_by_path_then_on_the_resource_path(tmp_path: pathlib.Path):
+    world = tmp_path / 'models' / 'sandbox.sdf'
+    world.parent.mkdir()
+    world.write_text('<sdf version="1.8"><world name="w"/></sdf>')
+    assert server(str(world), environ={}).parameters['world'] == str(world)
+    found = server('-r sandbox.sdf', environ={'GZ_SIM_RESOURCE_PATH': str(world.parent)},
+                   cwd=tmp_path)
+    assert found.parameters['world'] == str(world)
+
+
+def test_a_world_that_is_nowhere_is_one_line_naming_it(tmp_path):
+    with pytest.raises(GzArgsError, match="world 'shapes.sdf' not found"):
+        server('-r shapes.sdf', environ={}, cwd=tmp_path)
+
+
+def test_options_not_honoured_are_named_once_each_with_their_value():
+    started = server('-r --physics-engine gz-physics-bullet -z 1000 --seed=3 empty.sdf',
+                     environ={})
+    assert started.warnings == [
+        "gz_args: '--physics-engine gz-physics-bullet' is not honoured by sim_node",
+        "gz_args: '-z 1000' is not honoured by sim_node",
+        "gz_args: '--seed 3' is not honoured by sim_node"]
+    assert started.parameters['world'] == 'ground'
+
+
+def test_a_gui_only_gz_sim_starts_nothing():
+    started = server('-g -v 4', environ={})
+    assert not started.run and "'-g'" in started.warnings[-1]
