@@ -3,7 +3,7 @@
 ``control_msgs/action/FollowJointTrajectory`` (built by the standalone path,
 or a ROS install's), served with rclpy's ActionServer on sim_node's one
 executor, with ros2_controllers' semantics in sim time (the rules are the
-controller's, :mod:`pan_tilt_sim.controllers.trajectory.joint_trajectory_controller`) (see the design notes).
+controller's, :mod:`pan_tilt_sim.controllers.trajectory.joint_trajectory_controller`).
 
 Design notes: docs/design/ros.md#trajectory_actionpy.
 """
