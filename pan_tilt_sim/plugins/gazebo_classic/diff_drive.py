@@ -1,9 +1,8 @@
 """``libgazebo_ros_diff_drive.so`` as a unit of the simulation: the plugin's semantics, no ROS.
 
-Not a ros2_control controller: no controller_manager loads, lists or
-switches it.  The simulation creates one per plugin the URDF declares
-(:mod:`pan_tilt_sim.model.drive_plugins`) and updates it every physics
-step, before the controllers; it is always active.  As the plugin:
+Not a ros2_control controller: the simulation creates one per plugin
+element (:mod:`pan_tilt_sim.plugins.registry`); elements, defaults and
+checks per generation: docs/mobile-robots.md.  As the plugin:
 
 * **Command**: ``geometry_msgs/Twist`` on its command topic; only
   ``linear.x`` (m/s) and ``angular.z`` (rad/s) count, and the last one holds
@@ -29,6 +28,7 @@ odometry back at the origin, as the plugin's Reset.  Pure Python.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
@@ -41,25 +41,189 @@ from pan_tilt_sim.controllers.base import (
     CommandResult,
     JointHandle,
 )
-from pan_tilt_sim.controllers.diff_drive_controller import OdometrySink, TfSink
 from pan_tilt_sim.controllers.odometry import Odometry
-from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs
+from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs, TfSink
 from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
-from pan_tilt_sim.model.drive_plugins import ENCODER, DiffDrivePlugin
+from pan_tilt_sim.model.plugin_elements import PluginElement
+from pan_tilt_sim.model.robot import RobotModel
+from pan_tilt_sim.model.sensors import ROS1, ROS2, Ros2Names, ros1_resolve
 from pan_tilt_sim.model.transforms import Transform
+from pan_tilt_sim.plugins.framework.elements import (
+    UNPLANAR_COVARIANCE,
+    ElementReader,
+    check_frames,
+    check_wheels,
+    joints_by_name,
+)
+from pan_tilt_sim.plugins.framework.plugin import (
+    BaseState,
+    PlanarOdometrySink,
+    Plugin,
+    PluginWorld,
+)
 from pan_tilt_sim.schedule import DUE_EPSILON
 
 REACHED = 0.01  # m/s: a wheel this close to its speed is set to it directly (the plugin's)
-# The base's state: (x, y, heading) in the world (m, rad) and its twist in the base frame
-# (forward m/s, sideways m/s, yaw rate rad/s).
-BaseState = tuple[tuple[float, float, float], tuple[float, float, float]]
+ENCODER, WORLD = 'encoder', 'world'
+ROS2_SOURCES = {0: ENCODER, 1: WORLD}  # gazebo_ros's odometry_source numbers
+# Elements only ROS 1's diff drive reads: they tell which generation a plugin is.
+ROS1_DIFF_DRIVE_KEYS = {'leftJoint', 'rightJoint', 'wheelSeparation', 'wheelDiameter',
+                        'commandTopic', 'odometryTopic', 'odometryFrame', 'robotBaseFrame',
+                        'publishOdomTF', 'publishTf', 'updateRate', 'wheelTorque',
+                        'wheelAcceleration', 'odometrySource', 'robotNamespace'}
 
 
-class GazeboDiffDrive(OdometryOutputs, CommandController):
+@dataclasses.dataclass(frozen=True)
+class DiffDrivePlugin:
+    """One ``gazebo_ros_diff_drive`` plugin: wheels, geometry, limits, topics and frames.
+
+    ``left_joints[i]`` and ``right_joints[i]`` are wheel pair i, with
+    ``wheel_separation[i]`` (m) and ``wheel_diameter[i]`` (m).  Topics are
+    as the plugin resolves them, before sim_node's namespace override
+    (:meth:`topics`).  ``update_rate`` 0: every physics step.
+    """
+
+    name: str
+    convention: str
+    left_joints: tuple[str, ...]
+    right_joints: tuple[str, ...]
+    wheel_separation: tuple[float, ...]
+    wheel_diameter: tuple[float, ...]
+    max_wheel_torque: float = 5.0
+    max_wheel_acceleration: float = 0.0
+    update_rate: float = 100.0
+    odometry_frame: str = 'odom'
+    robot_base_frame: str = 'base_footprint'
+    odometry_source: str = WORLD
+    publish_odom: bool = False
+    publish_odom_tf: bool = False
+    covariance: tuple[float, float, float] = (1e-5, 1e-5, 1e-3)  # x, y, yaw
+    command_topic: str = 'cmd_vel'
+    odometry_topic: str = 'odom'
+    namespace: str = ''
+    remappings: tuple[tuple[str, str], ...] = ()
+
+    filename = 'libgazebo_ros_diff_drive.so'
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Every wheel, left ones first."""
+        return self.left_joints + self.right_joints
+
+    def topics(self, override: str = '') -> tuple[str, str]:
+        """Return the command and odometry topics (absolute), ``override`` as the namespace.
+
+        ``override`` (sim_node's namespace or ``robot_namespace``) replaces the
+        plugin's, as spawn's ``-robot_namespace`` does in Gazebo.
+        """
+        namespace = override or self.namespace
+        if self.convention == ROS1:
+            return (ros1_resolve(namespace, self.command_topic),
+                    ros1_resolve(namespace, self.odometry_topic))
+        names = Ros2Names(self.name, namespace, self.remappings)
+        return names.topic(self.command_topic), names.topic(self.odometry_topic)
+
+    @property
+    def pose_covariance(self) -> tuple[float, ...]:
+        """The odometry pose covariance's diagonal (x, y, z, roll, pitch, yaw)."""
+        x, y, yaw = self.covariance
+        return (x, y, UNPLANAR_COVARIANCE, UNPLANAR_COVARIANCE, UNPLANAR_COVARIANCE, yaw)
+
+    @property
+    def twist_covariance(self) -> tuple[float, ...]:
+        """The odometry twist covariance's diagonal: ROS 2 repeats the pose's, ROS 1 has none."""
+        return self.pose_covariance if self.convention == ROS2 else (0.0,) * 6
+
+
+def read_diff_drive(element: PluginElement, model: RobotModel) -> DiffDrivePlugin:
+    """Return the plugin's settings, ROS 1's or ROS 2's elements (the element spec)."""
+    reader = ElementReader(element, model.name)
+    ros1 = reader.has_any(ROS1_DIFF_DRIVE_KEYS) and 'ros' not in reader.texts
+    plugin = _ros1_diff_drive(reader) if ros1 else _ros2_diff_drive(reader)
+    keys = ('leftJoint', 'rightJoint') if ros1 else ('left_joint', 'right_joint')
+    check_wheels(reader, ((keys[0], plugin.left_joints), (keys[1], plugin.right_joints)),
+                 joints_by_name(model))
+    frames = ('odometryFrame', 'robotBaseFrame') if ros1 else (
+        'odometry_frame', 'robot_base_frame')
+    check_frames(reader, ((frames[0], plugin.odometry_frame),
+                          (frames[1], plugin.robot_base_frame)))
+    return plugin
+
+
+def _ros2_diff_drive(reader: ElementReader) -> DiffDrivePlugin:
+    pairs = reader.number('num_wheel_pairs', 1.0)
+    if pairs < 1 or pairs != int(pairs):
+        raise reader.error('num_wheel_pairs', f'must be a whole number >= 1, got {pairs:g}')
+    count = int(pairs)
+    left, right = reader.all('left_joint'), reader.all('right_joint')
+    if len(left) != count or len(right) != count:
+        raise reader.error('left_joint', f'{len(left)} left and {len(right)} right wheels for '
+                           f'num_wheel_pairs {count}: each pair needs one of each')
+    separations = [reader.check('wheel_separation', text, 0.34, positive=True)
+                   for text in reader.all('wheel_separation')[:count]]
+    diameters = [reader.check('wheel_diameter', text, 0.15, positive=True)
+                 for text in reader.all('wheel_diameter')[:count]]
+    source = reader.number('odometry_source', 1.0)
+    if source not in ROS2_SOURCES:
+        raise reader.error('odometry_source', f'must be 0 (encoder) or 1 (world), got {source:g}')
+    namespace, remappings = reader.ros()
+    return DiffDrivePlugin(
+        name=reader.name, convention=ROS2, left_joints=tuple(left), right_joints=tuple(right),
+        wheel_separation=tuple(separations + [0.34] * (count - len(separations))),
+        wheel_diameter=tuple(diameters + [0.15] * (count - len(diameters))),
+        max_wheel_torque=reader.number('max_wheel_torque', 5.0, positive=True),
+        max_wheel_acceleration=reader.number('max_wheel_acceleration', 0.0, non_negative=True),
+        update_rate=reader.number('update_rate', 100.0, non_negative=True),
+        odometry_frame=reader.text('odometry_frame', 'odom'),
+        robot_base_frame=reader.text('robot_base_frame', 'base_footprint'),
+        odometry_source=ROS2_SOURCES[int(source)],
+        publish_odom=reader.flag('publish_odom', False),
+        publish_odom_tf=reader.flag('publish_odom_tf', False),
+        covariance=(reader.number('covariance_x', 1e-5), reader.number('covariance_y', 1e-5),
+                    reader.number('covariance_yaw', 1e-3)),
+        namespace=namespace, remappings=remappings)
+
+
+def _ros1_diff_drive(reader: ElementReader) -> DiffDrivePlugin:
+    source = reader.text('odometrySource', WORLD).lower()
+    if source not in (ENCODER, WORLD):
+        raise reader.error('odometrySource', f"must be '{ENCODER}' or '{WORLD}', got '{source}'")
+    left, right = reader.text('leftJoint', 'left_joint'), reader.text('rightJoint', 'right_joint')
+    return DiffDrivePlugin(
+        name=reader.name, convention=ROS1, left_joints=(left,), right_joints=(right,),
+        wheel_separation=(reader.number('wheelSeparation', 0.34, positive=True),),
+        wheel_diameter=(reader.number('wheelDiameter', 0.15, positive=True),),
+        max_wheel_torque=reader.number('wheelTorque', 5.0, positive=True),
+        max_wheel_acceleration=reader.number('wheelAcceleration', 0.0, non_negative=True),
+        update_rate=reader.number('updateRate', 100.0, non_negative=True),
+        odometry_frame=reader.text('odometryFrame', 'odom'),
+        robot_base_frame=reader.text('robotBaseFrame', 'base_footprint'),
+        odometry_source=source,
+        publish_odom=reader.flag('publishTf', True),
+        publish_odom_tf=reader.flag('publishOdomTF', True),
+        covariance=(1e-5, 1e-5, 1e-3),
+        command_topic=reader.text('commandTopic', 'cmd_vel'),
+        odometry_topic=reader.text('odometryTopic', 'odom'),
+        namespace=reader.ros1_namespace())
+
+
+class GazeboDiffDrive(Plugin, OdometryOutputs, CommandController):
     """One ``gazebo_ros_diff_drive`` plugin: a Twist in, wheel velocities out, odometry back."""
 
+    filenames = frozenset({'gazebo_ros_diff_drive'})
+    filename = DiffDrivePlugin.filename
     drives_base: ClassVar[bool] = True
     command_kind = CommandKind.TWIST
+
+    @classmethod
+    def read(cls, element: PluginElement, model: RobotModel) -> DiffDrivePlugin:
+        """Return the settings of ``element`` (:func:`read_diff_drive`)."""
+        return read_diff_drive(element, model)
+
+    def attach(self, world: PluginWorld) -> None:
+        """Bind the wheels; the ``world`` odometry reads the base's state."""
+        self.configure(world.handles)
+        self.set_base_state(world.base_state)
 
     def __init__(self, plugin: DiffDrivePlugin, source: str = '') -> None:
         super().__init__(plugin.name, {}, source)
@@ -69,7 +233,7 @@ class GazeboDiffDrive(OdometryOutputs, CommandController):
                                   plugin.wheel_diameter[0] / 2.0, window=1)
         self._left: list[JointHandle] = []
         self._right: list[JointHandle] = []
-        self._odometry_sink: OdometrySink | None = None
+        self._odometry_sink: PlanarOdometrySink | None = None
         self._tf_sink: TfSink | None = None
         self._base_state: Callable[[], BaseState] | None = None
         self._problem = ''

@@ -1,8 +1,9 @@
 """``libgazebo_ros_joint_state_publisher.so`` as a unit of the simulation: joint states. No ROS.
 
-Not a ros2_control controller: the simulation creates one per plugin the
-URDF declares (:mod:`pan_tilt_sim.model.drive_plugins`) and updates it every
-physics step; it is always active and commands nothing.  As the plugin,
+Also gz-sim's JointStatePublisher system, which publishes the same.  Not a
+ros2_control controller: the simulation creates one per plugin element
+(:mod:`pan_tilt_sim.plugins.registry`) and updates it every physics step;
+it is always active and commands nothing.  As the plugin,
 every ``1 / update_rate`` s of sim time (0: every step) it publishes
 ``sensor_msgs/JointState`` with the named joints' positions (rad or m),
 velocities and efforts, in the order the plugin names them -- only while
@@ -11,11 +12,21 @@ someone listens.  Pure Python.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Mapping, Sequence
 
 from pan_tilt_sim.controllers.base import Controller, JointHandle
 from pan_tilt_sim.controllers.surface import Endpoint, StateTopic
-from pan_tilt_sim.model.drive_plugins import JointStatePlugin
+from pan_tilt_sim.model.plugin_elements import PluginElement
+from pan_tilt_sim.model.robot import RobotModel
+from pan_tilt_sim.model.sensors import GZ_WORLD, ROS1, ROS2, Ros2Names, ros1_resolve
+from pan_tilt_sim.plugins.framework.elements import (
+    GZ,
+    ElementReader,
+    gz_topic,
+    movable_joints,
+)
+from pan_tilt_sim.plugins.framework.plugin import Plugin, PluginWorld
 from pan_tilt_sim.schedule import DUE_EPSILON
 
 # sink(time, names, positions, velocities, efforts)
@@ -23,8 +34,89 @@ JointStateSink = Callable[[float, Sequence[str], Sequence[float], Sequence[float
                            Sequence[float]], None]
 
 
-class GazeboJointStatePublisher(Controller):
-    """One ``gazebo_ros_joint_state_publisher`` plugin: the named joints' states."""
+GZ_FILES = frozenset({'gz-sim-joint-state-publisher-system',
+                      'ignition-gazebo-joint-state-publisher-system'})
+GZ_NAMES = frozenset({'gz::sim::systems::JointStatePublisher',
+                      'ignition::gazebo::systems::JointStatePublisher'})
+
+
+@dataclasses.dataclass(frozen=True)
+class JointStatePlugin:
+    """One joint state publisher: which joints, how often (Hz; 0: every step)."""
+
+    name: str
+    convention: str
+    joints: tuple[str, ...]
+    update_rate: float = 100.0
+    namespace: str = ''
+    remappings: tuple[tuple[str, str], ...] = ()
+    topic: str = ''  # gz-sim's: the topic as the bridge carries it (no namespace applies)
+
+    def topics(self, override: str = '') -> str:
+        """Return the joint states topic (absolute), ``override`` as the namespace."""
+        if self.convention == GZ:
+            return self.topic
+        namespace = override or self.namespace
+        if self.convention == ROS1:
+            return ros1_resolve(namespace, 'joint_states')
+        return Ros2Names(self.name, namespace, self.remappings).topic('joint_states')
+
+
+def read_joint_state_publisher(element: PluginElement, model: RobotModel) -> JointStatePlugin:
+    """Return the plugin's settings (the element spec).
+
+    ROS 2: ``joint_name`` (one element per joint, required), ``update_rate``
+    (100 Hz), topic ``joint_states`` of its node; ROS 1: ``jointName``
+    (comma-separated), ``updateRate`` (100 Hz) in ``robotNamespace``.
+    gz-sim: ``joint_name`` (none: every movable joint), every step, on
+    ``topic`` (``/world/default/model/{model}/joint_state``).  A name that
+    is no movable joint of the robot ends start-up.
+    """
+    movable = movable_joints(model)
+    reader = ElementReader(element, model.name)
+    if element.stem in GZ_FILES or element.name.strip() in GZ_NAMES:
+        names = reader.all('joint_name')
+        for name in names:
+            if name not in movable:
+                raise reader.error('joint_name', f"'{name}' is not a movable joint of this robot")
+        topic = reader.text('topic', f'/world/{GZ_WORLD}/model/{model.name}/joint_state')
+        return JointStatePlugin(name=reader.name, convention=GZ,
+                                joints=tuple(names or movable), update_rate=0.0,
+                                topic=gz_topic(topic))
+    ros1 = reader.has_any({'jointName', 'updateRate', 'robotNamespace'})
+    key = 'jointName' if ros1 else 'joint_name'
+    names = [name.strip() for text in reader.all(key) for name in (
+        text.split(',') if ros1 else [text]) if name.strip()]
+    if not names:
+        raise reader.error(key, 'is missing: name the joints to publish')
+    for name in names:
+        if name not in movable:
+            raise reader.error(key, f"'{name}' is not a movable joint of this robot")
+    namespace, remappings = ('', ()) if ros1 else reader.ros()
+    return JointStatePlugin(
+        name=reader.name, convention=ROS1 if ros1 else ROS2, joints=tuple(names),
+        update_rate=reader.number('updateRate' if ros1 else 'update_rate', 100.0,
+                                  non_negative=True),
+        namespace=reader.ros1_namespace() if ros1 else namespace,
+        remappings=remappings)
+
+
+class GazeboJointStatePublisher(Plugin, Controller):
+    """One joint state publisher plugin (gazebo_ros's or gz-sim's): the named joints' states."""
+
+    filenames = frozenset({'gazebo_ros_joint_state_publisher'}) | GZ_FILES
+    system_names = GZ_NAMES
+    filename = 'libgazebo_ros_joint_state_publisher.so'
+    publishes_joint_states = True
+
+    @classmethod
+    def read(cls, element: PluginElement, model: RobotModel) -> JointStatePlugin:
+        """Return the settings of ``element`` (:func:`read_joint_state_publisher`)."""
+        return read_joint_state_publisher(element, model)
+
+    def attach(self, world: PluginWorld) -> None:
+        """Bind the named joints' handles."""
+        self.configure(world.handles)
 
     def __init__(self, plugin: JointStatePlugin, source: str = '') -> None:
         super().__init__(plugin.name, {}, source)

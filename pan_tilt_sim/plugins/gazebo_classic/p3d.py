@@ -1,8 +1,8 @@
 """``libgazebo_ros_p3d.so`` as a unit of the simulation: a link's true pose and twist. No ROS.
 
-Not a ros2_control controller: the simulation creates one per plugin the
-URDF declares (:mod:`pan_tilt_sim.model.drive_plugins`) and updates it every
-physics step; it is always active.  As the plugin, every ``1 / update_rate``
+Not a ros2_control controller: the simulation creates one per plugin
+element (:mod:`pan_tilt_sim.plugins.registry`) and updates it every physics
+step; it is always active.  As the plugin, every ``1 / update_rate``
 s of sim time (0: every step) and only while someone listens, it publishes
 ``nav_msgs/Odometry``: header frame ``frame_name``, child frame the link;
 the link frame's pose and the twist of its origin (m, rad, m/s, rad/s) in
@@ -16,12 +16,15 @@ states (:meth:`GazeboP3d.set_link_state`).
 
 from __future__ import annotations
 
+import dataclasses
 import random
 from collections.abc import Callable, Mapping
 
 from pan_tilt_sim.controllers.base import Controller, JointHandle
 from pan_tilt_sim.controllers.surface import Endpoint, StateTopic
-from pan_tilt_sim.model.drive_plugins import P3dPlugin
+from pan_tilt_sim.model.plugin_elements import PluginElement
+from pan_tilt_sim.model.robot import RobotModel
+from pan_tilt_sim.model.sensors import ROS1, ROS2, Ros2Names, ros1_resolve
 from pan_tilt_sim.model.transforms import (
     Transform,
     Vector,
@@ -29,13 +32,87 @@ from pan_tilt_sim.model.transforms import (
     quaternion_multiply,
     rotate,
 )
+from pan_tilt_sim.plugins.framework.elements import ElementReader
+from pan_tilt_sim.plugins.framework.plugin import (
+    LinkState,
+    Plugin,
+    PluginWorld,
+    SpatialOdometrySink,
+)
 from pan_tilt_sim.schedule import DUE_EPSILON
 
-# A link's state: its frame in the world, the world velocity of the frame's origin (m/s)
-# and its angular velocity (rad/s), both in world axes.
-LinkState = tuple[Transform, Vector, Vector]
-# sink(time, pose, linear, angular): a 3-D odometry sample.
-SpatialOdometrySink = Callable[[float, Transform, Vector, Vector], None]
+WORLD_FRAMES = ('world', '/world', 'map', '/map')  # poses in the world
+ROS1_P3D_KEYS = {'bodyName', 'frameName', 'topicName', 'xyzOffsets', 'rpyOffsets',
+                 'gaussianNoise', 'updateRate', 'robotNamespace'}
+
+
+@dataclasses.dataclass(frozen=True)
+class P3dPlugin:
+    """One ``gazebo_ros_p3d`` plugin: which link, in which frame, offsets, noise, rate, topic.
+
+    ``frame_name`` a link of the robot: the pose and twist relative to that
+    link; ``world``/``map``: in the world.  Offsets: m and rad (roll, pitch,
+    yaw); ``gaussian_noise``: the standard deviation added to each twist
+    component.  ``update_rate`` 0: every physics step.
+    """
+
+    name: str
+    convention: str
+    body_name: str
+    frame_name: str = 'world'
+    xyz_offsets: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy_offsets: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    gaussian_noise: float = 0.0
+    update_rate: float = 0.0
+    topic: str = 'odom'
+    namespace: str = ''
+    remappings: tuple[tuple[str, str], ...] = ()
+
+    @property
+    def in_world(self) -> bool:
+        """Whether poses are in the world (not relative to a link)."""
+        return self.frame_name in WORLD_FRAMES
+
+    def topics(self, override: str = '') -> str:
+        """Return the odometry topic (absolute), ``override`` as the namespace."""
+        namespace = override or self.namespace
+        if self.convention == ROS1:
+            return ros1_resolve(namespace, self.topic)
+        return Ros2Names(self.name, namespace, self.remappings).topic(self.topic)
+
+
+def read_p3d(element: PluginElement, model: RobotModel) -> P3dPlugin:
+    """Return the plugin's settings: ROS 2 ``body_name`` (required), ``frame_name``, ... .
+
+    ROS 1: ``bodyName``, ``frameName``, ``xyzOffsets``, ``rpyOffsets``,
+    ``gaussianNoise``, ``updateRate``, ``topicName`` in ``robotNamespace``.
+    A body or frame that is no link of the robot ends start-up.
+    """
+    links = set(model.link_names)
+    reader = ElementReader(element, model.name)
+    ros1 = reader.has_any(ROS1_P3D_KEYS) and 'ros' not in reader.texts
+    names = ('bodyName', 'frameName', 'xyzOffsets', 'rpyOffsets', 'gaussianNoise',
+             'updateRate') if ros1 else ('body_name', 'frame_name', 'xyz_offsets',
+                                         'rpy_offsets', 'gaussian_noise', 'update_rate')
+    body, frame, xyz, rpy, noise, rate = names
+    link = reader.text(body, '')
+    if link not in links:
+        raise reader.error(body, f"'{link}' is not a link of this robot" if link
+                           else 'is missing (the plugin needs the link to track)')
+    frame_name = reader.text(frame, 'world')
+    if frame_name not in WORLD_FRAMES and frame_name not in links:
+        raise reader.error(frame, f"'{frame_name}' is neither world, map nor a link of "
+                           'this robot')
+    namespace, remappings = ('', ()) if ros1 else reader.ros()
+    return P3dPlugin(
+        name=reader.name, convention=ROS1 if ros1 else ROS2, body_name=link,
+        frame_name=frame_name, xyz_offsets=reader.vector(xyz),
+        rpy_offsets=reader.vector(rpy),
+        gaussian_noise=reader.number(noise, 0.0, non_negative=True),
+        update_rate=reader.number(rate, 0.0, non_negative=True),
+        topic=reader.text('topicName', 'odom') if ros1 else 'odom',
+        namespace=reader.ros1_namespace() if ros1 else namespace,
+        remappings=remappings)
 
 
 def _inverse(transform: Transform) -> Transform:
@@ -45,8 +122,20 @@ def _inverse(transform: Transform) -> Transform:
     return Transform((-tx, -ty, -tz), conjugate)
 
 
-class GazeboP3d(Controller):
+class GazeboP3d(Plugin, Controller):
     """One ``gazebo_ros_p3d`` plugin: ground-truth odometry of one link."""
+
+    filenames = frozenset({'gazebo_ros_p3d'})
+    filename = 'libgazebo_ros_p3d.so'
+
+    @classmethod
+    def read(cls, element: PluginElement, model: RobotModel) -> P3dPlugin:
+        """Return the settings of ``element`` (:func:`read_p3d`)."""
+        return read_p3d(element, model)
+
+    def attach(self, world: PluginWorld) -> None:
+        """Read link states from the simulation."""
+        self.set_link_state(world.link_state)
 
     def __init__(self, plugin: P3dPlugin, source: str = '', *,
                  rng: random.Random | None = None) -> None:

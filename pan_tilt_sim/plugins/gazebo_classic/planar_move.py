@@ -1,8 +1,8 @@
 """``libgazebo_ros_planar_move.so`` as a unit of the simulation: the base moved by a Twist. No ROS.
 
-Not a ros2_control controller: the simulation creates one per plugin the
-URDF declares (:mod:`pan_tilt_sim.model.drive_plugins`) and updates it every
-physics step, before the controllers; it is always active.  As the plugin:
+Not a ros2_control controller: the simulation creates one per plugin
+element (:mod:`pan_tilt_sim.plugins.registry`) and updates it every physics
+step, before the controllers; it is always active.  As the plugin:
 
 * **Command**: ``geometry_msgs/Twist`` on its command topic; ``linear.x``,
   ``linear.y`` (m/s, in the base's heading) and ``angular.z`` (rad/s)
@@ -27,6 +27,7 @@ simulation hands in the base's state (:meth:`set_base_motion`).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
@@ -38,27 +39,128 @@ from pan_tilt_sim.controllers.base import (
     CommandResult,
     JointHandle,
 )
-from pan_tilt_sim.controllers.diff_drive_controller import TfSink
-from pan_tilt_sim.controllers.gazebo_p3d import SpatialOdometrySink
-from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs
+from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs, TfSink
 from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
-from pan_tilt_sim.model.drive_plugins import ROS1, PlanarMovePlugin
-from pan_tilt_sim.model.transforms import Transform, Vector
+from pan_tilt_sim.model.plugin_elements import PluginElement
+from pan_tilt_sim.model.robot import RobotModel
+from pan_tilt_sim.model.sensors import ROS1, ROS2, Ros2Names, ros1_resolve
+from pan_tilt_sim.model.transforms import Vector
+from pan_tilt_sim.plugins.framework.elements import (
+    UNPLANAR_COVARIANCE,
+    ElementReader,
+    check_frames,
+)
+from pan_tilt_sim.plugins.framework.plugin import (
+    BaseMotion,
+    Plugin,
+    PluginWorld,
+    SpatialOdometrySink,
+    heading,
+)
 from pan_tilt_sim.schedule import DUE_EPSILON
 
-# The base's motion: its frame in the world, its linear velocity (m/s) and angular velocity
-# (rad/s), both in world axes.
-BaseMotion = tuple[Transform, Vector, Vector]
+ROS1_PLANAR_MOVE_KEYS = {'commandTopic', 'odometryTopic', 'odometryFrame', 'odometryRate',
+                         'robotBaseFrame', 'publishOdometryTf', 'cmdTimeout', 'robotNamespace'}
 
 
-def heading(frame: Transform) -> float:
-    """Return the yaw (rad) of ``frame``'s rotation."""
-    qx, qy, qz, qw = frame.rotation
-    return math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+@dataclasses.dataclass(frozen=True)
+class PlanarMovePlugin:
+    """One ``gazebo_ros_planar_move`` plugin: the base's planar velocity set from a Twist.
+
+    ``update_rate`` (Hz, 0: every step): how often the base's velocity is
+    set; ``publish_rate`` (Hz, 0: every step): odometry and TF.
+    ``command_timeout`` (s, negative: none; ROS 1's ``cmdTimeout``).
+    """
+
+    name: str
+    convention: str
+    update_rate: float = 20.0
+    publish_rate: float = 20.0
+    odometry_frame: str = 'odom'
+    robot_base_frame: str = 'base_footprint'
+    publish_odom: bool = True
+    publish_odom_tf: bool = True
+    covariance: tuple[float, float, float] = (1e-5, 1e-5, 1e-3)  # x, y, yaw
+    command_timeout: float = -1.0
+    command_topic: str = 'cmd_vel'
+    odometry_topic: str = 'odom'
+    namespace: str = ''
+    remappings: tuple[tuple[str, str], ...] = ()
+
+    filename = 'libgazebo_ros_planar_move.so'
+
+    def topics(self, override: str = '') -> tuple[str, str]:
+        """Return the command and odometry topics (absolute), ``override`` as the namespace."""
+        namespace = override or self.namespace
+        if self.convention == ROS1:
+            return (ros1_resolve(namespace, self.command_topic),
+                    ros1_resolve(namespace, self.odometry_topic))
+        names = Ros2Names(self.name, namespace, self.remappings)
+        return names.topic(self.command_topic), names.topic(self.odometry_topic)
+
+    @property
+    def pose_covariance(self) -> tuple[float, ...]:
+        """The odometry pose (and twist) covariance's diagonal (x, y, z, roll, pitch, yaw)."""
+        x, y, yaw = self.covariance
+        return (x, y, UNPLANAR_COVARIANCE, UNPLANAR_COVARIANCE, UNPLANAR_COVARIANCE, yaw)
 
 
-class GazeboPlanarMove(OdometryOutputs, CommandController):
+def read_planar_move(element: PluginElement, model: RobotModel) -> PlanarMovePlugin:
+    """Return the plugin's settings (the element spec).
+
+    ROS 2: ``update_rate`` (20 Hz), ``publish_rate`` (20 Hz), ``publish_odom``
+    / ``publish_odom_tf`` (true), ``odometry_frame``, ``robot_base_frame``,
+    ``covariance_x|y|yaw``; ROS 1: ``commandTopic``, ``odometryTopic``,
+    ``odometryFrame``, ``robotBaseFrame``, ``odometryRate`` (20 Hz),
+    ``publishOdometryTf`` (true), ``cmdTimeout`` (-1: none).
+    """
+    reader = ElementReader(element, model.name)
+    if reader.has_any(ROS1_PLANAR_MOVE_KEYS) and 'ros' not in reader.texts:
+        rate = reader.number('odometryRate', 20.0, non_negative=True)
+        plugin = PlanarMovePlugin(
+            name=reader.name, convention=ROS1, update_rate=0.0, publish_rate=rate,
+            odometry_frame=reader.text('odometryFrame', 'odom'),
+            robot_base_frame=reader.text('robotBaseFrame', 'base_footprint'),
+            publish_odom=True, publish_odom_tf=reader.flag('publishOdometryTf', True),
+            command_timeout=reader.number('cmdTimeout', -1.0),
+            command_topic=reader.text('commandTopic', 'cmd_vel'),
+            odometry_topic=reader.text('odometryTopic', 'odom'),
+            namespace=reader.ros1_namespace())
+        check_frames(reader, (('odometryFrame', plugin.odometry_frame),
+                              ('robotBaseFrame', plugin.robot_base_frame)))
+        return plugin
+    namespace, remappings = reader.ros()
+    plugin = PlanarMovePlugin(
+        name=reader.name, convention=ROS2,
+        update_rate=reader.number('update_rate', 20.0, non_negative=True),
+        publish_rate=reader.number('publish_rate', 20.0, non_negative=True),
+        odometry_frame=reader.text('odometry_frame', 'odom'),
+        robot_base_frame=reader.text('robot_base_frame', 'base_footprint'),
+        publish_odom=reader.flag('publish_odom', True),
+        publish_odom_tf=reader.flag('publish_odom_tf', True),
+        covariance=(reader.number('covariance_x', 1e-5), reader.number('covariance_y', 1e-5),
+                    reader.number('covariance_yaw', 1e-3)),
+        namespace=namespace, remappings=remappings)
+    check_frames(reader, (('odometry_frame', plugin.odometry_frame),
+                          ('robot_base_frame', plugin.robot_base_frame)))
+    return plugin
+
+
+class GazeboPlanarMove(Plugin, OdometryOutputs, CommandController):
     """One ``gazebo_ros_planar_move`` plugin: a Twist sets the base's planar velocity."""
+
+    filenames = frozenset({'gazebo_ros_planar_move'})
+    filename = PlanarMovePlugin.filename
+    sets_base_velocity = True
+
+    @classmethod
+    def read(cls, element: PluginElement, model: RobotModel) -> PlanarMovePlugin:
+        """Return the settings of ``element`` (:func:`read_planar_move`)."""
+        return read_planar_move(element, model)
+
+    def attach(self, world: PluginWorld) -> None:
+        """Read the base's frame and velocities from the simulation."""
+        self.set_base_motion(world.base_motion)
 
     drives_base: ClassVar[bool] = True
     command_kind = CommandKind.TWIST

@@ -1,8 +1,8 @@
 """gz-sim's DiffDrive system as a unit of the simulation: a Twist in, wheels out, odometry back.
 
-Not a ros2_control controller: the simulation creates one per system the
-URDF declares (:mod:`pan_tilt_sim.model.drive_plugins`) and updates it every
-physics step, before the controllers; it is always active.  As the system:
+Not a ros2_control controller: the simulation creates one per system
+element (:mod:`pan_tilt_sim.plugins.registry`) and updates it every physics
+step, before the controllers; it is always active.  As the system:
 
 * **Command**: ``gz.msgs.Twist`` on ``topic`` -- here the
   ``geometry_msgs/msg/Twist`` ros_gz_bridge would carry on the same name
@@ -29,6 +29,7 @@ A reset drops the command and puts the odometry back at the origin.  Pure Python
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from typing import Any, ClassVar
@@ -41,16 +42,108 @@ from pan_tilt_sim.controllers.base import (
     CommandResult,
     JointHandle,
 )
-from pan_tilt_sim.controllers.diff_drive_controller import OdometrySink, TfSink
 from pan_tilt_sim.controllers.odometry import Odometry
-from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs
+from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs, TfSink
 from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError, RateLimiter, RateLimits
 from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
-from pan_tilt_sim.model.drive_plugins import GzDiffDrivePlugin
+from pan_tilt_sim.model.plugin_elements import PluginElement
+from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.model.transforms import Transform
+from pan_tilt_sim.plugins.framework.elements import (
+    GZ,
+    ElementReader,
+    check_frames,
+    check_wheels,
+    gz_topic,
+    joints_by_name,
+    root_link,
+)
+from pan_tilt_sim.plugins.framework.plugin import PlanarOdometrySink, Plugin, PluginWorld
 from pan_tilt_sim.schedule import DUE_EPSILON
 
 ODOMETRY_WINDOW = 10  # updates in the odometry twist's rolling mean (gz-math's default)
+GZ_DIFF_DRIVE_FILES = frozenset({'gz-sim-diff-drive-system', 'ignition-gazebo-diff-drive-system'})
+GZ_DIFF_DRIVE_NAMES = frozenset({'gz::sim::systems::DiffDrive',
+                                 'ignition::gazebo::systems::DiffDrive'})
+# DiffDrive's limits: (SDF element, jazzy RateLimits field) per group; min_acceleration
+# bounds every change, so it is both the deceleration and the reverse acceleration.
+GZ_LIMIT_ELEMENTS = ('min_velocity', 'max_velocity', 'min_acceleration', 'max_acceleration',
+                     'min_jerk', 'max_jerk')
+
+
+@dataclasses.dataclass(frozen=True)
+class GzDiffDrivePlugin:
+    """gz-sim's DiffDrive system: wheels, geometry, limits, topics, frames.
+
+    ``limits`` per group (``linear``, ``angular``): the SDF's
+    ``min_/max_velocity``, ``_acceleration``, ``_jerk`` (NaN: not given; a
+    group's own element overrides the shared one).  Topics are gz-transport
+    names, as ros_gz_bridge carries them under the same name.
+    """
+
+    name: str
+    left_joints: tuple[str, ...]
+    right_joints: tuple[str, ...]
+    wheel_separation: float = 1.0
+    wheel_radius: float = 0.2
+    odom_publish_frequency: float = 50.0
+    command_topic: str = ''
+    odometry_topic: str = ''
+    tf_topic: str = ''
+    frame_id: str = ''
+    child_frame_id: str = ''
+    linear_limits: tuple[float, ...] = (math.nan,) * 6
+    angular_limits: tuple[float, ...] = (math.nan,) * 6
+
+    convention = GZ
+    filename = 'gz-sim-diff-drive-system'
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Every wheel, left ones first."""
+        return self.left_joints + self.right_joints
+
+
+def read_gz_diff_drive(element: PluginElement, model: RobotModel) -> GzDiffDrivePlugin:
+    """Return the system's settings (the element spec), elements and defaults as gz-sim's.
+
+    The model's name is the URDF robot's.  A wheel the robot does not have, a
+    number that is not one, a separation, radius or frequency that is not
+    positive, or a limit's min above its max ends start-up.
+    """
+    name = model.name
+    reader = ElementReader(element, name)
+    left, right = tuple(reader.all('left_joint')), tuple(reader.all('right_joint'))
+    for key, wheels in (('left_joint', left), ('right_joint', right)):
+        if not wheels:
+            raise reader.error(key, 'is missing: the system needs at least one on each side')
+    check_wheels(reader, (('left_joint', left), ('right_joint', right)), joints_by_name(model))
+    limits = {}
+    for group in ('linear', 'angular'):
+        values = {}
+        for entry in GZ_LIMIT_ELEMENTS:
+            kind, what = entry.split('_')
+            own = f'{kind}_{group}_{what}'
+            values[own] = reader.number(own, reader.number(entry, math.nan))
+        for what in ('velocity', 'acceleration', 'jerk'):
+            low, high = values[f'min_{group}_{what}'], values[f'max_{group}_{what}']
+            if low > high:
+                raise reader.error(f'min_{group}_{what}', f'{low:g} is above max_{group}_'
+                                   f'{what} {high:g}')
+        limits[group] = tuple(values.values())
+    frame = reader.text('frame_id', f'{name}/odom')
+    child = reader.text('child_frame_id', f'{name}/{root_link(model)}')
+    check_frames(reader, (('frame_id', frame), ('child_frame_id', child)))
+    return GzDiffDrivePlugin(
+        name=reader.name, left_joints=left, right_joints=right,
+        wheel_separation=reader.number('wheel_separation', 1.0, positive=True),
+        wheel_radius=reader.number('wheel_radius', 0.2, positive=True),
+        odom_publish_frequency=reader.number('odom_publish_frequency', 50.0, positive=True),
+        command_topic=gz_topic(reader.text('topic', f'/model/{name}/cmd_vel')),
+        odometry_topic=gz_topic(reader.text('odom_topic', f'/model/{name}/odometry')),
+        tf_topic=gz_topic(reader.text('tf_topic', f'/model/{name}/tf')),
+        frame_id=frame, child_frame_id=child,
+        linear_limits=limits['linear'], angular_limits=limits['angular'])
 
 
 def gz_limiter(limits: tuple[float, ...], name: str, group: str) -> RateLimiter:
@@ -77,8 +170,21 @@ def gz_limiter(limits: tuple[float, ...], name: str, group: str) -> RateLimiter:
         raise ValueError(f"system '{name}': {group} limits: {err}") from None
 
 
-class GzDiffDrive(OdometryOutputs, CommandController):
+class GzDiffDrive(Plugin, OdometryOutputs, CommandController):
     """One gz-sim DiffDrive system: a Twist in, wheel velocities out, odometry back."""
+
+    filenames = GZ_DIFF_DRIVE_FILES
+    system_names = GZ_DIFF_DRIVE_NAMES
+    filename = GzDiffDrivePlugin.filename
+
+    @classmethod
+    def read(cls, element: PluginElement, model: RobotModel) -> GzDiffDrivePlugin:
+        """Return the settings of ``element`` (:func:`read_gz_diff_drive`)."""
+        return read_gz_diff_drive(element, model)
+
+    def attach(self, world: PluginWorld) -> None:
+        """Bind the wheels."""
+        self.configure(world.handles)
 
     drives_base: ClassVar[bool] = True
     command_kind = CommandKind.TWIST
@@ -93,7 +199,7 @@ class GzDiffDrive(OdometryOutputs, CommandController):
                                   plugin.wheel_radius, ODOMETRY_WINDOW)
         self._left: list[JointHandle] = []
         self._right: list[JointHandle] = []
-        self._odometry_sink: OdometrySink | None = None
+        self._odometry_sink: PlanarOdometrySink | None = None
         self._tf_sink: TfSink | None = None
         self._problem = ''
         self.reset()
