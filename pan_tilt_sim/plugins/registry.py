@@ -10,6 +10,8 @@ ros2_control plugins, sensors).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.plugins.framework.plugin import Plugin
@@ -28,6 +30,9 @@ PLUGIN_TYPES: tuple[type[Plugin], ...] = (
     GazeboP3d,                  # libgazebo_ros_p3d.so
     GzOdometryPublisher,        # gz-sim-odometry-publisher-system
 )
+# Plugins the simulation recognises but does not simulate, by file (no lib, no .so) or gz-sim
+# system name, with why: each gets one warning and is left out; the rest runs.
+UNSIMULATED: dict[str, str] = {}
 
 
 def plugin_type(element: PluginElement) -> type[Plugin] | None:
@@ -42,11 +47,18 @@ def recognised(model: RobotModel) -> list[tuple[PluginElement, type[Plugin]]]:
     return sorted(found, key=lambda pair: PLUGIN_TYPES.index(pair[1]))
 
 
-def create_plugins(model: RobotModel, source: str = '') -> list[Plugin]:
+def create_plugins(model: RobotModel, source: str = '',
+                   warn: Callable[[str], None] | None = None) -> list[Plugin]:
     """Return one unit per recognised element (DescriptionError: a malformed element).
 
-    ``source`` labels the units' messages (the controllers file's label).
+    ``source`` labels the units' messages (the controllers file's label);
+    ``warn`` gets one line per element of :data:`UNSIMULATED`.
     """
+    for element in model.plugins:
+        why = UNSIMULATED.get(element.stem) or UNSIMULATED.get(element.name.strip())
+        if why and warn is not None:
+            warn(f"{element.source}: plugin '{element.name or element.stem}' "
+                 f'({element.filename}) skipped: {why}')
     return [kind.from_element(element, model, source) for element, kind in recognised(model)]
 
 

@@ -155,14 +155,15 @@ class Simulation:
                  initial_pose: BasePose = ORIGIN) -> None:
         self.description = description
         self._logger: Logger = logger or logging.getLogger(LOGGER_NAME)
+        load_messages: list[str] = list(controllers.warnings)  # the file's dropped blocks
         # The model's Gazebo plugins (drive, joint states, ground truth), read before anything
         # is built (a malformed element ends start-up): always active, updated before the
         # controllers; no controller_manager knows them.
-        self.plugins: list[Plugin] = create_plugins(description.model, controllers.label)
+        self.plugins: list[Plugin] = create_plugins(description.model, controllers.label,
+                                                    load_messages.append)
         starts = start_positions(description.model, initial_positions)
         movable = [joint.name for joint in description.actuated_joints]
         gains = plugin_gains(controllers.pid_gains, movable, controllers.label)
-        load_messages: list[str] = list(controllers.warnings)  # the file's dropped blocks
         fixed, why = base_is_fixed(fixed_base, description, controllers, active_controllers,
                                    autostart_controllers)
         self.physics = Physics(

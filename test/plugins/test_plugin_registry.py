@@ -12,6 +12,7 @@ import pan_tilt_sim.plugins
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.urdf import parse_urdf
+from pan_tilt_sim.plugins import registry
 from pan_tilt_sim.plugins.framework.plugin import Plugin
 from pan_tilt_sim.plugins.gazebo_classic.diff_drive import GazeboDiffDrive
 from pan_tilt_sim.plugins.gazebo_classic.joint_state_publisher import GazeboJointStatePublisher
@@ -109,3 +110,14 @@ def test_a_malformed_element_ends_start_up_in_one_line_naming_file_plugin_and_el
         create_plugins(robot)
     assert str(raised.value) == (f"{SOURCE}: plugin 'move' (libgazebo_ros_planar_move.so): "
                                  "<update_rate> 'fast' is not a number")
+
+
+def test_a_plugin_recognised_but_not_simulated_is_one_warning_and_left_out(monkeypatch):
+    monkeypatch.setitem(registry.UNSIMULATED, 'gazebo_ros_bumper', 'contacts are not published')
+    robot = parse_urdf(plugin_rover_urdf(
+        '<plugin name="bump" filename="libgazebo_ros_bumper.so"/>', ground_truth='',
+        joint_states=''), SOURCE)
+    warnings: list[str] = []
+    assert create_plugins(robot, warn=warnings.append) == []
+    assert warnings == [f"{SOURCE}: plugin 'bump' (libgazebo_ros_bumper.so) skipped: contacts "
+                        'are not published']
