@@ -156,7 +156,7 @@ def test_a_plugin_uses_no_other_plugin_only_the_plugins_framework(module):
             assert parts[2] == 'framework', f'{module} imports {name} (another plugin)'
 
 
-def test_importing_model_and_controllers_pulls_in_neither_rclpy_nor_pybullet():
+def test_importing_model_controllers_and_plugins_pulls_in_neither_rclpy_nor_pybullet():
     names = sorted(m for m in MODULES if layer(m) in ('model', 'controllers', 'plugins'))
     code = '; '.join([*(f'import {name}' for name in names),
                       'import sys',
@@ -165,4 +165,4 @@ def test_importing_model_and_controllers_pulls_in_neither_rclpy_nor_pybullet():
                             env=sim_process.environment(), timeout=60, check=False)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == '[]'
-    assert len(names) > 20  # every module of both layers was imported
+    assert len(names) > 20  # every module of the three layers was imported

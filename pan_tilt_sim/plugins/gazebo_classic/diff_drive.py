@@ -16,7 +16,7 @@ checks per generation: docs/mobile-robots.md.  As the plugin:
   from the wheel's measured speed toward it by at most
   ``max_wheel_acceleration / update_rate`` per update, as the plugin does.
 * **Odometry**: ``encoder`` integrates the first pair's wheel velocities
-  every step (:class:`~.odometry.Odometry`); ``world`` is the base's true
+  every step (:class:`~pan_tilt_sim.controllers.odometry.Odometry`); ``world`` is the base's true
   planar pose and its twist in the base frame (read through the source the
   simulation hands in: :meth:`set_base_state`).  Published at
   ``update_rate`` on the odometry topic (``publish_odom``) and as

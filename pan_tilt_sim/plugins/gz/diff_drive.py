@@ -17,7 +17,7 @@ step, before the controllers; it is always active.  As the system:
   ...)``, reached by the ideal velocity actuator within the joint's effort
   limit.
 * **Odometry**: from the first left and first right wheels' positions
-  (:class:`~.odometry.Odometry`, its twist a rolling mean of 10 updates, as
+  (:class:`~pan_tilt_sim.controllers.odometry.Odometry`, its twist a rolling mean of 10 updates, as
   gz-math's DiffDriveOdometry), updated and published every ``1 /
   odom_publish_frequency`` s of sim time: ``gz.msgs.Odometry`` on
   ``odom_topic`` (``nav_msgs/msg/Odometry``, ``frame_id`` ->
