@@ -152,6 +152,8 @@ class GazeboPlanarMove(Plugin, OdometryOutputs, CommandController):
     filenames = frozenset({'gazebo_ros_planar_move'})
     filename = PlanarMovePlugin.filename
     sets_base_velocity = True
+    drives_base: ClassVar[bool] = True
+    command_kind = CommandKind.TWIST
 
     @classmethod
     def read(cls, element: PluginElement, model: RobotModel) -> PlanarMovePlugin:
@@ -161,9 +163,6 @@ class GazeboPlanarMove(Plugin, OdometryOutputs, CommandController):
     def attach(self, world: PluginWorld) -> None:
         """Read the base's frame and velocities from the simulation."""
         self.set_base_motion(world.base_motion)
-
-    drives_base: ClassVar[bool] = True
-    command_kind = CommandKind.TWIST
 
     def __init__(self, plugin: PlanarMovePlugin, source: str = '') -> None:
         super().__init__(plugin.name, {}, source)

@@ -176,6 +176,8 @@ class GzDiffDrive(Plugin, OdometryOutputs, CommandController):
     filenames = GZ_DIFF_DRIVE_FILES
     system_names = GZ_DIFF_DRIVE_NAMES
     filename = GzDiffDrivePlugin.filename
+    drives_base: ClassVar[bool] = True
+    command_kind = CommandKind.TWIST
 
     @classmethod
     def read(cls, element: PluginElement, model: RobotModel) -> GzDiffDrivePlugin:
@@ -185,9 +187,6 @@ class GzDiffDrive(Plugin, OdometryOutputs, CommandController):
     def attach(self, world: PluginWorld) -> None:
         """Bind the wheels."""
         self.configure(world.handles)
-
-    drives_base: ClassVar[bool] = True
-    command_kind = CommandKind.TWIST
 
     def __init__(self, plugin: GzDiffDrivePlugin, source: str = '') -> None:
         super().__init__(plugin.name, {}, source)
