@@ -1,29 +1,16 @@
 """``libgazebo_ros_diff_drive.so`` as a unit of the simulation: the plugin's semantics, no ROS.
 
 Not a ros2_control controller: the simulation creates one per plugin
-element (:mod:`pan_tilt_sim.plugins.registry`); elements, defaults and
-checks per generation: docs/mobile-robots.md.  As the plugin:
-
-* **Command**: ``geometry_msgs/Twist`` on its command topic; only
-  ``linear.x`` (m/s) and ``angular.z`` (rad/s) count, and the last one holds
-  until the next (the plugin has no timeout).  A twist with a NaN or
-  infinite value is refused (a throttled warning names it).
-* **Wheels**: every ``1 / update_rate`` s of sim time each pair's wheel
-  speeds ``v -+ w * separation / 2`` (m/s) are set as joint velocity
-  targets (divided by the radius), reached by a motor of at most
-  ``max_wheel_torque`` (N m).  With ``max_wheel_acceleration`` (m/s^2, 0:
-  none) and a wheel not yet within 0.01 m/s of its speed, the target moves
-  from the wheel's measured speed toward it by at most
-  ``max_wheel_acceleration / update_rate`` per update, as the plugin does.
-* **Odometry**: ``encoder`` integrates the first pair's wheel velocities
-  every step (:class:`~pan_tilt_sim.controllers.odometry.Odometry`); ``world`` is the base's true
-  planar pose and its twist in the base frame (read through the source the
-  simulation hands in: :meth:`set_base_state`).  Published at
-  ``update_rate`` on the odometry topic (``publish_odom``) and as
-  ``odometry_frame -> robot_base_frame`` on ``/tf`` (``publish_odom_tf``).
-
-A reset (``reset_simulation``) drops the command and puts the encoder
-odometry back at the origin, as the plugin's Reset.  Pure Python.
+element (:mod:`pan_tilt_sim.plugins.registry`) and updates it every physics
+step, before the controllers; it is always active.  As the plugin, a
+``geometry_msgs/Twist`` (``linear.x``, ``angular.z``; the last one holds, a
+non-finite one is refused) sets each wheel pair's velocity targets every
+``1 / update_rate`` s, reached by a motor of at most ``max_wheel_torque``
+N m and ramped by ``max_wheel_acceleration``; odometry (``encoder``: the
+first pair's wheels; ``world``: the base's true planar pose) goes to the
+odometry topic and ``/tf``.  A reset drops the command and puts the
+encoder odometry back at the origin.  Elements, defaults and the whole
+behaviour per generation: docs/design/gazebo-plugins.md.  Pure Python.
 """
 
 from __future__ import annotations

@@ -2,27 +2,15 @@
 
 Not a ros2_control controller: the simulation creates one per plugin
 element (:mod:`pan_tilt_sim.plugins.registry`) and updates it every physics
-step, before the controllers; it is always active.  As the plugin:
-
-* **Command**: ``geometry_msgs/Twist`` on its command topic; ``linear.x``,
-  ``linear.y`` (m/s, in the base's heading) and ``angular.z`` (rad/s)
-  count; the last one holds until the next (ROS 1: until ``cmdTimeout`` s
-  of sim time have passed, when that is not negative).  A twist with a NaN
-  or infinite value is refused (a throttled warning names it).
-* **Motion**: every ``1 / update_rate`` s of sim time (0, and ROS 1: every
-  step) the base's velocity is *set*: ``(x cos(yaw) - y sin(yaw),
-  y cos(yaw) + x sin(yaw), 0)`` m/s in the world and ``(0, 0, angular.z)``
-  rad/s.  No wheel turns: the plugin moves the model itself.  The unit
-  computes the velocity (:meth:`take_base_velocity`); the simulation sets
-  it on the base before the physics step.
-* **Odometry**: the base's true pose in the world (3-D) and its twist in
-  the base's heading axes, every ``1 / publish_rate`` s on the odometry
-  topic (``publish_odom``) and as ``odometry_frame -> robot_base_frame`` on
-  ``/tf`` (``publish_odom_tf``); covariance diagonals ``covariance_x``,
-  ``covariance_y``, 1e12 for z, roll, pitch, ``covariance_yaw``.
-
-A reset drops the command, as the plugin's Reset.  Pure Python: the
-simulation hands in the base's state (:meth:`set_base_motion`).
+step, before the controllers; it is always active.  As the plugin, a
+``geometry_msgs/Twist`` (``linear.x``, ``linear.y``, ``angular.z``; ROS 1:
+until ``cmdTimeout``; a non-finite one is refused) *sets* the base's planar
+velocity every ``1 / update_rate`` s: no wheel turns.  The unit computes the
+velocity (:meth:`GazeboPlanarMove.take_base_velocity`); the simulation sets
+it on the base before the physics step.  The base's true pose and twist go
+to the odometry topic and ``/tf`` every ``1 / publish_rate`` s.  A reset
+drops the command.  The whole behaviour: docs/design/gazebo-plugins.md.
+Pure Python: the simulation hands in the base's state.
 """
 
 from __future__ import annotations

@@ -2,29 +2,15 @@
 
 Not a ros2_control controller: the simulation creates one per system
 element (:mod:`pan_tilt_sim.plugins.registry`) and updates it every physics
-step, before the controllers; it is always active.  As the system:
-
-* **Command**: ``gz.msgs.Twist`` on ``topic`` -- here the
-  ``geometry_msgs/msg/Twist`` ros_gz_bridge would carry on the same name
-  (no bridge process needed); ``linear.x`` (m/s) and ``angular.z`` (rad/s)
-  count and the last one holds (the system has no timeout).  A twist with a
-  NaN or infinite value is refused (a throttled warning names it).
-* **Limits**: every step the linear and angular velocity go through the
-  system's speed limiter: jerk, acceleration, velocity, each bounded to
-  ``[min, max]`` (an absent ``min``/``max``: unbounded that way).
-* **Wheels**: every step each left wheel's velocity target is ``(v - w *
-  wheel_separation / 2) / wheel_radius`` rad/s and each right one's ``(v +
-  ...)``, reached by the ideal velocity actuator within the joint's effort
-  limit.
-* **Odometry**: from the first left and first right wheels' positions
-  (:class:`~pan_tilt_sim.controllers.odometry.Odometry`, its twist a rolling mean of 10 updates, as
-  gz-math's DiffDriveOdometry), updated and published every ``1 /
-  odom_publish_frequency`` s of sim time: ``gz.msgs.Odometry`` on
-  ``odom_topic`` (``nav_msgs/msg/Odometry``, ``frame_id`` ->
-  ``child_frame_id``, no covariance) and the same transform as
-  ``gz.msgs.Pose_V`` on ``tf_topic`` (``tf2_msgs/msg/TFMessage``).
-
-A reset drops the command and puts the odometry back at the origin.  Pure Python.
+step, before the controllers; it is always active.  As the system, the
+``geometry_msgs/msg/Twist`` ros_gz_bridge would carry on ``topic`` (the last
+one holds; a non-finite one is refused) goes through the system's speed
+limiter (jerk, acceleration, velocity, each within ``[min, max]``) and sets
+every wheel's velocity target each step; odometry from the first left and
+right wheels (a rolling mean of 10 updates, as gz-math's) goes to
+``odom_topic`` and ``tf_topic`` every ``1 / odom_publish_frequency`` s.  A
+reset drops the command and puts the odometry back at the origin.  The
+whole behaviour: docs/design/gazebo-plugins.md.  Pure Python.
 """
 
 from __future__ import annotations
