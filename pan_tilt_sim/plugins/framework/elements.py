@@ -1,16 +1,21 @@
-"""Reading a plugin's elements: numbers, flags, vectors, ``<ros>``, wheels, frames. No ROS.
+"""A plugin's element spec and its reading: numbers, flags, vectors, ``<ros>``, wheels, frames.
 
-The toolbox of the plugins' element specs.  :class:`ElementReader` reads one
+An :class:`ElementSpec` declares the child elements a plugin reads (name,
+kind, default, check), as a controller's ``ParameterSpec`` declares its
+parameters.  :class:`ElementReader` reads one
 :class:`~pan_tilt_sim.model.plugin_elements.PluginElement`; a value that is
 wrong ends start-up with a :class:`~pan_tilt_sim.errors.DescriptionError`
 naming the file, the plugin and the element, as a driving controller's
-checks do.
+checks do.  No ROS.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import enum
 import math
 from collections.abc import Mapping
+from typing import Any
 
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.frame_ids import frame_id_problem
@@ -117,6 +122,49 @@ class ElementReader:
     def has_any(self, keys: set[str]) -> bool:
         """Whether one of ``keys`` is an element of the plugin (tells a generation apart)."""
         return bool(set(self.texts) & keys)
+
+
+class Kind(enum.Enum):
+    """What an element's text is read as."""
+
+    NUMBER = 'number'  # a finite float (a rate: its period finite too)
+    TEXT = 'text'  # the text, stripped (empty: the default)
+    FLAG = 'flag'  # true/false/1/0
+    VECTOR = 'vector'  # three numbers (absent: zeros)
+
+
+@dataclasses.dataclass(frozen=True)
+class Element:
+    """One child element a plugin reads: its name, kind, default and check."""
+
+    name: str
+    default: Any = None
+    kind: Kind = Kind.NUMBER
+    positive: bool = False
+    non_negative: bool = False
+
+    def read(self, reader: ElementReader) -> Any:
+        """Return the element's value in ``reader``'s plugin (DescriptionError if wrong)."""
+        if self.kind is Kind.NUMBER:
+            return reader.number(self.name, self.default, positive=self.positive,
+                                 non_negative=self.non_negative)
+        if self.kind is Kind.TEXT:
+            return reader.text(self.name, self.default)
+        if self.kind is Kind.FLAG:
+            return reader.flag(self.name, self.default)
+        return reader.vector(self.name)
+
+
+class ElementSpec:
+    """The elements a plugin (of one generation) reads, in the order they are checked."""
+
+    def __init__(self, *elements: Element) -> None:
+        self.elements = elements
+        self.names = tuple(element.name for element in elements)
+
+    def read(self, reader: ElementReader) -> dict[str, Any]:
+        """Return every element's value by name; the first wrong one raises."""
+        return {element.name: element.read(reader) for element in self.elements}
 
 
 def check_wheels(reader: ElementReader, keyed: tuple[tuple[str, tuple[str, ...]], ...],

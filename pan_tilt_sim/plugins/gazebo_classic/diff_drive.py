@@ -37,7 +37,10 @@ from pan_tilt_sim.model.sensors import ROS1, ROS2, Ros2Names, ros1_resolve
 from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.plugins.framework.elements import (
     UNPLANAR_COVARIANCE,
+    Element,
     ElementReader,
+    ElementSpec,
+    Kind,
     check_frames,
     check_wheels,
     joints_by_name,
@@ -53,11 +56,42 @@ from pan_tilt_sim.schedule import DUE_EPSILON
 REACHED = 0.01  # m/s: a wheel this close to its speed is set to it directly (the plugin's)
 ENCODER, WORLD = 'encoder', 'world'
 ROS2_SOURCES = {0: ENCODER, 1: WORLD}  # gazebo_ros's odometry_source numbers
+# The element spec, per generation (gazebo_ros's and gazebo_plugins' names and defaults).
+# ROS 2 also reads left_joint/right_joint, wheel_separation and wheel_diameter once per
+# wheel pair, and <ros>.
+ROS2_ELEMENTS = ElementSpec(
+    Element('num_wheel_pairs', 1.0),
+    Element('odometry_source', 1.0),  # 0 encoder, 1 world
+    Element('max_wheel_torque', 5.0, positive=True),  # N m
+    Element('max_wheel_acceleration', 0.0, non_negative=True),  # m/s^2, 0: none
+    Element('update_rate', 100.0, non_negative=True),  # Hz, 0: every step
+    Element('odometry_frame', 'odom', Kind.TEXT),
+    Element('robot_base_frame', 'base_footprint', Kind.TEXT),
+    Element('publish_odom', False, Kind.FLAG),
+    Element('publish_odom_tf', False, Kind.FLAG),
+    Element('covariance_x', 1e-5),
+    Element('covariance_y', 1e-5),
+    Element('covariance_yaw', 1e-3),
+)
+# ROS 1 also reads robotNamespace.
+ROS1_ELEMENTS = ElementSpec(
+    Element('odometrySource', WORLD, Kind.TEXT),  # encoder or world
+    Element('leftJoint', 'left_joint', Kind.TEXT),
+    Element('rightJoint', 'right_joint', Kind.TEXT),
+    Element('wheelSeparation', 0.34, positive=True),  # m
+    Element('wheelDiameter', 0.15, positive=True),  # m
+    Element('wheelTorque', 5.0, positive=True),  # N m
+    Element('wheelAcceleration', 0.0, non_negative=True),  # m/s^2
+    Element('updateRate', 100.0, non_negative=True),  # Hz
+    Element('odometryFrame', 'odom', Kind.TEXT),
+    Element('robotBaseFrame', 'base_footprint', Kind.TEXT),
+    Element('publishTf', True, Kind.FLAG),  # the odometry
+    Element('publishOdomTF', True, Kind.FLAG),
+    Element('commandTopic', 'cmd_vel', Kind.TEXT),
+    Element('odometryTopic', 'odom', Kind.TEXT),
+)
 # Elements only ROS 1's diff drive reads: they tell which generation a plugin is.
-ROS1_DIFF_DRIVE_KEYS = {'leftJoint', 'rightJoint', 'wheelSeparation', 'wheelDiameter',
-                        'commandTopic', 'odometryTopic', 'odometryFrame', 'robotBaseFrame',
-                        'publishOdomTF', 'publishTf', 'updateRate', 'wheelTorque',
-                        'wheelAcceleration', 'odometrySource', 'robotNamespace'}
+ROS1_DIFF_DRIVE_KEYS = {*ROS1_ELEMENTS.names, 'robotNamespace'}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -138,7 +172,8 @@ def read_diff_drive(element: PluginElement, model: RobotModel) -> DiffDrivePlugi
 
 
 def _ros2_diff_drive(reader: ElementReader) -> DiffDrivePlugin:
-    pairs = reader.number('num_wheel_pairs', 1.0)
+    values = ROS2_ELEMENTS.read(reader)
+    pairs = values['num_wheel_pairs']
     if pairs < 1 or pairs != int(pairs):
         raise reader.error('num_wheel_pairs', f'must be a whole number >= 1, got {pairs:g}')
     count = int(pairs)
@@ -150,7 +185,7 @@ def _ros2_diff_drive(reader: ElementReader) -> DiffDrivePlugin:
                    for text in reader.all('wheel_separation')[:count]]
     diameters = [reader.check('wheel_diameter', text, 0.15, positive=True)
                  for text in reader.all('wheel_diameter')[:count]]
-    source = reader.number('odometry_source', 1.0)
+    source = values['odometry_source']
     if source not in ROS2_SOURCES:
         raise reader.error('odometry_source', f'must be 0 (encoder) or 1 (world), got {source:g}')
     namespace, remappings = reader.ros()
@@ -158,39 +193,29 @@ def _ros2_diff_drive(reader: ElementReader) -> DiffDrivePlugin:
         name=reader.name, convention=ROS2, left_joints=tuple(left), right_joints=tuple(right),
         wheel_separation=tuple(separations + [0.34] * (count - len(separations))),
         wheel_diameter=tuple(diameters + [0.15] * (count - len(diameters))),
-        max_wheel_torque=reader.number('max_wheel_torque', 5.0, positive=True),
-        max_wheel_acceleration=reader.number('max_wheel_acceleration', 0.0, non_negative=True),
-        update_rate=reader.number('update_rate', 100.0, non_negative=True),
-        odometry_frame=reader.text('odometry_frame', 'odom'),
-        robot_base_frame=reader.text('robot_base_frame', 'base_footprint'),
-        odometry_source=ROS2_SOURCES[int(source)],
-        publish_odom=reader.flag('publish_odom', False),
-        publish_odom_tf=reader.flag('publish_odom_tf', False),
-        covariance=(reader.number('covariance_x', 1e-5), reader.number('covariance_y', 1e-5),
-                    reader.number('covariance_yaw', 1e-3)),
+        max_wheel_torque=values['max_wheel_torque'],
+        max_wheel_acceleration=values['max_wheel_acceleration'],
+        update_rate=values['update_rate'], odometry_frame=values['odometry_frame'],
+        robot_base_frame=values['robot_base_frame'], odometry_source=ROS2_SOURCES[int(source)],
+        publish_odom=values['publish_odom'], publish_odom_tf=values['publish_odom_tf'],
+        covariance=(values['covariance_x'], values['covariance_y'], values['covariance_yaw']),
         namespace=namespace, remappings=remappings)
 
 
 def _ros1_diff_drive(reader: ElementReader) -> DiffDrivePlugin:
-    source = reader.text('odometrySource', WORLD).lower()
+    values = ROS1_ELEMENTS.read(reader)
+    source = values['odometrySource'].lower()
     if source not in (ENCODER, WORLD):
         raise reader.error('odometrySource', f"must be '{ENCODER}' or '{WORLD}', got '{source}'")
-    left, right = reader.text('leftJoint', 'left_joint'), reader.text('rightJoint', 'right_joint')
     return DiffDrivePlugin(
-        name=reader.name, convention=ROS1, left_joints=(left,), right_joints=(right,),
-        wheel_separation=(reader.number('wheelSeparation', 0.34, positive=True),),
-        wheel_diameter=(reader.number('wheelDiameter', 0.15, positive=True),),
-        max_wheel_torque=reader.number('wheelTorque', 5.0, positive=True),
-        max_wheel_acceleration=reader.number('wheelAcceleration', 0.0, non_negative=True),
-        update_rate=reader.number('updateRate', 100.0, non_negative=True),
-        odometry_frame=reader.text('odometryFrame', 'odom'),
-        robot_base_frame=reader.text('robotBaseFrame', 'base_footprint'),
-        odometry_source=source,
-        publish_odom=reader.flag('publishTf', True),
-        publish_odom_tf=reader.flag('publishOdomTF', True),
-        covariance=(1e-5, 1e-5, 1e-3),
-        command_topic=reader.text('commandTopic', 'cmd_vel'),
-        odometry_topic=reader.text('odometryTopic', 'odom'),
+        name=reader.name, convention=ROS1, left_joints=(values['leftJoint'],),
+        right_joints=(values['rightJoint'],), wheel_separation=(values['wheelSeparation'],),
+        wheel_diameter=(values['wheelDiameter'],), max_wheel_torque=values['wheelTorque'],
+        max_wheel_acceleration=values['wheelAcceleration'], update_rate=values['updateRate'],
+        odometry_frame=values['odometryFrame'], robot_base_frame=values['robotBaseFrame'],
+        odometry_source=source, publish_odom=values['publishTf'],
+        publish_odom_tf=values['publishOdomTF'], covariance=(1e-5, 1e-5, 1e-3),
+        command_topic=values['commandTopic'], odometry_topic=values['odometryTopic'],
         namespace=reader.ros1_namespace())
 
 
