@@ -32,7 +32,7 @@ from pan_tilt_sim.model.transforms import (
     quaternion_multiply,
     rotate,
 )
-from pan_tilt_sim.plugins.framework.elements import ElementReader
+from pan_tilt_sim.plugins.framework.elements import Element, ElementReader, ElementSpec, Kind
 from pan_tilt_sim.plugins.framework.plugin import (
     LinkState,
     Plugin,
@@ -42,8 +42,25 @@ from pan_tilt_sim.plugins.framework.plugin import (
 from pan_tilt_sim.schedule import DUE_EPSILON
 
 WORLD_FRAMES = ('world', '/world', 'map', '/map')  # poses in the world
-ROS1_P3D_KEYS = {'bodyName', 'frameName', 'topicName', 'xyzOffsets', 'rpyOffsets',
-                 'gaussianNoise', 'updateRate', 'robotNamespace'}
+# The element spec, per generation; ROS 2 also reads <ros>, ROS 1 robotNamespace.
+ROS2_ELEMENTS = ElementSpec(
+    Element('body_name', '', Kind.TEXT),  # required: the link
+    Element('frame_name', 'world', Kind.TEXT),  # world, map or a link
+    Element('xyz_offsets', kind=Kind.VECTOR),  # m
+    Element('rpy_offsets', kind=Kind.VECTOR),  # rad
+    Element('gaussian_noise', 0.0, non_negative=True),  # standard deviation
+    Element('update_rate', 0.0, non_negative=True),  # Hz, 0: every step
+)
+ROS1_ELEMENTS = ElementSpec(
+    Element('bodyName', '', Kind.TEXT),
+    Element('frameName', 'world', Kind.TEXT),
+    Element('xyzOffsets', kind=Kind.VECTOR),
+    Element('rpyOffsets', kind=Kind.VECTOR),
+    Element('gaussianNoise', 0.0, non_negative=True),
+    Element('updateRate', 0.0, non_negative=True),
+    Element('topicName', 'odom', Kind.TEXT),
+)
+ROS1_P3D_KEYS = {*ROS1_ELEMENTS.names, 'robotNamespace'}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -91,26 +108,23 @@ def read_p3d(element: PluginElement, model: RobotModel) -> P3dPlugin:
     links = set(model.link_names)
     reader = ElementReader(element, model.name)
     ros1 = reader.has_any(ROS1_P3D_KEYS) and 'ros' not in reader.texts
-    names = ('bodyName', 'frameName', 'xyzOffsets', 'rpyOffsets', 'gaussianNoise',
-             'updateRate') if ros1 else ('body_name', 'frame_name', 'xyz_offsets',
-                                         'rpy_offsets', 'gaussian_noise', 'update_rate')
-    body, frame, xyz, rpy, noise, rate = names
-    link = reader.text(body, '')
+    spec = ROS1_ELEMENTS if ros1 else ROS2_ELEMENTS
+    body, frame, xyz, rpy, noise, rate = spec.names[:6]
+    values = spec.read(reader)
+    link = values[body]
     if link not in links:
         raise reader.error(body, f"'{link}' is not a link of this robot" if link
                            else 'is missing (the plugin needs the link to track)')
-    frame_name = reader.text(frame, 'world')
+    frame_name = values[frame]
     if frame_name not in WORLD_FRAMES and frame_name not in links:
         raise reader.error(frame, f"'{frame_name}' is neither world, map nor a link of "
                            'this robot')
     namespace, remappings = ('', ()) if ros1 else reader.ros()
     return P3dPlugin(
         name=reader.name, convention=ROS1 if ros1 else ROS2, body_name=link,
-        frame_name=frame_name, xyz_offsets=reader.vector(xyz),
-        rpy_offsets=reader.vector(rpy),
-        gaussian_noise=reader.number(noise, 0.0, non_negative=True),
-        update_rate=reader.number(rate, 0.0, non_negative=True),
-        topic=reader.text('topicName', 'odom') if ros1 else 'odom',
+        frame_name=frame_name, xyz_offsets=values[xyz], rpy_offsets=values[rpy],
+        gaussian_noise=values[noise], update_rate=values[rate],
+        topic=values['topicName'] if ros1 else 'odom',
         namespace=reader.ros1_namespace() if ros1 else namespace,
         remappings=remappings)
 
