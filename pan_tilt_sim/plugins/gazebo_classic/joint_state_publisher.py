@@ -22,7 +22,10 @@ from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.model.sensors import GZ_WORLD, ROS1, ROS2, Ros2Names, ros1_resolve
 from pan_tilt_sim.plugins.framework.elements import (
     GZ,
+    Element,
     ElementReader,
+    ElementSpec,
+    Kind,
     gz_topic,
     movable_joints,
 )
@@ -38,6 +41,12 @@ GZ_FILES = frozenset({'gz-sim-joint-state-publisher-system',
                       'ignition-gazebo-joint-state-publisher-system'})
 GZ_NAMES = frozenset({'gz::sim::systems::JointStatePublisher',
                       'ignition::gazebo::systems::JointStatePublisher'})
+# The element spec, per generation.  Each also reads its joints: ROS 2 and gz-sim one
+# joint_name each (gz-sim: none, every movable joint), ROS 1 jointName (comma-separated);
+# ROS 2 reads <ros>, ROS 1 robotNamespace.
+ROS2_ELEMENTS = ElementSpec(Element('update_rate', 100.0, non_negative=True))  # Hz, 0: every step
+ROS1_ELEMENTS = ElementSpec(Element('updateRate', 100.0, non_negative=True))
+GZ_ELEMENTS = ElementSpec(Element('topic', '', Kind.TEXT))  # '': the world's model joint_state
 
 
 @dataclasses.dataclass(frozen=True)
@@ -79,11 +88,12 @@ def read_joint_state_publisher(element: PluginElement, model: RobotModel) -> Joi
         for name in names:
             if name not in movable:
                 raise reader.error('joint_name', f"'{name}' is not a movable joint of this robot")
-        topic = reader.text('topic', f'/world/{GZ_WORLD}/model/{model.name}/joint_state')
+        topic = GZ_ELEMENTS.read(reader)['topic'] or (
+            f'/world/{GZ_WORLD}/model/{model.name}/joint_state')
         return JointStatePlugin(name=reader.name, convention=GZ,
                                 joints=tuple(names or movable), update_rate=0.0,
                                 topic=gz_topic(topic))
-    ros1 = reader.has_any({'jointName', 'updateRate', 'robotNamespace'})
+    ros1 = reader.has_any({'jointName', *ROS1_ELEMENTS.names, 'robotNamespace'})
     key = 'jointName' if ros1 else 'joint_name'
     names = [name.strip() for text in reader.all(key) for name in (
         text.split(',') if ros1 else [text]) if name.strip()]
@@ -93,10 +103,10 @@ def read_joint_state_publisher(element: PluginElement, model: RobotModel) -> Joi
         if name not in movable:
             raise reader.error(key, f"'{name}' is not a movable joint of this robot")
     namespace, remappings = ('', ()) if ros1 else reader.ros()
+    rate = (ROS1_ELEMENTS if ros1 else ROS2_ELEMENTS).read(reader)
     return JointStatePlugin(
         name=reader.name, convention=ROS1 if ros1 else ROS2, joints=tuple(names),
-        update_rate=reader.number('updateRate' if ros1 else 'update_rate', 100.0,
-                                  non_negative=True),
+        update_rate=rate['updateRate' if ros1 else 'update_rate'],
         namespace=reader.ros1_namespace() if ros1 else namespace,
         remappings=remappings)
 
