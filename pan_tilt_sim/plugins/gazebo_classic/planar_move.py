@@ -35,7 +35,10 @@ from pan_tilt_sim.model.sensors import ROS1, ROS2, Ros2Names, ros1_resolve
 from pan_tilt_sim.model.transforms import Vector
 from pan_tilt_sim.plugins.framework.elements import (
     UNPLANAR_COVARIANCE,
+    Element,
     ElementReader,
+    ElementSpec,
+    Kind,
     check_frames,
 )
 from pan_tilt_sim.plugins.framework.plugin import (
@@ -47,8 +50,28 @@ from pan_tilt_sim.plugins.framework.plugin import (
 )
 from pan_tilt_sim.schedule import DUE_EPSILON
 
-ROS1_PLANAR_MOVE_KEYS = {'commandTopic', 'odometryTopic', 'odometryFrame', 'odometryRate',
-                         'robotBaseFrame', 'publishOdometryTf', 'cmdTimeout', 'robotNamespace'}
+# The element spec, per generation; ROS 2 also reads <ros>, ROS 1 robotNamespace.
+ROS2_ELEMENTS = ElementSpec(
+    Element('update_rate', 20.0, non_negative=True),  # Hz, 0: every step
+    Element('publish_rate', 20.0, non_negative=True),  # Hz, 0: every step
+    Element('odometry_frame', 'odom', Kind.TEXT),
+    Element('robot_base_frame', 'base_footprint', Kind.TEXT),
+    Element('publish_odom', True, Kind.FLAG),
+    Element('publish_odom_tf', True, Kind.FLAG),
+    Element('covariance_x', 1e-5),
+    Element('covariance_y', 1e-5),
+    Element('covariance_yaw', 1e-3),
+)
+ROS1_ELEMENTS = ElementSpec(  # ROS 1 sets the velocity every step
+    Element('odometryRate', 20.0, non_negative=True),  # Hz
+    Element('odometryFrame', 'odom', Kind.TEXT),
+    Element('robotBaseFrame', 'base_footprint', Kind.TEXT),
+    Element('publishOdometryTf', True, Kind.FLAG),
+    Element('cmdTimeout', -1.0),  # s, negative: none
+    Element('commandTopic', 'cmd_vel', Kind.TEXT),
+    Element('odometryTopic', 'odom', Kind.TEXT),
+)
+ROS1_PLANAR_MOVE_KEYS = {*ROS1_ELEMENTS.names, 'robotNamespace'}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -104,30 +127,25 @@ def read_planar_move(element: PluginElement, model: RobotModel) -> PlanarMovePlu
     """
     reader = ElementReader(element, model.name)
     if reader.has_any(ROS1_PLANAR_MOVE_KEYS) and 'ros' not in reader.texts:
-        rate = reader.number('odometryRate', 20.0, non_negative=True)
+        values = ROS1_ELEMENTS.read(reader)
         plugin = PlanarMovePlugin(
-            name=reader.name, convention=ROS1, update_rate=0.0, publish_rate=rate,
-            odometry_frame=reader.text('odometryFrame', 'odom'),
-            robot_base_frame=reader.text('robotBaseFrame', 'base_footprint'),
-            publish_odom=True, publish_odom_tf=reader.flag('publishOdometryTf', True),
-            command_timeout=reader.number('cmdTimeout', -1.0),
-            command_topic=reader.text('commandTopic', 'cmd_vel'),
-            odometry_topic=reader.text('odometryTopic', 'odom'),
+            name=reader.name, convention=ROS1, update_rate=0.0,
+            publish_rate=values['odometryRate'], odometry_frame=values['odometryFrame'],
+            robot_base_frame=values['robotBaseFrame'], publish_odom=True,
+            publish_odom_tf=values['publishOdometryTf'], command_timeout=values['cmdTimeout'],
+            command_topic=values['commandTopic'], odometry_topic=values['odometryTopic'],
             namespace=reader.ros1_namespace())
         check_frames(reader, (('odometryFrame', plugin.odometry_frame),
                               ('robotBaseFrame', plugin.robot_base_frame)))
         return plugin
     namespace, remappings = reader.ros()
+    values = ROS2_ELEMENTS.read(reader)
     plugin = PlanarMovePlugin(
-        name=reader.name, convention=ROS2,
-        update_rate=reader.number('update_rate', 20.0, non_negative=True),
-        publish_rate=reader.number('publish_rate', 20.0, non_negative=True),
-        odometry_frame=reader.text('odometry_frame', 'odom'),
-        robot_base_frame=reader.text('robot_base_frame', 'base_footprint'),
-        publish_odom=reader.flag('publish_odom', True),
-        publish_odom_tf=reader.flag('publish_odom_tf', True),
-        covariance=(reader.number('covariance_x', 1e-5), reader.number('covariance_y', 1e-5),
-                    reader.number('covariance_yaw', 1e-3)),
+        name=reader.name, convention=ROS2, update_rate=values['update_rate'],
+        publish_rate=values['publish_rate'], odometry_frame=values['odometry_frame'],
+        robot_base_frame=values['robot_base_frame'], publish_odom=values['publish_odom'],
+        publish_odom_tf=values['publish_odom_tf'],
+        covariance=(values['covariance_x'], values['covariance_y'], values['covariance_yaw']),
         namespace=namespace, remappings=remappings)
     check_frames(reader, (('odometry_frame', plugin.odometry_frame),
                           ('robot_base_frame', plugin.robot_base_frame)))
