@@ -37,7 +37,10 @@ from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.plugins.framework.elements import (
     GZ,
+    Element,
     ElementReader,
+    ElementSpec,
+    Kind,
     check_frames,
     check_wheels,
     gz_topic,
@@ -55,6 +58,29 @@ GZ_DIFF_DRIVE_NAMES = frozenset({'gz::sim::systems::DiffDrive',
 # bounds every change, so it is both the deceleration and the reverse acceleration.
 GZ_LIMIT_ELEMENTS = ('min_velocity', 'max_velocity', 'min_acceleration', 'max_acceleration',
                      'min_jerk', 'max_jerk')
+GROUPS = ('linear', 'angular')
+
+
+def _own(entry: str, group: str) -> str:
+    """Return a group's own limit element: min_velocity, linear -> min_linear_velocity."""
+    kind, what = entry.split('_')
+    return f'{kind}_{group}_{what}'
+
+
+# The element spec (gz-sim's names and defaults; '': named after the model).  The system also
+# reads one or more left_joint and right_joint.
+ELEMENTS = ElementSpec(
+    *(Element(entry, math.nan) for entry in GZ_LIMIT_ELEMENTS),  # both groups; NaN: none
+    *(Element(_own(entry, group), math.nan) for group in GROUPS for entry in GZ_LIMIT_ELEMENTS),
+    Element('frame_id', '', Kind.TEXT),  # {model}/odom
+    Element('child_frame_id', '', Kind.TEXT),  # {model}/{root link}
+    Element('wheel_separation', 1.0, positive=True),  # m
+    Element('wheel_radius', 0.2, positive=True),  # m
+    Element('odom_publish_frequency', 50.0, positive=True),  # Hz
+    Element('topic', '', Kind.TEXT),  # /model/{model}/cmd_vel
+    Element('odom_topic', '', Kind.TEXT),  # /model/{model}/odometry
+    Element('tf_topic', '', Kind.TEXT),  # /model/{model}/tf
+)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -104,30 +130,27 @@ def read_gz_diff_drive(element: PluginElement, model: RobotModel) -> GzDiffDrive
         if not wheels:
             raise reader.error(key, 'is missing: the system needs at least one on each side')
     check_wheels(reader, (('left_joint', left), ('right_joint', right)), joints_by_name(model))
+    values = ELEMENTS.read(reader)
     limits = {}
-    for group in ('linear', 'angular'):
-        values = {}
-        for entry in GZ_LIMIT_ELEMENTS:
-            kind, what = entry.split('_')
-            own = f'{kind}_{group}_{what}'
-            values[own] = reader.number(own, reader.number(entry, math.nan))
+    for group in GROUPS:
+        own = {_own(entry, group): values[entry] if math.isnan(values[_own(entry, group)])
+               else values[_own(entry, group)] for entry in GZ_LIMIT_ELEMENTS}
         for what in ('velocity', 'acceleration', 'jerk'):
-            low, high = values[f'min_{group}_{what}'], values[f'max_{group}_{what}']
+            low, high = own[f'min_{group}_{what}'], own[f'max_{group}_{what}']
             if low > high:
                 raise reader.error(f'min_{group}_{what}', f'{low:g} is above max_{group}_'
                                    f'{what} {high:g}')
-        limits[group] = tuple(values.values())
-    frame = reader.text('frame_id', f'{name}/odom')
-    child = reader.text('child_frame_id', f'{name}/{root_link(model)}')
+        limits[group] = tuple(own.values())
+    frame = values['frame_id'] or f'{name}/odom'
+    child = values['child_frame_id'] or f'{name}/{root_link(model)}'
     check_frames(reader, (('frame_id', frame), ('child_frame_id', child)))
     return GzDiffDrivePlugin(
         name=reader.name, left_joints=left, right_joints=right,
-        wheel_separation=reader.number('wheel_separation', 1.0, positive=True),
-        wheel_radius=reader.number('wheel_radius', 0.2, positive=True),
-        odom_publish_frequency=reader.number('odom_publish_frequency', 50.0, positive=True),
-        command_topic=gz_topic(reader.text('topic', f'/model/{name}/cmd_vel')),
-        odometry_topic=gz_topic(reader.text('odom_topic', f'/model/{name}/odometry')),
-        tf_topic=gz_topic(reader.text('tf_topic', f'/model/{name}/tf')),
+        wheel_separation=values['wheel_separation'], wheel_radius=values['wheel_radius'],
+        odom_publish_frequency=values['odom_publish_frequency'],
+        command_topic=gz_topic(values['topic'] or f'/model/{name}/cmd_vel'),
+        odometry_topic=gz_topic(values['odom_topic'] or f'/model/{name}/odometry'),
+        tf_topic=gz_topic(values['tf_topic'] or f'/model/{name}/tf'),
         frame_id=frame, child_frame_id=child,
         linear_limits=limits['linear'], angular_limits=limits['angular'])
 
