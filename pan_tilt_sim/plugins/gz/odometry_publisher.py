@@ -34,7 +34,15 @@ from pan_tilt_sim.model.transforms import (
     quaternion_multiply,
     rotate,
 )
-from pan_tilt_sim.plugins.framework.elements import GZ, ElementReader, check_frames, gz_topic
+from pan_tilt_sim.plugins.framework.elements import (
+    GZ,
+    Element,
+    ElementReader,
+    ElementSpec,
+    Kind,
+    check_frames,
+    gz_topic,
+)
 from pan_tilt_sim.plugins.framework.plugin import (
     BaseMotion,
     Plugin,
@@ -48,6 +56,18 @@ GZ_ODOMETRY_FILES = frozenset({'gz-sim-odometry-publisher-system',
                                'ignition-gazebo-odometry-publisher-system'})
 GZ_ODOMETRY_NAMES = frozenset({'gz::sim::systems::OdometryPublisher',
                                'ignition::gazebo::systems::OdometryPublisher'})
+# The element spec (gz-sim's names and defaults; '': named after the model).
+ELEMENTS = ElementSpec(
+    Element('dimensions', 2.0),  # 2: x, y, yaw; 3: the full pose
+    Element('odom_frame', '', Kind.TEXT),  # {model}/odom
+    Element('robot_base_frame', '', Kind.TEXT),  # {model}/base_footprint
+    Element('odom_publish_frequency', 50.0, positive=True),  # Hz
+    Element('odom_topic', '', Kind.TEXT),  # /model/{model}/odometry
+    Element('tf_topic', '', Kind.TEXT),  # /model/{model}/pose
+    Element('xyz_offset', kind=Kind.VECTOR),  # m
+    Element('rpy_offset', kind=Kind.VECTOR),  # rad
+    Element('gaussian_noise', 0.0, non_negative=True),  # standard deviation
+)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -77,20 +97,20 @@ def read_gz_odometry_publisher(element: PluginElement, model: RobotModel) -> GzO
     """Return the system's settings (the element spec), elements and defaults as gz-sim's."""
     name = model.name
     reader = ElementReader(element, name)
-    dimensions = reader.number('dimensions', 2.0)
+    values = ELEMENTS.read(reader)
+    dimensions = values['dimensions']
     if dimensions not in (2.0, 3.0):
         raise reader.error('dimensions', f'must be 2 or 3, got {dimensions:g}')
-    odom_frame = reader.text('odom_frame', f'{name}/odom')
-    base_frame = reader.text('robot_base_frame', f'{name}/base_footprint')
+    odom_frame = values['odom_frame'] or f'{name}/odom'
+    base_frame = values['robot_base_frame'] or f'{name}/base_footprint'
     check_frames(reader, (('odom_frame', odom_frame), ('robot_base_frame', base_frame)))
     return GzOdometryPlugin(
         name=reader.name, odom_frame=odom_frame, robot_base_frame=base_frame,
-        odom_publish_frequency=reader.number('odom_publish_frequency', 50.0, positive=True),
-        odometry_topic=gz_topic(reader.text('odom_topic', f'/model/{name}/odometry')),
-        tf_topic=gz_topic(reader.text('tf_topic', f'/model/{name}/pose')),
-        dimensions=int(dimensions), xyz_offset=reader.vector('xyz_offset'),
-        rpy_offset=reader.vector('rpy_offset'),
-        gaussian_noise=reader.number('gaussian_noise', 0.0, non_negative=True))
+        odom_publish_frequency=values['odom_publish_frequency'],
+        odometry_topic=gz_topic(values['odom_topic'] or f'/model/{name}/odometry'),
+        tf_topic=gz_topic(values['tf_topic'] or f'/model/{name}/pose'),
+        dimensions=int(dimensions), xyz_offset=values['xyz_offset'],
+        rpy_offset=values['rpy_offset'], gaussian_noise=values['gaussian_noise'])
 
 
 class GzOdometryPublisher(Plugin, OdometryOutputs, Controller):
