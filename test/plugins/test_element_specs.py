@@ -1,5 +1,6 @@
 """The plugins' element specs: each generation's element names, defaults, checks and topics."""
 
+import dataclasses
 import pathlib
 import re
 
@@ -17,9 +18,10 @@ from mobile_fixtures import (
 )
 
 from pan_tilt_sim.errors import DescriptionError
+from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.sensors import ROS1, ROS2
 from pan_tilt_sim.model.urdf import parse_urdf
-from pan_tilt_sim.plugins.framework.elements import GZ
+from pan_tilt_sim.plugins.framework.elements import GZ, Element, ElementReader, ElementSpec, Kind
 from pan_tilt_sim.plugins.gazebo_classic.diff_drive import ENCODER, WORLD, GazeboDiffDrive
 from pan_tilt_sim.plugins.gazebo_classic.joint_state_publisher import GazeboJointStatePublisher
 from pan_tilt_sim.plugins.gazebo_classic.p3d import GazeboP3d
@@ -489,3 +491,18 @@ def test_a_gz_odometry_publisher_with_one_frame_for_both_ends_start_up():
 def test_a_plugin_rate_whose_period_overflows_ends_start_up(plugin, element):
     with pytest.raises(DescriptionError, match=f'<{element}> .* must be a rate > 0 Hz'):
         model(plugin)
+
+
+def test_an_element_spec_reads_each_kind_with_its_default_and_check():
+    spec = ElementSpec(Element('rate', 10.0, non_negative=True),
+                       Element('frame', 'odom', Kind.TEXT), Element('on', True, Kind.FLAG),
+                       Element('offset', kind=Kind.VECTOR), Element('gain', 1.0, positive=True))
+    element = PluginElement(filename='libx.so', name='x', source='r.urdf',
+                            values={'rate': ('5',), 'offset': ('1 2 3',), 'frame': ('',)})
+    assert spec.names == ('rate', 'frame', 'on', 'offset', 'gain')
+    assert spec.read(ElementReader(element, 'robot')) == {
+        'rate': 5.0, 'frame': 'odom', 'on': True, 'offset': (1.0, 2.0, 3.0), 'gain': 1.0}
+    bad = dataclasses.replace(element, values={'gain': ('0',)})
+    with pytest.raises(DescriptionError) as raised:
+        spec.read(ElementReader(bad, 'robot'))
+    assert str(raised.value) == "r.urdf: plugin 'x' (libx.so): <gain> must be > 0, got 0"
