@@ -1,14 +1,15 @@
 """The package's layers: data flows one way, PyBullet and rclpy stay in their layer, no cycles.
 
-model -> controllers -> sim -> ros -> tools; ``errors``, ``schedule`` and
-``share`` are shared by all; viser (the browser view) only in ``ros/viewer.py``.
-Inside controllers/, each family (commands, trajectory, drives, grippers,
-broadcasters) and each plugin uses the framework and the toolbox, never
-another family or plugin; only the registry (and the manager, through it)
-knows every family.
-Read from the installed package's source with ``ast`` (every import, also
-those inside functions), and checked once more by importing: loading model/
-and controllers/ pulls in neither rclpy nor PyBullet.
+model -> controllers -> plugins -> sim -> ros -> tools; ``errors``, ``schedule``
+and ``share`` are shared by all; viser (the browser view) only in
+``ros/viewer.py``.  Inside controllers/, each family (commands, trajectory,
+drives, grippers, broadcasters) uses the framework and the toolbox, never
+another family; only the registry (and the manager, through it) knows every
+family.  A plugin uses the controllers' framework and toolbox pieces and the
+plugins' framework, never a controller family or another plugin.  Read from
+the installed package's source with ``ast`` (every import, also those inside
+functions), and checked once more by importing: loading model/, controllers/
+and plugins/ pulls in neither rclpy nor PyBullet.
 """
 
 import ast
@@ -27,10 +28,16 @@ SHARED = {'errors', 'schedule', 'share'}
 ALLOWED = {
     'model': set(),
     'controllers': {'model'},
-    'sim': {'model', 'controllers'},
-    'ros': {'model', 'controllers', 'sim'},
-    'tools': {'model', 'controllers', 'sim', 'ros'},
+    'plugins': {'model', 'controllers'},
+    'sim': {'model', 'controllers', 'plugins'},
+    'ros': {'model', 'controllers', 'plugins', 'sim'},
+    'tools': {'model', 'controllers', 'plugins', 'sim', 'ros'},
 }
+# The controllers' modules a plugin may use: the framework and the toolbox (by folder once
+# the controllers are sorted into families; by module until then), not a controller family.
+CONTROLLER_PIECES = {'framework', 'toolbox', 'base', 'surface', 'odometry', 'odometry_outputs',
+                     'rate_limiter', 'parameter_spec', 'hardware_interfaces', 'limits', 'pid'}
+PLUGIN_FOLDERS = ('gazebo_classic', 'gz')  # the plugins, one module each
 ROS_PACKAGE_SUFFIXES = ('_msgs', '_srvs', '_interfaces')
 ROS_PACKAGES = {'rclpy', 'builtin_interfaces'}
 VIEWER_MODULE = 'pan_tilt_sim.ros.viewer'  # the browser view: an optional dependency's adapter
@@ -131,8 +138,34 @@ def test_no_module_imports_one_that_imports_it_back():
     assert cycles == []
 
 
-def test_importing_model_and_controllers_pulls_in_neither_rclpy_nor_pybullet():
-    names = sorted(m for m in MODULES if layer(m) in ('model', 'controllers'))
+def plugin_modules() -> list[str]:
+    """Return the plugin modules (one per plugin, in ``plugins/<generation>/``)."""
+    return sorted(name for name in MODULES if layer(name) == 'plugins'
+                  and len(name.split('.')) == 4 and name.split('.')[2] in PLUGIN_FOLDERS)
+
+
+def test_there_are_plugin_modules():
+    assert len(plugin_modules()) >= 6
+
+
+@pytest.mark.parametrize('module', plugin_modules())
+def test_a_plugin_uses_the_controllers_framework_and_toolbox_but_no_family(module):
+    for name in imports(MODULES[module]):
+        parts = name.split('.')
+        if parts[:2] == ['pan_tilt_sim', 'controllers'] and len(parts) > 2:
+            assert parts[2] in CONTROLLER_PIECES, f'{module} imports {name} (a controller family)'
+
+
+@pytest.mark.parametrize('module', plugin_modules())
+def test_a_plugin_uses_no_other_plugin_only_the_plugins_framework(module):
+    for name in imports(MODULES[module]):
+        parts = name.split('.')
+        if parts[:2] == ['pan_tilt_sim', 'plugins'] and len(parts) > 2:
+            assert parts[2] == 'framework', f'{module} imports {name} (another plugin)'
+
+
+def test_importing_model_controllers_and_plugins_pulls_in_neither_rclpy_nor_pybullet():
+    names = sorted(m for m in MODULES if layer(m) in ('model', 'controllers', 'plugins'))
     code = '; '.join([*(f'import {name}' for name in names),
                       'import sys',
                       "print(sorted(m for m in ('rclpy', 'pybullet') if m in sys.modules))"])
@@ -140,7 +173,7 @@ def test_importing_model_and_controllers_pulls_in_neither_rclpy_nor_pybullet():
                             env=sim_process.environment(), timeout=60, check=False)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == '[]'
-    assert len(names) > 20  # every module of both layers was imported
+    assert len(names) > 20  # every module of the three layers was imported
 
 
 def controller_part(module: str) -> str:

@@ -167,8 +167,8 @@ def _line_of(text: str, needle: str) -> str:
 
 
 def controllers_files_for(given: str, description: RobotDescription, *,
-                          given_as: str = f"the parameter '{CONTROLLERS_FILE}'"
-                          ) -> tuple[pathlib.Path, ...]:
+                          given_as: str = f"the parameter '{CONTROLLERS_FILE}'",
+                          runs_by_plugins: bool = False) -> tuple[pathlib.Path, ...]:
     """Return the controller YAML file(s) to use for ``description``.
 
     ``given`` (the user's ``controllers_file``) wins; relative paths are
@@ -178,8 +178,9 @@ def controllers_files_for(given: str, description: RobotDescription, *,
     a relative path is taken from the description's folder, or from the
     current directory -- where Gazebo would look -- if only there it
     exists).  Else, for the shipped pan/tilt model, its shipped controllers.
-    Else, for a URDF whose Gazebo plugins run it (a diff drive, planar move, p3d, odometry or
-    joint state publisher plugin, :mod:`pan_tilt_sim.model.drive_plugins`), none: it runs without
+    Else, for a URDF whose Gazebo plugins run it (``runs_by_plugins``: a diff drive, planar
+    move, p3d, odometry or joint state publisher plugin, as
+    :func:`pan_tilt_sim.plugins.registry.runs_by_plugins` tells), none: it runs without
     controllers, as in Gazebo.
     """
     if given:
@@ -192,8 +193,7 @@ def controllers_files_for(given: str, description: RobotDescription, *,
         return named
     if description.name == DEFAULT_ROBOT_NAME:
         return (package_share() / DEFAULT_CONTROLLERS,)
-    model = description.model
-    if model.runs_by_plugins:
+    if runs_by_plugins:
         return ()
     raise ControllerConfigError(
         f'{description.source}: no controllers file: {given_as} is not set and the URDF names '

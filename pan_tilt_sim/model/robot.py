@@ -18,14 +18,7 @@ import functools
 import math
 from collections.abc import Mapping
 
-from pan_tilt_sim.model.drive_plugins import (
-    DiffDrivePlugin,
-    GzDiffDrivePlugin,
-    GzOdometryPlugin,
-    JointStatePlugin,
-    P3dPlugin,
-    PlanarMovePlugin,
-)
+from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.sensors import SensorSpec
 from pan_tilt_sim.model.surfaces import Surface
 from pan_tilt_sim.model.transforms import (
@@ -346,28 +339,9 @@ class RobotModel:
     sensor_warnings: tuple[str, ...] = ()
     # Contact surfaces from <gazebo reference="LINK"> (mu1, mu2, kp, kd), for links that give any.
     surfaces: tuple[Surface, ...] = ()
-    # Gazebo drive plugins (<gazebo><plugin> libgazebo_ros_diff_drive.so): they drive the base.
-    drive_plugins: tuple[DiffDrivePlugin, ...] = ()
-    # Gazebo ground-truth plugins (libgazebo_ros_p3d.so): a link's true pose on a topic.
-    p3d_plugins: tuple[P3dPlugin, ...] = ()
-    # Gazebo joint state publishers (libgazebo_ros_joint_state_publisher.so, gz-sim's system).
-    joint_state_plugins: tuple[JointStatePlugin, ...] = ()
-    # libgazebo_ros_planar_move.so: sets the base's planar velocity.
-    planar_move_plugins: tuple[PlanarMovePlugin, ...] = ()
-    # gz-sim's DiffDrive and OdometryPublisher systems.
-    gz_drive_plugins: tuple[GzDiffDrivePlugin, ...] = ()
-    gz_odometry_plugins: tuple[GzOdometryPlugin, ...] = ()
-
-    @property
-    def base_drivers(self) -> tuple[DiffDrivePlugin | PlanarMovePlugin | GzDiffDrivePlugin, ...]:
-        """The Gazebo plugins that move the base (they free it with ``fixed_base`` auto)."""
-        return (*self.drive_plugins, *self.planar_move_plugins, *self.gz_drive_plugins)
-
-    @property
-    def runs_by_plugins(self) -> bool:
-        """Whether a Gazebo plugin of the URDF gives it topics without any controller."""
-        return bool(self.base_drivers or self.p3d_plugins or self.joint_state_plugins
-                    or self.gz_odometry_plugins)
+    # The model-level <gazebo><plugin> elements (diff drive, p3d, ...), as data: what each
+    # plugin reads of them is its own (pan_tilt_sim.plugins).
+    plugins: tuple[PluginElement, ...] = ()
 
     @property
     def link_frictions(self) -> dict[str, Surface]:

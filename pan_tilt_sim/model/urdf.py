@@ -22,13 +22,7 @@ import xml.etree.ElementTree as ElementTree
 
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model import naming
-from pan_tilt_sim.model.drive_plugins import (
-    read_drive_plugins,
-    read_gz_plugins,
-    read_joint_state_plugins,
-    read_p3d_plugins,
-    read_planar_move_plugins,
-)
+from pan_tilt_sim.model.plugin_elements import read_plugin_elements
 from pan_tilt_sim.model.rates import rate_problem
 from pan_tilt_sim.model.robot import (
     DEFAULT_AXIS,
@@ -160,19 +154,10 @@ def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
     _check_position_gain(plugins, systems, source)
     _check_component_names(systems, source)
     sensors, sensor_warnings = _SensorReader(source, links, joints).read(root)
-    drive_plugins = read_drive_plugins(root, source, {joint.name: joint for joint in joints})
-    p3d_plugins = read_p3d_plugins(root, source, link_names)
-    movable = [joint.name for joint in joints if joint.kind.is_actuated]
-    joint_state_plugins = read_joint_state_plugins(root, source, set(movable))
-    gz_drives, gz_odometries, gz_states = read_gz_plugins(
-        root, source, {joint.name: joint for joint in joints}, movable)
     return RobotModel(name=name, links=links, joints=joints,
                       ros2_control=systems, control_plugins=plugins,
                       sensors=sensors, sensor_warnings=sensor_warnings,
-                      drive_plugins=drive_plugins, p3d_plugins=p3d_plugins,
-                      joint_state_plugins=joint_state_plugins + gz_states,
-                      planar_move_plugins=read_planar_move_plugins(root, source),
-                      gz_drive_plugins=gz_drives, gz_odometry_plugins=gz_odometries,
+                      plugins=read_plugin_elements(root, source),
                       surfaces=read_surfaces(root, source, link_names))
 
 

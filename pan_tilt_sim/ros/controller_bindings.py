@@ -549,7 +549,7 @@ class TrajectoryStateSink(_HeldSink):
         message.output.positions, message.output.effort = output
 
 
-class SpatialOdometrySink(OdometrySink):
+class SpatialOdometryMessageSink(OdometrySink):
     """Odometry samples in 3-D: ``sink(time, pose, linear, angular)``.
 
     ``pose`` a Transform (m, quaternion), ``linear`` and ``angular`` the
@@ -571,11 +571,11 @@ class SpatialOdometrySink(OdometrySink):
 
 def odometry_sink(publisher: Any, fields: Mapping[str, Any]) -> OdometrySink:
     """Return the odometry sink ``fields`` ask for: planar, or 3-D with ``spatial``."""
-    kind = SpatialOdometrySink if fields.get('spatial') else OdometrySink
+    kind = SpatialOdometryMessageSink if fields.get('spatial') else OdometrySink
     return kind(publisher, fields)
 
 
-class TfSink(_HeldSink):
+class TfMessageSink(_HeldSink):
     """Transforms as ``tf2_msgs/msg/TFMessage``: ``sink(time, [(parent, child, transform)])``."""
 
     def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
@@ -672,7 +672,7 @@ SERVICES: dict[str, tuple[type | None, Callable[[Any], Any], Callable[[Any, Any]
         QueryTrajectoryState, lambda request: seconds(request.time), _trajectory_state),
 }
 if tf_message_type() is not None:  # tf2_msgs is optional (see optional_interfaces)
-    STATE_SINKS['tf2_msgs/msg/TFMessage'] = (tf_message_type(), TfSink)
+    STATE_SINKS['tf2_msgs/msg/TFMessage'] = (tf_message_type(), TfMessageSink)
 # Each action type: the server that runs a controller's goals.
 ACTION_SERVERS: dict[str, Callable[..., Any]] = {
     'control_msgs/action/FollowJointTrajectory': TrajectoryActionServer,

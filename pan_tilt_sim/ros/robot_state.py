@@ -11,7 +11,7 @@
   (mimic joints follow their leader).  Without tf2_msgs TF is off (sim_node's
   start-up line of features off says so).
 
-TF leaves through a :class:`TfSink`, so the computation can be checked
+TF leaves through a :class:`TfOutput`, so the computation can be checked
 where tf2_msgs is not installed.
 """
 
@@ -42,7 +42,7 @@ LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
 
-class TfSink(Protocol):
+class TfOutput(Protocol):
     """Where TF goes: ``/tf`` and ``/tf_static`` messages of TransformStamped lists."""
 
     def tf(self, transforms: list[TransformStamped]) -> None:
@@ -89,7 +89,7 @@ class TfPublishers:
         return self._tf.get_subscription_count() > 0
 
 
-def create_tf_sink(node: Node) -> TfSink | None:
+def create_tf_sink(node: Node) -> TfOutput | None:
     """Return TF publishers on ``node``, or None where tf2_msgs is not installed."""
     message_type = tf_message_type()
     return None if message_type is None else TfPublishers(node, message_type)
@@ -132,7 +132,7 @@ class RobotStatePublisher:
                  description_topic: str | None, clock: Callable[[], float],
                  positions: Callable[[], Mapping[str, float]],
                  extra_static: Sequence[Frame] = (),
-                 tf_sink_factory: Callable[[Node], TfSink | None] | None = None, *,
+                 tf_sink_factory: Callable[[Node], TfOutput | None] | None = None, *,
                  publish_tf_default: bool = True) -> None:
         """``description_topic`` None: the description came from that topic; none is published."""
         self._model = model

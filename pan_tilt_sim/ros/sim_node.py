@@ -31,6 +31,7 @@ from pan_tilt_sim.model.controller_config import (
 )
 from pan_tilt_sim.model.description import RobotDescription, load_description
 from pan_tilt_sim.model.ros_arguments import parse_ros_arguments
+from pan_tilt_sim.plugins.registry import runs_by_plugins
 from pan_tilt_sim.ros import (
     bridged_topics,
     command_reader,
@@ -198,7 +199,8 @@ class SimNode(Node):
                 self, self._manager_settings, self._arguments, description)
         else:
             controllers = load_controllers_config(
-                controllers_files_for(self.settings.controllers_file, description),
+                controllers_files_for(self.settings.controllers_file, description,
+                                      runs_by_plugins=runs_by_plugins(description.model)),
                 parse_controllers_args(self.settings.controllers_args,
                                        f"parameter '{CONTROLLERS_ARGS}'"))
         # ros2_control_node's controllers live in its own namespace, and nowhere else.
@@ -660,7 +662,7 @@ class SimNode(Node):
         topic = self.topic('joint_states')
         if not broadcasters:
             # A Gazebo joint state publisher in the URDF publishes them instead.
-            if not self.simulation.description.model.joint_state_plugins:
+            if not any(plugin.publishes_joint_states for plugin in self.simulation.plugins):
                 local = [c.name for c in every]
                 where = (f' publishes on {topic} (use_local_topics: {", ".join(local)})'
                          if local else '')

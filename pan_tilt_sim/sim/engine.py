@@ -30,22 +30,18 @@ from typing import Protocol
 import numpy
 
 from pan_tilt_sim.controllers import CommandController, Controller, JointHandle
-from pan_tilt_sim.controllers.framework.base import Drive, idle_actuator
-from pan_tilt_sim.controllers.framework.manager import ControllerManager
-from pan_tilt_sim.controllers.framework.registry import drives_base
-from pan_tilt_sim.controllers.gazebo_diff_drive import GazeboDiffDrive
-from pan_tilt_sim.controllers.gazebo_joint_state_publisher import GazeboJointStatePublisher
-from pan_tilt_sim.controllers.gazebo_p3d import GazeboP3d
-from pan_tilt_sim.controllers.gazebo_planar_move import GazeboPlanarMove
-from pan_tilt_sim.controllers.gz_diff_drive import GzDiffDrive
-from pan_tilt_sim.controllers.gz_odometry_publisher import GzOdometryPublisher
-from pan_tilt_sim.controllers.toolbox.actuator import TRACKING_GAIN
-from pan_tilt_sim.controllers.toolbox.gains import plugin_gains
+from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
+from pan_tilt_sim.controllers.base import Drive, idle_actuator
+from pan_tilt_sim.controllers.gains import plugin_gains
+from pan_tilt_sim.controllers.manager import ControllerManager
+from pan_tilt_sim.controllers.registry import drives_base
 from pan_tilt_sim.model.base_pose import FIXED_BASE, ORIGIN, BasePose
 from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.initial_positions import FROM_DEFAULT, StartPosition, start_positions
 from pan_tilt_sim.model.transforms import Transform
+from pan_tilt_sim.plugins.framework.plugin import Plugin, PluginWorld
+from pan_tilt_sim.plugins.registry import base_drivers, create_plugins, runs_by_plugins
 from pan_tilt_sim.schedule import DUE_EPSILON
 from pan_tilt_sim.sim.hardware import SimulatedHardware
 from pan_tilt_sim.sim.physics import (
@@ -95,9 +91,9 @@ def base_is_fixed(fixed_base: bool | None, description: RobotDescription,
     ``fixed_base`` True or False is the answer, None is ``auto``: free if a
     controller that drives the base will be active -- with ``autostart``,
     one of ``active`` (None: every controller of the file); waiting for
-    spawners, any the file declares -- or if the URDF has a Gazebo drive
-    plugin (:mod:`pan_tilt_sim.model.drive_plugins`).  Waiting for spawners,
-    whose controllers are not known yet (a robot's own launch file), a robot
+    spawners, any the file declares -- or if the URDF has a Gazebo plugin
+    that drives the base (:func:`pan_tilt_sim.plugins.registry.base_drivers`).
+    Waiting for spawners, whose controllers are not known yet (a robot's own launch file), a robot
     that stands on wheels (``RobotModel.ground_wheels``) is free too.  A
     robot hung on a ``world`` link by a fixed joint is welded whatever
     ``fixed_base`` says, as in Gazebo.
@@ -106,10 +102,11 @@ def base_is_fixed(fixed_base: bool | None, description: RobotDescription,
         return True, "its root link 'world' holds it by a fixed joint, as in Gazebo"
     if fixed_base is not None:
         return fixed_base, f'{FIXED_BASE} is {str(fixed_base).lower()}'
-    plugins = description.model.base_drivers
+    plugins = base_drivers(description.model)
     if plugins:
-        return False, (f"{FIXED_BASE} is auto and Gazebo plugin '{plugins[0].name}' "
-                       f'({plugins[0].filename}) drives the base')
+        name, filename = plugins[0]
+        return False, (f"{FIXED_BASE} is auto and Gazebo plugin '{name}' "
+                       f'({filename}) drives the base')
     candidates = [spec for spec in controllers.controllers
                   if not autostart or active is None or spec.name in active]
     drivers = [spec for spec in candidates if drives_base(spec.type)]
@@ -147,10 +144,15 @@ class Simulation:
                  initial_pose: BasePose = ORIGIN) -> None:
         self.description = description
         self._logger: Logger = logger or logging.getLogger(LOGGER_NAME)
+        load_messages: list[str] = list(controllers.warnings)  # the file's dropped blocks
+        # The model's Gazebo plugins (drive, joint states, ground truth), read before anything
+        # is built (a malformed element ends start-up): always active, updated before the
+        # controllers; no controller_manager knows them.
+        self.plugins: list[Plugin] = create_plugins(description.model, controllers.label,
+                                                    load_messages.append)
         starts = start_positions(description.model, initial_positions)
         movable = [joint.name for joint in description.actuated_joints]
         gains = plugin_gains(controllers.pid_gains, movable, controllers.label)
-        load_messages: list[str] = list(controllers.warnings)  # the file's dropped blocks
         fixed, why = base_is_fixed(fixed_base, description, controllers, active_controllers,
                                    autostart_controllers)
         self.physics = Physics(
@@ -176,38 +178,13 @@ class Simulation:
                                              active=active_controllers,
                                              autostart=autostart_controllers,
                                              hardware=self.hardware.interfaces)
-            # The URDF's Gazebo plugins (drive, joint states, ground truth): always active,
-            # updated before the controllers; no controller_manager knows them.
-            self.plugins: list[Controller] = []
             self._link_readers: dict[str, LinkReader] = {}
-            for drive_plugin in description.model.drive_plugins:
-                drive = GazeboDiffDrive(drive_plugin, controllers.label)
-                drive.configure(self.handles)
-                drive.set_base_state(self.base_state)
-                self.plugins.append(drive)
+            world = PluginWorld(self.handles, self.base_state, self.base_motion, self.link_state)
+            for plugin in self.plugins:
+                plugin.attach(world)
             # Planar move sets the base's velocity itself: the step applies what it computed.
-            self._base_movers: list[GazeboPlanarMove] = []
-            for planar_plugin in description.model.planar_move_plugins:
-                mover = GazeboPlanarMove(planar_plugin, controllers.label)
-                mover.set_base_motion(self.base_motion)
-                self._base_movers.append(mover)
-                self.plugins.append(mover)
-            for gz_drive_plugin in description.model.gz_drive_plugins:
-                gz_drive = GzDiffDrive(gz_drive_plugin, controllers.label)
-                gz_drive.configure(self.handles)
-                self.plugins.append(gz_drive)
-            for states_plugin in description.model.joint_state_plugins:
-                states = GazeboJointStatePublisher(states_plugin, controllers.label)
-                states.configure(self.handles)
-                self.plugins.append(states)
-            for p3d_plugin in description.model.p3d_plugins:
-                p3d = GazeboP3d(p3d_plugin, controllers.label)
-                p3d.set_link_state(self.link_state)
-                self.plugins.append(p3d)
-            for gz_odometry_plugin in description.model.gz_odometry_plugins:
-                gz_odometry = GzOdometryPublisher(gz_odometry_plugin, controllers.label)
-                gz_odometry.set_base_motion(self.base_motion)
-                self.plugins.append(gz_odometry)
+            self._base_movers = [plugin for plugin in self.plugins
+                                 if plugin.sets_base_velocity]
         except BaseException:
             self.physics.close()
             raise
@@ -701,7 +678,8 @@ def make_simulation(description_file: str, controllers_file: str | None, time_st
     from pan_tilt_sim.model.description import load_description
 
     description = load_description(description_file, xacro_args)
-    files = controllers_files_for(str(controllers_file or ''), description)
+    files = controllers_files_for(str(controllers_file or ''), description,
+                                  runs_by_plugins=runs_by_plugins(description.model))
     simulation = Simulation(description, load_controllers_config(files, controllers_args),
                             time_step, gui=gui, active_controllers=active_controllers,
                             initial_positions=initial_positions, logger=logger,

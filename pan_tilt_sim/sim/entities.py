@@ -18,6 +18,7 @@ import re
 import tempfile
 from collections.abc import Callable, Sequence
 
+from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.entity_resource import (
@@ -30,6 +31,7 @@ from pan_tilt_sim.model.entity_resource import (
 )
 from pan_tilt_sim.model.transforms import IDENTITY_ROTATION, ZERO_VECTOR, Transform, Vector
 from pan_tilt_sim.model.world_file import World, WorldFileError
+from pan_tilt_sim.plugins.registry import create_plugins
 from pan_tilt_sim.sim.bullet import pybullet, quiet_native_output
 from pan_tilt_sim.sim.physics import (
     BASE_LINK_INDEX,
@@ -372,6 +374,10 @@ class Entities:
                                             limits=self.limits)
         except EntityResourceError as err:
             raise SpawnError(_RESOURCE_PROBLEMS[err.problem], str(err)) from None
+        try:  # a malformed plugin element refuses the object as it ends the robot's start-up
+            create_plugins(resource.model)
+        except DescriptionError as err:
+            raise SpawnError(SpawnProblem.RESOURCE_PARSE_ERROR, str(err)) from None
         path = pathlib.Path(self._workdir.name, f'{next(self._files)}.urdf')
         path.write_text(resource.physics_urdf, encoding='utf-8')
         try:

@@ -37,6 +37,7 @@ from pan_tilt_sim.model.controller_config import (
 )
 from pan_tilt_sim.model.description import RobotDescription, load_description
 from pan_tilt_sim.model.variation import PhysicalVariation, vary_description
+from pan_tilt_sim.plugins.registry import runs_by_plugins
 from pan_tilt_sim.sim.engine import Simulation
 from pan_tilt_sim.tools.step_response import (
     StepMetrics,
@@ -85,7 +86,8 @@ def load_scenario(model: str | pathlib.Path, controllers: str | pathlib.Path | N
     if not (math.isfinite(time_step) and 0.0 < time_step <= 0.1):
         raise ConfigurationError(f'--time-step: {time_step} must be > 0 and <= 0.1 s')
     description = load_description(model, xacro_args)
-    files = controllers_files_for(str(controllers or ''), description, given_as='--controllers')
+    files = controllers_files_for(str(controllers or ''), description, given_as='--controllers',
+                                  runs_by_plugins=runs_by_plugins(description.model))
     config = load_controllers_config(
         files, parse_controllers_args(controllers_args, '--controllers-args'),
         args_name='--controllers-args')

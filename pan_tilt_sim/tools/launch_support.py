@@ -29,6 +29,7 @@ from pan_tilt_sim.model.controller_config import (
 )
 from pan_tilt_sim.model.description import load_description
 from pan_tilt_sim.model.topic_based import topic_based_system
+from pan_tilt_sim.plugins.registry import runs_by_plugins
 from pan_tilt_sim.ros.runner import PARENT_PID_VARIABLE
 
 ROOT_NAMESPACE = '/'
@@ -92,7 +93,8 @@ def robot_setup(model: str, controllers: str = '', xacro_args: Sequence[str] = (
     controllers_namespace = None
     if topic_based_system(description.model) is None:  # topic-based hardware runs no YAML
         files = controllers_files_for(controllers, description,
-                                      given_as="the launch argument 'controllers'")
+                                      given_as="the launch argument 'controllers'",
+                                      runs_by_plugins=runs_by_plugins(description.model))
         config = load_controllers_config(
             files, parse_controllers_args(controllers_args, "launch argument 'controllers_args'"),
             args_name="the launch argument 'controllers_args'")

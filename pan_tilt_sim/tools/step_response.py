@@ -40,6 +40,7 @@ from pan_tilt_sim.model.controller_config import (
 )
 from pan_tilt_sim.model.description import load_description
 from pan_tilt_sim.model.robot import JointKind
+from pan_tilt_sim.plugins.registry import runs_by_plugins
 from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
 from pan_tilt_sim.sim.engine import Simulation
 
@@ -411,7 +412,8 @@ def check_plot_target(path: pathlib.Path) -> None:
 def build_simulation(args: argparse.Namespace) -> Simulation:
     """Load the model and its controllers as sim_node would, activated as ``args`` say."""
     description = load_description(args.model, args.xacro_args)
-    files = controllers_files_for(args.controllers, description, given_as='--controllers')
+    files = controllers_files_for(args.controllers, description, given_as='--controllers',
+                                  runs_by_plugins=runs_by_plugins(description.model))
     config = load_controllers_config(
         files, parse_controllers_args(args.controllers_args, '--controllers-args'),
         args_name='--controllers-args')

@@ -25,6 +25,10 @@ from pan_tilt_sim.model.robot import JointKind
 from pan_tilt_sim.model.sdf import is_sdf_text, sdf_robot_to_urdf
 from pan_tilt_sim.model.sensors import SensorKind
 from pan_tilt_sim.model.transforms import rotate
+from pan_tilt_sim.plugins.gazebo_classic.diff_drive import GazeboDiffDrive
+from pan_tilt_sim.plugins.gazebo_classic.joint_state_publisher import GazeboJointStatePublisher
+from pan_tilt_sim.plugins.gz.diff_drive import GzDiffDrive
+from pan_tilt_sim.plugins.registry import read_settings
 
 SOURCE = pathlib.Path('robot.sdf')
 
@@ -297,16 +301,16 @@ def test_camera_depth_and_force_torque_sensors():
 
 def test_gz_sim_systems_and_classic_plugins_are_read():
     model = model_of(rover_sdf())
-    (drive,) = model.gz_drive_plugins
+    (drive,) = read_settings(model, GzDiffDrive)
     assert drive.left_joints == ('left_wheel_joint',)
     assert drive.wheel_separation == WHEEL_SEPARATION
-    assert model.joint_state_plugins
+    assert read_settings(model, GazeboJointStatePublisher)
     classic = ('<plugin name="drive" filename="libgazebo_ros_diff_drive.so">'
                '<left_joint>left_wheel_joint</left_joint><right_joint>right_wheel_joint'
                '</right_joint><wheel_separation>0.3</wheel_separation>'
                '<wheel_diameter>0.1</wheel_diameter></plugin>')
     model = model_of(rover_sdf(extra=classic))
-    (classic_drive,) = model.drive_plugins
+    (classic_drive,) = read_settings(model, GazeboDiffDrive)
     assert classic_drive.left_joints == ('left_wheel_joint',)
 
 

@@ -250,6 +250,16 @@ def test_the_joint_state_publisher_publishes_the_wheels(tmp_path):
         assert len(states) == pytest.approx(0.5 * 50, abs=2)  # at the plugin's 50 Hz
 
 
+@pytest.mark.parametrize(('joint_states', 'warned'), [('', True), (None, False)],
+                         ids=['no publisher', 'a joint state publisher'])
+def test_start_up_warns_of_empty_joint_states_only_without_a_joint_state_publisher(
+        tmp_path, capfd, joint_states, warned):
+    with running(tmp_path, ROS2_DIFF_DRIVE, joint_states=joint_states):
+        pass
+    said = 'nothing will be published on /joint_states' in capfd.readouterr().err
+    assert said is warned
+
+
 GZ_TOPICS = {'command': GZ_COMMAND, 'odometry': GZ_ODOMETRY_TOPIC, 'tf': GZ_TF}
 
 

@@ -413,3 +413,16 @@ def test_a_static_sdf_mesh_is_hit_where_its_triangles_are_not_on_its_hull(pan_ti
     hit = pybullet.rayTest((10.0, 0.0, 0.5), (10.0, 5.0, 0.5), physicsClientId=client)[0]
     assert hit[0] == entities.get('walls').body
     assert hit[3] == pytest.approx((10.0, 1.0, 0.5), abs=1e-3)
+
+
+def test_an_object_with_a_malformed_gazebo_plugin_is_refused_naming_the_element(pan_tilt):
+    simulation, entities = pan_tilt
+    before = entities.names()
+    plugin = ('<gazebo><plugin name="truth" filename="libgazebo_ros_p3d.so">'
+              '<body_name>nowhere</body_name></plugin></gazebo></robot>')
+    with pytest.raises(SpawnError) as refused:
+        entities.spawn('thing', resource_string=box_urdf().replace('</robot>', plugin))
+    assert refused.value.problem is SpawnProblem.RESOURCE_PARSE_ERROR
+    assert "plugin 'truth' (libgazebo_ros_p3d.so): <body_name> 'nowhere' is not a link" in str(
+        refused.value)
+    assert entities.names() == before

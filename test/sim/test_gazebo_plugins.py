@@ -16,7 +16,8 @@ from mobile_fixtures import (
     plugin_rover_urdf,
 )
 
-from pan_tilt_sim.controllers.framework.surface import StampedTwist
+from pan_tilt_sim.controllers.surface import StampedTwist
+from pan_tilt_sim.plugins import registry
 from pan_tilt_sim.sim.bullet import pybullet
 from pan_tilt_sim.sim.engine import make_simulation
 
@@ -38,6 +39,25 @@ def test_a_drive_plugin_frees_the_base_with_fixed_base_auto_and_no_controllers_f
         assert simulation.controllers == []
     with make_simulation(rover_file, None, DT, fixed_base=True) as simulation:
         assert simulation.physics.fixed_base
+
+
+def test_a_plugin_recognised_but_not_simulated_is_one_warning_and_the_rest_runs(
+        tmp_path, monkeypatch):
+    monkeypatch.setitem(registry.UNSIMULATED, 'gazebo_ros_bumper', 'contacts are not published')
+    path = tmp_path / 'rover.urdf'
+    path.write_text(plugin_rover_urdf(
+        ROS2_DIFF_DRIVE + '<plugin name="bump" filename="libgazebo_ros_bumper.so"/>'),
+        encoding='utf-8')
+    collector = Collector()
+    logger = logging.getLogger('test_unsimulated')
+    logger.addHandler(collector)
+    with make_simulation(str(path), None, DT, fixed_base=None, logger=logger) as simulation:
+        said = [line for line in collector.lines if "'bump'" in line]
+        assert len(said) == 1
+        assert said[0].endswith("rover.urdf: plugin 'bump' (libgazebo_ros_bumper.so) skipped: "
+                                'contacts are not published')
+        assert [unit.name for unit in simulation.plugins] == [
+            'diff_drive', 'joint_states', 'ground_truth']
 
 
 def test_the_drive_moves_the_base_and_keeps_driving_after_time_is_reset(rover_file):

@@ -1,5 +1,6 @@
-"""Gazebo drive plugins in a URDF: each generation's element names, defaults and topics."""
+"""The plugins' element specs: each generation's element names, defaults, checks and topics."""
 
+import dataclasses
 import pathlib
 import re
 
@@ -17,15 +18,28 @@ from mobile_fixtures import (
 )
 
 from pan_tilt_sim.errors import DescriptionError
-from pan_tilt_sim.model.drive_plugins import ENCODER, GZ, WORLD
+from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.sensors import ROS1, ROS2
 from pan_tilt_sim.model.urdf import parse_urdf
+from pan_tilt_sim.plugins.framework.elements import GZ, Element, ElementReader, ElementSpec, Kind
+from pan_tilt_sim.plugins.gazebo_classic.diff_drive import ENCODER, WORLD, GazeboDiffDrive
+from pan_tilt_sim.plugins.gazebo_classic.joint_state_publisher import GazeboJointStatePublisher
+from pan_tilt_sim.plugins.gazebo_classic.p3d import GazeboP3d
+from pan_tilt_sim.plugins.gazebo_classic.planar_move import GazeboPlanarMove
+from pan_tilt_sim.plugins.gz.diff_drive import GzDiffDrive
+from pan_tilt_sim.plugins.gz.odometry_publisher import GzOdometryPublisher
+from pan_tilt_sim.plugins.registry import (
+    base_drivers,
+    create_plugins,
+    read_settings,
+    runs_by_plugins,
+)
 
 SOURCE = pathlib.Path('rover.urdf')
 
 
 def plugins(plugin: str):
-    return parse_urdf(plugin_rover_urdf(plugin), SOURCE).drive_plugins
+    return read_settings(parse_urdf(plugin_rover_urdf(plugin), SOURCE), GazeboDiffDrive)
 
 
 def bare_ros2(*elements: str) -> str:
@@ -78,7 +92,7 @@ def test_ros1_diff_drive_reads_the_ros1_names():
 
 
 def test_a_robot_without_drive_plugins_has_none():
-    assert parse_urdf(plugin_rover_urdf(''), SOURCE).drive_plugins == ()
+    assert read_settings(parse_urdf(plugin_rover_urdf(''), SOURCE), GazeboDiffDrive) == ()
 
 
 @pytest.mark.parametrize(('plugin', 'element', 'problem'), [
@@ -105,11 +119,11 @@ def test_a_bad_plugin_element_ends_start_up_naming_the_plugin_and_the_element(
 
 
 def p3d(text: str):
-    return parse_urdf(plugin_rover_urdf(ground_truth=text), SOURCE).p3d_plugins
+    return read_settings(parse_urdf(plugin_rover_urdf(ground_truth=text), SOURCE), GazeboP3d)
 
 
 def test_ros2_p3d_reads_its_elements_and_topic():
-    (plugin,) = parse_urdf(plugin_rover_urdf(), SOURCE).p3d_plugins
+    (plugin,) = read_settings(parse_urdf(plugin_rover_urdf(), SOURCE), GazeboP3d)
     assert plugin.convention == ROS2 and plugin.body_name == 'base_link'
     assert plugin.in_world and plugin.update_rate == 50.0
     assert plugin.topics() == '/ground_truth'
@@ -160,11 +174,12 @@ def test_a_bad_p3d_element_ends_start_up_naming_the_plugin_and_the_element(
 
 
 def joint_states(text: str):
-    return parse_urdf(plugin_rover_urdf(joint_states=text), SOURCE).joint_state_plugins
+    robot = parse_urdf(plugin_rover_urdf(joint_states=text), SOURCE)
+    return read_settings(robot, GazeboJointStatePublisher)
 
 
 def test_ros2_joint_state_publisher_reads_its_joints_rate_and_topic():
-    (plugin,) = parse_urdf(plugin_rover_urdf(), SOURCE).joint_state_plugins
+    (plugin,) = read_settings(parse_urdf(plugin_rover_urdf(), SOURCE), GazeboJointStatePublisher)
     assert plugin.convention == ROS2
     assert plugin.joints == ('left_wheel_joint', 'right_wheel_joint')
     assert plugin.update_rate == 50.0 and plugin.topics() == '/joint_states'
@@ -198,11 +213,14 @@ def test_a_bad_joint_state_publisher_element_ends_start_up(elements, problem):
 
 
 def model(plugin: str, **others: str):
-    return parse_urdf(plugin_rover_urdf(plugin, **others), SOURCE)
+    """Return the rover's model once start-up has read every plugin element (or the error)."""
+    robot = parse_urdf(plugin_rover_urdf(plugin, **others), SOURCE)
+    create_plugins(robot)
+    return robot
 
 
 def planar(text: str):
-    return model(text).planar_move_plugins
+    return read_settings(model(text), GazeboPlanarMove)
 
 
 def test_ros2_planar_move_reads_its_elements_and_defaults_are_the_plugins():
@@ -255,7 +273,9 @@ def test_a_bad_planar_move_element_ends_start_up_naming_it(elements, problem):
 
 def test_a_planar_move_robot_needs_no_controllers_and_its_base_is_driven():
     robot = model(PLANAR_MOVE)
-    assert robot.runs_by_plugins and robot.base_drivers == robot.planar_move_plugins
+    (plugin,) = read_settings(robot, GazeboPlanarMove)
+    assert runs_by_plugins(robot)
+    assert base_drivers(robot) == [(plugin.name, 'libgazebo_ros_planar_move.so')]
 
 
 def gz_bare(elements: str = '', filename: str = 'gz-sim-diff-drive-system',
@@ -266,7 +286,7 @@ def gz_bare(elements: str = '', filename: str = 'gz-sim-diff-drive-system',
 
 
 def test_gz_diff_drive_reads_its_elements():
-    (plugin,) = model(GZ_DIFF_DRIVE).gz_drive_plugins
+    (plugin,) = read_settings(model(GZ_DIFF_DRIVE), GzDiffDrive)
     assert plugin.convention == GZ
     assert plugin.left_joints == ('left_wheel_joint',)
     assert (plugin.wheel_separation, plugin.wheel_radius) == (WHEEL_SEPARATION, WHEEL_RADIUS)
@@ -275,7 +295,7 @@ def test_gz_diff_drive_reads_its_elements():
 
 
 def test_gz_diff_drive_defaults_are_the_systems_named_after_the_model():
-    (plugin,) = model(gz_bare()).gz_drive_plugins
+    (plugin,) = read_settings(model(gz_bare()), GzDiffDrive)
     assert (plugin.wheel_separation, plugin.wheel_radius) == (1.0, 0.2)
     assert plugin.odom_publish_frequency == 50.0
     assert plugin.command_topic == '/model/rover/cmd_vel'
@@ -291,14 +311,14 @@ def test_gz_diff_drive_defaults_are_the_systems_named_after_the_model():
     ('some-other-file', 'gz::sim::systems::DiffDrive'),
 ])
 def test_gz_diff_drive_is_known_by_either_generations_file_or_name(filename, name):
-    (plugin,) = model(gz_bare(filename=filename, name=name)).gz_drive_plugins
+    (plugin,) = read_settings(model(gz_bare(filename=filename, name=name)), GzDiffDrive)
     assert plugin.joint_names == ('left_wheel_joint', 'right_wheel_joint')
 
 
 def test_gz_diff_drive_topics_are_absolute_and_a_groups_own_limit_overrides_the_shared_one():
-    (plugin,) = model(gz_bare('<topic>cmd_vel</topic><odom_topic>odom</odom_topic>'
+    (plugin,) = read_settings(model(gz_bare('<topic>cmd_vel</topic><odom_topic>odom</odom_topic>'
                               '<max_velocity>2</max_velocity>'
-                              '<max_angular_velocity>1</max_angular_velocity>')).gz_drive_plugins
+                              '<max_angular_velocity>1</max_angular_velocity>')), GzDiffDrive)
     assert (plugin.command_topic, plugin.odometry_topic) == ('/cmd_vel', '/odom')
     assert plugin.linear_limits[1] == 2.0 and plugin.angular_limits[1] == 1.0
 
@@ -321,12 +341,12 @@ def test_a_bad_gz_diff_drive_element_ends_start_up_naming_it(plugin, problem):
 
 
 def test_gz_odometry_publisher_reads_its_elements_and_defaults():
-    (plugin,) = model(GZ_DIFF_DRIVE, ground_truth=GZ_ODOMETRY).gz_odometry_plugins
+    (plugin,) = read_settings(model(GZ_DIFF_DRIVE, ground_truth=GZ_ODOMETRY), GzOdometryPublisher)
     assert (plugin.odom_frame, plugin.robot_base_frame) == ('odom', 'base_link')
     assert plugin.odometry_topic == '/ground_truth' and plugin.odom_publish_frequency == 50.0
-    (bare,) = model(GZ_DIFF_DRIVE, ground_truth=(
+    (bare,) = read_settings(model(GZ_DIFF_DRIVE, ground_truth=(
         '<plugin filename="gz-sim-odometry-publisher-system" '
-        'name="gz::sim::systems::OdometryPublisher"/>')).gz_odometry_plugins
+        'name="gz::sim::systems::OdometryPublisher"/>')), GzOdometryPublisher)
     assert (bare.odom_frame, bare.robot_base_frame) == ('rover/odom', 'rover/base_footprint')
     assert (bare.odometry_topic, bare.tf_topic) == ('/model/rover/odometry', '/model/rover/pose')
     assert bare.dimensions == 2 and bare.odom_publish_frequency == 50.0
@@ -343,12 +363,13 @@ def test_gz_joint_state_publisher_defaults_to_every_movable_joint_on_the_worlds_
     robot = model(GZ_DIFF_DRIVE, joint_states=(
         '<plugin filename="gz-sim-joint-state-publisher-system" '
         'name="gz::sim::systems::JointStatePublisher"/>'))
-    (plugin,) = robot.joint_state_plugins
+    (plugin,) = read_settings(robot, GazeboJointStatePublisher)
     assert plugin.convention == GZ and plugin.update_rate == 0.0  # every step
     assert plugin.joints == ('left_wheel_joint', 'right_wheel_joint')
     assert plugin.topics() == '/world/default/model/rover/joint_state'
     assert plugin.topics('robot1') == '/world/default/model/rover/joint_state'
-    (given,) = model(GZ_DIFF_DRIVE, joint_states=GZ_JOINT_STATES).joint_state_plugins
+    (given,) = read_settings(model(GZ_DIFF_DRIVE, joint_states=GZ_JOINT_STATES),
+                             GazeboJointStatePublisher)
     assert given.topics() == '/joint_states'
 
 
@@ -427,7 +448,7 @@ def test_a_plugin_wheel_that_mimics_another_joint_ends_start_up():
     urdf = urdf.replace('<mimic joint="left_wheel_joint"/>', '', 1)  # the right wheel mimics
     with pytest.raises(DescriptionError, match="<right_joint> 'right_wheel_joint' mimics "
                                                "'left_wheel_joint'"):
-        parse_urdf(urdf, SOURCE)
+        create_plugins(parse_urdf(urdf, SOURCE))
 
 
 @pytest.mark.parametrize(('plugin', 'problem'), [
@@ -470,3 +491,18 @@ def test_a_gz_odometry_publisher_with_one_frame_for_both_ends_start_up():
 def test_a_plugin_rate_whose_period_overflows_ends_start_up(plugin, element):
     with pytest.raises(DescriptionError, match=f'<{element}> .* must be a rate > 0 Hz'):
         model(plugin)
+
+
+def test_an_element_spec_reads_each_kind_with_its_default_and_check():
+    spec = ElementSpec(Element('rate', 10.0, non_negative=True),
+                       Element('frame', 'odom', Kind.TEXT), Element('on', True, Kind.FLAG),
+                       Element('offset', kind=Kind.VECTOR), Element('gain', 1.0, positive=True))
+    element = PluginElement(filename='libx.so', name='x', source='r.urdf',
+                            values={'rate': ('5',), 'offset': ('1 2 3',), 'frame': ('',)})
+    assert spec.names == ('rate', 'frame', 'on', 'offset', 'gain')
+    assert spec.read(ElementReader(element, 'robot')) == {
+        'rate': 5.0, 'frame': 'odom', 'on': True, 'offset': (1.0, 2.0, 3.0), 'gain': 1.0}
+    bad = dataclasses.replace(element, values={'gain': ('0',)})
+    with pytest.raises(DescriptionError) as raised:
+        spec.read(ElementReader(bad, 'robot'))
+    assert str(raised.value) == "r.urdf: plugin 'x' (libx.so): <gain> must be > 0, got 0"

@@ -8,9 +8,10 @@ import pathlib
 import pytest
 from mobile_fixtures import GZ_DIFF_DRIVE, plugin_rover_urdf
 
-from pan_tilt_sim.controllers.gz_odometry_publisher import GzOdometryPublisher
 from pan_tilt_sim.model.transforms import Transform, quaternion_from_rpy
 from pan_tilt_sim.model.urdf import parse_urdf
+from pan_tilt_sim.plugins.gz.odometry_publisher import GzOdometryPublisher
+from pan_tilt_sim.plugins.registry import read_settings
 
 DT = 0.001
 TILTED = (Transform((1.0, 2.0, 0.3), quaternion_from_rpy(0.1, 0.0, math.pi / 2)),
@@ -20,8 +21,8 @@ TILTED = (Transform((1.0, 2.0, 0.3), quaternion_from_rpy(0.1, 0.0, math.pi / 2))
 def unit(elements: str = '') -> tuple[GzOdometryPublisher, list]:
     text = ('<plugin filename="gz-sim-odometry-publisher-system" name="odometry">'
             f'{elements}</plugin>')
-    (plugin,) = parse_urdf(plugin_rover_urdf(GZ_DIFF_DRIVE, ground_truth=text),
-                           pathlib.Path('r.urdf')).gz_odometry_plugins
+    (plugin,) = read_settings(parse_urdf(plugin_rover_urdf(GZ_DIFF_DRIVE, ground_truth=text),
+                                         pathlib.Path('r.urdf')), GzOdometryPublisher)
     publisher = GzOdometryPublisher(plugin)
     publisher.set_base_motion(lambda: TILTED)
     samples: list = []

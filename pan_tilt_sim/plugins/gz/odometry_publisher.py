@@ -1,8 +1,8 @@
 """gz-sim's OdometryPublisher system as a unit of the simulation: true-pose odometry. No ROS.
 
-Not a ros2_control controller: the simulation creates one per system the
-URDF declares (:mod:`pan_tilt_sim.model.drive_plugins`) and updates it every
-physics step; it is always active.  As the system, every ``1 /
+Not a ros2_control controller: the simulation creates one per system
+element (:mod:`pan_tilt_sim.plugins.registry`) and updates it every physics
+step; it is always active.  As the system, every ``1 /
 odom_publish_frequency`` s of sim time it publishes the model's pose in the
 world (its root link frame, moved by ``xyz_offset`` and turned by
 ``rpy_offset``) and its twist in the base's own axes: ``gz.msgs.Odometry``
@@ -17,16 +17,16 @@ base's state (:meth:`GzOdometryPublisher.set_base_motion`).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import random
 from collections.abc import Callable, Mapping
 
-from pan_tilt_sim.controllers.framework.base import Controller, JointHandle
-from pan_tilt_sim.controllers.framework.surface import Endpoint, StateTopic
-from pan_tilt_sim.controllers.gazebo_p3d import SpatialOdometrySink
-from pan_tilt_sim.controllers.gazebo_planar_move import BaseMotion, heading
-from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, TfSink
-from pan_tilt_sim.model.drive_plugins import GzOdometryPlugin
+from pan_tilt_sim.controllers.base import Controller, JointHandle
+from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs, TfSink
+from pan_tilt_sim.controllers.surface import Endpoint, StateTopic
+from pan_tilt_sim.model.plugin_elements import PluginElement
+from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.model.transforms import (
     Transform,
     Vector,
@@ -34,11 +34,100 @@ from pan_tilt_sim.model.transforms import (
     quaternion_multiply,
     rotate,
 )
+from pan_tilt_sim.plugins.framework.elements import (
+    GZ,
+    Element,
+    ElementReader,
+    ElementSpec,
+    Kind,
+    check_frames,
+    gz_topic,
+)
+from pan_tilt_sim.plugins.framework.plugin import (
+    BaseMotion,
+    Plugin,
+    PluginWorld,
+    SpatialOdometrySink,
+    heading,
+)
 from pan_tilt_sim.schedule import DUE_EPSILON
 
+GZ_ODOMETRY_FILES = frozenset({'gz-sim-odometry-publisher-system',
+                               'ignition-gazebo-odometry-publisher-system'})
+GZ_ODOMETRY_NAMES = frozenset({'gz::sim::systems::OdometryPublisher',
+                               'ignition::gazebo::systems::OdometryPublisher'})
+# The element spec (gz-sim's names and defaults; '': named after the model).
+ELEMENTS = ElementSpec(
+    Element('dimensions', 2.0),  # 2: x, y, yaw; 3: the full pose
+    Element('odom_frame', '', Kind.TEXT),  # {model}/odom
+    Element('robot_base_frame', '', Kind.TEXT),  # {model}/base_footprint
+    Element('odom_publish_frequency', 50.0, positive=True),  # Hz
+    Element('odom_topic', '', Kind.TEXT),  # /model/{model}/odometry
+    Element('tf_topic', '', Kind.TEXT),  # /model/{model}/pose
+    Element('xyz_offset', kind=Kind.VECTOR),  # m
+    Element('rpy_offset', kind=Kind.VECTOR),  # rad
+    Element('gaussian_noise', 0.0, non_negative=True),  # standard deviation
+)
 
-class GzOdometryPublisher(OdometryOutputs, Controller):
+
+@dataclasses.dataclass(frozen=True)
+class GzOdometryPlugin:
+    """gz-sim's OdometryPublisher system: the model's true pose as odometry.
+
+    ``dimensions`` 2: x, y and yaw only (z, roll, pitch 0); 3: the full pose.
+    ``xyz_offset`` (m) and ``rpy_offset`` (rad) move the published pose,
+    ``gaussian_noise`` is the standard deviation added to pose and twist.
+    """
+
+    name: str
+    odom_frame: str
+    robot_base_frame: str
+    odom_publish_frequency: float = 50.0
+    odometry_topic: str = ''
+    tf_topic: str = ''
+    dimensions: int = 2
+    xyz_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    gaussian_noise: float = 0.0
+
+    convention = GZ
+
+
+def read_gz_odometry_publisher(element: PluginElement, model: RobotModel) -> GzOdometryPlugin:
+    """Return the system's settings (the element spec), elements and defaults as gz-sim's."""
+    name = model.name
+    reader = ElementReader(element, name)
+    values = ELEMENTS.read(reader)
+    dimensions = values['dimensions']
+    if dimensions not in (2.0, 3.0):
+        raise reader.error('dimensions', f'must be 2 or 3, got {dimensions:g}')
+    odom_frame = values['odom_frame'] or f'{name}/odom'
+    base_frame = values['robot_base_frame'] or f'{name}/base_footprint'
+    check_frames(reader, (('odom_frame', odom_frame), ('robot_base_frame', base_frame)))
+    return GzOdometryPlugin(
+        name=reader.name, odom_frame=odom_frame, robot_base_frame=base_frame,
+        odom_publish_frequency=values['odom_publish_frequency'],
+        odometry_topic=gz_topic(values['odom_topic'] or f'/model/{name}/odometry'),
+        tf_topic=gz_topic(values['tf_topic'] or f'/model/{name}/pose'),
+        dimensions=int(dimensions), xyz_offset=values['xyz_offset'],
+        rpy_offset=values['rpy_offset'], gaussian_noise=values['gaussian_noise'])
+
+
+class GzOdometryPublisher(Plugin, OdometryOutputs, Controller):
     """One gz-sim OdometryPublisher system: the model's true pose and twist as odometry."""
+
+    filenames = GZ_ODOMETRY_FILES
+    system_names = GZ_ODOMETRY_NAMES
+    filename = 'gz-sim-odometry-publisher-system'
+
+    @classmethod
+    def read(cls, element: PluginElement, model: RobotModel) -> GzOdometryPlugin:
+        """Return the settings of ``element`` (:func:`read_gz_odometry_publisher`)."""
+        return read_gz_odometry_publisher(element, model)
+
+    def attach(self, world: PluginWorld) -> None:
+        """Read the base's frame and velocities from the simulation."""
+        self.set_base_motion(world.base_motion)
 
     def __init__(self, plugin: GzOdometryPlugin, source: str = '', *,
                  rng: random.Random | None = None) -> None:

@@ -7,9 +7,10 @@ import pathlib
 from mobile_fixtures import plugin_rover_urdf
 
 from pan_tilt_sim.controllers import JointHandle
-from pan_tilt_sim.controllers.gazebo_joint_state_publisher import GazeboJointStatePublisher
 from pan_tilt_sim.model.robot import JointKind, JointSpec
 from pan_tilt_sim.model.urdf import parse_urdf
+from pan_tilt_sim.plugins.gazebo_classic.joint_state_publisher import GazeboJointStatePublisher
+from pan_tilt_sim.plugins.registry import read_settings
 
 DT = 0.001
 WHEELS = ('left_wheel_joint', 'right_wheel_joint')
@@ -19,8 +20,8 @@ def publisher(elements: str) -> tuple[GazeboJointStatePublisher, dict[str, Joint
     """Return the configured unit of ``elements``, the wheels' handles and its samples."""
     text = (f'<plugin name="js" filename="libgazebo_ros_joint_state_publisher.so">{elements}'
             '</plugin>')
-    (plugin,) = parse_urdf(plugin_rover_urdf(joint_states=text),
-                           pathlib.Path('r.urdf')).joint_state_plugins
+    (plugin,) = read_settings(parse_urdf(plugin_rover_urdf(joint_states=text),
+                                         pathlib.Path('r.urdf')), GazeboJointStatePublisher)
     handles = {name: JointHandle(JointSpec(name, JointKind.CONTINUOUS)) for name in WHEELS}
     unit = GazeboJointStatePublisher(plugin)
     unit.configure(handles)

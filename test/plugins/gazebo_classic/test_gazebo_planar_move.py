@@ -11,11 +11,12 @@ import pathlib
 import pytest
 from mobile_fixtures import PLANAR_MOVE, plugin_rover_urdf
 
-from pan_tilt_sim.controllers.framework.base import CommandResult
-from pan_tilt_sim.controllers.framework.surface import StampedTwist
-from pan_tilt_sim.controllers.gazebo_planar_move import GazeboPlanarMove
+from pan_tilt_sim.controllers.base import CommandResult
+from pan_tilt_sim.controllers.surface import StampedTwist
 from pan_tilt_sim.model.transforms import Transform, quaternion_from_rpy
 from pan_tilt_sim.model.urdf import parse_urdf
+from pan_tilt_sim.plugins.gazebo_classic.planar_move import GazeboPlanarMove
+from pan_tilt_sim.plugins.registry import read_settings
 
 DT = 0.001
 FACING_LEFT = (Transform((1.0, 2.0, 0.075), quaternion_from_rpy(0.0, 0.0, math.pi / 2)),
@@ -29,8 +30,8 @@ def twist(x: float, y: float, angular: float) -> StampedTwist:
 
 
 def unit(text: str = PLANAR_MOVE) -> GazeboPlanarMove:
-    (plugin,) = parse_urdf(plugin_rover_urdf(text),
-                           pathlib.Path('r.urdf')).planar_move_plugins
+    (plugin,) = read_settings(parse_urdf(plugin_rover_urdf(text),
+                                         pathlib.Path('r.urdf')), GazeboPlanarMove)
     mover = GazeboPlanarMove(plugin)
     mover.set_base_motion(lambda: FACING_LEFT)
     return mover

@@ -1,15 +1,21 @@
 """gz-sim's DiffDrive system as a unit of the simulation: a Twist in, wheels out, odometry back.
 
-Not a ros2_control controller: the simulation creates one per system the
-URDF declares (:mod:`pan_tilt_sim.model.drive_plugins`) and updates it every
-physics step, before the controllers; it is always active.
-It does what the system does (see the design notes).
-
-Design notes: docs/design/plugins.md#gz_diff_drivepy.
+Not a ros2_control controller: the simulation creates one per system
+element (:mod:`pan_tilt_sim.plugins.registry`) and updates it every physics
+step, before the controllers; it is always active.  As the system, the
+``geometry_msgs/msg/Twist`` ros_gz_bridge would carry on ``topic`` (the last
+one holds; a non-finite one is refused) goes through the system's speed
+limiter (jerk, acceleration, velocity, each within ``[min, max]``) and sets
+every wheel's velocity target each step; odometry from the first left and
+right wheels (a rolling mean of 10 updates, as gz-math's) goes to
+``odom_topic`` and ``tf_topic`` every ``1 / odom_publish_frequency`` s.  A
+reset drops the command and puts the odometry back at the origin.  The
+whole behaviour: docs/design/gazebo-plugins.md.  Pure Python.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from typing import Any, ClassVar
@@ -22,24 +28,131 @@ from pan_tilt_sim.controllers.framework.base import (
     CommandResult,
     JointHandle,
 )
-from pan_tilt_sim.controllers.framework.surface import (
-    CommandTopic,
-    Endpoint,
-    StampedTwist,
-    StateTopic,
-)
-from pan_tilt_sim.controllers.toolbox.odometry import Odometry
-from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, OdometrySink, TfSink
-from pan_tilt_sim.controllers.toolbox.rate_limiter import (
-    InvalidLimitsError,
-    RateLimiter,
-    RateLimits,
-)
-from pan_tilt_sim.model.drive_plugins import GzDiffDrivePlugin
+from pan_tilt_sim.controllers.odometry import Odometry
+from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs, TfSink
+from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError, RateLimiter, RateLimits
+from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
+from pan_tilt_sim.model.plugin_elements import PluginElement
+from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.model.transforms import Transform
+from pan_tilt_sim.plugins.framework.elements import (
+    GZ,
+    Element,
+    ElementReader,
+    ElementSpec,
+    Kind,
+    check_frames,
+    check_wheels,
+    gz_topic,
+    joints_by_name,
+    root_link,
+)
+from pan_tilt_sim.plugins.framework.plugin import PlanarOdometrySink, Plugin, PluginWorld
 from pan_tilt_sim.schedule import DUE_EPSILON
 
 ODOMETRY_WINDOW = 10  # updates in the odometry twist's rolling mean (gz-math's default)
+GZ_DIFF_DRIVE_FILES = frozenset({'gz-sim-diff-drive-system', 'ignition-gazebo-diff-drive-system'})
+GZ_DIFF_DRIVE_NAMES = frozenset({'gz::sim::systems::DiffDrive',
+                                 'ignition::gazebo::systems::DiffDrive'})
+# DiffDrive's limits: (SDF element, jazzy RateLimits field) per group; min_acceleration
+# bounds every change, so it is both the deceleration and the reverse acceleration.
+GZ_LIMIT_ELEMENTS = ('min_velocity', 'max_velocity', 'min_acceleration', 'max_acceleration',
+                     'min_jerk', 'max_jerk')
+GROUPS = ('linear', 'angular')
+
+
+def _own(entry: str, group: str) -> str:
+    """Return a group's own limit element: min_velocity, linear -> min_linear_velocity."""
+    kind, what = entry.split('_')
+    return f'{kind}_{group}_{what}'
+
+
+# The element spec (gz-sim's names and defaults; '': named after the model).  The system also
+# reads one or more left_joint and right_joint.
+ELEMENTS = ElementSpec(
+    *(Element(entry, math.nan) for entry in GZ_LIMIT_ELEMENTS),  # both groups; NaN: none
+    *(Element(_own(entry, group), math.nan) for group in GROUPS for entry in GZ_LIMIT_ELEMENTS),
+    Element('frame_id', '', Kind.TEXT),  # {model}/odom
+    Element('child_frame_id', '', Kind.TEXT),  # {model}/{root link}
+    Element('wheel_separation', 1.0, positive=True),  # m
+    Element('wheel_radius', 0.2, positive=True),  # m
+    Element('odom_publish_frequency', 50.0, positive=True),  # Hz
+    Element('topic', '', Kind.TEXT),  # /model/{model}/cmd_vel
+    Element('odom_topic', '', Kind.TEXT),  # /model/{model}/odometry
+    Element('tf_topic', '', Kind.TEXT),  # /model/{model}/tf
+)
+
+
+@dataclasses.dataclass(frozen=True)
+class GzDiffDrivePlugin:
+    """gz-sim's DiffDrive system: wheels, geometry, limits, topics, frames.
+
+    ``limits`` per group (``linear``, ``angular``): the SDF's
+    ``min_/max_velocity``, ``_acceleration``, ``_jerk`` (NaN: not given; a
+    group's own element overrides the shared one).  Topics are gz-transport
+    names, as ros_gz_bridge carries them under the same name.
+    """
+
+    name: str
+    left_joints: tuple[str, ...]
+    right_joints: tuple[str, ...]
+    wheel_separation: float = 1.0
+    wheel_radius: float = 0.2
+    odom_publish_frequency: float = 50.0
+    command_topic: str = ''
+    odometry_topic: str = ''
+    tf_topic: str = ''
+    frame_id: str = ''
+    child_frame_id: str = ''
+    linear_limits: tuple[float, ...] = (math.nan,) * 6
+    angular_limits: tuple[float, ...] = (math.nan,) * 6
+
+    convention = GZ
+    filename = 'gz-sim-diff-drive-system'
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Every wheel, left ones first."""
+        return self.left_joints + self.right_joints
+
+
+def read_gz_diff_drive(element: PluginElement, model: RobotModel) -> GzDiffDrivePlugin:
+    """Return the system's settings (the element spec), elements and defaults as gz-sim's.
+
+    The model's name is the URDF robot's.  A wheel the robot does not have, a
+    number that is not one, a separation, radius or frequency that is not
+    positive, or a limit's min above its max ends start-up.
+    """
+    name = model.name
+    reader = ElementReader(element, name)
+    left, right = tuple(reader.all('left_joint')), tuple(reader.all('right_joint'))
+    for key, wheels in (('left_joint', left), ('right_joint', right)):
+        if not wheels:
+            raise reader.error(key, 'is missing: the system needs at least one on each side')
+    check_wheels(reader, (('left_joint', left), ('right_joint', right)), joints_by_name(model))
+    values = ELEMENTS.read(reader)
+    limits = {}
+    for group in GROUPS:
+        own = {_own(entry, group): values[entry] if math.isnan(values[_own(entry, group)])
+               else values[_own(entry, group)] for entry in GZ_LIMIT_ELEMENTS}
+        for what in ('velocity', 'acceleration', 'jerk'):
+            low, high = own[f'min_{group}_{what}'], own[f'max_{group}_{what}']
+            if low > high:
+                raise reader.error(f'min_{group}_{what}', f'{low:g} is above max_{group}_'
+                                   f'{what} {high:g}')
+        limits[group] = tuple(own.values())
+    frame = values['frame_id'] or f'{name}/odom'
+    child = values['child_frame_id'] or f'{name}/{root_link(model)}'
+    check_frames(reader, (('frame_id', frame), ('child_frame_id', child)))
+    return GzDiffDrivePlugin(
+        name=reader.name, left_joints=left, right_joints=right,
+        wheel_separation=values['wheel_separation'], wheel_radius=values['wheel_radius'],
+        odom_publish_frequency=values['odom_publish_frequency'],
+        command_topic=gz_topic(values['topic'] or f'/model/{name}/cmd_vel'),
+        odometry_topic=gz_topic(values['odom_topic'] or f'/model/{name}/odometry'),
+        tf_topic=gz_topic(values['tf_topic'] or f'/model/{name}/tf'),
+        frame_id=frame, child_frame_id=child,
+        linear_limits=limits['linear'], angular_limits=limits['angular'])
 
 
 def gz_limiter(limits: tuple[float, ...], name: str, group: str) -> RateLimiter:
@@ -66,11 +179,23 @@ def gz_limiter(limits: tuple[float, ...], name: str, group: str) -> RateLimiter:
         raise ValueError(f"system '{name}': {group} limits: {err}") from None
 
 
-class GzDiffDrive(OdometryOutputs, CommandController):
+class GzDiffDrive(Plugin, OdometryOutputs, CommandController):
     """One gz-sim DiffDrive system: a Twist in, wheel velocities out, odometry back."""
 
+    filenames = GZ_DIFF_DRIVE_FILES
+    system_names = GZ_DIFF_DRIVE_NAMES
+    filename = GzDiffDrivePlugin.filename
     drives_base: ClassVar[bool] = True
     command_kind = CommandKind.TWIST
+
+    @classmethod
+    def read(cls, element: PluginElement, model: RobotModel) -> GzDiffDrivePlugin:
+        """Return the settings of ``element`` (:func:`read_gz_diff_drive`)."""
+        return read_gz_diff_drive(element, model)
+
+    def attach(self, world: PluginWorld) -> None:
+        """Bind the wheels."""
+        self.configure(world.handles)
 
     def __init__(self, plugin: GzDiffDrivePlugin, source: str = '') -> None:
         super().__init__(plugin.name, {}, source)
@@ -82,7 +207,7 @@ class GzDiffDrive(OdometryOutputs, CommandController):
                                   plugin.wheel_radius, ODOMETRY_WINDOW)
         self._left: list[JointHandle] = []
         self._right: list[JointHandle] = []
-        self._odometry_sink: OdometrySink | None = None
+        self._odometry_sink: PlanarOdometrySink | None = None
         self._tf_sink: TfSink | None = None
         self._problem = ''
         self.reset()

@@ -12,9 +12,10 @@ import random
 import pytest
 from mobile_fixtures import plugin_rover_urdf
 
-from pan_tilt_sim.controllers.gazebo_p3d import GazeboP3d
 from pan_tilt_sim.model.transforms import Transform, quaternion_from_rpy
 from pan_tilt_sim.model.urdf import parse_urdf
+from pan_tilt_sim.plugins.gazebo_classic.p3d import GazeboP3d
+from pan_tilt_sim.plugins.registry import read_settings
 
 DT = 0.001
 BASE = (Transform((1.0, 2.0, 0.1), quaternion_from_rpy(0.0, 0.0, math.pi / 2)),
@@ -25,8 +26,8 @@ WHEEL = (Transform((1.0, 2.0, 0.05)), (0.0, 0.5, 0.0), (0.0, 0.0, 0.0))
 def unit(elements: str, **kwargs) -> tuple[GazeboP3d, list]:
     """Return the p3d unit of ``elements``, reading BASE and WHEEL; and its samples."""
     text = f'<plugin name="truth" filename="libgazebo_ros_p3d.so">{elements}</plugin>'
-    (plugin,) = parse_urdf(plugin_rover_urdf(ground_truth=text),
-                           pathlib.Path('r.urdf')).p3d_plugins
+    (plugin,) = read_settings(parse_urdf(plugin_rover_urdf(ground_truth=text),
+                                         pathlib.Path('r.urdf')), GazeboP3d)
     p3d = GazeboP3d(plugin, **kwargs)
     p3d.set_link_state({'base_link': BASE, 'left_wheel': WHEEL}.__getitem__)
     samples: list = []

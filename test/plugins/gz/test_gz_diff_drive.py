@@ -13,11 +13,12 @@ import pytest
 from mobile_fixtures import GZ_DIFF_DRIVE, WHEEL_RADIUS, WHEEL_SEPARATION, plugin_rover_urdf
 
 from pan_tilt_sim.controllers import JointHandle
-from pan_tilt_sim.controllers.framework.base import ActuatorKind, CommandResult
-from pan_tilt_sim.controllers.framework.surface import CommandTopic, StampedTwist, StateTopic
-from pan_tilt_sim.controllers.gz_diff_drive import GzDiffDrive
+from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult
+from pan_tilt_sim.controllers.surface import CommandTopic, StampedTwist, StateTopic
 from pan_tilt_sim.model.robot import JointKind, JointSpec
 from pan_tilt_sim.model.urdf import parse_urdf
+from pan_tilt_sim.plugins.gz.diff_drive import GzDiffDrive
+from pan_tilt_sim.plugins.registry import read_settings
 
 DT = 0.001
 WHEELS = ('left_wheel_joint', 'right_wheel_joint')
@@ -29,7 +30,8 @@ def twist(linear: float, angular: float) -> StampedTwist:
 
 
 def unit(text: str = GZ_DIFF_DRIVE) -> tuple[GzDiffDrive, dict[str, JointHandle]]:
-    (plugin,) = parse_urdf(plugin_rover_urdf(text), pathlib.Path('r.urdf')).gz_drive_plugins
+    robot = parse_urdf(plugin_rover_urdf(text), pathlib.Path('r.urdf'))
+    (plugin,) = read_settings(robot, GzDiffDrive)
     handles = {name: JointHandle(JointSpec(name, JointKind.CONTINUOUS)) for name in WHEELS}
     drive = GzDiffDrive(plugin)
     drive.configure(handles)

@@ -20,11 +20,12 @@ from mobile_fixtures import (
 )
 
 from pan_tilt_sim.controllers import JointHandle
-from pan_tilt_sim.controllers.framework.base import ActuatorKind, CommandResult
-from pan_tilt_sim.controllers.framework.surface import CommandTopic, StampedTwist, StateTopic
-from pan_tilt_sim.controllers.gazebo_diff_drive import GazeboDiffDrive
+from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult
+from pan_tilt_sim.controllers.surface import CommandTopic, StampedTwist, StateTopic
 from pan_tilt_sim.model.robot import JointKind, JointSpec
 from pan_tilt_sim.model.urdf import parse_urdf
+from pan_tilt_sim.plugins.gazebo_classic.diff_drive import GazeboDiffDrive
+from pan_tilt_sim.plugins.registry import read_settings
 
 DT = 0.001
 WHEELS = ('left_wheel_joint', 'right_wheel_joint')
@@ -37,7 +38,8 @@ def twist(linear: float, angular: float) -> StampedTwist:
 
 def unit(plugin_text: str = ROS2_DIFF_DRIVE) -> tuple[GazeboDiffDrive, dict[str, JointHandle]]:
     """Return the configured plugin unit of the rover, and its wheels' handles."""
-    (plugin,) = parse_urdf(plugin_rover_urdf(plugin_text), pathlib.Path('r.urdf')).drive_plugins
+    robot = parse_urdf(plugin_rover_urdf(plugin_text), pathlib.Path('r.urdf'))
+    (plugin,) = read_settings(robot, GazeboDiffDrive)
     handles = {name: JointHandle(JointSpec(name, JointKind.CONTINUOUS)) for name in WHEELS}
     drive = GazeboDiffDrive(plugin)
     drive.configure(handles)

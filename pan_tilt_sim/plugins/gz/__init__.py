@@ -1,0 +1,1 @@
+"""gz-sim (and Ignition Gazebo) systems."""
