@@ -30,11 +30,11 @@ from typing import Protocol
 import numpy
 
 from pan_tilt_sim.controllers import CommandController, Controller, JointHandle
-from pan_tilt_sim.controllers.actuator import TRACKING_GAIN
-from pan_tilt_sim.controllers.base import Drive, idle_actuator
-from pan_tilt_sim.controllers.gains import plugin_gains
-from pan_tilt_sim.controllers.manager import ControllerManager
-from pan_tilt_sim.controllers.registry import drives_base
+from pan_tilt_sim.controllers.framework.base import Drive, idle_actuator
+from pan_tilt_sim.controllers.framework.manager import ControllerManager
+from pan_tilt_sim.controllers.framework.registry import drives_base
+from pan_tilt_sim.controllers.toolbox.actuator import TRACKING_GAIN
+from pan_tilt_sim.controllers.toolbox.gains import plugin_gains
 from pan_tilt_sim.model.base_pose import FIXED_BASE, ORIGIN, BasePose
 from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription

@@ -16,7 +16,7 @@ from mobile_fixtures import (
     plugin_rover_urdf,
 )
 
-from pan_tilt_sim.controllers.surface import StampedTwist
+from pan_tilt_sim.controllers.framework.surface import StampedTwist
 from pan_tilt_sim.plugins import registry
 from pan_tilt_sim.sim.bullet import pybullet
 from pan_tilt_sim.sim.engine import make_simulation

@@ -1,6 +1,6 @@
 """What every Gazebo plugin unit is: the element names it answers to, its spec, how it binds.
 
-A plugin is a :class:`~pan_tilt_sim.controllers.base.Controller` no
+A plugin is a :class:`~pan_tilt_sim.controllers.framework.base.Controller` no
 controller_manager knows: always active, updated every physics step before
 the controllers.  It is also a :class:`Plugin`: it names the ``<plugin>``
 files (``filenames``, without ``lib``/``.so``) and gz-sim system names it
@@ -18,7 +18,7 @@ import math
 from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
-from pan_tilt_sim.controllers.base import JointHandle
+from pan_tilt_sim.controllers.framework.base import JointHandle
 from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.model.transforms import Transform, Vector

@@ -20,7 +20,7 @@ import math
 from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
-from pan_tilt_sim.controllers.base import (
+from pan_tilt_sim.controllers.framework.base import (
     Actuator,
     ActuatorKind,
     CommandController,
@@ -28,9 +28,14 @@ from pan_tilt_sim.controllers.base import (
     CommandResult,
     JointHandle,
 )
-from pan_tilt_sim.controllers.odometry import Odometry
-from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs, TfSink
-from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
+from pan_tilt_sim.controllers.framework.surface import (
+    CommandTopic,
+    Endpoint,
+    StampedTwist,
+    StateTopic,
+)
+from pan_tilt_sim.controllers.toolbox.odometry import Odometry
+from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, TfSink
 from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.model.sensors import ROS1, ROS2, Ros2Names, ros1_resolve

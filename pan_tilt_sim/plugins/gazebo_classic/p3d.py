@@ -20,8 +20,8 @@ import dataclasses
 import random
 from collections.abc import Callable, Mapping
 
-from pan_tilt_sim.controllers.base import Controller, JointHandle
-from pan_tilt_sim.controllers.surface import Endpoint, StateTopic
+from pan_tilt_sim.controllers.framework.base import Controller, JointHandle
+from pan_tilt_sim.controllers.framework.surface import Endpoint, StateTopic
 from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.model.sensors import ROS1, ROS2, Ros2Names, ros1_resolve

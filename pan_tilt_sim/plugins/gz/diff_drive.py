@@ -28,10 +28,19 @@ from pan_tilt_sim.controllers.framework.base import (
     CommandResult,
     JointHandle,
 )
-from pan_tilt_sim.controllers.odometry import Odometry
-from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs, TfSink
-from pan_tilt_sim.controllers.rate_limiter import InvalidLimitsError, RateLimiter, RateLimits
-from pan_tilt_sim.controllers.surface import CommandTopic, Endpoint, StampedTwist, StateTopic
+from pan_tilt_sim.controllers.framework.surface import (
+    CommandTopic,
+    Endpoint,
+    StampedTwist,
+    StateTopic,
+)
+from pan_tilt_sim.controllers.toolbox.odometry import Odometry
+from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, TfSink
+from pan_tilt_sim.controllers.toolbox.rate_limiter import (
+    InvalidLimitsError,
+    RateLimiter,
+    RateLimits,
+)
 from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.model.transforms import Transform

@@ -22,9 +22,9 @@ import math
 import random
 from collections.abc import Callable, Mapping
 
-from pan_tilt_sim.controllers.base import Controller, JointHandle
-from pan_tilt_sim.controllers.odometry_outputs import OdometryOutputs, TfSink
-from pan_tilt_sim.controllers.surface import Endpoint, StateTopic
+from pan_tilt_sim.controllers.framework.base import Controller, JointHandle
+from pan_tilt_sim.controllers.framework.surface import Endpoint, StateTopic
+from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, TfSink
 from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.model.transforms import (

@@ -20,8 +20,8 @@ from mobile_fixtures import (
 )
 
 from pan_tilt_sim.controllers import JointHandle
-from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult
-from pan_tilt_sim.controllers.surface import CommandTopic, StampedTwist, StateTopic
+from pan_tilt_sim.controllers.framework.base import ActuatorKind, CommandResult
+from pan_tilt_sim.controllers.framework.surface import CommandTopic, StampedTwist, StateTopic
 from pan_tilt_sim.model.robot import JointKind, JointSpec
 from pan_tilt_sim.model.urdf import parse_urdf
 from pan_tilt_sim.plugins.gazebo_classic.diff_drive import GazeboDiffDrive

@@ -11,8 +11,8 @@ import pathlib
 import pytest
 from mobile_fixtures import PLANAR_MOVE, plugin_rover_urdf
 
-from pan_tilt_sim.controllers.base import CommandResult
-from pan_tilt_sim.controllers.surface import StampedTwist
+from pan_tilt_sim.controllers.framework.base import CommandResult
+from pan_tilt_sim.controllers.framework.surface import StampedTwist
 from pan_tilt_sim.model.transforms import Transform, quaternion_from_rpy
 from pan_tilt_sim.model.urdf import parse_urdf
 from pan_tilt_sim.plugins.gazebo_classic.planar_move import GazeboPlanarMove

@@ -13,8 +13,8 @@ import pytest
 from mobile_fixtures import GZ_DIFF_DRIVE, WHEEL_RADIUS, WHEEL_SEPARATION, plugin_rover_urdf
 
 from pan_tilt_sim.controllers import JointHandle
-from pan_tilt_sim.controllers.base import ActuatorKind, CommandResult
-from pan_tilt_sim.controllers.surface import CommandTopic, StampedTwist, StateTopic
+from pan_tilt_sim.controllers.framework.base import ActuatorKind, CommandResult
+from pan_tilt_sim.controllers.framework.surface import CommandTopic, StampedTwist, StateTopic
 from pan_tilt_sim.model.robot import JointKind, JointSpec
 from pan_tilt_sim.model.urdf import parse_urdf
 from pan_tilt_sim.plugins.gz.diff_drive import GzDiffDrive
