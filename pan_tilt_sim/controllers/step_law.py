@@ -23,7 +23,13 @@ The laws (``KIND``):
 * ``EFFORT`` (``JointEffortController``): the command is the effort.
 
 A row has every field; a law reads the ones it needs (the gains are a
-Pid's, the antiwindup flag as 0.0 / 1.0).
+Pid's, the antiwindup flag as 0.0 / 1.0).  Every law runs on its
+controller's clock: it updates every ``UPDATE_STEPS`` physics steps, first
+after ``NEXT_UPDATE`` steps (0: at the first step), with ``PERIOD`` s as its
+``dt`` (0: the physics step), and its effort is held in between, as a
+hardware interface holds a command.  The stepping loop fills these three in
+(:meth:`pan_tilt_sim.sim.engine.Simulation.advance`); the rows below update
+every step.
 
 The compiled loop has its own copy of this layout; :data:`FIELDS` and
 :data:`KINDS` name it for :mod:`pan_tilt_sim.sim.compiled_step`, which
@@ -36,15 +42,18 @@ from __future__ import annotations
 # The fields' names in row order: FIELDS[index] names the constant equal to index.
 FIELDS = ('KIND', 'P_GAIN', 'I_GAIN', 'D_GAIN', 'I_CLAMP_MIN', 'I_CLAMP_MAX', 'ANTIWINDUP',
           'MAX_VELOCITY', 'EFFORT_LIMIT', 'SETPOINT', 'COMMAND', 'INTEGRAL', 'OUTPUT',
-          'LAST_MEASUREMENT')
+          'LAST_MEASUREMENT', 'UPDATE_STEPS', 'NEXT_UPDATE', 'PERIOD')
 ROW_SIZE = len(FIELDS)
 (KIND, P_GAIN, I_GAIN, D_GAIN, I_CLAMP_MIN, I_CLAMP_MAX, ANTIWINDUP, MAX_VELOCITY, EFFORT_LIMIT,
- SETPOINT, COMMAND, INTEGRAL, OUTPUT, LAST_MEASUREMENT) = range(ROW_SIZE)
+ SETPOINT, COMMAND, INTEGRAL, OUTPUT, LAST_MEASUREMENT, UPDATE_STEPS, NEXT_UPDATE,
+ PERIOD) = range(ROW_SIZE)
 
 POSITION_PID, VELOCITY_PID, EFFORT = 0.0, 1.0, 2.0
 # Each law kind's name and its code in a row's KIND field.
 KINDS = {'POSITION_PID': POSITION_PID, 'VELOCITY_PID': VELOCITY_PID, 'EFFORT': EFFORT}
 _UNUSED = 0.0
+# A row's clock as the laws build it: every step, due at the first, dt the physics step.
+EVERY_STEP, DUE_NOW, PHYSICS_STEP = 1.0, 0.0, 0.0
 
 
 def pid_row(kind: float, pid_values: list[float], max_velocity: float, effort_limit: float,
@@ -52,7 +61,7 @@ def pid_row(kind: float, pid_values: list[float], max_velocity: float, effort_li
     """Return a PID law's row from :meth:`~.pid.Pid.law_values` and the controller's state."""
     p, i, d, i_min, i_max, antiwindup, integral, output, last = pid_values
     return [kind, p, i, d, i_min, i_max, antiwindup, max_velocity, effort_limit, setpoint,
-            command, integral, output, last]
+            command, integral, output, last, EVERY_STEP, DUE_NOW, PHYSICS_STEP]
 
 
 def effort_row(command: float) -> list[float]:
@@ -60,4 +69,5 @@ def effort_row(command: float) -> list[float]:
     row = [_UNUSED] * ROW_SIZE
     row[KIND] = EFFORT
     row[COMMAND] = command
+    row[UPDATE_STEPS], row[NEXT_UPDATE], row[PERIOD] = EVERY_STEP, DUE_NOW, PHYSICS_STEP
     return row
