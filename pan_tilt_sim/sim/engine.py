@@ -59,6 +59,7 @@ from pan_tilt_sim.model.base_pose import FIXED_BASE, ORIGIN, BasePose
 from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.initial_positions import FROM_DEFAULT, StartPosition, start_positions
+from pan_tilt_sim.model.physics_settings import DEFAULT_PHYSICS, PhysicsSettings
 from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.schedule import DUE_EPSILON
 from pan_tilt_sim.sim.hardware import SimulatedHardware
@@ -145,6 +146,9 @@ class Simulation:
     ``fixed_base`` welds the base to the world (True, the default for
     tools and tests), frees it (False) or decides by the controllers (None,
     sim_node's ``auto``: see :func:`base_is_fixed`); ``initial_pose`` places it.
+    ``physics_settings`` are PyBullet's solver settings
+    (:mod:`pan_tilt_sim.model.physics_settings`; :meth:`Physics.apply_settings`
+    changes them later).
     What the simulation has to say at start-up waits in
     :attr:`startup_report` until :meth:`report_startup` logs it (the node
     does that once it is completely built, so that a start-up error stays
@@ -158,7 +162,8 @@ class Simulation:
                  logger: Logger | None = None,
                  autostart_controllers: bool = True,
                  fixed_base: bool | None = True,
-                 initial_pose: BasePose = ORIGIN) -> None:
+                 initial_pose: BasePose = ORIGIN,
+                 physics_settings: PhysicsSettings = DEFAULT_PHYSICS) -> None:
         self.description = description
         self._logger: Logger = logger or logging.getLogger(LOGGER_NAME)
         starts = start_positions(description.model, initial_positions)
@@ -170,7 +175,8 @@ class Simulation:
         self.physics = Physics(
             description, time_step, gui=gui,
             initial_positions=[starts[joint].position for joint in movable],
-            warn=load_messages.append, fixed_base=fixed, initial_pose=initial_pose)
+            warn=load_messages.append, fixed_base=fixed, initial_pose=initial_pose,
+            settings=physics_settings)
         self._base_report = self._describe_base(why, fixed_base, initial_pose)
         self._time_step = time_step
         self._steps = 0
@@ -753,7 +759,8 @@ def make_simulation(description_file: str, controllers_file: str | None, time_st
                     logger: Logger | None = None,
                     autostart_controllers: bool = True,
                     fixed_base: bool | None = True,
-                    initial_pose: BasePose = ORIGIN) -> Simulation:
+                    initial_pose: BasePose = ORIGIN,
+                    physics_settings: PhysicsSettings = DEFAULT_PHYSICS) -> Simulation:
     """Load both files and build a :class:`Simulation` (for tools and tests); log its report.
 
     Without ``controllers_file`` the URDF's control plugin names it (see
@@ -771,7 +778,8 @@ def make_simulation(description_file: str, controllers_file: str | None, time_st
                             time_step, gui=gui, active_controllers=active_controllers,
                             initial_positions=initial_positions, logger=logger,
                             autostart_controllers=autostart_controllers,
-                            fixed_base=fixed_base, initial_pose=initial_pose)
+                            fixed_base=fixed_base, initial_pose=initial_pose,
+                            physics_settings=physics_settings)
     for warning in description.warnings:
         simulation._logger.warning(warning)
     simulation.report_startup()
