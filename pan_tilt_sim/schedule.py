@@ -66,3 +66,14 @@ class PeriodicSchedule:
     def reset(self) -> None:
         """Start again: the next call is due at once (as at sim time 0)."""
         self.next_due = 0.0
+
+
+def steps_per_update(period: float, time_step: float) -> int:
+    """Return after how many physics steps of ``time_step`` s ``period`` s have passed.
+
+    The first whole number of steps whose time reaches the period (within
+    :data:`DUE_EPSILON`), at least one: a controller's clock, as
+    gz_ros2_control updates at the first step where the time since the last
+    update reaches the control period.
+    """
+    return max(1, math.ceil((period - DUE_EPSILON) / time_step))

@@ -1,6 +1,8 @@
 """PeriodicSchedule: what is due when, in sim time and in physics steps."""
 
-from pan_tilt_sim.schedule import DUE_EPSILON, PeriodicSchedule
+import pytest
+
+from pan_tilt_sim.schedule import DUE_EPSILON, PeriodicSchedule, steps_per_update
 
 
 def test_something_is_due_at_once_then_once_per_period():
@@ -30,3 +32,13 @@ def test_the_first_due_step_is_the_one_the_stepping_loop_finds_due():
                             if step * time_step + DUE_EPSILON >= schedule.next_due)
             assert schedule.first_due_step(first, time_step) == expected
             assert schedule.first_due_step(expected + 3, time_step) == expected + 3  # overdue
+
+
+@pytest.mark.parametrize(('period', 'time_step', 'steps'), [
+    (0.01, 0.001, 10), (1.0 / 1000, 0.001, 1), (1.0 / 300, 0.001, 4), (1.0 / 500, 0.002, 1),
+    (1.0 / 3000, 0.001, 1), (0.1, 0.004, 25), (1.0 / 70, 0.001, 15), (0.1 * 3, 0.1, 3),
+])
+def test_a_clock_updates_at_the_first_step_whose_time_reaches_its_period(period, time_step,
+                                                                         steps):
+    # (0.1 * 3) / 0.1 is 3.0000000000000004 in floats: still three steps, not four.
+    assert steps_per_update(period, time_step) == steps

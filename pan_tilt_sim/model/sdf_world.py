@@ -10,7 +10,12 @@ What is read from ``<sdf><world>``:
   its links' collisions and visuals (:mod:`pan_tilt_sim.model.sdf`), placed
   by its ``<pose>``;
 * ``<physics>`` (the default one, else the first): ``max_step_size`` (s),
-  ``real_time_factor`` and ``<ode><solver><iters>``;
+  ``real_time_factor``, and from the section of its engine (``type``, ODE
+  by default; ``<ode>`` or ``<bullet>``) ``<solver><iters>`` and
+  ``<constraints>``: ``<erp>`` (PyBullet's ``erp`` and ``contact_erp``: ODE's
+  one ERP serves joints and contacts), ``<cfm>``, ``<contact_surface_layer>``
+  (``contact_slop``) and Bullet's ``<split_impulse>``; the elements with no
+  PyBullet counterpart are named in :attr:`WorldPhysics.unmatched`;
 * lights, ``<scene>``, ``<gui>``, the atmosphere, gravity and magnetic field,
   spherical coordinates, and gz-sim's and Gazebo classic's system plugins
   whose work the simulator does itself: accepted, with nothing to do.  Any other
@@ -59,6 +64,13 @@ FUEL_GROUND_PLANES = ('ground plane', 'ground_plane')
 FUEL_LIGHTS = ('sun',)
 GROUND_PLANE = object()  # what an <include> of a ground plane model reads as
 GROUND_TOLERANCE = 1e-9  # m, rad: how close to z = 0, facing up, a ground plane must be
+# By <physics type>: the engine section's elements PyBullet has a counterpart for.
+PYBULLET_COUNTERPARTS = {
+    'ode': ('solver/iters', 'constraints/erp', 'constraints/cfm',
+            'constraints/contact_surface_layer'),
+    'bullet': ('solver/iters', 'constraints/erp', 'constraints/cfm',
+               'constraints/contact_surface_layer', 'constraints/split_impulse'),
+}
 
 
 class SdfWorldError(ConfigurationError):
@@ -82,6 +94,19 @@ class WorldPhysics:
     time_step: float | None = None  # s
     real_time_factor: float | None = None
     solver_iterations: int | None = None
+    erp: float | None = None  # joints and contacts alike, 0..1
+    cfm: float | None = None  # >= 0
+    contact_slop: float | None = None  # m: <contact_surface_layer>
+    split_impulse: bool | None = None
+    # The elements it gives that PyBullet has no counterpart for, as <a><b> paths.
+    unmatched: tuple[str, ...] = ()
+
+    def settings(self) -> dict[str, float | int | bool]:
+        """Return the sim_node physics parameters it sets, by name (see physics_settings)."""
+        values = {'solver_iterations': self.solver_iterations, 'erp': self.erp,
+                  'contact_erp': self.erp, 'cfm': self.cfm, 'contact_slop': self.contact_slop,
+                  'split_impulse': self.split_impulse}
+        return {name: value for name, value in values.items() if value is not None}
 
 
 def is_sdf_world_path(path: pathlib.Path) -> bool:
@@ -236,13 +261,35 @@ class _WorldReader:
         chosen = next((element for element in elements
                        if _true(element.get('default'))), elements[0])
         where = f'<physics name="{chosen.get("name", "")}">'
+        engine = (chosen.get('type') or 'ode').strip().lower()
+        used = {'max_step_size', 'real_time_factor'}
         step = self.number(chosen, 'max_step_size', where, positive=True)
         factor = self.number(chosen, 'real_time_factor', where, positive=False)
-        iterations = self.number(chosen, 'ode/solver/iters', where, positive=True)
-        if iterations is not None and iterations != int(iterations):
-            raise self.error(where, f'<ode><solver><iters> must be a whole number, got '
-                             f'{iterations:g}')
-        return WorldPhysics(step, factor, None if iterations is None else int(iterations))
+        iterations = erp = cfm = layer = split = None
+        if engine in PYBULLET_COUNTERPARTS:
+            used |= {f'{engine}/{path}' for path in PYBULLET_COUNTERPARTS[engine]}
+            iterations = self.number(chosen, f'{engine}/solver/iters', where, positive=True)
+            if iterations is not None and iterations != int(iterations):
+                raise self.error(where, f'<{engine}><solver><iters> must be a whole number, '
+                                 f'got {iterations:g}')
+            erp = self.number(chosen, f'{engine}/constraints/erp', where, positive=False)
+            if erp is not None and erp > 1.0:
+                raise self.error(where, f'<{engine}><constraints><erp> must be from 0 to 1 (a '
+                                 f'share of the error per step), got {erp:g}')
+            cfm = self.number(chosen, f'{engine}/constraints/cfm', where, positive=False)
+            layer = self.number(chosen, f'{engine}/constraints/contact_surface_layer', where,
+                                positive=False)
+            split_text = (chosen.findtext(f'{engine}/constraints/split_impulse') or '').strip()
+            if split_text:
+                if split_text.lower() not in ('1', '0', 'true', 'false'):
+                    raise self.error(where, f'<{engine}><constraints><split_impulse> must be '
+                                     f'true or false, got {split_text!r}')
+                split = _true(split_text)
+        unmatched = tuple(
+            ''.join(f'<{tag}>' for tag in path.split('/')) for path in _leaf_paths(chosen)
+            if path not in used)
+        return WorldPhysics(step, factor, None if iterations is None else int(iterations),
+                            erp, cfm, layer, split, unmatched)
 
     def number(self, element: ElementTree.Element, path: str, where: str, *,
                positive: bool) -> float | None:
@@ -257,6 +304,15 @@ class _WorldReader:
             raise self.error(where, f"<{path}>{text}</...> must be a number "
                              f"{'>' if positive else '>='} 0")
         return value
+
+
+def _leaf_paths(element: ElementTree.Element, prefix: str = '') -> list[str]:
+    """Return the paths (``a/b``) of the elements under ``element`` that hold no others."""
+    paths = []
+    for child in element:
+        path = f'{prefix}{child.tag}'
+        paths.extend(_leaf_paths(child, f'{path}/') if len(child) else [path])
+    return paths
 
 
 def _true(text: str | None) -> bool:

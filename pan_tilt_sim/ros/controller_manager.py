@@ -328,7 +328,9 @@ class ControllerManagerServices:
             state = manager.state(controller.name)
             configured = state in (INACTIVE, ACTIVE)
             commands = _flatten(controller.command_interfaces())
-            rate = controller.params.get(UPDATE_RATE_FIELD, self.update_rate)
+            # Its own update_rate, else the controller_manager's (a ROS 1 file's controllers
+            # give none: they update every physics step, and are shown at the manager's rate).
+            rate = manager.update_rate_of(controller.name) or self.update_rate
             # As upstream: the chain of a controller that is inactive or active, the
             # interfaces named without their controller's prefix.
             references = [_without_prefix(name) for name in controller.reference_interfaces()]

@@ -29,6 +29,12 @@ from pan_tilt_sim.model.base_pose import (
 )
 from pan_tilt_sim.model.initial_positions import parse_initial_positions
 from pan_tilt_sim.model.naming import check_namespace
+from pan_tilt_sim.model.physics_settings import (
+    DEFAULT_PHYSICS,
+    DESCRIPTIONS,
+    PhysicsSettings,
+    setting_problem,
+)
 from pan_tilt_sim.ros.pacing import MAX_REAL_TIME_FACTOR
 from pan_tilt_sim.share import DEFAULT_DESCRIPTION, package_share
 
@@ -47,6 +53,13 @@ MAX_TIME_STEP = 0.1  # s; beyond this the PID loop is meaningless
 # wall second (real_time_factor / time_step) would leave the range of floats.
 MIN_TIME_STEP = 1e-6
 DEFAULT_REAL_TIME_FACTOR = 1.0
+# The solver settings among the parameters, and their types.
+PHYSICS_PARAMETERS = ('solver_iterations', 'erp', 'contact_erp', 'cfm', 'contact_slop',
+                      'split_impulse')
+PHYSICS_TYPES = {'solver_iterations': ParameterType.PARAMETER_INTEGER,
+                 'split_impulse': ParameterType.PARAMETER_BOOL,
+                 **{name: ParameterType.PARAMETER_DOUBLE
+                    for name in ('erp', 'contact_erp', 'cfm', 'contact_slop')}}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -127,6 +140,10 @@ def _specs(controller_manager: bool = False) -> tuple[_Spec, ...]:
         _Spec('record_sensors', ParameterType.PARAMETER_BOOL, False,
               "With 'record': record the sensors' topics too (camera, depth, lidar, IMU, "
               'force-torque).'),
+        # PyBullet's solver settings (pan_tilt_sim.model.physics_settings), settable live.
+        *(_Spec(name, PHYSICS_TYPES[name], getattr(DEFAULT_PHYSICS, name),
+                DESCRIPTIONS[name] + " An SDF world's <physics> sets the default.",
+                read_only=False) for name in PHYSICS_PARAMETERS),
     )
 
 
@@ -152,6 +169,18 @@ class SimParameters:
     initial_pose: BasePose
     record: str  # '' = no recording
     record_sensors: bool
+    # PyBullet's solver settings (see physics_settings).
+    solver_iterations: int
+    erp: float
+    contact_erp: float
+    cfm: float
+    contact_slop: float
+    split_impulse: bool
+
+    @property
+    def physics_settings(self) -> PhysicsSettings:
+        """The solver settings the parameters give."""
+        return PhysicsSettings(**{name: getattr(self, name) for name in PHYSICS_PARAMETERS})
 
 
 def declare_parameters(node: Node, *, controller_manager: bool = False,
@@ -170,6 +199,7 @@ def declare_parameters(node: Node, *, controller_manager: bool = False,
         defaults = {name: value for name, value in (
             ('time_step', world_physics.time_step),
             ('real_time_factor', world_physics.real_time_factor)) if value is not None}
+        defaults.update(world_physics.settings())
     values = {spec.name: declare(node, spec.name, spec.type,
                                  defaults.get(spec.name, spec.default), spec.description,
                                  read_only=spec.read_only)
@@ -183,6 +213,8 @@ def declare_parameters(node: Node, *, controller_manager: bool = False,
     checked = SimParameters(**values)
     check_time_step(checked.time_step)
     check_real_time_factor(checked.real_time_factor)
+    for name in PHYSICS_PARAMETERS:
+        check_physics_setting(name, getattr(checked, name))
     check_namespace('robot_namespace', checked.robot_namespace)
     if controller_manager:
         for name, instead in (('controllers_file', "the controller_manager's own parameters "
@@ -258,6 +290,13 @@ def check_time_step(value: float) -> None:
             f'second), got {value}')
 
 
+def check_physics_setting(name: str, value: Any) -> None:
+    """Refuse a solver setting PyBullet cannot take (see physics_settings): ParameterError."""
+    problem = setting_problem(name, value)
+    if problem is not None:
+        raise ParameterError(problem)
+
+
 def check_real_time_factor(value: float) -> None:
     """``real_time_factor`` must lie in [0, MAX_REAL_TIME_FACTOR] (0: as fast as possible)."""
     if not (math.isfinite(value) and value >= 0.0):
@@ -306,6 +345,12 @@ def world_physics_line(physics: Any, settings: SimParameters, given: set[str]) -
                         f'<physics> says {value:g}{unit})')
         else:
             said.append(f"{name} {value:g}{unit} (the world's <physics>)")
-    if physics.solver_iterations is not None:
-        said.append(f"{physics.solver_iterations} solver iterations (the world's <iters>)")
+    for name, value in physics.settings().items():
+        if name in given:
+            said.append(f"{name} {getattr(settings, name)} (the parameter; the world's "
+                        f'<physics> says {value})')
+        else:
+            said.append(f"{name} {value} (the world's <physics>)")
+    if physics.unmatched:
+        said.append('no PyBullet counterpart, not simulated: ' + ', '.join(physics.unmatched))
     return 'physics: ' + '; '.join(said) if said else ''

@@ -216,9 +216,8 @@ class SimNode(Node):
             initial_positions=self.settings.initial_positions, logger=self.get_logger(),
             autostart_controllers=(self._topic_settings is not None
                                    or self.settings.autostart_controllers),
-            fixed_base=self.settings.fixed_base, initial_pose=self.settings.initial_pose)
-        if world.physics is not None and world.physics.solver_iterations is not None:
-            self.simulation.physics.set_solver_iterations(world.physics.solver_iterations)
+            fixed_base=self.settings.fixed_base, initial_pose=self.settings.initial_pose,
+            physics_settings=self.settings.physics_settings)
         if self.settings.record:
             # Before the first publisher: /clock, the state topics and TF are all recorded.
             self.recorder = Recorder(
@@ -681,6 +680,9 @@ class SimNode(Node):
                    if p.name in _OWN_PARAMETERS}  # other callbacks own the rest
         if 'real_time_factor' in updates:
             parameters.check_real_time_factor(updates['real_time_factor'])
+        for name in parameters.PHYSICS_PARAMETERS:
+            if name in updates:
+                parameters.check_physics_setting(name, updates[name])
         return updates
 
     def _check_parameters(self, changed: list[Parameter]) -> SetParametersResult:
@@ -697,3 +699,8 @@ class SimNode(Node):
         if 'real_time_factor' in updates:
             self._pacer.real_time_factor = updates['real_time_factor']
             self._retime()
+        physics = {name: updates[name] for name in parameters.PHYSICS_PARAMETERS
+                   if name in updates}
+        if physics:  # from the next step (callbacks run between batches of steps)
+            settings = self.simulation.physics.settings
+            self.simulation.physics.apply_settings(dataclasses.replace(settings, **physics))

@@ -410,7 +410,8 @@ static PyObject *stepper_call(Stepper *self, PyObject *args, PyObject *kwargs)
 #define LAW_FIELD_LIST(FIELD)                                                               \
     FIELD(KIND) FIELD(P_GAIN) FIELD(I_GAIN) FIELD(D_GAIN) FIELD(I_CLAMP_MIN) FIELD(I_CLAMP_MAX) \
     FIELD(ANTIWINDUP) FIELD(MAX_VELOCITY) FIELD(EFFORT_LIMIT) FIELD(SETPOINT) FIELD(COMMAND)    \
-    FIELD(INTEGRAL) FIELD(OUTPUT) FIELD(LAST_MEASUREMENT)
+    FIELD(INTEGRAL) FIELD(OUTPUT) FIELD(LAST_MEASUREMENT) FIELD(UPDATE_STEPS)               \
+    FIELD(NEXT_UPDATE) FIELD(PERIOD)
 #define LAW_KIND_LIST(KIND) KIND(POSITION_PID) KIND(VELOCITY_PID) KIND(EFFORT)
 
 #define LAW_FIELD_INDEX(name) LAW_##name,
@@ -429,6 +430,10 @@ typedef struct {
     double p, i, d, i_min, i_max, max_velocity, effort_limit;
     int antiwindup;
     double setpoint, command, integral, output, last_measurement;
+    /* The controller's clock: an update every `every` steps, the next after `next_update`
+       more (0: this step), each with `period` s as its dt (0 in the row: the physics step). */
+    Py_ssize_t every, next_update;
+    double period;
     double position, velocity; /* the joint's measured state at this step */
 } Law;
 
@@ -501,7 +506,7 @@ static int store_float(PyObject *list, Py_ssize_t index, double value)
 /* Read a law's kind, gains, limits and state from a snapshot of its row. */
 static int read_row(PyObject *row, Law *law)
 {
-    double kind, antiwindup;
+    double kind, antiwindup, every, next_update;
     if (PyTuple_GET_SIZE(row) != LAW_SIZE) {
         PyErr_Format(PyExc_ValueError, "a law row has %d values, not %zd", LAW_SIZE,
                      PyTuple_GET_SIZE(row));
@@ -526,10 +531,27 @@ static int read_row(PyObject *row, Law *law)
         || !float_item(row, LAW_COMMAND, &law->command)
         || !float_item(row, LAW_INTEGRAL, &law->integral)
         || !float_item(row, LAW_OUTPUT, &law->output)
-        || !float_item(row, LAW_LAST_MEASUREMENT, &law->last_measurement)) {
+        || !float_item(row, LAW_LAST_MEASUREMENT, &law->last_measurement)
+        || !float_item(row, LAW_UPDATE_STEPS, &every)
+        || !float_item(row, LAW_NEXT_UPDATE, &next_update)
+        || !float_item(row, LAW_PERIOD, &law->period)) {
         return 0;
     }
     law->antiwindup = antiwindup != 0.0;
+    /* Whole step counts well inside Py_ssize_t, and a period >= 0 (0: the physics step). */
+    if (!(every >= 1.0 && every < 1e15) || (double)(Py_ssize_t)every != every
+        || !(next_update >= 0.0 && next_update < 1e15)
+        || (double)(Py_ssize_t)next_update != next_update
+        || !(law->period >= 0.0 && law->period < Py_HUGE_VAL)) {
+        PyErr_Format(PyExc_ValueError,
+                     "a law's clock is UPDATE_STEPS %R (a whole number >= 1), NEXT_UPDATE %R "
+                     "(a whole number >= 0) and PERIOD %R (finite, >= 0)",
+                     PyTuple_GET_ITEM(row, LAW_UPDATE_STEPS),
+                     PyTuple_GET_ITEM(row, LAW_NEXT_UPDATE), PyTuple_GET_ITEM(row, LAW_PERIOD));
+        return 0;
+    }
+    law->every = (Py_ssize_t)every;
+    law->next_update = (Py_ssize_t)next_update;
     return 1;
 }
 
@@ -584,9 +606,11 @@ static int read_law(PyObject *item, const Stepper *self, PyObject *states, Law *
 /*
  * stepper.run_laws(steps, dt, efforts, laws, states) -> (before_last, last)
  *
- * ``steps`` times: each law's effort from the joint's state, the torques
- * (``efforts``, the laws' slots overwritten), one step, the joint states --
- * the Python loop's steps with every controller updated each step one of the laws.
+ * ``steps`` times: each law due at this step computes its effort from the
+ * joint's state (the others hold theirs), the torques (``efforts``, the
+ * laws' slots overwritten when due), one step, the joint states -- the
+ * Python loop's steps with every controller on the physics step's clock one
+ * of the laws.
  * ``states`` are the states the first step starts from; the result is the
  * states the last step started from and the states after it.  ``efforts``
  * ends with the last step's torques and each law row with its state.
@@ -642,9 +666,19 @@ static PyObject *stepper_run_laws(Stepper *self, PyObject *args)
     Py_INCREF(given_states);
     before = given_states;
     struct JointSensorState state;
+    for (Py_ssize_t k = 0; k < law_count; k++) {
+        if (table[k].period == 0.0) {
+            table[k].period = dt;
+        }
+    }
     for (Py_ssize_t step = 0; step < steps; step++) {
         for (Py_ssize_t k = 0; k < law_count; k++) {
-            torques[table[k].effort_slot] = law_effort(&table[k], dt);
+            Law *law = &table[k];
+            if (law->next_update == 0) { /* due: update; otherwise the effort is held */
+                torques[law->effort_slot] = law_effort(law, law->period);
+                law->next_update = law->every;
+            }
+            law->next_update--;
         }
         StatusHandle status = step_once(self, client, torques);
         if (status == NULL) {
@@ -683,7 +717,8 @@ static PyObject *stepper_run_laws(Stepper *self, PyObject *args)
         if (!store_float(law->values, LAW_SETPOINT, law->setpoint)
             || !store_float(law->values, LAW_INTEGRAL, law->integral)
             || !store_float(law->values, LAW_OUTPUT, law->output)
-            || !store_float(law->values, LAW_LAST_MEASUREMENT, law->last_measurement)) {
+            || !store_float(law->values, LAW_LAST_MEASUREMENT, law->last_measurement)
+            || !store_float(law->values, LAW_NEXT_UPDATE, (double)law->next_update)) {
             goto done;
         }
     }

@@ -3,9 +3,12 @@
 Each step is ros2_control's read / update / write around one physics step:
 the measured joint states go into the joint handles (and, for joints an
 ideal actuator drives, the effort its motor applied), every active
-controller updates (command controllers first, so broadcasters sample fresh
-efforts), the efforts and velocity targets go to PyBullet, and PyBullet
-advances one ``time_step``.  Sim time is kept as a step count, so it never
+controller due on its own clock updates (command controllers first, so
+broadcasters sample fresh efforts; see
+:mod:`pan_tilt_sim.controllers.manager` for the clocks), the hardware's
+per-step part runs on the held commands (an ideal actuator's tracking), the
+efforts and velocity targets go to PyBullet, and PyBullet advances one
+``time_step``.  Sim time is kept as a step count, so it never
 accumulates rounding error.  Which controllers are loaded and which are
 active is the :class:`~pan_tilt_sim.controllers.framework.manager.ControllerManager`'s
 business; the active ones say how each of their joints is driven
@@ -29,7 +32,7 @@ from typing import Protocol
 
 import numpy
 
-from pan_tilt_sim.controllers import CommandController, Controller, JointHandle
+from pan_tilt_sim.controllers import CommandController, Controller, JointHandle, step_law
 from pan_tilt_sim.controllers.framework.base import Drive, idle_actuator
 from pan_tilt_sim.controllers.framework.manager import ControllerManager
 from pan_tilt_sim.controllers.framework.registry import drives_base
@@ -39,6 +42,7 @@ from pan_tilt_sim.model.base_pose import FIXED_BASE, ORIGIN, BasePose
 from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.initial_positions import FROM_DEFAULT, StartPosition, start_positions
+from pan_tilt_sim.model.physics_settings import DEFAULT_PHYSICS, PhysicsSettings
 from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.plugins.framework.plugin import Plugin, PluginWorld
 from pan_tilt_sim.plugins.registry import base_drivers, create_plugins, runs_by_plugins
@@ -128,6 +132,9 @@ class Simulation:
     ``fixed_base`` welds the base to the world (True, the default for
     tools and tests), frees it (False) or decides by the controllers (None,
     sim_node's ``auto``: see :func:`base_is_fixed`); ``initial_pose`` places it.
+    ``physics_settings`` are PyBullet's solver settings
+    (:mod:`pan_tilt_sim.model.physics_settings`; :meth:`Physics.apply_settings`
+    changes them later).
     What the simulation has to say at start-up waits in
     :attr:`startup_report` until :meth:`report_startup` logs it (the node
     does that once it is completely built, so that a start-up error stays
@@ -141,7 +148,8 @@ class Simulation:
                  logger: Logger | None = None,
                  autostart_controllers: bool = True,
                  fixed_base: bool | None = True,
-                 initial_pose: BasePose = ORIGIN) -> None:
+                 initial_pose: BasePose = ORIGIN,
+                 physics_settings: PhysicsSettings = DEFAULT_PHYSICS) -> None:
         self.description = description
         self._logger: Logger = logger or logging.getLogger(LOGGER_NAME)
         load_messages: list[str] = list(controllers.warnings)  # the file's dropped blocks
@@ -158,7 +166,8 @@ class Simulation:
         self.physics = Physics(
             description, time_step, gui=gui,
             initial_positions=[starts[joint].position for joint in movable],
-            warn=load_messages.append, fixed_base=fixed, initial_pose=initial_pose)
+            warn=load_messages.append, fixed_base=fixed, initial_pose=initial_pose,
+            settings=physics_settings)
         self._base_report = self._describe_base(why, fixed_base, initial_pose)
         self._time_step = time_step
         self._steps = 0
@@ -177,7 +186,8 @@ class Simulation:
             self.manager = ControllerManager(controllers, self.handles, description.model,
                                              active=active_controllers,
                                              autostart=autostart_controllers,
-                                             hardware=self.hardware.interfaces)
+                                             hardware=self.hardware.interfaces,
+                                             time_step=time_step)
             self._link_readers: dict[str, LinkReader] = {}
             world = PluginWorld(self.handles, self.base_state, self.base_motion, self.link_state)
             for plugin in self.plugins:
@@ -195,6 +205,9 @@ class Simulation:
         # gz_ros2_control's hold_joints holds it; once driven, it is passive when undriven.
         self._hold_undriven = not autostart_controllers
         self._driven: set[str] = set()
+        # Per step member (by id), [step at which it next updates, every so many steps,
+        # period s, its update]: the controllers' clocks, kept across switches.
+        self._clocks: list[list] = []
         # The active controllers' wheels with free rollers (mecanum, omni), and their friction.
         self._roller_angles: dict[str, float] = {}
         self._rollers: RollerWheels | None = None
@@ -235,6 +248,7 @@ class Simulation:
         self._velocity_handles = [handle for handle, driven in zip(
             self._handle_list, velocity_driven, strict=True) if driven]
         self._velocity_slots = [slot for slot, driven in enumerate(velocity_driven) if driven]
+        self._set_clocks()
         self._efforts = [0.0] * len(self._effort_handles)
         self._targets = [0.0] * len(self._velocity_handles)
         # The velocity motors' force limits: the effort limits, but a controller's own
@@ -249,6 +263,24 @@ class Simulation:
         self._effort_slot = {handle.name: index
                              for index, handle in enumerate(self._effort_handles)}
         self._state_slot = {handle.name: index for index, handle in enumerate(self._handle_list)}
+
+    def _set_clocks(self) -> None:
+        """Give each active step member its clock; those active before keep their next update.
+
+        A controller just activated updates at the next step.
+        """
+        kept = {id(clock[3].__self__): clock[0] for clock in self._clocks}
+        self._clocks = [
+            [kept.get(id(member), self._steps), every, period, member.update]
+            for member, (every, period) in zip(self.manager.step_members,
+                                               self.manager.step_clocks, strict=True)]
+        # Every member every step (a ROS 1 file): the loop need not look at the clocks.
+        self._every_step = all(clock[1] == 1 for clock in self._clocks)
+
+    def _restart_clocks(self) -> None:
+        """Make every controller due at the present step (after a reset)."""
+        for clock in self._clocks:
+            clock[0] = self._steps
 
     def _apply_rollers(self) -> None:
         """Give the active controllers' roller wheels their friction (a free base only).
@@ -306,6 +338,7 @@ class Simulation:
     def _startup_report(self, description: RobotDescription, starts: Mapping[str, StartPosition],
                         load_messages: Sequence[str]) -> list[tuple[str, str]]:
         report = [(WARNING, message) for message in load_messages]
+        report.extend((INFO, note) for note in self.manager.clock_notes)
         if self._base_report is not None:
             report.append(self._base_report)
         for handle in self._handle_list:
@@ -317,8 +350,10 @@ class Simulation:
             if line:
                 report.append((WARNING if start.clamped and start.source != FROM_DEFAULT
                                else INFO, line))
+        periods = {controller.name: self.manager.clock_of(controller)[1]
+                   for controller in self.manager.active}
         report.extend((WARNING, message) for message in pid_stability_warnings(
-            self.physics, self._handle_list, self._time_step))
+            self.physics, self._handle_list, self._time_step, periods))
         report.extend(self.hardware.startup_report())
         return report
 
@@ -390,11 +425,16 @@ class Simulation:
         """Return each step member's law with its slots, or None if one has none."""
         effort_slot, state_slot = self._effort_slot, self._state_slot
         laws = []
-        for member in self.manager.step_members:
+        count = self._steps
+        for member, (next_update, every, period, _) in zip(self.manager.step_members,
+                                                            self._clocks, strict=True):
             law = member.step_law()
             if law is None:
                 return None
             handle, row = law
+            row[step_law.UPDATE_STEPS] = float(every)
+            row[step_law.NEXT_UPDATE] = float(max(0, next_update - count))
+            row[step_law.PERIOD] = period
             laws.append((effort_slot[handle.name], state_slot[handle.name], row))
         return laws
 
@@ -410,11 +450,14 @@ class Simulation:
             handle.velocity = state[STATE_VELOCITY]
         for handle, effort in zip(effort_handles, efforts, strict=False):
             handle.effort = effort
-        for member, (_, _, row) in zip(self.manager.step_members, laws, strict=True):
+        end = self._steps + steps
+        for member, clock, (_, _, row) in zip(self.manager.step_members, self._clocks, laws,
+                                              strict=True):
             member.absorb_step_law(row)
+            clock[0] = end + int(row[step_law.NEXT_UPDATE])
         self.compiled_steps += steps
         self._states = states
-        self._steps += steps
+        self._steps = end
 
     def _advance_python(self, steps: int) -> None:
         """Run ``steps`` steps, every controller updated in Python."""
@@ -423,7 +466,12 @@ class Simulation:
         # and scheduled ones (the broadcasters) only when due.  This loop's
         # Python is what the compiled laws save (docs/performance.md).
         handles = self._handle_list
-        updates = [unit.update for unit in self.plugins] + self.manager.updates
+        plugin_updates = [unit.update for unit in self.plugins]
+        updates = plugin_updates + self.manager.updates
+        # Controllers on clocks slower than the physics: each updates when due, with its
+        # period, and the hardware acts on the held commands every step (see actuations).
+        clocks = None if self._every_step else self._clocks
+        actuations = self.manager.actuations
         scheduled = self.manager.scheduled_updates
         effort_handles, efforts = self._effort_handles, self._efforts
         velocity_handles, targets = self._velocity_handles, self._targets
@@ -445,8 +493,18 @@ class Simulation:
             for handle, slot in readback:  # what the ideal actuators applied
                 handle.effort = states[slot][STATE_MOTOR_TORQUE]
             time = count * dt
-            for update in updates:
-                update(time, dt)
+            if clocks is None:
+                for update in updates:
+                    update(time, dt)
+            else:
+                for update in plugin_updates:
+                    update(time, dt)
+                for clock in clocks:
+                    if count >= clock[0]:
+                        clock[0] = count + clock[1]
+                        clock[3](time, clock[2])
+                for actuate in actuations:
+                    actuate(dt)
             for schedule, update in scheduled:
                 if time + DUE_EPSILON >= schedule.next_due:
                     update(time, dt)
@@ -575,6 +633,7 @@ class Simulation:
             self._apply_actuators()
         if reset_time:
             self._steps = 0
+        self._restart_clocks()
         self._leaning_since = self._upright_since = None
         self._lean_reported = False
         self.hardware.reset()
@@ -589,6 +648,7 @@ class Simulation:
         for controller in [*self.plugins, *self.controllers]:
             controller.reset()
         self._steps = 0
+        self._restart_clocks()
         # A lean, or standing upright, goes on, timed on the new clock.
         if self._leaning_since is not None:
             self._leaning_since = 0.0
@@ -665,7 +725,8 @@ def make_simulation(description_file: str, controllers_file: str | None, time_st
                     logger: Logger | None = None,
                     autostart_controllers: bool = True,
                     fixed_base: bool | None = True,
-                    initial_pose: BasePose = ORIGIN) -> Simulation:
+                    initial_pose: BasePose = ORIGIN,
+                    physics_settings: PhysicsSettings = DEFAULT_PHYSICS) -> Simulation:
     """Load both files and build a :class:`Simulation` (for tools and tests); log its report.
 
     Without ``controllers_file`` the URDF's control plugin names it (see
@@ -684,7 +745,8 @@ def make_simulation(description_file: str, controllers_file: str | None, time_st
                             time_step, gui=gui, active_controllers=active_controllers,
                             initial_positions=initial_positions, logger=logger,
                             autostart_controllers=autostart_controllers,
-                            fixed_base=fixed_base, initial_pose=initial_pose)
+                            fixed_base=fixed_base, initial_pose=initial_pose,
+                            physics_settings=physics_settings)
     for warning in description.warnings:
         simulation._logger.warning(warning)
     simulation.report_startup()

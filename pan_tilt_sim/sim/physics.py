@@ -25,6 +25,7 @@ from pan_tilt_sim.model.base_pose import ORIGIN, BasePose
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.inertials import with_massive_root
 from pan_tilt_sim.model.mimic import follow_leaders, mimic_couplings
+from pan_tilt_sim.model.physics_settings import DEFAULT_PHYSICS, PhysicsSettings
 from pan_tilt_sim.model.robot import JointSpec, RobotModel
 from pan_tilt_sim.model.surfaces import Surface
 from pan_tilt_sim.model.transforms import Transform, quaternion_from_rpy
@@ -174,6 +175,14 @@ def apply_surface_friction(body: int, links: Mapping[str, int],
                                     physicsClientId=client)
 
 
+def engine_parameters(settings: PhysicsSettings) -> dict[str, float | int]:
+    """Return ``settings`` as ``pybullet.setPhysicsEngineParameter``'s keyword arguments."""
+    return {'numSolverIterations': settings.solver_iterations, 'erp': settings.erp,
+            'contactERP': settings.contact_erp, 'globalCFM': settings.cfm,
+            'contactSlop': settings.contact_slop,
+            'useSplitImpulse': int(settings.split_impulse)}
+
+
 class Physics:
     """A PyBullet world holding one robot, its base welded to the world or free.
 
@@ -188,7 +197,8 @@ class Physics:
     def __init__(self, description: RobotDescription, time_step: float, *,
                  gui: bool = False, initial_positions: Sequence[float] | None = None,
                  warn: LogFunction = _ignore, fixed_base: bool = True,
-                 initial_pose: BasePose = ORIGIN) -> None:
+                 initial_pose: BasePose = ORIGIN,
+                 settings: PhysicsSettings = DEFAULT_PHYSICS) -> None:
         self._description = description
         self._time_step = time_step
         self._fixed_base = fixed_base
@@ -203,6 +213,7 @@ class Physics:
         # (a signal during start-up) or left behind at interpreter exit.
         self._compiled: list[compiled_step.Connection] = []
         self._disconnect = weakref.finalize(self, _disconnect, self._client, self._compiled)
+        self.apply_settings(settings)
         try:
             self._body = self._load(description, warn)
             connection = compiled_step.connect(self._client)
@@ -540,10 +551,16 @@ class Physics:
             return [0.0] * len(self._indices)
         return [torques[self._dof_indices[index]] for index in self._indices]
 
-    def set_solver_iterations(self, iterations: int) -> None:
-        """Set PyBullet's constraint solver iterations per step (an SDF world's ``<iters>``)."""
-        pybullet.setPhysicsEngineParameter(numSolverIterations=int(iterations),
+    @property
+    def settings(self) -> PhysicsSettings:
+        """The solver settings in force (see :mod:`pan_tilt_sim.model.physics_settings`)."""
+        return self._settings
+
+    def apply_settings(self, settings: PhysicsSettings) -> None:
+        """Give PyBullet's constraint solver ``settings`` (checked already), from the next step."""
+        pybullet.setPhysicsEngineParameter(**engine_parameters(settings),
                                            physicsClientId=self._client)
+        self._settings = settings
 
     def close(self) -> None:
         """Disconnect the PyBullet client and remove temporary files (idempotent)."""

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 import pathlib
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 from pan_tilt_sim.controllers.framework.base import ActuatorKind, Drive, JointHandle
 from pan_tilt_sim.errors import DescriptionError
@@ -201,8 +201,13 @@ def largest_stable_time_step(p: float, d: float, inertia: float) -> float:
 
 
 def pid_stability_warnings(physics: Physics, handles: Sequence[JointHandle],
-                           time_step: float) -> list[str]:
-    """Return one warning per PID-driven joint whose gains are unstable at ``time_step``."""
+                           time_step: float,
+                           periods: Mapping[str, float] | None = None) -> list[str]:
+    """Return one warning per PID-driven joint whose gains are unstable at its controller's period.
+
+    ``periods``: each controller's update period (s) by name, a whole number
+    of ``time_step`` s; a controller not named updates every step.
+    """
     # A PID whose output is not an effort (a velocity target, say) is no explicit effort loop.
     checked = [handle for handle in handles
                if handle.actuator.pid is not None and handle.drive is Drive.EFFORT]
@@ -210,7 +215,6 @@ def pid_stability_warnings(physics: Physics, handles: Sequence[JointHandle],
         return []
     inertias = dict(zip((joint.name for joint in physics.joints), physics.smallest_inertias(),
                         strict=True))
-    dt = time_step
     warnings = []
     for handle in checked:
         actuator = handle.actuator
@@ -218,6 +222,14 @@ def pid_stability_warnings(physics: Physics, handles: Sequence[JointHandle],
         inertia = inertias[handle.name]
         unit = 'kg' if handle.spec.kind is JointKind.PRISMATIC else 'kg*m^2'
         where = f"joint '{handle.name}' ({actuator.controller})"
+        dt = (periods or {}).get(actuator.controller, time_step)
+        steps = max(1, round(dt / time_step))
+        if steps > 1:
+            warning = _held_effort_warning(where, actuator.kind, gains.p, gains.d, inertia,
+                                           unit, dt, steps)
+            if warning is not None:
+                warnings.append(warning)
+            continue
         if actuator.kind is ActuatorKind.VELOCITY_PID:
             if gains.p * dt / 2.0 < inertia:
                 continue
@@ -240,3 +252,29 @@ def pid_stability_warnings(physics: Physics, handles: Sequence[JointHandle],
             f'{largest_stable_time_step(gains.p, gains.d, inertia):.3g} s, or no gains '
             '(the ideal actuator)')
     return warnings
+
+
+def _held_effort_warning(where: str, kind: ActuatorKind, p: float, d: float, inertia: float,
+                         unit: str, period: float, steps: int) -> str | None:
+    """Say why a PID updated every ``steps`` physics steps (``period`` s) is unstable, or None.
+
+    The rules of the module's description for an effort held ``steps`` steps.
+    """
+    at = (f'at its update period {period:g} s ({steps} physics steps, the effort held in '
+          'between)')
+    if kind is ActuatorKind.VELOCITY_PID:
+        if p * period / 2.0 < inertia:
+            return None
+        return (f'{where}: velocity PID p {p:g} is unstable {at} for its effective inertia '
+                f'{inertia:.3g} {unit} (needs p * period / 2 < inertia): use p < '
+                f'{2.0 * inertia / period:.3g}, a higher update_rate, or no gains '
+                '(the ideal actuator)')
+    need = d * period / 2.0 + p * period * period / (4.0 * steps)
+    least_d = p * period * (steps - 1) / (2.0 * steps)
+    if need < inertia and d > least_d:
+        return None
+    return (f'{where}: PID p {p:g} d {d:g} is unstable {at} for its effective inertia '
+            f'{inertia:.3g} {unit} (needs d * period / 2 + p * period^2 / (4 n) = '
+            f'{need:.3g} < inertia and d > p * period * (n - 1) / (2 n) = '
+            f'{least_d:.3g}, n = {steps}): a higher update_rate, other gains, or no gains '
+            '(the ideal actuator)')

@@ -331,7 +331,7 @@ def ros2_arm_yaml():
     return f"""
         controller_manager:
           ros__parameters:
-            update_rate: 100
+            update_rate: 1000  # the physics rate, at which ROS 1 ran every controller
             joint_state_broadcaster:
               type: joint_state_broadcaster/JointStateBroadcaster
             arm_controller:

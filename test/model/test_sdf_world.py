@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pathlib
+import re
 
 import pytest
 from mesh_fixtures import obj_text
@@ -62,6 +63,61 @@ def test_physics_gives_the_step_the_factor_and_the_solver_iterations(tmp_path):
             '</physics>')
     assert read(tmp_path, world(body)).physics == WorldPhysics(0.003, 2.0, 80)
     assert read(tmp_path, world('')).physics == WorldPhysics()
+
+
+ODE_PHYSICS = ('<physics name="1ms" type="ode"><max_step_size>0.001</max_step_size>'
+               '<real_time_update_rate>1000</real_time_update_rate>'
+               '<ode><solver><type>quick</type><iters>20</iters><sor>1.3</sor></solver>'
+               '<constraints><cfm>0.00001</cfm><erp>0.5</erp>'
+               '<contact_max_correcting_vel>100</contact_max_correcting_vel>'
+               '<contact_surface_layer>0.001</contact_surface_layer></constraints></ode>'
+               '</physics>')
+
+
+def test_physics_gives_pybullets_counterparts_of_odes_constraints_and_names_the_rest(tmp_path):
+    physics = read(tmp_path, world(ODE_PHYSICS)).physics
+    assert (physics.solver_iterations, physics.erp, physics.cfm, physics.contact_slop,
+            physics.split_impulse) == (20, 0.5, 1e-5, 0.001, None)
+    # ODE's one ERP corrects joints and contacts alike: PyBullet's erp and contact_erp.
+    assert physics.settings() == {'solver_iterations': 20, 'erp': 0.5, 'contact_erp': 0.5,
+                                  'cfm': 1e-5, 'contact_slop': 0.001}
+    assert physics.unmatched == ('<real_time_update_rate>', '<ode><solver><type>',
+                                 '<ode><solver><sor>',
+                                 '<ode><constraints><contact_max_correcting_vel>')
+
+
+def test_a_bullet_physics_reads_its_own_section_and_split_impulse(tmp_path):
+    body = ('<physics type="bullet"><bullet><solver><iters>15</iters></solver><constraints>'
+            '<erp>0.3</erp><split_impulse>false</split_impulse>'
+            '<split_impulse_penetration_threshold>-0.02</split_impulse_penetration_threshold>'
+            '</constraints></bullet><ode><solver><iters>99</iters></solver></ode></physics>')
+    physics = read(tmp_path, world(body)).physics
+    assert physics.settings() == {'solver_iterations': 15, 'erp': 0.3, 'contact_erp': 0.3,
+                                  'split_impulse': False}
+    assert physics.unmatched == (
+        '<bullet><constraints><split_impulse_penetration_threshold>',
+        '<ode><solver><iters>')  # the engine is Bullet: the ODE section is not read
+
+
+def test_an_engine_pybullet_has_no_counterpart_for_gives_only_step_and_factor(tmp_path):
+    body = ('<physics type="dart"><max_step_size>0.002</max_step_size>'
+            '<dart><solver><solver_type>pgs</solver_type></solver></dart></physics>')
+    physics = read(tmp_path, world(body)).physics
+    assert (physics.time_step, physics.settings()) == (0.002, {})
+    assert physics.unmatched == ('<dart><solver><solver_type>',)
+
+
+@pytest.mark.parametrize(('element', 'named'), [
+    ('<constraints><erp>1.5</erp></constraints>',
+     '<ode><constraints><erp> must be from 0 to 1 (a share of the error per step), got 1.5'),
+    ('<constraints><cfm>-1</cfm></constraints>', '<ode/constraints/cfm>-1</...> must be'),
+    ('<constraints><contact_surface_layer>x</contact_surface_layer></constraints>',
+     '<ode/constraints/contact_surface_layer>x</...> must be'),
+    ('<solver><iters>2.5</iters></solver>', '<ode><solver><iters> must be a whole number'),
+])
+def test_a_physics_value_pybullet_cannot_take_names_the_element(tmp_path, element, named):
+    with pytest.raises(WorldFileError, match='<physics name="p">: ' + re.escape(named)):
+        read(tmp_path, world(f'<physics name="p"><ode>{element}</ode></physics>'))
 
 
 def test_known_systems_lights_and_scene_are_quiet_and_other_plugins_warn_once(tmp_path):

@@ -69,7 +69,8 @@ def test_the_spawner_call_sequence_loads_configures_and_activates(spawner_mode):
     assert list(arm.claimed_interfaces) == [f'{j}/effort' for j in ARM_JOINTS]
     assert list(arm.required_state_interfaces) == [
         f'{j}/{i}' for j in ARM_JOINTS for i in ('position', 'velocity')]
-    assert arm.update_rate == 100
+    # Its own update_rate (the shipped file's 1000 Hz), not the controller_manager's 100 Hz.
+    assert arm.update_rate == 1000 and listed[JSB].update_rate == 100
     # What it spawned works: joint states flow, the trajectory topic moves the arm.
     assert sim.spin_until(lambda: sim.states), 'no joint_states after spawning the broadcaster'
     sim.command('arm_controller', JointTrajectory(joint_names=ARM_JOINTS, points=[

@@ -13,6 +13,7 @@ from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
 
 from pan_tilt_sim.ros.sim_node import CLOCK_BURST, clock_period_steps
+from pan_tilt_sim.sim.physics import pybullet
 
 NS = '/ex_urdf_pan_tilt'
 PAN = 'joint1_position_controller'
@@ -318,3 +319,20 @@ def test_a_real_time_factor_pacing_cannot_follow_is_refused_and_the_node_runs_on
         assert accepted.successful, accepted.reason
         paced = harness.simulation.time
         assert harness.spin_until(lambda: harness.simulation.time > paced + 0.05)
+
+
+def test_the_solver_settings_are_parameters_checked_when_set_and_applied_from_the_next_step():
+    with sim_node(real_time_factor=0.0, solver_iterations=20, contact_slop=0) as harness:
+        physics = harness.simulation.physics
+        assert (physics.settings.solver_iterations, physics.settings.contact_slop) == (20, 0.0)
+        assert physics.settings.erp == 0.2 and physics.settings.split_impulse is True
+        refused, = harness.set_parameters(contact_erp=2.0)
+        assert not refused.successful
+        assert refused.reason == "parameter 'contact_erp' must be from 0 to 1 (a share of " \
+                                 'the error per step), got 2.0'
+        assert physics.settings.contact_erp == 0.08
+        accepted, = harness.set_parameters(solver_iterations=8)
+        assert accepted.successful, accepted.reason
+        assert physics.settings.solver_iterations == 8
+        assert pybullet.getPhysicsEngineParameters(
+            physicsClientId=physics._client)['numSolverIterations'] == 8

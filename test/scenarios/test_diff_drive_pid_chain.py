@@ -32,7 +32,9 @@ pytestmark = pytest.mark.skipif(
     reason='controller_manager_msgs or control_msgs is not installed')
 
 TIME_STEP = 0.001
-PERIOD_STEPS = 20  # one odometry period at example 16's publish_rate of 50 Hz
+# One update at example 16's update_rate of 10 Hz: the diff drive publishes in its update,
+# so its publish_rate of 50 Hz gives a message at every update, as upstream's does.
+PERIOD_STEPS = 100
 DRIVE = 'diffbot_base_controller'
 PIDS = {'left_wheel_joint': 'pid_controller_left_wheel_joint',
         'right_wheel_joint': 'pid_controller_right_wheel_joint'}

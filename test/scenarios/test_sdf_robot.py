@@ -18,6 +18,8 @@ from sdf_fixtures import LIDAR_RANGE, cylinders_world, rover_sdf, write
 from sensor_msgs.msg import Imu, JointState, LaserScan
 from sim_interfaces_client import SimInterfaces, position
 
+from pan_tilt_sim.model.physics_settings import PhysicsSettings
+
 CYLINDERS = [(2.0, 0.0, 0.3), (0.0, 1.5, 0.2), (-1.2, -1.2, 0.25)]
 WORLD_STEP = 0.002  # s: the world's <max_step_size>
 SCAN_TOLERANCE = 0.01  # m: the median beam's range against the analytic one
@@ -123,3 +125,23 @@ def test_it_drives_on_cmd_vel_and_its_scan_sees_the_cylinders_where_they_are(rov
             assert not math.isfinite(measured) or measured >= LIDAR_RANGE[1], (index, measured)
     assert len(errors) > 20
     assert statistics.median(errors) < SCAN_TOLERANCE
+
+
+def test_the_worlds_constraints_set_the_solver_parameters_unless_they_are_given(tmp_path,
+                                                                               capfd):
+    world = write(tmp_path / 'solver.sdf', (
+        '<sdf version="1.9"><world name="w"><physics type="ode"><ode><solver><iters>20</iters>'
+        '<sor>1.3</sor></solver><constraints><erp>0.5</erp><cfm>0.00001</cfm>'
+        '<contact_surface_layer>0.001</contact_surface_layer></constraints></ode></physics>'
+        '</world></sdf>'))
+    with sim_node(paused=True, world=str(world), cfm=0.0) as sim:
+        assert sim.simulation.physics.settings == PhysicsSettings(
+            solver_iterations=20, erp=0.5, contact_erp=0.5, cfm=0.0, contact_slop=0.001)
+        assert sim.node.get_parameter('contact_erp').value == 0.5
+    lines = [line for line in capfd.readouterr().err.splitlines() if 'physics: ' in line]
+    assert len(lines) == 1
+    assert lines[0].endswith(
+        "physics: solver_iterations 20 (the world's <physics>); erp 0.5 (the world's "
+        "<physics>); contact_erp 0.5 (the world's <physics>); cfm 0.0 (the parameter; the "
+        "world's <physics> says 1e-05); contact_slop 0.001 (the world's <physics>); no "
+        'PyBullet counterpart, not simulated: <ode><solver><sor>')

@@ -221,8 +221,9 @@ def test_switching_controllers_switches_the_actuators(tmp_path):
     yaml = ros2_control_yaml({
         'arm': ('joint_trajectory_controller/JointTrajectoryController',
                 {'joints': ARM_JOINTS, 'command_interfaces': '[position]'}),
+        # At the physics rate: the gains are tuned for a 1 ms loop.
         'pid_arm': ('position_controllers/JointGroupPositionController',
-                    {'joints': ARM_JOINTS, 'gains': gains})})
+                    {'joints': ARM_JOINTS, 'gains': gains, 'update_rate': 1000})})
     with simulation(tmp_path, two_link_arm_urdf(), yaml,
                     active_controllers=['joint_state_broadcaster', 'arm']) as sim:
         assert sim.handles['joint1'].drive is Drive.VELOCITY

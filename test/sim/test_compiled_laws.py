@@ -264,9 +264,12 @@ def test_one_step_of_the_effort_law_is_the_python_update(one_joint_runner, comma
     assert c_effort.hex() == effort.hex() == command.hex()
 
 
-def law_row(kind: float) -> list[float]:
+def law_row(kind: float, every: float = 1.0, next_update: float = 0.0,
+            period: float = 0.0) -> list[float]:
     row = [0.0] * step_law.ROW_SIZE
     row[step_law.KIND] = kind
+    row[step_law.UPDATE_STEPS], row[step_law.NEXT_UPDATE] = every, next_update
+    row[step_law.PERIOD] = period
     return row
 
 
@@ -278,6 +281,12 @@ def law_row(kind: float) -> list[float]:
     ([(0, 0, law_row(math.nan))], ValueError),
     ([(0, 0, [0.0] * (step_law.ROW_SIZE - 1) + ['x'])], TypeError),
     ([[0, 0, law_row(step_law.EFFORT)]], TypeError),  # not a tuple
+    ([(0, 0, law_row(step_law.EFFORT, every=0.0))], ValueError),  # no clock
+    ([(0, 0, law_row(step_law.EFFORT, every=2.5))], ValueError),
+    ([(0, 0, law_row(step_law.EFFORT, next_update=-1.0))], ValueError),
+    ([(0, 0, law_row(step_law.EFFORT, next_update=math.inf))], ValueError),
+    ([(0, 0, law_row(step_law.EFFORT, period=-0.01))], ValueError),
+    ([(0, 0, law_row(step_law.EFFORT, period=math.nan))], ValueError),
 ])
 def test_a_malformed_law_is_refused_before_anything_is_sent(one_joint_runner, laws, error):
     physics, run = one_joint_runner

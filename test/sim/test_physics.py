@@ -15,9 +15,16 @@ from robot_fixtures import (
 
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.model.physics_settings import DEFAULT_PHYSICS, PhysicsSettings
 from pan_tilt_sim.model.robot import JointKind, JointSpec
 from pan_tilt_sim.sim.bullet import message_lines
-from pan_tilt_sim.sim.physics import DEFAULT_VELOCITY_CAP, Physics, pybullet, velocity_cap
+from pan_tilt_sim.sim.physics import (
+    DEFAULT_VELOCITY_CAP,
+    Physics,
+    engine_parameters,
+    pybullet,
+    velocity_cap,
+)
 
 
 @pytest.fixture
@@ -226,3 +233,86 @@ def test_an_sdf_ball_joint_swings_freely_in_three_degrees_of_freedom(tmp_path):
         physics.reset_joints()
         assert pybullet.getLinkState(body, physics.link_index('bob'), physicsClientId=client)[
             0] == pytest.approx((0.3, 0.0, 1.0), abs=1e-6)
+
+
+# --- PyBullet's solver settings -----------------------------------------------------------
+
+def contact_and_constraint_scene(settings: PhysicsSettings | None) -> list:
+    """Run a box pushed along the ground, one hung on a point constraint, a pendulum held by
+    its joint limit; return their poses and the pendulum's joint state at every step.
+
+    ``settings`` None: PyBullet as it starts; else those settings given to it first.
+    """
+    client = pybullet.connect(pybullet.DIRECT)
+    try:
+        pybullet.setGravity(0.0, 0.0, -9.81, physicsClientId=client)
+        pybullet.setTimeStep(0.001, physicsClientId=client)
+        if settings is not None:
+            pybullet.setPhysicsEngineParameter(**engine_parameters(settings),
+                                               physicsClientId=client)
+        pybullet.createMultiBody(0.0, pybullet.createCollisionShape(
+            pybullet.GEOM_PLANE, physicsClientId=client), physicsClientId=client)
+        shape = pybullet.createCollisionShape(pybullet.GEOM_BOX, halfExtents=[0.1] * 3,
+                                              physicsClientId=client)
+        pushed = pybullet.createMultiBody(1.0, shape, basePosition=[0, 0, 0.09],
+                                          physicsClientId=client)  # 1 cm into the ground
+        anchor = pybullet.createMultiBody(0.0, shape, basePosition=[2, 0, 1.3],
+                                          physicsClientId=client)
+        hung = pybullet.createMultiBody(1.0, shape, basePosition=[2.05, 0, 1.0],
+                                        physicsClientId=client)
+        pybullet.setCollisionFilterPair(anchor, hung, -1, -1, 0, physicsClientId=client)
+        pybullet.createConstraint(anchor, -1, hung, -1, pybullet.JOINT_POINT2POINT, [0, 0, 0],
+                                  [0, 0, -0.15], [0, 0, 0.15], physicsClientId=client)
+        # A pendulum starting 0.2 rad beyond its joint limit.
+        ball = pybullet.createCollisionShape(pybullet.GEOM_SPHERE, radius=0.05,
+                                             physicsClientId=client)
+        pendulum = pybullet.createMultiBody(
+            0.0, -1, basePosition=[-2, 0, 1], linkMasses=[1.0], linkCollisionShapeIndices=[ball],
+            linkVisualShapeIndices=[-1], linkPositions=[[0, 0, -0.5]],
+            linkOrientations=[[0, 0, 0, 1]], linkInertialFramePositions=[[0, 0, 0]],
+            linkInertialFrameOrientations=[[0, 0, 0, 1]], linkParentIndices=[0],
+            linkJointTypes=[pybullet.JOINT_REVOLUTE], linkJointAxis=[[0, 1, 0]],
+            physicsClientId=client)
+        pybullet.changeDynamics(pendulum, 0, jointLowerLimit=-0.1, jointUpperLimit=0.1,
+                                physicsClientId=client)
+        pybullet.resetJointState(pendulum, 0, 0.3, physicsClientId=client)
+        pybullet.setJointMotorControl2(pendulum, 0, pybullet.VELOCITY_CONTROL, force=0.0,
+                                       physicsClientId=client)
+        poses = []
+        for _ in range(300):
+            pybullet.applyExternalForce(pushed, -1, [3, 0, 0], [0, 0.05, 0.1],
+                                        pybullet.WORLD_FRAME, physicsClientId=client)
+            pybullet.stepSimulation(physicsClientId=client)
+            poses.append([pybullet.getBasePositionAndOrientation(body, physicsClientId=client)
+                          for body in (pushed, hung)]
+                         + [pybullet.getJointState(pendulum, 0, physicsClientId=client)[:2]])
+        return poses
+    finally:
+        pybullet.disconnect(client)
+
+
+def test_the_default_settings_are_pybullets_own_giving_them_changes_nothing():
+    assert contact_and_constraint_scene(DEFAULT_PHYSICS) == contact_and_constraint_scene(None)
+
+
+@pytest.mark.parametrize('change', [
+    {'solver_iterations': 5}, {'erp': 0.8}, {'contact_erp': 0.2}, {'cfm': 1e-6},
+    {'contact_slop': 0.0}, {'split_impulse': False}])
+def test_each_setting_reaches_pybullet(change):
+    changed = dataclasses.replace(DEFAULT_PHYSICS, **change)
+    assert contact_and_constraint_scene(changed) != contact_and_constraint_scene(None)
+
+
+def test_a_physics_takes_its_settings_at_start_and_when_changed(description):
+    def iterations(physics):
+        return pybullet.getPhysicsEngineParameters(
+            physicsClientId=physics._client)['numSolverIterations']
+
+    with Physics(description, 0.001, settings=PhysicsSettings(solver_iterations=7)) as physics:
+        assert iterations(physics) == 7
+        assert physics.settings == PhysicsSettings(solver_iterations=7)
+        physics.apply_settings(PhysicsSettings(solver_iterations=12, contact_slop=0.0))
+        assert iterations(physics) == 12
+        assert physics.settings.contact_slop == 0.0
+    with Physics(description, 0.001) as physics:
+        assert iterations(physics) == 50 and physics.settings == DEFAULT_PHYSICS

@@ -17,7 +17,7 @@ start, so the joint holds still.  What follows the setpoint:
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from pan_tilt_sim.controllers.framework.base import ActuatorKind, CommandResult, JointHandle
 from pan_tilt_sim.controllers.framework.single_joint import PidJointController
@@ -42,6 +42,9 @@ class JointPositionController(PidJointController):
     default_gains = DEFAULT_POSITION_GAINS
     pid_kind = ActuatorKind.POSITION_PID
     ideal_kind = ActuatorKind.IDEAL_POSITION
+    # The command the ideal actuator ramps to, as the last update took it; None while the
+    # controller updates every physics step and ramps in its update itself.
+    _held: float | None = None
 
     @property
     def setpoint(self) -> float:
@@ -63,6 +66,8 @@ class JointPositionController(PidJointController):
         self._setpoint = self._handle.position
         self._rate = 0.0
         self._command = self._setpoint
+        if self._held is not None:
+            self._held = self._command
         if self._pid is not None:
             self._pid.reset()
 
@@ -86,33 +91,32 @@ class JointPositionController(PidJointController):
         self._setpoint = row[SETPOINT]
         self._pid.restore(row[INTEGRAL], row[OUTPUT], row[LAST_MEASUREMENT])
 
+    def actuation(self) -> Callable[[float], None] | None:
+        """Without gains: the ideal actuator, which ramps and tracks the held command every step.
+
+        From then on an update only takes the command (the command
+        interface's value), as ros2_control's forward command controller does.
+        """
+        if self._pid is not None:
+            return None
+        self._held = self._command
+        return self._actuate
+
+    def _actuate(self, time_step: float) -> None:
+        self._ideal_step(self._held, time_step)
+
     def update(self, time: float, period: float) -> None:
         """Move the setpoint, then compute the effort or the velocity target."""
+        if self._pid is None:
+            if self._held is None:
+                self._ideal_step(self._command, period)
+            else:  # the hardware ramps and tracks it every physics step (actuation)
+                self._held = self._command
+            return
         handle = self._handle
         setpoint = self._setpoint
         command = self._command
         max_velocity = self._max_velocity
-        if self._pid is None:
-            # The ideal actuator: the trapezoidal ramp and the tracking target,
-            # written out (the common case of a setpoint at rest on its command
-            # costs two comparisons).
-            rate = self._rate
-            delta = command - setpoint
-            if rate != 0.0 or not -ARRIVED < delta < ARRIVED:
-                setpoint, rate = ramp(setpoint, rate, command, period, max_velocity,
-                                      SETPOINT_ACCELERATION)
-                # Braking for a command that reversed can carry the setpoint a little
-                # past the one it was heading for: it stops at a limit it would cross.
-                limits = self._limits
-                if setpoint > limits.upper >= self._setpoint:
-                    setpoint, rate = limits.upper, 0.0
-                elif setpoint < limits.lower <= self._setpoint:
-                    setpoint, rate = limits.lower, 0.0
-                self._setpoint, self._rate = setpoint, rate
-            target = rate + self._tracking_gain / period * (setpoint - handle.position)
-            handle.velocity_target = (max_velocity if target > max_velocity else
-                                      -max_velocity if target < -max_velocity else target)
-            return
         # The ramp (at most max_velocity * period per step) and clamp_effort,
         # written out: this runs every physics step, and the two calls cost a
         # third of it.
@@ -128,3 +132,27 @@ class JointPositionController(PidJointController):
         effort = self._pid.compute(setpoint, handle.position, period, handle.velocity)
         limit = self._effort_limit
         handle.effort = limit if effort > limit else -limit if effort < -limit else effort
+
+    def _ideal_step(self, command: float, period: float) -> None:
+        """Run the ideal actuator for one step of ``period`` s: the ramp, the velocity target."""
+        handle = self._handle
+        setpoint = self._setpoint
+        max_velocity = self._max_velocity
+        # Written out: the common case of a setpoint at rest on its command costs two
+        # comparisons.
+        rate = self._rate
+        delta = command - setpoint
+        if rate != 0.0 or not -ARRIVED < delta < ARRIVED:
+            setpoint, rate = ramp(setpoint, rate, command, period, max_velocity,
+                                  SETPOINT_ACCELERATION)
+            # Braking for a command that reversed can carry the setpoint a little
+            # past the one it was heading for: it stops at a limit it would cross.
+            limits = self._limits
+            if setpoint > limits.upper >= self._setpoint:
+                setpoint, rate = limits.upper, 0.0
+            elif setpoint < limits.lower <= self._setpoint:
+                setpoint, rate = limits.lower, 0.0
+            self._setpoint, self._rate = setpoint, rate
+        target = rate + self._tracking_gain / period * (setpoint - handle.position)
+        handle.velocity_target = (max_velocity if target > max_velocity else
+                                  -max_velocity if target < -max_velocity else target)

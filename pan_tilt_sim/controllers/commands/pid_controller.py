@@ -242,6 +242,9 @@ class PidController(CommandController):
     chainable = True
     command_topic = 'reference'
     command_kind = CommandKind.MULTI_DOF_COMMAND
+    # Whether the position outputs step every physics step in the hardware's place (see
+    # actuation) rather than in the update: the controller updates less often.
+    _stepped_by_hardware = False
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
@@ -504,6 +507,23 @@ class PidController(CommandController):
         return {dof: reference.value
                 for dof, reference in zip(self._dofs, self._references[0], strict=True)}
 
+    def actuation(self) -> Callable[[float], None] | None:
+        """For position outputs: the ideal actuator, ramping to and tracking the held command.
+
+        From then on an update writes the commands, and the outputs step
+        every physics step here.
+        """
+        tracked = [output for output in self._outputs if isinstance(output, _PositionOutput)]
+        if not tracked:
+            return None
+        self._stepped_by_hardware = True
+
+        def step(time_step: float) -> None:
+            for output in tracked:
+                output.step(time_step)
+
+        return step
+
     def update(self, time: float, period: float) -> None:
         """Take the topic's references (not in chained mode), compute and write the commands."""
         references = self._references
@@ -548,7 +568,8 @@ class PidController(CommandController):
                                  settings.u_max)
                 self._commands[position] = command
                 output.write(command)
-            output.step(period)
+            if not self._stepped_by_hardware:
+                output.step(period)
             if rows is not None:
                 rows.append((reference, state, measured[1][position] if two else 0.0, error,
                              error_dot if two else 0.0, period, self._commands[position]))

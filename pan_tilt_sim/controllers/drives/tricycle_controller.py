@@ -167,6 +167,7 @@ class TricycleController(OdometryOutputs, CommandController):
 
     type_names = ('tricycle_controller/TricycleController',)
     drives_base: ClassVar[bool] = True
+    own_clock: ClassVar[bool] = True  # the kinematics at update_rate, the steering every step
     command_topic = 'cmd_vel'
     command_kind = CommandKind.TWIST_STAMPED
     parameters = ParameterSpec([

@@ -2,11 +2,13 @@
 
 A controller is pure Python: it is built from its YAML parameters, then
 :meth:`Controller.configure` hands it the :class:`JointHandle` objects of
-the joints it names, and :meth:`Controller.update` runs once per physics
-step.  Handles carry the measured state (written by the simulation before
-each update) and what the controller wants the physics to do with the joint
-(read by the simulation after it).  At configure time the controller tells
-each of its joints' handles which :class:`Actuator` drives it:
+the joints it names, and :meth:`Controller.update` runs at the
+controller's update rate (the stepping loop's clock: see
+:mod:`pan_tilt_sim.controllers.manager`).  Handles carry the measured
+state (written by the simulation before each update) and what the
+controller wants the physics to do with the joint (read by the simulation
+after it).  At configure time the controller tells each of its joints'
+handles which :class:`Actuator` drives it:
 
 * :attr:`Drive.EFFORT` -- the physics applies ``handle.effort`` (N*m or N):
   an effort command, or a PID's output;
@@ -25,7 +27,7 @@ import abc
 import dataclasses
 import enum
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from types import MappingProxyType
 from typing import Any, ClassVar
 
@@ -294,6 +296,10 @@ class Controller(abc.ABC):
     # Whether the type commands joints (a command controller, a gripper's action controller)
     # rather than only reading them (a broadcaster); those update first in every step.
     commands_joints: ClassVar[bool] = False
+    # Whether the type keeps its update rate inside its own update, which then runs every
+    # physics step (a steered base tracks its steering angles every step, its kinematics at
+    # update_rate); the stepping loop gives it no clock of its own.
+    own_clock: ClassVar[bool] = False
     # Chained mode, and the references offered before configure (see the methods below).
     _chained: bool = False
     _available_references: Mapping[str, Reference] = MappingProxyType({})
@@ -323,6 +329,22 @@ class Controller(abc.ABC):
     @abc.abstractmethod
     def update(self, time: float, period: float) -> None:
         """Run one control step at sim ``time`` (s), ``period`` s after the previous one."""
+
+    def actuation(self) -> Callable[[float], None] | None:
+        """Return what the hardware does with this controller's held commands every physics step.
+
+        Asked when the controller is active on a clock slower than the
+        physics; the returned function is then called with the physics step
+        (s) at every step, after the step's updates, as a hardware
+        interface's ``write`` runs every step: an ideal position actuator
+        ramps its setpoint toward the held command and turns it into a
+        velocity target from the joint's present position
+        (gz_ros2_control's ``position_proportional_gain`` per physics step).
+        A controller that returns one may leave that part out of its update
+        from then on.  None (the default): the held commands are all the
+        physics needs.
+        """
+        return None
 
     def ros_surface(self) -> tuple[Endpoint, ...]:
         """Return the topics and actions this controller has while configured (none here)."""

@@ -41,9 +41,14 @@ from pan_tilt_sim.model.command_modes import (
     mode_switch_refusal,
     system_claims,
 )
-from pan_tilt_sim.model.controller_config import ControllersConfig, ControllerSpec
+from pan_tilt_sim.model.controller_config import (
+    UPDATE_RATE_FIELD,
+    ControllersConfig,
+    ControllerSpec,
+)
+from pan_tilt_sim.model.rates import rate_problem
 from pan_tilt_sim.model.robot import RobotModel
-from pan_tilt_sim.schedule import PeriodicSchedule
+from pan_tilt_sim.schedule import DUE_EPSILON, PeriodicSchedule, steps_per_update
 
 ACTIVE_CONTROLLERS = 'active_controllers'
 # ros2_control's lifecycle labels (controller_manager_msgs/ControllerState.state).
@@ -68,8 +73,18 @@ class ControllerManager:
                  model: RobotModel | None = None, *, active: Sequence[str] | None = None,
                  active_name: str = f"the parameter '{ACTIVE_CONTROLLERS}'",
                  autostart: bool = True,
-                 hardware: HardwareInterfaces = NO_HARDWARE) -> None:
+                 hardware: HardwareInterfaces = NO_HARDWARE,
+                 time_step: float | None = None) -> None:
         self._source = config.label
+        # The physics step (s) the controllers' clocks count in; None: every controller
+        # updates at every step (a manager driven by hand, without physics).
+        self._time_step = time_step
+        # Each loaded controller's update_rate (Hz) as its parameters give it; None: none
+        # given (a ROS 1 file), every physics step.
+        self._rates: dict[str, float | None] = {}
+        # One line each: a rate whose period is not a whole number of physics steps, and
+        # what the controllers on it do instead (the start-up log says them).
+        self.clock_notes: list[str] = []
         self._model = model
         self._handles = handles
         # The robot's <ros2_control> sensors and gpios, offered to every controller.
@@ -185,6 +200,7 @@ class ControllerManager:
             where = self._source if wanted is None else active_name
             raise ControllerConfigError(f'{where}: {refusal}')
         self._change_active(active_names, set())
+        self.clock_notes = self._clock_notes(self.configured)
 
     @property
     def controllers(self) -> list[Controller]:
@@ -210,6 +226,50 @@ class ControllerManager:
     def step_members(self) -> list[Controller]:
         """The controllers whose updates :attr:`updates` are, in the same order."""
         return self._step_members
+
+    @property
+    def step_clocks(self) -> list[tuple[int, float]]:
+        """Each of :attr:`step_members`' clock: (update every so many physics steps, period s).
+
+        The period is that many physics steps: the time since the last update.
+        """
+        return self._step_clocks
+
+    @property
+    def actuations(self) -> list[Callable[[float], None]]:
+        """What the hardware does every physics step with held commands, in update order.
+
+        The :meth:`~pan_tilt_sim.controllers.base.Controller.actuation` of every
+        step member that updates less often than every physics step; called
+        with the physics step (s) after the step's updates.
+        """
+        return self._actuations
+
+    def update_rate_of(self, name: str) -> float | None:
+        """Return the rate (Hz) the loaded controller ``name`` updates at.
+
+        Its own ``update_rate``, else the controller_manager's (a ros2_control
+        style file gives every controller that one); None for a ROS 1 file's
+        controller, which updates at every physics step.
+        """
+        return self._rates[name]
+
+    def clock_of(self, controller: Controller) -> tuple[int, float]:
+        """Return the loaded ``controller``'s clock: (every so many physics steps, period s).
+
+        Every step for a ROS 1 file's controller, and for one that keeps its
+        rate itself (:attr:`~pan_tilt_sim.controllers.base.Controller.own_clock`);
+        otherwise the first step at which ``1 / update_rate`` has passed since
+        the last update, as gz_ros2_control counts (at least one step).
+        """
+        dt = self._time_step
+        rate = self._rates.get(controller.name)
+        if dt is None:
+            return 1, 0.0
+        if rate is None or controller.own_clock:
+            return 1, dt
+        steps = steps_per_update(1.0 / rate, dt)
+        return steps, steps * dt
 
     @property
     def scheduled_updates(self) -> list[tuple[PeriodicSchedule, Callable[[float, float], None]]]:
@@ -273,6 +333,7 @@ class ControllerManager:
             raise ControllerConfigError(f"a controller named '{name}' was already loaded")
         controller = self._create(name, type_name, params, source or self._source)
         self._add(controller, UNCONFIGURED)
+        controller.notices.extend(self._clock_notes([controller]))
         return controller
 
     def configure(self, name: str) -> Controller:
@@ -321,7 +382,7 @@ class ControllerManager:
             raise ControllerConfigError(
                 f"could not unload controller with name '{name}' because it is still active")
         self._controllers.remove(controller)
-        del self._by_name[name], self._states[name]
+        del self._by_name[name], self._states[name], self._rates[name]
         self._bound.pop(name, None)
         return controller
 
@@ -471,8 +532,18 @@ class ControllerManager:
         active = [c for c in self._controllers if c.name in self._active_names]
         ordered = self._chain_order(active)  # None only for loops, which switch() refuses
         self._active = active if ordered is None else ordered
-        self._step_members = [member for controller in self._active
-                              for member in controller.step_members()]
+        members: list[Controller] = []
+        clocks: list[tuple[int, float]] = []
+        actuations: list[Callable[[float], None]] = []
+        for controller in self._active:
+            clock = self.clock_of(controller)
+            for member in controller.step_members():
+                members.append(member)
+                clocks.append(clock)
+                actuation = member.actuation() if clock[0] > 1 else None
+                if actuation is not None:
+                    actuations.append(actuation)
+        self._step_members, self._step_clocks, self._actuations = members, clocks, actuations
         self._updates = [member.update for member in self._step_members]
         self._scheduled = [(schedule, controller.update) for controller in self._active
                            if (schedule := controller.schedule()) is not None]
@@ -496,7 +567,45 @@ class ControllerManager:
                     f"{source}: {name}: joint '{joint}' is a "
                     f'{self._unmovable[joint].value} joint; a controller can only drive '
                     'revolute, continuous and prismatic joints')
+        rate = params.get(UPDATE_RATE_FIELD)
+        if rate is not None:  # checked here for every type: not all of them declare it
+            if isinstance(rate, bool) or not isinstance(rate, int | float):
+                raise ControllerConfigError(
+                    f'{source}: {name}.{UPDATE_RATE_FIELD}: {rate!r} is not a number of Hz')
+            problem = rate_problem(rate)
+            if problem is not None:
+                raise ControllerConfigError(f'{source}: {name}.{UPDATE_RATE_FIELD}: {problem}')
+            rate = float(rate)
+        self._rates[name] = rate
         return controller
+
+    def _clock_notes(self, controllers: Iterable[Controller]) -> list[str]:
+        """Return one line per rate whose period is not a whole number of physics steps.
+
+        Naming the controllers on it (only those on the stepping loop's clock)
+        and the rate they update at instead.
+        """
+        dt = self._time_step
+        if dt is None:
+            return []
+        uneven: dict[float, list[str]] = {}
+        for controller in controllers:
+            rate = self._rates.get(controller.name)
+            if rate is None or controller.own_clock or controller.schedule() is not None:
+                continue
+            if abs(self.clock_of(controller)[1] - 1.0 / rate) > DUE_EPSILON:
+                uneven.setdefault(rate, []).append(controller.name)
+        notes = []
+        for rate, names in uneven.items():
+            steps = steps_per_update(1.0 / rate, dt)
+            period = steps * dt
+            notes.append(
+                f"update_rate {rate:g} Hz of {', '.join(names)} is not a whole number of "
+                f'physics steps ({dt:g} s): updates every {steps} step'
+                f"{'s' if steps > 1 else ''}, {1.0 / period:.4g} Hz (period {period:g} s), at "
+                'the first step where 1 / update_rate has passed since the last update, '
+                'as gz_ros2_control runs it')
+        return notes
 
     def _add(self, controller: Controller, state: str) -> None:
         self._controllers.append(controller)

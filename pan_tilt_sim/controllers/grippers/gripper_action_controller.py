@@ -15,7 +15,7 @@ Design notes: docs/design/controllers.md#gripper_action_controllerpy.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.framework.base import (
@@ -271,6 +271,14 @@ class GripperActionController(Controller):
         if self._goal is not None:
             self._judge(self._goal, time, error, handle)
         self.drive(handle, error, period)
+
+    def actuation(self) -> Callable[[float], None] | None:
+        """Return the ideal actuator (this type's :meth:`drive`): it tracks every step."""
+        return self._track if type(self).drive is GripperActionController.drive else None
+
+    def _track(self, time_step: float) -> None:
+        handle = self._handle
+        self.drive(handle, self._command.position - handle.position, time_step)
 
     def drive(self, handle: JointHandle, error: float, period: float) -> None:
         """Drive the joint toward the command (the ideal actuator, force at most the cap)."""

@@ -19,15 +19,18 @@ from __future__ import annotations
 # The fields' names in row order: FIELDS[index] names the constant equal to index.
 FIELDS = ('KIND', 'P_GAIN', 'I_GAIN', 'D_GAIN', 'I_CLAMP_MIN', 'I_CLAMP_MAX', 'ANTIWINDUP',
           'MAX_VELOCITY', 'EFFORT_LIMIT', 'SETPOINT', 'COMMAND', 'INTEGRAL', 'OUTPUT',
-          'LAST_MEASUREMENT')
+          'LAST_MEASUREMENT', 'UPDATE_STEPS', 'NEXT_UPDATE', 'PERIOD')
 ROW_SIZE = len(FIELDS)
 (KIND, P_GAIN, I_GAIN, D_GAIN, I_CLAMP_MIN, I_CLAMP_MAX, ANTIWINDUP, MAX_VELOCITY, EFFORT_LIMIT,
- SETPOINT, COMMAND, INTEGRAL, OUTPUT, LAST_MEASUREMENT) = range(ROW_SIZE)
+ SETPOINT, COMMAND, INTEGRAL, OUTPUT, LAST_MEASUREMENT, UPDATE_STEPS, NEXT_UPDATE,
+ PERIOD) = range(ROW_SIZE)
 
 POSITION_PID, VELOCITY_PID, EFFORT = 0.0, 1.0, 2.0
 # Each law kind's name and its code in a row's KIND field.
 KINDS = {'POSITION_PID': POSITION_PID, 'VELOCITY_PID': VELOCITY_PID, 'EFFORT': EFFORT}
 _UNUSED = 0.0
+# A row's clock as the laws build it: every step, due at the first, dt the physics step.
+EVERY_STEP, DUE_NOW, PHYSICS_STEP = 1.0, 0.0, 0.0
 
 
 def pid_row(kind: float, pid_values: list[float], max_velocity: float, effort_limit: float,
@@ -35,7 +38,7 @@ def pid_row(kind: float, pid_values: list[float], max_velocity: float, effort_li
     """Return a PID law's row from :meth:`~.pid.Pid.law_values` and the controller's state."""
     p, i, d, i_min, i_max, antiwindup, integral, output, last = pid_values
     return [kind, p, i, d, i_min, i_max, antiwindup, max_velocity, effort_limit, setpoint,
-            command, integral, output, last]
+            command, integral, output, last, EVERY_STEP, DUE_NOW, PHYSICS_STEP]
 
 
 def effort_row(command: float) -> list[float]:
@@ -43,4 +46,5 @@ def effort_row(command: float) -> list[float]:
     row = [_UNUSED] * ROW_SIZE
     row[KIND] = EFFORT
     row[COMMAND] = command
+    row[UPDATE_STEPS], row[NEXT_UPDATE], row[PERIOD] = EVERY_STEP, DUE_NOW, PHYSICS_STEP
     return row

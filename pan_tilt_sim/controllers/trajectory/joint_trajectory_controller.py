@@ -520,6 +520,25 @@ class JointTrajectoryController(MultiJointController):
             return CommandResult.CLAMPED
         return CommandResult.ACCEPTED
 
+    def actuation(self) -> Callable[[float], None] | None:
+        """For joints without gains: the ideal actuator tracking the held desired state."""
+        ideal = [index for index in self._indices if self._pids[index] is None]
+        if not ideal:
+            return None
+
+        def track(time_step: float) -> None:
+            handles, positions = self._handles, self._desired_positions
+            velocities, gains = self._desired_velocities, self._tracking_gains
+            for index in ideal:
+                handle = handles[index]
+                target = velocities[index] + gains[index] / time_step * (
+                    positions[index] - handle.position)
+                limit = self._max_velocities[index]
+                handle.velocity_target = (limit if target > limit else
+                                          -limit if target < -limit else target)
+
+        return track
+
     def update(self, time: float, period: float) -> None:
         """Start a due trajectory, sample the desired state, run the PIDs."""
         pending = self._pending

@@ -437,7 +437,8 @@ def test_velocity_group_spins_its_joints_at_the_command(tmp_path, type_name):
 def test_velocity_group_with_gains_lags_like_a_first_order_loop(tmp_path, type_name):
     commands, seconds, gain = [0.5, -0.1], 0.5, 10.0
     gains = f'{{pan: {{p: {gain}}}, slide: {{p: {gain}}}}}'
-    with star_simulation(tmp_path, type_name, gains=gains,
+    # At every physics step: the loop's law, without the lag of an effort held 10 steps.
+    with star_simulation(tmp_path, type_name, gains=gains, update_rate=1.0 / DT,
                          **interface_params(type_name, 'velocity')) as sim:
         sim.controller('group').set_command(commands)
         sim.advance(round(seconds / DT))
@@ -557,8 +558,10 @@ def test_acceleration_group_speeds_its_joints_up_at_the_command(tmp_path):
         sim.controller('group').set_command(accelerations)
         sim.advance(steps)
         velocities, positions = sim.joint_velocities(), sim.joint_positions()
-    # As ros2_control's mock hardware: v += a * dt, then x += v * dt, every step.
+    # As ros2_control's mock hardware at the controller_manager's 100 Hz: v += a * period
+    # at every update, held for its 10 physics steps, over which x grows by v * dt each.
+    period, updates = 0.01, steps // 10
     for joint, acceleration in zip(('pan', 'slide'), accelerations, strict=True):
         assert velocities[joint] == pytest.approx(acceleration * steps * DT, abs=1e-6)
         assert positions[joint] == pytest.approx(
-            acceleration * DT * DT * steps * (steps + 1) / 2, abs=1e-5)
+            acceleration * period * period * updates * (updates + 1) / 2, abs=1e-5)

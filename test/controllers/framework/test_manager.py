@@ -12,6 +12,7 @@ from robot_fixtures import JointDef, star_robot_urdf
 from ros2_control_fixtures import UR_STYLE_YAML, write, write_arm
 
 from pan_tilt_sim.controllers import JointHandle
+from pan_tilt_sim.controllers.toolbox.actuator import ramp
 from pan_tilt_sim.controllers.framework.manager import (
     ACTIVE,
     INACTIVE,
@@ -584,3 +585,111 @@ def test_two_active_controllers_on_one_gpio_command_interface_is_refused(tmp_pat
         manager.switch(['io'])
     manager.switch(['io'], ['gripper'])
     assert [c.name for c in manager.active] == ['io']
+
+
+# --- each controller's clock, as ros2_control runs it ------------------------------------
+
+def star_manager(tmp_path, controllers: str, *, time_step: float | None = DT):
+    """Return a manager of a two-joint star robot with ``controllers`` (YAML text)."""
+    urdf = tmp_path / 'star.urdf'
+    urdf.write_text(star_robot_urdf([JointDef('a'), JointDef('b')]), encoding='utf-8')
+    description = load_description(urdf)
+    handles = {joint.name: JointHandle(joint) for joint in description.actuated_joints}
+    path = write(tmp_path, 'controllers.yaml', controllers)
+    return ControllerManager(load_controllers_config(path), handles, description.model,
+                             time_step=time_step)
+
+
+def ros2_style(manager_rate: float, own_rate: str = '', *, position: bool = True,
+               tricycle: bool = False) -> str:
+    """A ros2_control style file: a broadcaster, and a position and/or a tricycle controller."""
+    declared = ['jsb: {type: joint_state_broadcaster/JointStateBroadcaster}']
+    sections = []
+    if position:
+        declared.append('pos: {type: position_controllers/JointPositionController}')
+        sections.append(f'pos:\n  ros__parameters: {{joint: a, {own_rate}}}')
+    if tricycle:
+        declared.append('steer: {type: tricycle_controller/TricycleController}')
+        sections.append('steer:\n  ros__parameters: {traction_joint_name: b, '
+                        'steering_joint_name: a, wheelbase: 1.0, wheel_radius: 0.1}')
+    lines = '\n'.join(f'    {entry}' for entry in declared)
+    return (f'controller_manager:\n  ros__parameters:\n    update_rate: {manager_rate}\n'
+            f'{lines}\n' + '\n'.join(sections) + '\n')
+
+
+def test_each_controller_updates_at_the_managers_rate_or_its_own(tmp_path):
+    manager = star_manager(tmp_path, ros2_style(100))
+    assert manager.update_rate_of('pos') == 100.0
+    assert manager.clock_of(manager.controller('pos')) == (10, 10 * DT)
+    assert manager.step_clocks == [(10, 10 * DT)]
+    manager = star_manager(tmp_path, ros2_style(100, 'update_rate: 500'))
+    assert manager.update_rate_of('pos') == 500.0
+    assert manager.step_clocks == [(2, 2 * DT)]
+    assert manager.clock_notes == []
+
+
+def test_a_ros1_files_controllers_update_at_every_physics_step(tmp_path):
+    manager = star_manager(tmp_path, """
+        pos: {type: position_controllers/JointPositionController, joint: a}
+        """)
+    assert manager.update_rate_of('pos') is None
+    assert manager.step_clocks == [(1, DT)]
+    assert manager.actuations == []  # the update itself tracks, every step
+
+
+def test_a_rate_whose_period_is_no_whole_number_of_steps_is_said_in_one_line(tmp_path):
+    manager = star_manager(tmp_path, ros2_style(300))
+    assert manager.step_clocks == [(4, 4 * DT)]
+    # The broadcaster keeps its own schedule: it is not named.
+    assert manager.clock_notes == [
+        'update_rate 300 Hz of pos is not a whole number of physics steps (0.001 s): updates '
+        'every 4 steps, 250 Hz (period 0.004 s), at the first step where 1 / update_rate has '
+        'passed since the last update, as gz_ros2_control runs it']
+    faster = star_manager(tmp_path, ros2_style(100, 'update_rate: 2500'))
+    assert faster.step_clocks == [(1, DT)]
+    assert faster.clock_notes[0].startswith(
+        'update_rate 2500 Hz of pos is not a whole number of physics steps (0.001 s): updates '
+        'every 1 step, 1000 Hz (period 0.001 s)')
+
+
+def test_a_controller_keeping_its_own_rate_is_called_every_step(tmp_path):
+    manager = star_manager(tmp_path, ros2_style(300, position=False, tricycle=True))
+    assert manager.update_rate_of('steer') == 300.0
+    assert [member.name for member in manager.step_members] == ['steer']
+    assert manager.step_clocks == [(1, DT)] and manager.clock_notes == []
+
+
+def test_an_ideal_actuator_on_a_slower_clock_ramps_and_tracks_every_step(tmp_path):
+    manager = star_manager(tmp_path, ros2_style(100))
+    (actuate,) = manager.actuations
+    controller = manager.controller('pos')
+    handle = controller._handle
+    controller.set_command(0.5)
+    manager.updates[0](0.0, 0.01)  # takes the command; the hardware moves toward it
+    assert controller.setpoint == 0.0 and handle.velocity_target == 0.0
+    handle.position = -0.001
+    actuate(DT)  # one physics step of the ramp, then the target from the joint's position
+    setpoint, rate = ramp(0.0, 0.0, 0.5, DT, 2.0)
+    assert (controller.setpoint, controller._rate) == (setpoint, rate)
+    assert handle.velocity_target == rate + handle.tracking_gain / DT * (setpoint + 0.001)
+
+
+def test_without_a_time_step_every_controller_updates_every_call(tmp_path):
+    manager = star_manager(tmp_path, ros2_style(100),
+                           time_step=None)
+    assert manager.step_clocks == [(1, 0.0)] and manager.actuations == []
+
+
+@pytest.mark.parametrize(('rate', 'problem'), [
+    ("'fast'", "'fast' is not a number of Hz"),
+    ('true', 'True is not a number of Hz'),
+    ('-5', '-5 must be a rate > 0 Hz whose period 1 / rate is finite'),
+    ('5.0e-324', '5e-324 must be a rate > 0 Hz whose period 1 / rate is finite'),
+])
+def test_a_controllers_own_update_rate_that_is_no_rate_is_refused_naming_it(tmp_path, rate,
+                                                                             problem):
+    # JointPositionController does not list update_rate among its parameters: the
+    # manager checks it for every type.
+    with pytest.raises(ControllerConfigError) as caught:
+        star_manager(tmp_path, ros2_style(100, f'update_rate: {rate}'))
+    assert str(caught.value).endswith(f'controllers.yaml: pos.update_rate: {problem}')

@@ -189,6 +189,7 @@ class SteeringController(OdometryOutputs, CommandController):
 
     chainable = True
     drives_base: ClassVar[bool] = True
+    own_clock: ClassVar[bool] = True  # the kinematics at update_rate, the steering every step
     command_topic = 'reference'
     command_kind = CommandKind.TWIST_STAMPED
     configuration: ClassVar[Configuration]
