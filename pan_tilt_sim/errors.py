@@ -6,10 +6,10 @@ names the file, field or parameter and what is wrong with it.
 
 
 class ConfigurationError(Exception):
-    """A user-supplied file or parameter is wrong; the message says how.
+    r"""A user-supplied file or parameter is wrong; the message says how.
 
-    Its text is always one line: a line break it quotes (a joint named ``"a\\nb"``)
-    reads as ``\\n``, so the one-line error of a start-up stays one line.
+    Its text is always one line: a line break it quotes (a joint named ``"a\nb"``)
+    reads as ``\n``, so the one-line error of a start-up stays one line.
     """
 
     def __str__(self) -> str:

@@ -5,7 +5,7 @@ the measured joint states go into the joint handles (and, for joints an
 ideal actuator drives, the effort its motor applied), every active
 controller due on its own clock updates (command controllers first, so
 broadcasters sample fresh efforts; see
-:mod:`pan_tilt_sim.controllers.manager` for the clocks), the hardware's
+:mod:`pan_tilt_sim.controllers.framework.manager` for the clocks), the hardware's
 per-step part runs on the held commands (an ideal actuator's tracking), the
 efforts and velocity targets go to PyBullet, and PyBullet advances one
 ``time_step``.  Sim time is kept as a step count, so it never
@@ -32,10 +32,11 @@ from typing import Protocol
 
 import numpy
 
-from pan_tilt_sim.controllers import CommandController, Controller, JointHandle, step_law
+from pan_tilt_sim.controllers import CommandController, Controller, JointHandle
 from pan_tilt_sim.controllers.framework.base import Drive, idle_actuator
 from pan_tilt_sim.controllers.framework.manager import ControllerManager
 from pan_tilt_sim.controllers.framework.registry import drives_base
+from pan_tilt_sim.controllers.toolbox import step_law
 from pan_tilt_sim.controllers.toolbox.actuator import TRACKING_GAIN
 from pan_tilt_sim.controllers.toolbox.gains import plugin_gains
 from pan_tilt_sim.model.base_pose import FIXED_BASE, ORIGIN, BasePose

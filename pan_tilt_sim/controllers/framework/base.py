@@ -4,7 +4,7 @@ A controller is pure Python: it is built from its YAML parameters, then
 :meth:`Controller.configure` hands it the :class:`JointHandle` objects of
 the joints it names, and :meth:`Controller.update` runs at the
 controller's update rate (the stepping loop's clock: see
-:mod:`pan_tilt_sim.controllers.manager`).  Handles carry the measured
+:mod:`pan_tilt_sim.controllers.framework.manager`).  Handles carry the measured
 state (written by the simulation before each update) and what the
 controller wants the physics to do with the joint (read by the simulation
 after it).  At configure time the controller tells each of its joints'

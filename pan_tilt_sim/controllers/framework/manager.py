@@ -239,7 +239,7 @@ class ControllerManager:
     def actuations(self) -> list[Callable[[float], None]]:
         """What the hardware does every physics step with held commands, in update order.
 
-        The :meth:`~pan_tilt_sim.controllers.base.Controller.actuation` of every
+        The :meth:`~pan_tilt_sim.controllers.framework.base.Controller.actuation` of every
         step member that updates less often than every physics step; called
         with the physics step (s) after the step's updates.
         """
@@ -258,7 +258,7 @@ class ControllerManager:
         """Return the loaded ``controller``'s clock: (every so many physics steps, period s).
 
         Every step for a ROS 1 file's controller, and for one that keeps its
-        rate itself (:attr:`~pan_tilt_sim.controllers.base.Controller.own_clock`);
+        rate itself (:attr:`~pan_tilt_sim.controllers.framework.base.Controller.own_clock`);
         otherwise the first step at which ``1 / update_rate`` has passed since
         the last update, as gz_ros2_control counts (at least one step).
         """

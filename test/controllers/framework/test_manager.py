@@ -12,13 +12,13 @@ from robot_fixtures import JointDef, star_robot_urdf
 from ros2_control_fixtures import UR_STYLE_YAML, write, write_arm
 
 from pan_tilt_sim.controllers import JointHandle
-from pan_tilt_sim.controllers.toolbox.actuator import ramp
 from pan_tilt_sim.controllers.framework.manager import (
     ACTIVE,
     INACTIVE,
     UNCONFIGURED,
     ControllerManager,
 )
+from pan_tilt_sim.controllers.toolbox.actuator import ramp
 from pan_tilt_sim.errors import ControllerConfigError, ControllerSwitchError
 from pan_tilt_sim.model.controller_config import load_controllers_config
 from pan_tilt_sim.model.description import load_description
