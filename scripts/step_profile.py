@@ -150,12 +150,12 @@ def scene_figures(scene: str) -> None:
                                 ground=has_ground(world.scenery))
             spawn_world_objects(entities, world)
             for topic, message in case.messages.items():
-                simulation.controller(topic.split('/')[1]).set_command(
+                simulation.controller(topic.rsplit('/', 2)[-2]).set_command(
                     bench_scenes._command_value(message))
             for action, goal in case.goals.items():
                 from pan_tilt_sim.ros.ros_interfaces import joint_trajectory
 
-                simulation.controller(action.split('/')[1]).set_command(
+                simulation.controller(action.rsplit('/', 2)[-2]).set_command(
                     joint_trajectory(goal.trajectory))
             engine = per_step_us(simulation.advance, ENGINE_STEPS)
             profiler = cProfile.Profile()

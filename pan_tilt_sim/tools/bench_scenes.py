@@ -51,6 +51,7 @@ import math
 import pathlib
 import statistics
 import xml.etree.ElementTree as ElementTree
+from collections.abc import Callable
 
 import yaml
 from builtin_interfaces.msg import Duration
@@ -59,7 +60,8 @@ from geometry_msgs.msg import Twist, TwistStamped
 from std_msgs.msg import Float64, Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from pan_tilt_sim.controllers.surface import StampedTwist
+from pan_tilt_sim.controllers.surface import CommandTopic, StampedTwist
+from pan_tilt_sim.model.base_pose import parse_initial_pose
 from pan_tilt_sim.model.world_file import world_from_parameter
 from pan_tilt_sim.ros.ros_interfaces import joint_trajectory
 from pan_tilt_sim.sim.bullet import pybullet
@@ -651,13 +653,27 @@ def tb3_sandbox(folder: pathlib.Path) -> dict[str, SceneCase]:
 
 def _command_value(message: object) -> object:
     """Return a bench message as the command value its controller takes in-process."""
-    if isinstance(message, TwistStamped):
-        linear, angular = message.twist.linear, message.twist.angular
+    if isinstance(message, TwistStamped | Twist):
+        twist = message.twist if isinstance(message, TwistStamped) else message
+        linear, angular = twist.linear, twist.angular
         return StampedTwist(0.0, (linear.x, linear.y, linear.z),
                             (angular.x, angular.y, angular.z))
     if isinstance(message, Float64MultiArray):
         return list(message.data)
     return message.data
+
+
+def _command_taker(simulation: object, topic: str) -> Callable[[object], object]:
+    """Return what takes ``topic``'s commands: its controller, else a Gazebo plugin's topic."""
+    try:
+        return simulation.controller(topic.rsplit('/', 2)[-2]).set_command
+    except KeyError:
+        leaf = topic.rsplit('/', 1)[-1]
+        for plugin in simulation.plugins:
+            for endpoint in plugin.ros_surface():
+                if isinstance(endpoint, CommandTopic) and endpoint.name.rsplit('/', 1)[-1] == leaf:
+                    return endpoint.accept
+        raise
 
 
 def in_process_figures(case: SceneCase, time_step: float,
@@ -681,10 +697,13 @@ def in_process_figures(case: SceneCase, time_step: float,
     """
     fixed = case.parameters.get('fixed_base')
     world = world_from_parameter(case.parameters.get('world', 'empty'))
+    pose = case.parameters.get('initial_pose')
     with CommandRecorder() as recorder, make_simulation(
             str(case.description_file),
             None if case.controllers_file is None else str(case.controllers_file), time_step,
-            fixed_base=None if fixed is None else fixed == 'true') as simulation:
+            fixed_base=None if fixed is None else fixed == 'true',
+            initial_pose=parse_initial_pose(None if pose is None else yaml.safe_load(pose))
+            ) as simulation:
         client = simulation.physics.client_id
         if world.physics is not None and world.physics.solver_iterations is not None:
             simulation.physics.set_solver_iterations(world.physics.solver_iterations)
@@ -694,9 +713,9 @@ def in_process_figures(case: SceneCase, time_step: float,
         try:
             spawn_world_objects(entities, world)
             for topic, message in case.messages.items():
-                simulation.controller(topic.split('/')[1]).set_command(_command_value(message))
+                _command_taker(simulation, topic)(_command_value(message))
             for action, goal in case.goals.items():
-                simulation.controller(action.split('/')[1]).set_command(
+                simulation.controller(action.rsplit('/', 2)[-2]).set_command(
                     joint_trajectory(goal.trajectory))
             simulation.advance(round(settle_s / time_step))
             saved = pybullet.saveState(physicsClientId=client)
