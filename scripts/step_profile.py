@@ -13,7 +13,13 @@ microseconds per physics step:
   Nobody subscribes here, so nothing is published (0.00): ``bench`` measures
   the node with a /clock or JointState subscriber in another process.
 
-Usage: ``python scripts/step_profile.py [--seconds S]``
+``--scene driving_base|grasp|ur5e_like`` profiles a bench scene's first case
+instead (:mod:`pan_tilt_sim.tools.bench_scenes`), in this process without
+ROS: PyBullet alone on its recorded commands (``raw_step_us``), the engine
+per step, and the engine's Python functions that cost the most per step
+(cProfile's own time, which cProfile inflates: read them as shares).
+
+Usage: ``python scripts/step_profile.py [--seconds S] [--scene NAME]``
 (sets ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST; use your own ROS_DOMAIN_ID).
 """
 
@@ -109,12 +115,77 @@ def node_figures(seconds: float) -> dict[str, float]:
     return figures
 
 
+SCENE_CASES = {'driving_base': 'on_ground', 'grasp': 'holding', 'ur5e_like': 'follow_trajectory'}
+PROFILE_TOP = 15
+
+
+def scene_figures(scene: str) -> None:
+    """Print where one step of a bench scene's first case goes, in this process."""
+    import cProfile
+    import pathlib
+    import pstats
+    import tempfile
+
+    from pan_tilt_sim.model.world_file import world_from_parameter
+    from pan_tilt_sim.share import package_share
+    from pan_tilt_sim.sim.engine import make_simulation
+    from pan_tilt_sim.sim.entities import Entities, spawn_world_objects
+    from pan_tilt_sim.sim.world import build_world, has_ground
+    from pan_tilt_sim.tools import bench_scenes
+
+    with tempfile.TemporaryDirectory() as folder:
+        makers = {'driving_base': lambda: bench_scenes.driving_base(package_share(),
+                                                                    pathlib.Path(folder)),
+                  'grasp': lambda: bench_scenes.grasp(pathlib.Path(folder)),
+                  'ur5e_like': lambda: bench_scenes.ur5e_like(pathlib.Path(folder))}
+        case = makers[scene]()[SCENE_CASES[scene]]
+        raw = bench_scenes.in_process_figures(case, TIME_STEP)
+        fixed = case.parameters.get('fixed_base')
+        world = world_from_parameter(case.parameters.get('world', 'empty'))
+        with make_simulation(str(case.description_file), str(case.controllers_file), TIME_STEP,
+                             fixed_base=None if fixed is None else fixed == 'true'
+                             ) as simulation:
+            entities = Entities(simulation.physics, simulation.description.name,
+                                targets=build_world(world.scenery, simulation.physics.client_id),
+                                ground=has_ground(world.scenery))
+            spawn_world_objects(entities, world)
+            for topic, message in case.messages.items():
+                simulation.controller(topic.rsplit('/', 2)[-2]).set_command(
+                    bench_scenes._command_value(message))
+            for action, goal in case.goals.items():
+                from pan_tilt_sim.ros.ros_interfaces import joint_trajectory
+
+                simulation.controller(action.rsplit('/', 2)[-2]).set_command(
+                    joint_trajectory(goal.trajectory))
+            engine = per_step_us(simulation.advance, ENGINE_STEPS)
+            profiler = cProfile.Profile()
+            profiler.runcall(simulation.advance, ENGINE_STEPS)
+            entities.close()
+    print(f'{scene} ({SCENE_CASES[scene]}), time_step {TIME_STEP} s: thread CPU us per step')
+    print(f'  {"PyBullet alone, its commands replayed (raw_step_us)":60s} '
+          f'{raw["raw_step_us"]:7.2f}')
+    print(f'  {"engine: PyBullet + controllers (Simulation.advance)":60s} {engine:7.2f}')
+    print(f'  {"ratio_to_raw of the engine alone":60s} {raw["raw_step_us"] / engine:7.2f}')
+    print("the engine's costliest functions, own time per step (cProfile, inflated):")
+    stats = pstats.Stats(profiler)
+    rows = sorted(stats.stats.items(), key=lambda item: item[1][2], reverse=True)[:PROFILE_TOP]
+    for (filename, line, function), (_, calls, own, _, _) in rows:
+        where = f'{pathlib.Path(filename).name}:{line} {function}'
+        print(f'  {where[:60]:60s} {own / ENGINE_STEPS * MICROSECONDS:7.2f}  '
+              f'({calls / ENGINE_STEPS:.2f} calls)')
+
+
 def main() -> None:
     """Print the per-step figures."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--seconds', type=float, default=5.0, help='node run, wall s')
+    parser.add_argument('--scene', choices=sorted(SCENE_CASES), default=None,
+                        help="profile a bench scene's first case instead (no ROS)")
     args = parser.parse_args()
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    if args.scene is not None:
+        scene_figures(args.scene)
+        return
     from pan_tilt_sim.share import DEFAULT_CONTROLLERS, DEFAULT_DESCRIPTION, package_share
     from pan_tilt_sim.sim.engine import make_simulation
 

@@ -1,5 +1,5 @@
 /*
- * PyBullet's three per-step calls -- joint torques, stepSimulation,
+ * PyBullet's per-step calls -- velocity motors, joint torques, stepSimulation,
  * getJointStates -- made from C, for pan_tilt_sim.sim.compiled_step.
  *
  * This file is two things at once:
@@ -35,6 +35,7 @@ enum {
     ACTUAL_STATE_UPDATE_COMPLETED = 21,
     STEP_FORWARD_SIMULATION_COMPLETED = 26,
     SYNC_BODY_INFO_COMPLETED = 66,
+    CONTROL_MODE_VELOCITY = 0,
     CONTROL_MODE_TORQUE = 1,
 };
 
@@ -57,6 +58,9 @@ struct PluginContext {
 static struct {
     CommandHandle (*control_init)(ClientHandle, int body, int mode);
     int (*set_torque)(CommandHandle, int dof, double value);
+    int (*set_velocity)(CommandHandle, int dof, double value);
+    int (*set_kd)(CommandHandle, int dof, double value);
+    int (*set_max_force)(CommandHandle, int dof, double value);
     StatusHandle (*submit)(ClientHandle, CommandHandle);
     int (*status_type)(StatusHandle);
     int (*can_submit)(ClientHandle);
@@ -106,6 +110,9 @@ static PyObject *bind(PyObject *module, PyObject *args)
     struct { void **slot; const char *name; } wanted[] = {
         {(void **)&api.control_init, "b3JointControlCommandInit2"},
         {(void **)&api.set_torque, "b3JointControlSetDesiredForceTorque"},
+        {(void **)&api.set_velocity, "b3JointControlSetDesiredVelocity"},
+        {(void **)&api.set_kd, "b3JointControlSetKd"},
+        {(void **)&api.set_max_force, "b3JointControlSetMaximumForce"},
         {(void **)&api.submit, "b3SubmitClientCommandAndWaitStatus"},
         {(void **)&api.status_type, "b3GetStatusType"},
         {(void **)&api.can_submit, "b3CanSubmitCommand"},
@@ -185,6 +192,8 @@ typedef struct {
     int *joints;
     Py_ssize_t effort_count;
     int *effort_dofs;
+    Py_ssize_t motor_count;
+    int *motor_dofs;
 } Stepper;
 
 static int *int_array(PyObject *sequence, Py_ssize_t *count, const char *what)
@@ -213,12 +222,12 @@ static int *int_array(PyObject *sequence, Py_ssize_t *count, const char *what)
     return values;
 }
 
-/* connection.stepper(body, joints, effort_dofs) */
+/* connection.stepper(body, joints, effort_dofs[, motor_dofs]) */
 static PyObject *connection_stepper(Connection *self, PyObject *args)
 {
     int body;
-    PyObject *joints, *effort_dofs;
-    if (!PyArg_ParseTuple(args, "iOO", &body, &joints, &effort_dofs)) {
+    PyObject *joints, *effort_dofs, *motor_dofs = NULL;
+    if (!PyArg_ParseTuple(args, "iOO|O", &body, &joints, &effort_dofs, &motor_dofs)) {
         return NULL;
     }
     Stepper *stepper = PyObject_New(Stepper, &StepperType);
@@ -227,6 +236,8 @@ static PyObject *connection_stepper(Connection *self, PyObject *args)
     }
     stepper->joints = NULL;
     stepper->effort_dofs = NULL;
+    stepper->motor_dofs = NULL;
+    stepper->motor_count = 0;
     Py_INCREF(self);
     stepper->connection = self;
     stepper->body = body;
@@ -241,6 +252,14 @@ static PyObject *connection_stepper(Connection *self, PyObject *args)
         Py_DECREF(stepper);
         return NULL;
     }
+    if (motor_dofs != NULL) {
+        stepper->motor_dofs = int_array(motor_dofs, &stepper->motor_count,
+                                        "motor_dofs: a sequence of ints");
+        if (stepper->motor_dofs == NULL) {
+            Py_DECREF(stepper);
+            return NULL;
+        }
+    }
     return (PyObject *)stepper;
 }
 
@@ -248,6 +267,7 @@ static void stepper_dealloc(Stepper *self)
 {
     PyMem_Free(self->joints);
     PyMem_Free(self->effort_dofs);
+    PyMem_Free(self->motor_dofs);
     Py_XDECREF(self->connection);
     PyObject_Free(self);
 }
@@ -394,6 +414,77 @@ static PyObject *stepper_call(Stepper *self, PyObject *args, PyObject *kwargs)
         return NULL;
     }
     return joint_states(client, status, self);
+}
+
+/*
+ * ``values``, one per velocity motor, into ``into`` (``what`` names them in the
+ * error); 0 with an exception set if they are not that many numbers.
+ */
+static int read_motor_values(const Stepper *self, PyObject *values, double *into,
+                             const char *what)
+{
+    PyObject *tuple = PySequence_Tuple(values);
+    if (tuple == NULL) {
+        return 0;
+    }
+    int ok = PyTuple_GET_SIZE(tuple) == self->motor_count;
+    if (!ok) {
+        PyErr_Format(PyExc_ValueError, "%zd %s for %zd velocity motors",
+                     PyTuple_GET_SIZE(tuple), what, self->motor_count);
+    }
+    for (Py_ssize_t k = 0; ok && k < self->motor_count; k++) {
+        ok = float_item(tuple, k, &into[k]);
+    }
+    Py_DECREF(tuple);
+    return ok;
+}
+
+/*
+ * stepper.drive(efforts, targets, forces, gains) -> the joint states after one step:
+ * the velocity motors of ``motor_dofs`` first (target velocity, maximum force,
+ * velocity gain each), as pybullet.c sends setJointMotorControlArray in
+ * VELOCITY_CONTROL, then what calling the stepper does.
+ */
+static PyObject *stepper_drive(Stepper *self, PyObject *args)
+{
+    PyObject *efforts, *targets, *forces, *gains;
+    if (!PyArg_ParseTuple(args, "OOOO", &efforts, &targets, &forces, &gains)) {
+        return NULL;
+    }
+    Py_ssize_t size = (self->effort_count > self->motor_count
+                       ? self->effort_count : self->motor_count) + 1;
+    double *buffer = PyMem_Malloc(sizeof(double) * (size_t)(4 * size));
+    if (buffer == NULL) {
+        return PyErr_NoMemory();
+    }
+    double *torques = buffer, *velocities = buffer + size, *limits = buffer + 2 * size;
+    double *kds = buffer + 3 * size;
+    ClientHandle client = NULL;
+    /* Nothing is sent unless every value is a number; the client looked up last. */
+    if (read_torques(self, efforts, torques)
+        && read_motor_values(self, targets, velocities, "targets")
+        && read_motor_values(self, forces, limits, "forces")
+        && read_motor_values(self, gains, kds, "gains")) {
+        client = open_client(self);
+    }
+    PyObject *result = NULL;
+    if (client != NULL) {
+        if (self->motor_count > 0) {
+            CommandHandle command = api.control_init(client, self->body, CONTROL_MODE_VELOCITY);
+            for (Py_ssize_t k = 0; k < self->motor_count; k++) {
+                api.set_velocity(command, self->motor_dofs[k], velocities[k]);
+                api.set_kd(command, self->motor_dofs[k], kds[k]);
+                api.set_max_force(command, self->motor_dofs[k], limits[k]);
+            }
+            api.submit(client, command);
+        }
+        StatusHandle status = step_once(self, client, torques);
+        if (status != NULL) {
+            result = joint_states(client, status, self);
+        }
+    }
+    PyMem_Free(buffer);
+    return result;
 }
 
 /* ---- the controller laws: many steps without Python ---- */
@@ -734,6 +825,8 @@ done:
 }
 
 static PyMethodDef stepper_methods[] = {
+    {"drive", (PyCFunction)stepper_drive, METH_VARARGS,
+     "drive(efforts, targets, forces, gains) -> states: the velocity motors, then a step"},
     {"run_laws", (PyCFunction)stepper_run_laws, METH_VARARGS,
      "run_laws(steps, dt, efforts, laws, states) -> (before_last, last): "
      "steps with every per-step controller one of the laws"},

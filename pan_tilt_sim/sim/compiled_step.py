@@ -1,7 +1,8 @@
 """PyBullet's per-step calls from compiled code, where the package was built with it.
 
 Every physics step makes three PyBullet calls: the joint torques, one
-``stepSimulation``, the joint states.  Through PyBullet's Python module each
+``stepSimulation``, the joint states (and a fourth before them where velocity
+motors drive joints: their targets and forces).  Through PyBullet's Python module each
 call parses its arguments, and ``stepSimulation`` builds a dict of solver
 statistics per step that nobody reads.  ``_compiled_step`` (C, built by
 ``pip install`` / colcon when a compiler is there) sends the same commands
@@ -90,9 +91,14 @@ class Connection(Protocol):
 
     closed: bool
 
-    def stepper(self, body: int, joints: Sequence[int],
-                effort_dofs: Sequence[int]) -> Callable[[Sequence[float]], tuple]:
-        """Return ``step(efforts)``: torques on ``effort_dofs``, one step, ``joints``' states."""
+    def stepper(self, body: int, joints: Sequence[int], effort_dofs: Sequence[int],
+                motor_dofs: Sequence[int] = ()) -> Callable[[Sequence[float]], tuple]:
+        """Return ``step(efforts)``: torques on ``effort_dofs``, one step, ``joints``' states.
+
+        Its ``drive(efforts, targets, forces, gains)`` first sets the velocity
+        motors of ``motor_dofs`` (target velocity, maximum force, velocity
+        gain), as ``setJointMotorControlArray`` in ``VELOCITY_CONTROL`` does.
+        """
 
     def close(self) -> None:
         """Forget the client; steppers raise RuntimeError from then on."""

@@ -368,19 +368,25 @@ class Physics:
         """Whether each step's PyBullet calls are made from C (:mod:`.compiled_step`)."""
         return bool(self._compiled)
 
-    def effort_stepper(self, effort_indices: Sequence[int]
+    def effort_stepper(self, effort_indices: Sequence[int], motor_indices: Sequence[int] = ()
                        ) -> Callable[[Sequence[float]], Sequence]:
         """Return ``step(efforts)``: torques on the joints at ``effort_indices``, a step, states.
 
         The states are :meth:`read_states`'s.  The function is compiled
         where :attr:`compiled_step` says so, else three PyBullet calls; both
-        send PyBullet the same commands.
+        send PyBullet the same commands.  The compiled one also has
+        ``drive(efforts, targets, forces, gains)``: the velocity motors of the
+        joints at ``motor_indices`` first (as ``setJointMotorControlArray``
+        in ``VELOCITY_CONTROL``), then the same.
         """
         body, client, indices = self._body, self._client, self._indices
         if self._compiled:
-            dofs = [pybullet.getJointInfo(body, index, physicsClientId=client)[4]
-                    for index in effort_indices]  # uIndex, as setJointMotorControlArray takes it
-            return self._compiled[0].stepper(body, indices, dofs)
+            def dofs(joints: Sequence[int]) -> list[int]:
+                # uIndex, as setJointMotorControlArray takes it
+                return [pybullet.getJointInfo(body, index, physicsClientId=client)[4]
+                        for index in joints]
+            return self._compiled[0].stepper(body, indices, dofs(effort_indices),
+                                             dofs(motor_indices))
         set_motors, torque_mode = pybullet.setJointMotorControlArray, pybullet.TORQUE_CONTROL
         step_simulation, get_states = pybullet.stepSimulation, pybullet.getJointStates
         effort_indices = list(effort_indices)
@@ -729,8 +735,10 @@ class _Drives:
         self._countdown = [0]
 
         set_motors = pybullet.setJointMotorControlArray
-        # Torques, one step, the states: compiled where the package was built with it.
-        effort_step = physics.effort_stepper(effort_indices)
+        # Torques, one step, the states: compiled where the package was built with it;
+        # there, the velocity motors go from C in the same call (drive_motors).
+        effort_step = physics.effort_stepper(effort_indices, motor_indices)
+        drive_motors = getattr(effort_step, 'drive', None)
         velocity_mode = pybullet.VELOCITY_CONTROL
         countdown, refresh = self._countdown, self._refresh
         states_box = [physics.read_states()]
@@ -767,9 +775,14 @@ class _Drives:
                     excess = (drive if drive >= 0.0 else -drive) - friction
                     motor_forces[motor_slot] = (friction + gain * excess if excess > 0.0
                                                 else friction)
-                set_motors(body, motor_indices, velocity_mode, motor_zeros, motor_targets,
-                           motor_forces, motor_zeros, motor_gains, client)
-            states = effort_step(efforts)
+                if drive_motors is not None:
+                    states = drive_motors(efforts, motor_targets, motor_forces, motor_gains)
+                else:
+                    set_motors(body, motor_indices, velocity_mode, motor_zeros, motor_targets,
+                               motor_forces, motor_zeros, motor_gains, client)
+                    states = effort_step(efforts)
+            else:
+                states = effort_step(efforts)
             for row in rows:
                 slot = row[0]
                 state = states[slot]

@@ -10,13 +10,18 @@ the engine makes them: from C where the package was built with its compiled
 step (:mod:`pan_tilt_sim.sim.compiled_step`).  Windows alternate between the
 two; either way PyBullet gets the same commands, so the replay retraces the
 recorded motion exactly.
+
+For any scene, :class:`CommandRecorder` records the commands a simulation
+sends PyBullet step by step, and :func:`replay_step_cost` replays them on the
+same bodies (from a saved state) and times ``stepSimulation`` alone.
 """
 
 from __future__ import annotations
 
+import os
 import statistics
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from pan_tilt_sim.sim.bullet import pybullet
 from pan_tilt_sim.sim.physics import Physics
@@ -81,3 +86,111 @@ def _clock_overhead_ns() -> float:
         samples.append((clock() - began) / 1000.0 / 2.0)
         del before
     return statistics.median(samples)
+
+
+# PyBullet's calls that change what the next step does: motors, dynamics, base motion, forces.
+COMMAND_CALLS = ('setJointMotorControlArray', 'setJointMotorControl2',
+                 'setJointMotorControlMultiDof', 'setJointMotorControlMultiDofArray',
+                 'changeDynamics', 'resetBaseVelocity', 'applyExternalForce',
+                 'applyExternalTorque')
+
+
+class CommandRecorder:
+    """Records, step by step, the commands a simulation sends PyBullet (a context manager).
+
+    While open, PyBullet's command calls (:data:`COMMAND_CALLS`) and
+    ``stepSimulation`` pass through the recorder, and the compiled step is
+    switched off, so that a simulation built inside the block makes every call
+    through PyBullet's Python module (the compiled step sends the same
+    commands, to the last bit).  Between :meth:`start` and :meth:`stop`,
+    :attr:`steps` gets one list per ``stepSimulation``: the calls made before
+    it, with copies of their list arguments.  :func:`replay_step_cost` plays
+    them back.
+    """
+
+    def __init__(self) -> None:
+        self.steps: list[list[tuple]] = []
+        self._pending: list[tuple] = []
+        self._recording = False
+        self._originals: dict[str, object] = {}
+        self._switch: str | None = None
+
+    def __enter__(self) -> CommandRecorder:
+        from pan_tilt_sim.sim import compiled_step
+
+        self._switch = os.environ.get(compiled_step.ENVIRONMENT_SWITCH)
+        os.environ[compiled_step.ENVIRONMENT_SWITCH] = '0'
+        for name in (*COMMAND_CALLS, 'stepSimulation'):
+            original = getattr(pybullet, name)
+            self._originals[name] = original
+            setattr(pybullet, name, self._stepping(original) if name == 'stepSimulation'
+                    else self._command(original))
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        from pan_tilt_sim.sim import compiled_step
+
+        for name, original in self._originals.items():
+            setattr(pybullet, name, original)
+        self._originals.clear()
+        if self._switch is None:
+            os.environ.pop(compiled_step.ENVIRONMENT_SWITCH, None)
+        else:
+            os.environ[compiled_step.ENVIRONMENT_SWITCH] = self._switch
+
+    def start(self) -> None:
+        """Forget what was recorded; record every step from now on."""
+        self.steps, self._pending, self._recording = [], [], True
+
+    def stop(self) -> None:
+        """Stop recording (the calls made since the last step are dropped)."""
+        self._recording = False
+
+    def _command(self, original: Callable) -> Callable:
+        def record(*args: object, **kwargs: object) -> object:
+            if self._recording:
+                self._pending.append((original, tuple(
+                    list(arg) if isinstance(arg, list) else arg for arg in args), {
+                    key: list(value) if isinstance(value, list) else value
+                    for key, value in kwargs.items()}))
+            return original(*args, **kwargs)
+        return record
+
+    def _stepping(self, original: Callable) -> Callable:
+        def step(*args: object, **kwargs: object) -> object:
+            if self._recording:
+                self.steps.append(self._pending)
+                self._pending = []
+            return original(*args, **kwargs)
+        return step
+
+
+def replay_step_cost(client: int, steps: Sequence[Sequence[tuple]]) -> float:
+    """Replay recorded steps (:class:`CommandRecorder`) on ``client``; return CPU us per step.
+
+    Each step's commands are sent as recorded, then one ``stepSimulation``
+    is timed with this thread's CPU clock; the figure is the median over
+    whole windows of ``WINDOW_STEPS`` steps, or of all of them where there
+    are fewer (the clock reads calibrated out).  Restore the state the
+    recording started from first, and the replay retraces the recorded motion.
+    """
+    if not steps:
+        raise ValueError('no steps to replay')
+    step_simulation = pybullet.stepSimulation
+    clock = time.thread_time_ns
+    overhead = _clock_overhead_ns()
+    window = min(WINDOW_STEPS, len(steps))
+    costs = []
+    # Every step is replayed; a last window shorter than the others is not timed.
+    for start in range(0, len(steps), window):
+        stepping = 0
+        part = steps[start:start + window]
+        for calls in part:
+            for function, args, kwargs in calls:
+                function(*args, **kwargs)
+            before = clock()
+            step_simulation(client)
+            stepping += clock() - before - overhead
+        if len(part) == window:
+            costs.append(stepping / window / NANOSECONDS_PER_MICROSECOND)
+    return statistics.median(costs)

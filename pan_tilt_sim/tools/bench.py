@@ -30,6 +30,8 @@ from collections.abc import Callable, Iterator, Sequence
 
 import rclpy
 import yaml
+from control_msgs.action import FollowJointTrajectory
+from rclpy.action import ActionClient
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import QoSProfile
@@ -103,7 +105,8 @@ class Plan:
     sensor_sim_s: float = 2.0  # sim seconds with every sensor watched
     services_s: float = 5.0  # wall seconds of service calls
     scene_s: float = 5.0  # wall seconds each case of a contact scene is measured
-    scene_contact_s: float = 1.0  # sim seconds over which a case's contacts are counted
+    scene_settle_s: float = 2.0  # sim seconds a case runs in this process before it is recorded
+    scene_contact_s: float = 5.0  # sim seconds recorded: contacts, accuracy, replayed raw
     scene_lidar_s: float = 20.0  # sim seconds over which the sandbox's lidar is timed
 
 
@@ -111,7 +114,7 @@ FULL_PLAN = Plan(raw_s=3.0, raw_sim_s=RAW_SIM_S, warmup_s=1.0, fast_s=5.0, paced
                  startup_runs=STARTUP_RUNS, chain_s=3.0)
 QUICK_PLAN = Plan(raw_s=0.3, raw_sim_s=QUICK_RAW_SIM_S, warmup_s=0.2, fast_s=0.6, paced_s=0.6,
                   startup_runs=1, chain_s=0.4, sensor_sim_s=0.3, services_s=0.5,
-                  scene_s=0.4, scene_contact_s=0.1, scene_lidar_s=0.6)
+                  scene_s=0.4, scene_settle_s=0.3, scene_contact_s=0.2, scene_lidar_s=0.6)
 
 
 class BenchError(RuntimeError):
@@ -132,6 +135,8 @@ class Model:
     parameters: dict[str, str] = dataclasses.field(default_factory=dict)
     # Topic -> a message sent unchanged every COMMAND_PERIOD_S.
     messages: dict[str, object] = dataclasses.field(default_factory=dict)
+    # Action name -> a FollowJointTrajectory goal, sent once the node runs.
+    goals: dict[str, object] = dataclasses.field(default_factory=dict)
 
 
 def load_model(description_file: pathlib.Path, controllers_file: pathlib.Path) -> Model:
@@ -580,6 +585,8 @@ class Bench:
                     self.listener(model.joint_states_topic, JOINT_STATE_TYPE))
             commander = Commander(self.probe, model)
             self.joint_state_sample(node, model)  # it runs
+            for client in self._send_goals(node, model.goals):
+                running.callback(client.destroy)
             self._wait(node, commander, self.plan.warmup_s)
             wall_start, sim_start = self.joint_state_sample(node, model)
             node_threads = node.thread_cpu_seconds()
@@ -596,6 +603,21 @@ class Bench:
         if listener is not None:
             figures['subscriber_cpu_percent'] = listener_cpu / (wall_end - wall_start) * PERCENT
         return figures
+
+    def _send_goals(self, node: NodeProcess, goals: dict[str, object]) -> list[ActionClient]:
+        """Send each FollowJointTrajectory goal; return the clients once all are accepted."""
+        clients = []
+        for action, goal in goals.items():
+            client = ActionClient(self.probe.node, FollowJointTrajectory, action)
+            clients.append(client)
+            self.spin_until(node, client.server_is_ready, FIRST_MESSAGE_TIMEOUT_S,
+                            f'action server {action}')
+            sent = client.send_goal_async(goal)
+            self.spin_until(node, sent.done, FIRST_MESSAGE_TIMEOUT_S,
+                            f'answer to the goal on {action}')
+            if not sent.result().accepted:
+                raise BenchError(f'the goal on {action} was rejected')
+        return clients
 
     def _wait(self, node: NodeProcess, commander: Commander, seconds: float) -> None:
         """Let the node run for ``seconds`` of wall time, sending the commands when due."""
@@ -833,7 +855,14 @@ def run_once(bench: Bench, model: Model) -> dict:
     for joints in CHAIN_JOINTS:
         bench.log(f'chain of {joints} joints at real_time_factor 0')
         urdf, controllers = chain_files(joints, bench.folder)
-        scaling[str(joints)] = bench.fast(load_model(urdf, controllers), plan.chain_s)
+        chain = load_model(urdf, controllers)
+        fast = bench.fast(chain, plan.chain_s)
+        case = bench_scenes.SceneCase(urdf, controllers, {}, {
+            topic: Float64(data=targets[1]) for topic, targets in chain.commands.items()})
+        raw_step = bench_scenes.in_process_figures(
+            case, bench.time_step, plan.scene_settle_s, plan.scene_contact_s)['raw_step_us']
+        scaling[str(joints)] = {**fast, 'raw_step_us': raw_step,
+                                'ratio_to_raw': raw_step / fast['node_cpu_us_per_step']}
     scenes = scene_figures(bench)
     bench.log('sensors, every topic watched')
     sensors = {name: figures['us_per_message'] for name, figures in sensor_costs(
@@ -867,6 +896,7 @@ def scene_figures(bench: Bench) -> dict[str, dict[str, dict[str, float]]]:
     """
     scenes = {'driving_base': bench_scenes.driving_base(package_share(), bench.folder),
               'grasp': bench_scenes.grasp(bench.folder),
+              'ur5e_like': bench_scenes.ur5e_like(bench.folder),
               'tb3_sandbox': bench_scenes.tb3_sandbox(bench.folder)}
     figures: dict[str, dict[str, dict[str, float]]] = {}
     for scene, cases in scenes.items():
@@ -876,14 +906,14 @@ def scene_figures(bench: Bench) -> dict[str, dict[str, dict[str, float]]]:
                       'at real_time_factor 0')
             model = Model(case.description_file, case.controllers_file,
                           case.joint_states_topic, {}, parameters=case.parameters,
-                          messages=case.messages)
+                          messages=case.messages, goals=case.goals)
             fast = bench.fast(model, bench.plan.scene_s, watched=case.watched)
             time_step = bench.step_of(model)
-            if case.watched is None:
-                extra = bench_scenes.contact_points(case, time_step,
-                                                    count_s=bench.plan.scene_contact_s)
-            else:
-                extra = lidar_figures(bench, case, time_step)
+            extra = bench_scenes.in_process_figures(case, time_step, bench.plan.scene_settle_s,
+                                                    bench.plan.scene_contact_s)
+            extra['ratio_to_raw'] = extra['raw_step_us'] / fast['node_cpu_us_per_step']
+            if case.watched is not None:
+                extra.update(lidar_figures(bench, case, time_step))
             figures[scene][case_name] = {
                 **fast, 'real_time_multiple': fast['steps_per_s'] * time_step, **extra}
     return figures

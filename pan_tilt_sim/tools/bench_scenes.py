@@ -1,4 +1,4 @@
-"""The bench's scenes: a driving base in the room, a grasp, and a TurtleBot3-like sandbox.
+"""The bench's scenes: a driving base, a grasp, a six-joint arm and a TurtleBot3-like sandbox.
 
 Each scene is a robot and a world written into the bench's folder from
 package files (the bench runs from an installed package, so it makes its
@@ -14,17 +14,25 @@ import dataclasses
 import itertools
 import math
 import pathlib
+import statistics
 import xml.etree.ElementTree as ElementTree
+from collections.abc import Callable
 
 import yaml
+from builtin_interfaces.msg import Duration
+from control_msgs.action import FollowJointTrajectory
 from geometry_msgs.msg import Twist, TwistStamped
 from std_msgs.msg import Float64, Float64MultiArray
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from pan_tilt_sim.controllers.framework.surface import StampedTwist
+from pan_tilt_sim.controllers.framework.surface import CommandTopic, StampedTwist
+from pan_tilt_sim.model.base_pose import parse_initial_pose
 from pan_tilt_sim.model.world_file import world_from_parameter
+from pan_tilt_sim.ros.ros_interfaces import joint_trajectory
 from pan_tilt_sim.sim.bullet import pybullet
 from pan_tilt_sim.sim.engine import make_simulation
 from pan_tilt_sim.sim.entities import Entities, spawn_world_objects
+from pan_tilt_sim.sim.profiling import CommandRecorder, replay_step_cost
 from pan_tilt_sim.sim.world import build_world, has_ground
 
 ROVER_DESCRIPTION = pathlib.Path('urdf', 'diff_drive_rover.urdf')
@@ -37,6 +45,7 @@ CMD_VEL_TOPIC = f'/{BASE_CONTROLLER}/cmd_vel'
 LINEAR_SPEED = 0.3  # m/s
 CIRCLE_RADIUS = 0.5  # m: from the origin, the circle stays clear of the room's walls and objects
 UPDATE_RATE = 100  # Hz, the controller manager's (the JointStateBroadcaster publishes at it)
+FEW_SOLVER_ITERATIONS = 10  # the driving base's second world: <ode><solver><iters>
 
 FINGER_JOINT = 'left_finger_joint'
 LIFT_JOINT = 'lift_joint'
@@ -68,8 +77,28 @@ SANDBOX_CIRCLE_CENTRE = (PILLAR_GRID / 2, PILLAR_GRID / 2)  # m: a cell between 
 SANDBOX_CIRCLE_RADIUS = 0.3  # m: the robot stays clear of the four cylinders
 SANDBOX_SPEED = 0.2  # m/s
 
-CONTACT_SETTLE_S = 2.0  # sim s before contacts are counted: the grasp closed, the lift up
-CONTACT_COUNT_S = 1.0  # sim s over which contacts are counted
+# The arm: UR5e's published figures (Universal Robots' DH parameters and its ROS 2
+# description's physical_parameters.yaml and joint_limits.yaml); the geometry is ours.
+UR5E_JOINTS = ('shoulder_pan_joint', 'shoulder_lift_joint', 'elbow_joint',
+               'wrist_1_joint', 'wrist_2_joint', 'wrist_3_joint')
+UR5E_MASSES = {'base_link': 4.0, 'shoulder_link': 3.761, 'upper_arm_link': 8.058,
+               'forearm_link': 2.846, 'wrist_1_link': 1.37, 'wrist_2_link': 1.3,
+               'wrist_3_link': 0.365}  # kg
+UR5E_DH = {'d1': 0.1625, 'a2': -0.425, 'a3': -0.3922, 'd4': 0.1333, 'd5': 0.0997,
+           'd6': 0.0996}  # m
+UR5E_EFFORT = (150.0, 150.0, 150.0, 28.0, 28.0, 28.0)  # N m
+UR5E_VELOCITY = math.pi  # rad/s, every joint
+UR5E_UPDATE_RATE = 500  # Hz, UR's controller manager
+ARM_CONTROLLER = 'joint_trajectory_controller'
+ARM_ACTION = f'/{ARM_CONTROLLER}/follow_joint_trajectory'
+ARM_HOME = (0.0, -1.57, 1.57, -1.57, -1.57, 0.0)  # rad: upright, the wrist level
+ARM_AMPLITUDE = 0.5  # rad, each joint's sine about its home position
+ARM_PERIOD = 8.0  # s
+ARM_POINT_S = 0.5  # s between the goal's points
+ARM_GOAL_S = 2000.0  # sim s the goal lasts: beyond any bench window
+
+CONTACT_SETTLE_S = 2.0  # sim s before the recording: the grasp closed, the lift up
+CONTACT_COUNT_S = 5.0  # sim s recorded: contacts counted, accuracy judged, replayed
 
 
 @dataclasses.dataclass(frozen=True)
@@ -86,6 +115,11 @@ class SceneCase:
     messages: dict[str, object]
     joint_states_topic: str = '/joint_states'
     watched: tuple[str, str] | None = None  # (topic, type) a subscriber process reads
+    # Action name -> a FollowJointTrajectory goal, sent once when the node runs.
+    goals: dict[str, object] = dataclasses.field(default_factory=dict)
+    # What in_process_figures checks the physics by: 'odometry', 'box_held',
+    # 'box_on_ground', 'tracking' or ''.
+    accuracy: str = ''
 
 
 def rover_urdf(shipped: str) -> str:
@@ -150,9 +184,73 @@ def driving_base(share: pathlib.Path, folder: pathlib.Path) -> dict[str, SceneCa
     twist.twist.linear.x = LINEAR_SPEED
     twist.twist.angular.z = LINEAR_SPEED / CIRCLE_RADIUS
     world = str(share / ROOM_WORLD)
-    return {case: SceneCase(description, controllers,
-                            {'world': world, 'fixed_base': fixed}, {CMD_VEL_TOPIC: twist})
-            for case, fixed in (('on_ground', 'false'), ('base_fixed', 'true'))}
+    few = folder / 'room_10_iterations.sdf'
+    few.write_text(room_sdf(world_from_parameter(world), FEW_SOLVER_ITERATIONS),
+                   encoding='utf-8')
+    return {case: SceneCase(description, controllers, {'world': path, 'fixed_base': fixed},
+                            {CMD_VEL_TOPIC: twist}, accuracy=accuracy)
+            for case, path, fixed, accuracy in (
+                ('on_ground', world, 'false', 'odometry'),
+                ('base_fixed', world, 'true', ''),
+                ('on_ground_10_iterations', str(few), 'false', 'odometry'))}
+
+
+def room_sdf(room: object, iterations: int) -> str:
+    """Return the room world (``config/worlds/room.yaml``) as an SDF world.
+
+    ``room``: the room read as a :class:`~pan_tilt_sim.model.world_file.World`;
+    its objects become SDF models with the same shapes, poses, masses and
+    statics; ``<physics>`` asks for ``iterations`` solver iterations.
+    """
+    models = []
+    for entity in room.entities:
+        robot = ElementTree.fromstring(entity.resource_string)
+        link = robot.find('link')
+        shape = _sdf_geometry(link.find('collision/geometry'))
+        static = robot.findtext('gazebo/static', 'false').strip()
+        inertia = link.find('inertial/inertia')
+        moments = ''.join(f'<{axis}>{inertia.get(axis)}</{axis}>'
+                          for axis in ('ixx', 'iyy', 'izz'))
+        mass = (f'<inertial><mass>{link.find("inertial/mass").get("value")}</mass>'
+                f'<inertia>{moments}</inertia></inertial>')
+        x, y, z = entity.position
+        roll, pitch, yaw = _rpy(entity.orientation)
+        models.append(f'<model name="{entity.name}"><static>{static}</static>'
+                      f'<pose>{x} {y} {z} {roll} {pitch} {yaw}</pose><link name="link">{mass}'
+                      f'<collision name="c"><geometry>{shape}</geometry></collision>'
+                      f'<visual name="v"><geometry>{shape}</geometry></visual></link></model>')
+    return f'''<?xml version="1.0"?>
+<sdf version="1.6">
+  <world name="room">
+    <physics name="1ms" type="ode"><max_step_size>0.001</max_step_size>
+      <ode><solver><iters>{iterations}</iters></solver></ode></physics>
+    <model name="ground_plane"><static>true</static><link name="link">
+      <collision name="c"><geometry><plane><normal>0 0 1</normal><size>20 20</size></plane>
+      </geometry></collision></link></model>
+    {''.join(models)}
+  </world>
+</sdf>
+'''
+
+
+def _sdf_geometry(geometry: ElementTree.Element) -> str:
+    """Return a URDF ``<geometry>``'s box, cylinder or sphere as SDF."""
+    box, cylinder, sphere = (geometry.find(kind) for kind in ('box', 'cylinder', 'sphere'))
+    if box is not None:
+        return f'<box><size>{box.get("size")}</size></box>'
+    if cylinder is not None:
+        return (f'<cylinder><radius>{cylinder.get("radius")}</radius>'
+                f'<length>{cylinder.get("length")}</length></cylinder>')
+    return f'<sphere><radius>{sphere.get("radius")}</radius></sphere>'
+
+
+def _rpy(q: tuple[float, float, float, float]) -> tuple[float, float, float]:
+    """Roll, pitch, yaw (rad) of a unit quaternion (x, y, z, w)."""
+    x, y, z, w = q
+    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
+    yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    return roll, pitch, yaw
 
 
 def _finger(name: str, side: float) -> str:
@@ -238,8 +336,122 @@ def grasp(folder: pathlib.Path) -> dict[str, SceneCase]:
     # box long before the lift has risen by a millimetre or two.
     return {case: SceneCase(description, controllers, {'world': str(world)}, {
         f'/{FINGER_CONTROLLER}/commands': Float64MultiArray(data=[grip]),
-        f'/{LIFT_CONTROLLER}/command': Float64(data=LIFT_M)})
-        for case, grip in (('holding', -GRIP_N), ('open', GRIP_N))}
+        f'/{LIFT_CONTROLLER}/command': Float64(data=LIFT_M)}, accuracy=accuracy)
+        for case, grip, accuracy in (('holding', -GRIP_N, 'box_held'),
+                                     ('open', GRIP_N, 'box_on_ground'))}
+
+
+def _cylinder_inertia(mass: float, radius: float, length: float) -> str:
+    """Return a solid cylinder's inertia about its centre, its axis along z."""
+    side = mass * (3.0 * radius ** 2 + length ** 2) / 12.0
+    return (f'<inertia ixx="{side:.6g}" ixy="0" ixz="0" iyy="{side:.6g}" iyz="0" '
+            f'izz="{mass * radius ** 2 / 2.0:.6g}"/>')
+
+
+def ur5e_like_urdf() -> str:
+    """Return the six-joint arm: UR5e's masses, lengths and limits on cylinders of our own.
+
+    Joint frames follow the UR5e's DH parameters (:data:`UR5E_DH`): every
+    joint turns about its frame's z axis.  Each link is a cylinder whose mass
+    (:data:`UR5E_MASSES`) sits at its middle.
+    """
+    dh = UR5E_DH
+    half_pi = math.pi / 2
+    # (joint origin xyz, rpy) in the parent's frame; (link cylinder centre xyz, rpy, length).
+    joints = [((0.0, 0.0, dh['d1']), (0.0, 0.0, 0.0)),
+              ((0.0, 0.0, 0.0), (half_pi, 0.0, 0.0)),
+              ((dh['a2'], 0.0, 0.0), (0.0, 0.0, 0.0)),
+              ((dh['a3'], 0.0, dh['d4']), (0.0, 0.0, 0.0)),
+              ((0.0, -dh['d5'], 0.0), (half_pi, 0.0, 0.0)),
+              ((0.0, dh['d6'], 0.0), (-half_pi, 0.0, 0.0))]
+    links = [((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.12),
+             ((dh['a2'] / 2, 0.0, 0.0), (0.0, half_pi, 0.0), abs(dh['a2'])),
+             ((dh['a3'] / 2, 0.0, 0.0), (0.0, half_pi, 0.0), abs(dh['a3'])),
+             ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.1),
+             ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.1),
+             ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.04)]
+    radius = 0.045
+    names = list(UR5E_MASSES)
+
+    def triple(values: tuple[float, float, float]) -> str:
+        return ' '.join(f'{value:.6g}' for value in values)
+
+    def link(name: str, centre: tuple, rpy: tuple, length: float) -> str:
+        mass = UR5E_MASSES[name]
+        origin = f'<origin xyz="{triple(centre)}" rpy="{triple(rpy)}"/>'
+        shape = f'<geometry><cylinder radius="{radius}" length="{length:.6g}"/></geometry>'
+        return (f'<link name="{name}"><inertial>{origin}<mass value="{mass}"/>'
+                f'{_cylinder_inertia(mass, radius, length)}</inertial>'
+                f'<visual>{origin}{shape}</visual><collision>{origin}{shape}</collision></link>')
+
+    parts = [link(names[0], (0.0, 0.0, 0.025), (0.0, 0.0, 0.0), 0.05)]
+    control = []
+    for index, (joint, effort) in enumerate(zip(UR5E_JOINTS, UR5E_EFFORT, strict=True)):
+        (xyz, rpy), (centre, link_rpy, length) = joints[index], links[index]
+        limit = math.pi if joint == 'elbow_joint' else 2 * math.pi
+        parts.append(
+            f'<joint name="{joint}" type="revolute"><parent link="{names[index]}"/>'
+            f'<child link="{names[index + 1]}"/><origin xyz="{triple(xyz)}" '
+            f'rpy="{triple(rpy)}"/><axis xyz="0 0 1"/><limit lower="{-limit:.6g}" '
+            f'upper="{limit:.6g}" effort="{effort}" velocity="{UR5E_VELOCITY:.6g}"/></joint>')
+        parts.append(link(names[index + 1], centre, link_rpy, length))
+        control.append(f'<joint name="{joint}"><command_interface name="position"/>'
+                       f'<state_interface name="position"><param name="initial_value">'
+                       f'{ARM_HOME[index]}</param></state_interface>'
+                       '<state_interface name="velocity"/></joint>')
+    return ('<?xml version="1.0"?><robot name="ur5e_like">' + ''.join(parts)
+            + '<ros2_control name="ur5e_like" type="system"><hardware><plugin>'
+            'gz_ros2_control/GazeboSimSystem</plugin></hardware>' + ''.join(control)
+            + '</ros2_control></robot>\n')
+
+
+def ur5e_like_controllers() -> str:
+    """Return the arm's controllers: a broadcaster and a position JointTrajectoryController."""
+    return yaml.safe_dump({
+        'controller_manager': {'ros__parameters': {
+            'update_rate': UR5E_UPDATE_RATE,
+            'joint_state_broadcaster': {'type': 'joint_state_broadcaster/JointStateBroadcaster'},
+            ARM_CONTROLLER: {'type': 'joint_trajectory_controller/JointTrajectoryController'}}},
+        'joint_state_broadcaster': {'ros__parameters': {'publish_rate': 100.0}},
+        ARM_CONTROLLER: {'ros__parameters': {
+            'joints': list(UR5E_JOINTS), 'command_interfaces': ['position'],
+            'state_interfaces': ['position', 'velocity']}},
+    }, sort_keys=False)
+
+
+def arm_goal(duration: float = ARM_GOAL_S) -> FollowJointTrajectory.Goal:
+    """Return a goal swinging every joint in a sine about :data:`ARM_HOME` for ``duration`` s.
+
+    Points every :data:`ARM_POINT_S` with positions and velocities; it starts
+    at home, at rest, and so does it end (whole periods).
+    """
+    omega = 2.0 * math.pi / ARM_PERIOD
+    periods = max(1, round(duration / ARM_PERIOD))
+    points = []
+    for index in range(1, round(periods * ARM_PERIOD / ARM_POINT_S) + 1):
+        t = index * ARM_POINT_S
+        # (1 - cos) keeps every joint at rest at the start and the end of each period.
+        swing = ARM_AMPLITUDE * (1.0 - math.cos(omega * t)) / 2.0
+        speed = ARM_AMPLITUDE * omega * math.sin(omega * t) / 2.0
+        seconds = math.floor(t)
+        points.append(JointTrajectoryPoint(
+            positions=[home + swing * (1 if joint % 2 else -1)
+                       for joint, home in enumerate(ARM_HOME)],
+            velocities=[speed * (1 if joint % 2 else -1) for joint in range(len(ARM_HOME))],
+            time_from_start=Duration(sec=seconds, nanosec=round((t - seconds) * 1e9))))
+    return FollowJointTrajectory.Goal(
+        trajectory=JointTrajectory(joint_names=list(UR5E_JOINTS), points=points))
+
+
+def ur5e_like(folder: pathlib.Path) -> dict[str, SceneCase]:
+    """Write the arm's files into ``folder``; return its case (follow_trajectory)."""
+    description = folder / 'ur5e_like.urdf'
+    description.write_text(ur5e_like_urdf(), encoding='utf-8')
+    controllers = folder / 'ur5e_like_controllers.yaml'
+    controllers.write_text(ur5e_like_controllers(), encoding='utf-8')
+    return {'follow_trajectory': SceneCase(
+        description, controllers, {'world': 'empty'}, {}, goals={ARM_ACTION: arm_goal()},
+        accuracy='tracking')}
 
 
 def waffle_sdf() -> str:
@@ -406,8 +618,9 @@ def tb3_sandbox(folder: pathlib.Path) -> dict[str, SceneCase]:
 
 def _command_value(message: object) -> object:
     """Return a bench message as the command value its controller takes in-process."""
-    if isinstance(message, TwistStamped):
-        linear, angular = message.twist.linear, message.twist.angular
+    if isinstance(message, TwistStamped | Twist):
+        twist = message.twist if isinstance(message, TwistStamped) else message
+        linear, angular = twist.linear, twist.angular
         return StampedTwist(0.0, (linear.x, linear.y, linear.z),
                             (angular.x, angular.y, angular.z))
     if isinstance(message, Float64MultiArray):
@@ -415,41 +628,127 @@ def _command_value(message: object) -> object:
     return message.data
 
 
-def contact_points(case: SceneCase, time_step: float,
-                   settle_s: float = CONTACT_SETTLE_S,
-                   count_s: float = CONTACT_COUNT_S) -> dict[str, float]:
-    """Run ``case`` in this process as sim_node would; count PyBullet's contact points.
+def _command_taker(simulation: object, topic: str) -> Callable[[object], object]:
+    """Return what takes ``topic``'s commands: its controller, else a Gazebo plugin's topic."""
+    try:
+        return simulation.controller(topic.rsplit('/', 2)[-2]).set_command
+    except KeyError:
+        leaf = topic.rsplit('/', 1)[-1]
+        for plugin in simulation.plugins:
+            for endpoint in plugin.ros_surface():
+                if isinstance(endpoint, CommandTopic) and endpoint.name.rsplit('/', 1)[-1] == leaf:
+                    return endpoint.accept
+        raise
 
-    The case's commands go to its controllers at the start; after
-    ``settle_s`` of sim time, the contact points of every step of the next
-    ``count_s`` are counted.  Returns ``contact_points`` (the mean per step)
-    and, where the world has a ``box``, ``box_height_m`` (its centre's z at
-    the end, m): the figures say what PyBullet solved, not how fast.
+
+def in_process_figures(case: SceneCase, time_step: float,
+                       settle_s: float = CONTACT_SETTLE_S,
+                       count_s: float = CONTACT_COUNT_S) -> dict[str, float]:
+    """Run ``case`` in this process as sim_node would; what PyBullet solved, and alone costs.
+
+    The case's commands (and goals, as trajectories) go to its controllers at
+    the start.  After ``settle_s`` of sim time the state is saved and the
+    next ``count_s`` are run with every command sent to PyBullet recorded;
+    then the state is restored and the recorded commands are replayed with
+    nothing else running.  Returns ``contact_points`` (PyBullet's per step,
+    mean), ``raw_step_us`` (thread CPU us of one ``stepSimulation`` in the
+    replay, median over windows) and the case's accuracy at the end of the
+    recorded run: ``odometry_error_percent`` (the controller's odometry
+    against the base's true position, % of the distance driven),
+    ``box_height_m`` and ``box_height_error_m`` (the box's centre, and how far
+    it is from where a held box, or one on the ground, belongs) or
+    ``tracking_error_rad`` (the trajectory controller's largest position
+    error over the recorded run).
     """
     fixed = case.parameters.get('fixed_base')
-    with make_simulation(str(case.description_file), str(case.controllers_file), time_step,
-                         fixed_base=None if fixed is None else fixed == 'true') as simulation:
-        world = world_from_parameter(case.parameters['world'])
+    world = world_from_parameter(case.parameters.get('world', 'empty'))
+    pose = case.parameters.get('initial_pose')
+    with CommandRecorder() as recorder, make_simulation(
+            str(case.description_file),
+            None if case.controllers_file is None else str(case.controllers_file), time_step,
+            fixed_base=None if fixed is None else fixed == 'true',
+            initial_pose=parse_initial_pose(None if pose is None else yaml.safe_load(pose))
+            ) as simulation:
         client = simulation.physics.client_id
+        if world.physics is not None and world.physics.solver_iterations is not None:
+            simulation.physics.set_solver_iterations(world.physics.solver_iterations)
         targets = build_world(world.scenery, client)
         entities = Entities(simulation.physics, simulation.description.name, targets=targets,
                             ground=has_ground(world.scenery))
         try:
             spawn_world_objects(entities, world)
             for topic, message in case.messages.items():
-                controller = simulation.controller(topic.split('/')[1])
-                controller.set_command(_command_value(message))
+                _command_taker(simulation, topic)(_command_value(message))
+            for action, goal in case.goals.items():
+                simulation.controller(action.rsplit('/', 2)[-2]).set_command(
+                    joint_trajectory(goal.trajectory))
             simulation.advance(round(settle_s / time_step))
+            saved = pybullet.saveState(physicsClientId=client)
             steps = round(count_s / time_step)
-            total = 0
+            tracking = case.accuracy == 'tracking'
+            contacts, error = 0, 0.0
+            start = _odometry_and_truth(case, simulation)
+            recorder.start()
             for _ in range(steps):
                 simulation.advance(1)
-                total += len(pybullet.getContactPoints(physicsClientId=client))
-            heights = {name: entities.state(name).pose.translation[2]
-                       for name in entities.names() if name == 'box'}
+                contacts += len(pybullet.getContactPoints(physicsClientId=client))
+                if tracking:
+                    error = max(error, *map(abs, simulation.controller(
+                        ARM_CONTROLLER).position_errors()))
+            recorder.stop()
+            figures = {'contact_points': contacts / steps,
+                       **_accuracy(case, simulation, entities, start, steps * time_step)}
+            if tracking:
+                figures['tracking_error_rad'] = error
+            pybullet.restoreState(stateId=saved, physicsClientId=client)
+            figures['raw_step_us'] = replay_step_cost(client, recorder.steps)
         finally:
             entities.close()
-    figures = {'contact_points': total / steps}
-    if heights:
-        figures['box_height_m'] = heights['box']
     return figures
+
+
+def _odometry_and_truth(case: SceneCase, simulation: object) -> tuple | None:
+    """Return the odometry's pose and the base's true pose (x, y, heading), if the case drives."""
+    if case.accuracy != 'odometry':
+        return None
+    odometry = simulation.controller(BASE_CONTROLLER).odometry
+    # The odometry follows the middle of the wheels' axle: the truth's point there too.
+    robot = ElementTree.fromstring(case.description_file.read_text(encoding='utf-8'))
+    joints = {joint.get('name'): joint for joint in robot.findall('joint')}
+    ahead = statistics.fmean(float(joints[wheel].find('origin').get('xyz').split()[0])
+                             for wheel in WHEELS)
+    x, y, heading = simulation.base_state()[0]
+    return ((odometry.x, odometry.y, odometry.heading),
+            (x + ahead * math.cos(heading), y + ahead * math.sin(heading), heading))
+
+
+def _moved(start: tuple[float, float, float], end: tuple[float, float, float]
+           ) -> tuple[float, float]:
+    """Return the way from pose ``start`` to ``end`` in ``start``'s own axes (m)."""
+    dx, dy = end[0] - start[0], end[1] - start[1]
+    cos, sin = math.cos(start[2]), math.sin(start[2])
+    return cos * dx + sin * dy, cos * dy - sin * dx
+
+
+def _accuracy(case: SceneCase, simulation: object, entities: Entities, start: tuple | None,
+              seconds: float) -> dict[str, float]:
+    """Return the case's accuracy over the recorded ``seconds`` (see :func:`in_process_figures`).
+
+    The odometry is compared with the truth over the recorded run: where
+    each says the base went from where each said it was at the start,
+    in its own axes then, so that what slipped while the wheels spun up
+    does not count again at every later step.
+    """
+    if case.accuracy == 'odometry':
+        (odometry_start, truth_start), (odometry_end, truth_end) = start, _odometry_and_truth(
+            case, simulation)
+        odometry, truth = _moved(odometry_start, odometry_end), _moved(truth_start, truth_end)
+        return {'odometry_error_percent': math.hypot(odometry[0] - truth[0],
+                                                     odometry[1] - truth[1])
+                / (LINEAR_SPEED * seconds) * 100.0}
+    if case.accuracy in ('box_held', 'box_on_ground'):
+        height = entities.state('box').pose.translation[2]
+        # Held, the box belongs where the fingers took it: lifted as far as the lift is.
+        lift = simulation.joint_positions()[LIFT_JOINT] if case.accuracy == 'box_held' else 0.0
+        return {'box_height_m': height, 'box_height_error_m': abs(height - BOX_SIZE / 2 - lift)}
+    return {}

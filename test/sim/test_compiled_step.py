@@ -206,3 +206,46 @@ def test_a_number_that_closes_the_simulation_is_an_error_not_a_crash(description
             return 1.0
     with pytest.raises(RuntimeError, match='closed'):
         step([Closing(), 1.0])  # the client is looked up after the efforts are read
+
+
+def drive_reference(description, targets: list[float], steps: int) -> list:
+    """Velocity motors on both joints then a step, through PyBullet's Python module."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv(compiled_step.ENVIRONMENT_SWITCH, '0')
+        with Physics(description, 0.001) as physics:
+            indices = [physics.joint_index(joint.name) for joint in physics.joints]
+            step = physics.effort_stepper([])
+            count = len(indices)
+            states = []
+            for _ in range(steps):
+                pybullet.setJointMotorControlArray(
+                    physics.body_id, indices, pybullet.VELOCITY_CONTROL, [0.0] * count,
+                    targets, [5.0] * count, [0.0] * count, [0.7] * count, physics.client_id)
+                states.append(step([]))
+            return states
+
+
+@needs_the_compiled_step
+def test_velocity_motors_driven_from_c_move_the_joints_as_pybullet_s_own_call(description):
+    targets = [1.5, -0.5]
+    expected = drive_reference(description, targets, 50)
+    with Physics(description, 0.001) as physics:
+        indices = [physics.joint_index(joint.name) for joint in physics.joints]
+        drive = physics.effort_stepper([], indices).drive
+        seen = [drive([], targets, [5.0, 5.0], [0.7, 0.7]) for _ in range(50)]
+    assert seen == expected  # to the last bit
+    assert expected[-1][0][1] != 0.0  # the motors moved the joints
+
+
+@needs_the_compiled_step
+@pytest.mark.parametrize(('targets', 'forces', 'error'), [
+    ([1.0], [5.0, 5.0], ValueError), ([1.0, 2.0], [5.0, 'x'], TypeError)])
+def test_motor_values_it_cannot_apply_are_refused_before_anything_is_sent(description, targets,
+                                                                         forces, error):
+    with Physics(description, 0.001) as physics:
+        indices = [physics.joint_index(joint.name) for joint in physics.joints]
+        drive = physics.effort_stepper([], indices).drive
+        before = physics.read_states()
+        with pytest.raises(error):
+            drive([], targets, forces, [1.0, 1.0])
+        assert physics.read_states() == before  # no step was taken

@@ -17,7 +17,10 @@ from nav_msgs.msg import Odometry
 from node_harness import PROBE_QUEUE, sim_node
 from sensor_msgs.msg import LaserScan
 
+from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.model.world_file import world_from_parameter
 from pan_tilt_sim.share import package_share
+from pan_tilt_sim.sim.bullet import pybullet
 from pan_tilt_sim.sim.engine import make_simulation
 from pan_tilt_sim.tools import bench, bench_scenes
 
@@ -32,14 +35,21 @@ FACTOR_0 = {
     'recording': {'steps_per_s', 'node_cpu_us_per_step', 'ratio_to_raw'},
 }
 SERVICE_ROUND_TRIP = {'p50_ms', 'p99_ms', 'answers_per_s', 'unanswered'}
-SCENES = {'driving_base': {'on_ground', 'base_fixed'}, 'grasp': {'holding', 'open'},
+SCENES = {'driving_base': {'on_ground', 'base_fixed', 'on_ground_10_iterations'},
+          'grasp': {'holding', 'open'}, 'ur5e_like': {'follow_trajectory'},
           'tb3_sandbox': {'circle'}}
-SCENE_CASE = {'steps_per_s', 'node_cpu_us_per_step', 'real_time_multiple', 'contact_points'}
-SCENE_CASES = {'driving_base': SCENE_CASE, 'grasp': SCENE_CASE | {'box_height_m'},
-               'tb3_sandbox': {'steps_per_s', 'node_cpu_us_per_step', 'real_time_multiple',
-                               'subscriber_cpu_percent', 'lidar_us_per_scan',
-                               'lidar_us_per_step'}}
+SCENE_CASE = {'steps_per_s', 'node_cpu_us_per_step', 'real_time_multiple', 'contact_points',
+              'raw_step_us', 'ratio_to_raw'}
+ODOMETRY = SCENE_CASE | {'odometry_error_percent'}
+BOX = SCENE_CASE | {'box_height_m', 'box_height_error_m'}
+SCENE_CASES = {'on_ground': ODOMETRY, 'base_fixed': SCENE_CASE,
+               'on_ground_10_iterations': ODOMETRY, 'holding': BOX, 'open': BOX,
+               'follow_trajectory': SCENE_CASE | {'tracking_error_rad'},
+               'circle': SCENE_CASE | {'subscriber_cpu_percent', 'lidar_us_per_scan',
+                                       'lidar_us_per_step'}}
+CHAIN = {'steps_per_s', 'node_cpu_us_per_step', 'raw_step_us', 'ratio_to_raw'}
 TIME_STEPS = {'driving_base': bench.DEFAULT_TIME_STEP, 'grasp': bench.DEFAULT_TIME_STEP,
+              'ur5e_like': bench.DEFAULT_TIME_STEP,
               'tb3_sandbox': bench_scenes.SANDBOX_STEP}  # the sandbox's world says 3 ms
 FACTOR_1 = {'cpu_percent', 'cpu_percent_with_joint_states', 'cpu_percent_recording',
             'clock_subscriber_cpu_percent',
@@ -78,6 +88,7 @@ def test_quick_prints_exactly_one_json_object_with_every_figure(quick_run):
     assert {case: set(values) for case, values in figures['factor_0'].items()} == FACTOR_0
     assert set(figures['factor_1']) == FACTOR_1
     assert set(figures['scaling']) == {str(joints) for joints in bench.CHAIN_JOINTS}
+    assert all(set(chain) == CHAIN for chain in figures['scaling'].values())
     # The test run's install is built with its compiled step (.ci/run has a compiler).
     assert figures['raw'].pop('compiled_step') is True
     for key, value in leaves(figures).items():
@@ -109,11 +120,15 @@ def test_quick_runs_each_contact_scene_in_each_case_and_reports_its_figures(quic
     assert {scene: set(cases) for scene, cases in scenes.items()} == SCENES
     for scene, cases in scenes.items():
         for case, values in cases.items():
-            assert set(values) == SCENE_CASES[scene], case
+            assert set(values) == SCENE_CASES[case], case
             assert values['steps_per_s'] > 0, case
             # The multiple of real time is the step rate in sim seconds.
             assert values['real_time_multiple'] == pytest.approx(
                 values['steps_per_s'] * TIME_STEPS[scene], rel=1e-3, abs=1e-3), case
+            # Both steps are thread CPU; the ratio is PyBullet's alone over the node's.
+            assert values['raw_step_us'] > 0, case
+            assert values['ratio_to_raw'] == pytest.approx(
+                values['raw_step_us'] / values['node_cpu_us_per_step'], rel=2e-3), case
     lidar = scenes['tb3_sandbox']['circle']
     assert lidar['lidar_us_per_scan'] > 0 and 0 < lidar['lidar_us_per_step'] < lidar[
         'lidar_us_per_scan']
@@ -268,18 +283,39 @@ def test_pan_tilt_model_commands_both_position_controllers(repo_root):
 
 
 def scene_cases(tmp_path):
-    """Return every case of both contact scenes, written into ``tmp_path``."""
+    """Return every case of the driving base, the grasp and the arm, written into ``tmp_path``."""
     return {**bench_scenes.driving_base(package_share(), tmp_path),
-            **bench_scenes.grasp(tmp_path)}
+            **bench_scenes.grasp(tmp_path), **bench_scenes.ur5e_like(tmp_path)}
 
 
 def test_the_driving_base_touches_the_ground_only_when_its_base_is_free(tmp_path):
     cases = scene_cases(tmp_path)
-    on_ground = bench_scenes.contact_points(cases['on_ground'], 0.001)
-    base_fixed = bench_scenes.contact_points(cases['base_fixed'], 0.001)
+    on_ground = bench_scenes.in_process_figures(cases['on_ground'], 0.001)
+    base_fixed = bench_scenes.in_process_figures(cases['base_fixed'], 0.001)
     # Two wheels and the caster on the ground, beside the room's ball on it; then the ball alone.
     assert on_ground['contact_points'] >= 4
     assert base_fixed['contact_points'] == 1
+    # Its odometry follows the base it drives within 1 % of the way driven.
+    assert on_ground['odometry_error_percent'] < 1.0
+    assert on_ground['raw_step_us'] > base_fixed['raw_step_us'] > 0  # the contacts' solve
+
+
+def test_the_driving_base_at_10_solver_iterations_is_the_room_as_an_sdf_world(tmp_path):
+    cases = scene_cases(tmp_path)
+    few = world_from_parameter(cases['on_ground_10_iterations'].parameters['world'])
+    room = world_from_parameter(cases['on_ground'].parameters['world'])
+    assert few.physics.solver_iterations == bench_scenes.FEW_SOLVER_ITERATIONS
+    assert few.scenery == room.scenery == 'ground'
+    assert [entity.name for entity in few.entities] == [entity.name for entity in room.entities]
+    for ours, theirs in zip(few.entities, room.entities, strict=True):
+        assert ours.position == pytest.approx(theirs.position), ours.name
+        assert ours.orientation == pytest.approx(theirs.orientation, abs=1e-9), ours.name
+        # Static where the room's is (the ball alone rolls).
+        assert ('<static>true</static>' in ours.resource_string) == (
+            '<static>true</static>' in theirs.resource_string), ours.name
+    figures = bench_scenes.in_process_figures(cases['on_ground_10_iterations'], 0.001)
+    # Fewer iterations let the wheels slip more: its odometry drifts, but it drives its circle.
+    assert figures['contact_points'] >= 4 and figures['odometry_error_percent'] < 5.0
 
 
 def test_the_driving_base_is_the_shipped_rover_driven_by_a_diff_drive_controller(tmp_path):
@@ -299,13 +335,49 @@ def test_the_driving_base_is_the_shipped_rover_driven_by_a_diff_drive_controller
 
 def test_the_grasp_holds_the_box_up_and_the_open_gripper_leaves_it_on_the_ground(tmp_path):
     cases = scene_cases(tmp_path)
-    holding = bench_scenes.contact_points(cases['holding'], 0.001)
-    opened = bench_scenes.contact_points(cases['open'], 0.001)
+    holding = bench_scenes.in_process_figures(cases['holding'], 0.001)
+    opened = bench_scenes.in_process_figures(cases['open'], 0.001)
     half_box = bench_scenes.BOX_SIZE / 2
     assert holding['box_height_m'] > half_box + 0.9 * bench_scenes.LIFT_M
-    assert opened['box_height_m'] == pytest.approx(half_box, abs=0.002)
+    assert opened['box_height_m'] == pytest.approx(half_box, abs=0.001)
+    # Held where the fingers took it, within a millimetre, as the lift rose.
+    assert holding['box_height_error_m'] < 0.001 and opened['box_height_error_m'] < 0.001
     # Two fingers' faces on the box; the box's face on the ground.
     assert holding['contact_points'] >= 4 and opened['contact_points'] >= 1
+
+
+def test_the_arm_has_the_ur5e_s_masses_lengths_and_limits(tmp_path):
+    case = scene_cases(tmp_path)['follow_trajectory']
+    model = load_description(case.description_file).model
+    with make_simulation(str(case.description_file), str(case.controllers_file),
+                         0.001) as simulation:
+        assert tuple(simulation.handles) == bench_scenes.UR5E_JOINTS
+        # Each link's mass as PyBullet loaded it.
+        body, client = simulation.physics.body_id, simulation.physics.client_id
+        for name, mass in list(bench_scenes.UR5E_MASSES.items())[1:]:  # the base is welded
+            index = simulation.physics.link_index(name)
+            assert pybullet.getDynamicsInfo(body, index, physicsClientId=client)[0] == mass
+        # Stretched out (shoulder lift and elbow at 0), the reach is UR's: d1 up, a2 + a3 out.
+        simulation.physics.reset_joints([0.0] * 6)
+        wrist = simulation.link_state('wrist_1_link')[0].translation
+        dh = bench_scenes.UR5E_DH
+        assert abs(wrist[0]) == pytest.approx(abs(dh['a2'] + dh['a3']), abs=1e-6)
+        assert wrist[2] == pytest.approx(dh['d1'], abs=1e-6)
+    limits = {joint.name: (joint.effort_limit, joint.upper) for joint in model.joints
+              if joint.name in bench_scenes.UR5E_JOINTS}
+    assert [effort for effort, _ in limits.values()] == list(bench_scenes.UR5E_EFFORT)
+    assert limits['elbow_joint'][1] == pytest.approx(math.pi, abs=1e-5)
+
+
+def test_the_arm_follows_its_trajectory_goal_closely(tmp_path):
+    case = scene_cases(tmp_path)['follow_trajectory']
+    goal = case.goals[bench_scenes.ARM_ACTION]
+    assert goal.trajectory.joint_names == list(bench_scenes.UR5E_JOINTS)
+    last = goal.trajectory.points[-1].time_from_start
+    assert last.sec >= bench_scenes.ARM_GOAL_S - bench_scenes.ARM_PERIOD
+    figures = bench_scenes.in_process_figures(case, 0.001, settle_s=1.0, count_s=4.0)
+    assert 0.0 < figures['tracking_error_rad'] < 0.01
+    assert figures['raw_step_us'] > 0 and figures['contact_points'] == 0
 
 
 def median_range(scan: LaserScan, bearing: float, half_width: float = math.radians(2)) -> float:

@@ -634,6 +634,8 @@ class JointTrajectoryController(MultiJointController):
         tolerances = self._tolerances
         end_time = self._plan.end_time
         before_last = time < end_time - TIME_EPSILON
+        if before_last and not self._first_sample and not tolerances.checks_path:
+            return  # before the last point only path tolerances count, and none is set
         first, self._first_sample = self._first_sample, False
         handles, velocities = self._handles, self._desired_velocities
         path_broken = outside_goal = False

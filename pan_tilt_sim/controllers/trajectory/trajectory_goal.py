@@ -21,6 +21,8 @@ A tolerance of 0 is not checked, as in ros2_controllers.
 from __future__ import annotations
 
 import dataclasses
+import enum
+import functools
 import math
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -81,6 +83,11 @@ class Tolerances:
     def checks_anything(self) -> bool:
         """Whether any tolerance is set (all 0: nothing to check, ever)."""
         return any(t.position > 0.0 or t.velocity > 0.0 for t in (*self.path, *self.goal))
+
+    @functools.cached_property
+    def checks_path(self) -> bool:
+        """Whether any path tolerance is set (all 0: nothing to check before the last point)."""
+        return any(t.position > 0.0 or t.velocity > 0.0 for t in self.path)
 
 
 @dataclasses.dataclass(frozen=True)
