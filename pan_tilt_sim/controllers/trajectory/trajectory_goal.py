@@ -21,7 +21,6 @@ A tolerance of 0 is not checked, as in ros2_controllers.
 from __future__ import annotations
 
 import dataclasses
-import enum
 import functools
 import math
 from collections.abc import Mapping, Sequence
