@@ -2,24 +2,16 @@
 
 What is read from ``<sdf><world>``:
 
-* a ground plane: a static model whose collisions are all planes through the
-  origin facing up (Gazebo's ``ground_plane``) is the simulator's own ground
-  (the plane z = 0); a world without one has no ground;
-* every other ``<model>`` and ``<include>`` (``model://``, a Fuel URI found in
-  the local Fuel cache, ``file://``, a path), static or not, as an object with
-  its links' collisions and visuals (:mod:`pan_tilt_sim.model.sdf`), placed
-  by its ``<pose>``;
-* ``<physics>`` (the default one, else the first): ``max_step_size`` (s),
-  ``real_time_factor``, and from the section of its engine (``type``, ODE
-  by default; ``<ode>`` or ``<bullet>``) ``<solver><iters>`` and
-  ``<constraints>``: ``<erp>`` (PyBullet's ``erp`` and ``contact_erp``: ODE's
-  one ERP serves joints and contacts), ``<cfm>``, ``<contact_surface_layer>``
-  (``contact_slop``) and Bullet's ``<split_impulse>``; the elements with no
-  PyBullet counterpart are named in :attr:`WorldPhysics.unmatched`;
-* lights, ``<scene>``, ``<gui>``, the atmosphere, gravity and magnetic field,
-  spherical coordinates, and gz-sim's and Gazebo classic's system plugins
-  whose work the simulator does itself: accepted, with nothing to do.  Any other
-  world plugin, and actors, populations and roads, get one warning each.
+* a ground plane (Gazebo's ``ground_plane``: a static model of planes through
+  the origin facing up) becomes the simulator's own ground, z = 0;
+* every other ``<model>`` and ``<include>`` (``model://``, a cached Fuel URI,
+  ``file://``, a path), static or not, as an object placed by its ``<pose>``;
+* ``<physics>``: ``max_step_size`` (s), ``real_time_factor``, and the solver
+  settings PyBullet has a counterpart for (:class:`WorldPhysics`); the others
+  are named in :attr:`WorldPhysics.unmatched`;
+* lights, scene, GUI, atmosphere, gravity and the system plugins whose work
+  the simulator does itself are accepted; any other world plugin, actors,
+  populations and roads get one warning each.
 
 Design notes: docs/design/model.md#sdf_worldpy.
 """

@@ -1,22 +1,19 @@
 """The simulation loop: physics and controllers, stepped together, no ROS.
 
 Each step is ros2_control's read / update / write around one physics step:
-the measured joint states go into the joint handles (and, for joints an
-ideal actuator drives, the effort its motor applied), every active
-controller due on its own clock updates (command controllers first, so
-broadcasters sample fresh efforts; see
-:mod:`pan_tilt_sim.controllers.framework.manager` for the clocks), the hardware's
-per-step part runs on the held commands (an ideal actuator's tracking), the
-efforts and velocity targets go to PyBullet, and PyBullet advances one
-``time_step``.  Sim time is kept as a step count, so it never
-accumulates rounding error.  Which controllers are loaded and which are
-active is the :class:`~pan_tilt_sim.controllers.framework.manager.ControllerManager`'s
-business; the active ones say how each of their joints is driven
-(:meth:`~pan_tilt_sim.controllers.framework.base.Controller.actuators`), and a joint no
-active controller claims is passive -- it keeps the last effort applied.
+measured joint states go into the joint handles, every active controller
+due on its own clock updates (command controllers first, so broadcasters
+sample fresh efforts; clocks: :mod:`pan_tilt_sim.controllers.framework.manager`),
+the hardware's per-step part runs on the held commands, the efforts and
+velocity targets go to PyBullet, and PyBullet advances one ``time_step``.
+Sim time is kept as a step count, so it never accumulates rounding error.
+Which controllers are loaded and active is the
+:class:`~pan_tilt_sim.controllers.framework.manager.ControllerManager`'s
+business; a joint no active controller claims is passive (it keeps the
+last effort applied).
 
-The robot's base is welded to the world unless it is mobile (see
-:func:`base_is_fixed` and :mod:`pan_tilt_sim.model.base_pose`); a free base
+The robot's base is welded to the world unless it is mobile
+(:func:`base_is_fixed`, :mod:`pan_tilt_sim.model.base_pose`); a free base
 starts resting on the ground and a reset puts it back there.
 
 Design notes: docs/design/sim.md#enginepy.

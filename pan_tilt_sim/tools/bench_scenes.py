@@ -27,6 +27,7 @@ from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from pan_tilt_sim.controllers.framework.surface import CommandTopic, StampedTwist
 from pan_tilt_sim.model.base_pose import parse_initial_pose
+from pan_tilt_sim.model.physics_settings import DEFAULT_PHYSICS
 from pan_tilt_sim.model.world_file import world_from_parameter
 from pan_tilt_sim.ros.ros_interfaces import joint_trajectory
 from pan_tilt_sim.sim.bullet import pybullet
@@ -663,15 +664,16 @@ def in_process_figures(case: SceneCase, time_step: float,
     fixed = case.parameters.get('fixed_base')
     world = world_from_parameter(case.parameters.get('world', 'empty'))
     pose = case.parameters.get('initial_pose')
+    # The solver settings the world's <physics> asks for, as sim_node applies them.
+    settings = (DEFAULT_PHYSICS if world.physics is None
+                else dataclasses.replace(DEFAULT_PHYSICS, **world.physics.settings()))
     with CommandRecorder() as recorder, make_simulation(
             str(case.description_file),
             None if case.controllers_file is None else str(case.controllers_file), time_step,
             fixed_base=None if fixed is None else fixed == 'true',
-            initial_pose=parse_initial_pose(None if pose is None else yaml.safe_load(pose))
-            ) as simulation:
+            initial_pose=parse_initial_pose(None if pose is None else yaml.safe_load(pose)),
+            physics_settings=settings) as simulation:
         client = simulation.physics.client_id
-        if world.physics is not None and world.physics.solver_iterations is not None:
-            simulation.physics.set_solver_iterations(world.physics.solver_iterations)
         targets = build_world(world.scenery, client)
         entities = Entities(simulation.physics, simulation.description.name, targets=targets,
                             ground=has_ground(world.scenery))

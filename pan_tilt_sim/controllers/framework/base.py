@@ -1,22 +1,18 @@
 """The small base every controller stands on (after ros2_control's ControllerInterface).
 
-A controller is pure Python: it is built from its YAML parameters, then
+A controller is pure Python: built from its YAML parameters, then
 :meth:`Controller.configure` hands it the :class:`JointHandle` objects of
-the joints it names, and :meth:`Controller.update` runs at the
-controller's update rate (the stepping loop's clock: see
-:mod:`pan_tilt_sim.controllers.framework.manager`).  Handles carry the measured
-state (written by the simulation before each update) and what the
-controller wants the physics to do with the joint (read by the simulation
-after it).  At configure time the controller tells each of its joints'
-handles which :class:`Actuator` drives it:
+its joints, and :meth:`Controller.update` runs on the controller's clock
+(:mod:`pan_tilt_sim.controllers.framework.manager`).  Handles carry the
+measured state (written by the simulation before each update) and what the
+controller wants the physics to do with the joint (read after it).  At
+configure time the controller tells each handle which :class:`Actuator`
+drives it:
 
-* :attr:`Drive.EFFORT` -- the physics applies ``handle.effort`` (N*m or N):
-  an effort command, or a PID's output;
+* :attr:`Drive.EFFORT` -- the physics applies ``handle.effort`` (N*m or N);
 * :attr:`Drive.VELOCITY` -- the ideal actuator: a velocity motor moves the
-  joint at ``handle.velocity_target`` with at most ``handle.force_limit``
-  (the joint's effort limit unless its controller asks for less: a gripper's
-  ``max_effort``), and the simulation writes the effort it applied back into
-  ``handle.effort`` (an acceleration command is integrated into that target).
+  joint at ``handle.velocity_target`` with at most ``handle.force_limit``,
+  and the effort it applied is written back into ``handle.effort``.
 
 Design notes: docs/design/controllers.md#basepy.
 """
