@@ -12,8 +12,7 @@ Design notes: docs/design/ros.md#controller_bindingspy.
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
@@ -38,23 +37,29 @@ from pan_tilt_sim.ros import optional_interfaces
 from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.gain_parameters import GainParameters
 from pan_tilt_sim.ros.gripper_action import GripperCommandServer, ParallelGripperCommandServer
-from pan_tilt_sim.ros.robot_state import tf_message_type, transform_message
+from pan_tilt_sim.ros.robot_state import tf_message_type
 from pan_tilt_sim.ros.ros_interfaces import (
     COMMAND_MESSAGES,
     GROUP_VALUES,
-    joint_state_message,
     optional_message,
     seconds,
-    stamp,
 )
 from pan_tilt_sim.ros.state_sinks import (
     AckermannDriveSink,
+    DofStateSink,
+    DynamicJointStateSink,
     GroupValuesSink,
     ImuSink,
+    JointStateSink,
+    MecanumStateSink,
     PoseSink,
     RangeSink,
     SteeringStatusSink,
+    TfMessageSink,
+    TrajectoryStateSink,
+    TwistSink,
     WrenchSink,
+    odometry_sink,
 )
 from pan_tilt_sim.ros.trajectory_action import TrajectoryActionServer
 from pan_tilt_sim.sim.engine import Simulation
@@ -360,271 +365,6 @@ class ControllerBindings:
                 logger.warning(f'{name}: {problem(value, result)}',
                                throttle_duration_sec=WARNING_THROTTLE_S)
         return store
-
-
-class JointStateSink:
-    """A broadcaster's samples as JointState messages, held until :meth:`flush`.
-
-    A sample is written into one reused message when the broadcaster takes
-    it (mid-batch), and leaves when the node flushes -- after the batch, or
-    where a chunk of it ends -- or when the next sample comes first.  Every
-    sample leaves, in order, with the state of the step it was taken at;
-    only the moment changes, by at most a batch (at real_time_factor 1 a
-    fraction of a millisecond).  Published with the node's other messages,
-    while DDS's code is warm: right after a sleep the first publish costs
-    several times what the ones right after it cost.
-    """
-
-    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
-        names: Iterable[str] = fields['names']
-        self._publisher = publisher
-        self._message = JointState()
-        self._message.name = list(names)  # once: the names never change
-        self._pending = False
-
-    def __call__(self, time: float, names: Any, positions: Any, velocities: Any,
-                 efforts: Any) -> None:
-        """Take a sample (the broadcaster's lists are copied into the message)."""
-        if self._pending:
-            self._publisher.publish(self._message)
-        joint_state_message(time, positions, velocities, efforts, self._message)
-        self._pending = True
-
-    def flush(self) -> None:
-        """Publish the sample taken since the last flush, if any."""
-        if self._pending:
-            self._pending = False
-            self._publisher.publish(self._message)
-
-
-class DynamicJointStateSink:
-    """A broadcaster's samples as DynamicJointState messages, held until :meth:`flush`.
-
-    The topic's fields name the joints (``joint_names``) and each joint's
-    interfaces (``interface_names``), once; a sample is a list of values per
-    joint, copied into one reused message.  Held and published as
-    :class:`JointStateSink` holds and publishes its samples.
-    """
-
-    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
-        self._publisher = publisher
-        self._message = DynamicJointState()
-        self._message.joint_names = list(fields['joint_names'])
-        self._message.interface_values = [InterfaceValue(interface_names=list(names))
-                                          for names in fields['interface_names']]
-        self._pending = False
-
-    def __call__(self, time: float, values: Sequence[Sequence[float]]) -> None:
-        """Take a sample: ``values[i]`` are joint i's interface values."""
-        if self._pending:
-            self._publisher.publish(self._message)
-        message = self._message
-        stamp(time, message.header.stamp)
-        for interface_value, joint_values in zip(message.interface_values, values, strict=True):
-            interface_value.values = joint_values
-        self._pending = True
-
-    def flush(self) -> None:
-        """Publish the sample taken since the last flush, if any."""
-        if self._pending:
-            self._pending = False
-            self._publisher.publish(self._message)
-
-
-class DofStateSink:
-    """A controller's per-DoF samples as ``control_msgs/msg/MultiDOFStateStamped`` messages.
-
-    A sample is the time and, per DoF of ``fields['names']``, ``(reference,
-    feedback, feedback_dot, error, error_dot, time_step, output)``; it is
-    held and leaves as :class:`JointStateSink`'s do: when the next sample
-    comes, or at :meth:`flush`.
-    """
-
-    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
-        self._publisher = publisher
-        self._message = MultiDOFStateStamped(
-            dof_states=[SingleDOFState(name=name) for name in fields['names']])
-        self._pending = False
-
-    def __call__(self, time: float, rows: Iterable[Iterable[float]]) -> None:
-        """Take a sample."""
-        if self._pending:
-            self._publisher.publish(self._message)
-        stamp(time, self._message.header.stamp)
-        for state, row in zip(self._message.dof_states, rows, strict=True):
-            (state.reference, state.feedback, state.feedback_dot, state.error, state.error_dot,
-             state.time_step, state.output) = row
-        self._pending = True
-
-    def flush(self) -> None:
-        """Publish the sample taken since the last flush, if any."""
-        if self._pending:
-            self._pending = False
-            self._publisher.publish(self._message)
-
-
-class _HeldSink:
-    """Samples written into one reused message, published at :meth:`flush` (or before the next).
-
-    As :class:`JointStateSink`: every sample leaves, in order, with the
-    node's other messages after the batch of steps it was taken in.
-    """
-
-    def __init__(self, publisher: Any, message: Any) -> None:
-        self._publisher = publisher
-        self._message = message
-        self._pending = False
-
-    def _take(self) -> Any:
-        """Return the message to fill with a new sample (the pending one leaves first)."""
-        if self._pending:
-            self._publisher.publish(self._message)
-        self._pending = True
-        return self._message
-
-    def flush(self) -> None:
-        """Publish the sample taken since the last flush, if any."""
-        if self._pending:
-            self._pending = False
-            self._publisher.publish(self._message)
-
-
-class OdometrySink(_HeldSink):
-    """Planar odometry samples as ``nav_msgs/msg/Odometry``.
-
-    Fields: ``frame_id``, ``child_frame_id`` and the six-element
-    ``pose_covariance_diagonal`` and ``twist_covariance_diagonal``.
-    """
-
-    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
-        message = Odometry()
-        message.header.frame_id = fields['frame_id']
-        message.child_frame_id = fields['child_frame_id']
-        size = len(fields['pose_covariance_diagonal'])
-        pose_covariance, twist_covariance = [0.0] * size * size, [0.0] * size * size
-        for index in range(size):
-            pose_covariance[index * (size + 1)] = fields['pose_covariance_diagonal'][index]
-            twist_covariance[index * (size + 1)] = fields['twist_covariance_diagonal'][index]
-        message.pose.covariance = pose_covariance
-        message.twist.covariance = twist_covariance
-        super().__init__(publisher, message)
-
-    def __call__(self, time: float, x: float, y: float, heading: float, linear: float,
-                 angular: float) -> None:
-        """Take a sample: the pose (m, rad) in the odometry frame, the twist (m/s, rad/s)."""
-        message = self._take()
-        stamp(time, message.header.stamp)
-        pose = message.pose.pose
-        pose.position.x, pose.position.y = x, y
-        pose.orientation.z, pose.orientation.w = math.sin(heading / 2.0), math.cos(heading / 2.0)
-        message.twist.twist.linear.x = linear
-        message.twist.twist.angular.z = angular
-
-
-class TrajectoryStateSink(_HeldSink):
-    """A trajectory controller's samples as ``control_msgs/msg/JointTrajectoryControllerState``.
-
-    Field ``joint_names``, once.  A sample is the time and the reference
-    (positions, velocities, accelerations), feedback (positions, velocities),
-    error (positions, velocities) and output (positions, efforts) per joint;
-    an empty list leaves its field empty.  No multi-DOF joints; the speed
-    scaling factor is 1 (no scaling here).
-    """
-
-    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
-        message = JointTrajectoryControllerState(joint_names=list(fields['joint_names']),
-                                                 speed_scaling_factor=1.0)
-        super().__init__(publisher, message)
-
-    def __call__(self, time: float, reference: Sequence[list[float]],
-                 feedback: Sequence[list[float]], error: Sequence[list[float]],
-                 output: Sequence[list[float]]) -> None:
-        """Take a sample (see the class)."""
-        message = self._take()
-        stamp(time, message.header.stamp)
-        (message.reference.positions, message.reference.velocities,
-         message.reference.accelerations) = reference
-        message.feedback.positions, message.feedback.velocities = feedback
-        message.error.positions, message.error.velocities = error
-        message.output.positions, message.output.effort = output
-
-
-class SpatialOdometryMessageSink(OdometrySink):
-    """Odometry samples in 3-D: ``sink(time, pose, linear, angular)``.
-
-    ``pose`` a Transform (m, quaternion), ``linear`` and ``angular`` the
-    twist's (x, y, z) in m/s and rad/s.  The fields are the planar sink's.
-    """
-
-    def __call__(self, time: float, pose: Any, linear: Sequence[float],
-                 angular: Sequence[float]) -> None:
-        """Take a sample."""
-        message = self._take()
-        stamp(time, message.header.stamp)
-        position, orientation = message.pose.pose.position, message.pose.pose.orientation
-        position.x, position.y, position.z = pose.translation
-        orientation.x, orientation.y, orientation.z, orientation.w = pose.rotation
-        twist = message.twist.twist
-        twist.linear.x, twist.linear.y, twist.linear.z = linear
-        twist.angular.x, twist.angular.y, twist.angular.z = angular
-
-
-def odometry_sink(publisher: Any, fields: Mapping[str, Any]) -> OdometrySink:
-    """Return the odometry sink ``fields`` ask for: planar, or 3-D with ``spatial``."""
-    kind = SpatialOdometryMessageSink if fields.get('spatial') else OdometrySink
-    return kind(publisher, fields)
-
-
-class TfMessageSink(_HeldSink):
-    """Transforms as ``tf2_msgs/msg/TFMessage``: ``sink(time, [(parent, child, transform)])``."""
-
-    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
-        super().__init__(publisher, tf_message_type()())
-
-    def __call__(self, time: float, frames: Iterable[tuple[str, str, Any]]) -> None:
-        """Take a sample of the frames (parent, child, Transform), stamped ``time``."""
-        message = self._take()
-        message.transforms = [transform_message(parent, child, transform, time)
-                              for parent, child, transform in frames]
-
-
-class TwistSink(_HeldSink):
-    """Planar twists as ``geometry_msgs/msg/TwistStamped`` (frame id ``frame_id``, default '')."""
-
-    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
-        message = TwistStamped()
-        message.header.frame_id = fields.get('frame_id', '')
-        super().__init__(publisher, message)
-
-    def __call__(self, time: float, linear: float, angular: float) -> None:
-        """Take a sample: linear.x (m/s) and angular.z (rad/s)."""
-        message = self._take()
-        stamp(time, message.header.stamp)
-        message.twist.linear.x = linear
-        message.twist.angular.z = angular
-
-
-class MecanumStateSink(_HeldSink):
-    """A mecanum drive's state as ``control_msgs/msg/MecanumDriveControllerState``.
-
-    Field ``frame_id`` (the odometry frame, as upstream).  A sample is the
-    time, the measured wheel velocities (rad/s: front left, front right,
-    rear right, rear left) and the reference (vx m/s, vy m/s, wz rad/s).
-    """
-
-    def __init__(self, publisher: Any, fields: Mapping[str, Any]) -> None:
-        message = MecanumDriveControllerState()
-        message.header.frame_id = fields['frame_id']
-        super().__init__(publisher, message)
-
-    def __call__(self, time: float, wheels: Sequence[float], reference: Sequence[float]) -> None:
-        """Take a sample (see the class)."""
-        message = self._take()
-        stamp(time, message.header.stamp)
-        (message.front_left_wheel_velocity, message.front_right_wheel_velocity,
-         message.back_right_wheel_velocity, message.back_left_wheel_velocity) = wheels
-        twist = message.reference_velocity
-        twist.linear.x, twist.linear.y, twist.angular.z = reference
 
 
 # Each state message type (by its ROS name): its class (None where its interface package is

@@ -10,7 +10,6 @@ latest command, and only the tick writes to the simulation.
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Sequence
 
 from rcl_interfaces.msg import SetParametersResult
@@ -45,43 +44,24 @@ from pan_tilt_sim.ros import (
     view_feed,
 )
 from pan_tilt_sim.ros.camera_publisher import declare_world
+from pan_tilt_sim.ros.clock_publisher import CLOCK_TOPIC, ClockPublisher
 from pan_tilt_sim.ros.command_reader import CommandReader
 from pan_tilt_sim.ros.controller_bindings import ControllerBindings
 from pan_tilt_sim.ros.features import NodeFeatures
 from pan_tilt_sim.ros.gain_parameters import GainParameters
-from pan_tilt_sim.ros.pacing import Pacer, Throttle
+from pan_tilt_sim.ros.pacing import Pacer
 from pan_tilt_sim.ros.physics_thread import PhysicsThread, Turns
 from pan_tilt_sim.ros.recording import RecordedPublisher, Recorder
-from pan_tilt_sim.ros.ros_interfaces import NANOSECONDS_PER_SECOND, clock_message
+from pan_tilt_sim.ros.ros_interfaces import NANOSECONDS_PER_SECOND
 from pan_tilt_sim.sim.engine import Simulation
 
 NODE_NAME = 'sim_node'
 # Wall seconds between ticks when paced to real time: one JointState (50 Hz)
 # per tick, and few enough wake-ups that waking stays a small share of a core.
 TICK_PERIOD_S = 0.02
-CLOCK_PERIOD_S = 0.01  # sim seconds between /clock messages (100 Hz of sim time)
-# /clock leaves at most once per this much wall time on average (Gazebo's clock
-# publisher throttles the same way), in bursts of up to CLOCK_BURST messages;
-# the newest stamp always leaves at the end of each batch, on a token borrowed if need be.
-CLOCK_MIN_WALL_PERIOD_S = 0.001
-# A tick's worth (20 ms) of bursts: up to 10x real time every 10 ms stamp leaves.
-CLOCK_BURST = 20
-# Without a token, the stamps a chunk of steps may run past before it looks again
-# (one token's worth of wall time at 100x real time, when tokens come one per ms).
-CLOCK_STAMPS_SKIPPED = 10
 QUEUE_DEPTH = 10
 _OWN_PARAMETERS = {field.name for field in dataclasses.fields(parameters.SimParameters)}
 PAUSED = 'paused'  # the parameter; services and set_paused() go through it
-
-
-def clock_period_steps(time_step: float) -> int:
-    """Return the physics steps between /clock messages: the whole number nearest 10 ms.
-
-    /clock stamps stay on the step grid, so with a time step that does not
-    divide 10 ms the period is the nearest whole number of steps (halves
-    round up): 9 ms at 0.003 s, 12 ms at 0.004 s, every step from 0.02 s on.
-    """
-    return max(1, math.floor(CLOCK_PERIOD_S / time_step + 0.5 + 1e-9))
 
 
 class SimNode(Node):
@@ -226,12 +206,8 @@ class SimNode(Node):
         self._paused = self.settings.paused
         self.steps_run = 0  # physics steps this node has run (never reset; see run_steps)
         self._pacer = Pacer(self.settings.real_time_factor, self.settings.time_step)
-        self._clock_every = clock_period_steps(self.settings.time_step)
-        self._clock_publisher = self.create_publisher(Clock, '/clock', QUEUE_DEPTH)
-        self._clock_message = Clock()
-        self._clock_readers = True  # until the first batch asks
-        self._clock_pending = False
-        self._clock_throttle = Throttle(CLOCK_MIN_WALL_PERIOD_S, CLOCK_BURST)
+        self.clock_publisher = ClockPublisher(
+            self.create_publisher(Clock, CLOCK_TOPIC, QUEUE_DEPTH), self.simulation.time_step)
         self.gain_parameters = GainParameters(self)
         topic_mode = self._topic_settings is not None
         # With a physics thread, commands have a reader of their own where this rclpy allows
@@ -265,7 +241,7 @@ class SimNode(Node):
             publish_description=not from_topic, world=world,
             publish_tf_default=not self.is_controller_manager)
         self._start_controller_manager(controllers)
-        self._publish_clock()
+        self.clock_publisher.publish_newest(self.simulation.steps)
         self.features.after_steps()  # their first samples at t = 0, as /clock's
         if self.turns is not None:
             self._physics_thread = PhysicsThread(self._on_tick, self._thread_period, self.turns)
@@ -283,11 +259,9 @@ class SimNode(Node):
         self._log_missing_interfaces()
         # Actuators, start positions, PyBullet's load messages, unstable gains.
         self.simulation.report_startup()
-        clock_period = self._clock_every * self.settings.time_step
-        if abs(clock_period - CLOCK_PERIOD_S) > 1e-9:
-            self.get_logger().info(
-                f'/clock every {self._clock_every} steps ({clock_period * 1e3:g} ms of sim '
-                f'time): the nearest whole number of time_step to 10 ms')
+        clock_line = self.clock_publisher.period_line()
+        if clock_line is not None:
+            self.get_logger().info(clock_line)
         self.get_logger().info(
             f"simulating '{description.name}' from {description.source} "
             f"with {len(self.simulation.manager.active)} active controllers from "
@@ -369,20 +343,15 @@ class SimNode(Node):
     def run_steps(self, steps: int) -> None:
         """Advance ``steps`` physics steps, publishing /clock and the features when due.
 
-        /clock stamps stay on the 10 ms grid of sim time.  They leave through a
-        token bucket -- one token per wall millisecond, at most CLOCK_BURST held
-        -- and the newest grid stamp reached always leaves at the end of the
-        batch, taking a token even if none is there (a debt the next stamps
-        wait for), so on average /clock never leaves more than once per wall
-        millisecond.  So up to 10x real time every stamp leaves (at factor 1 nothing
-        is dropped); far above it /clock comes about once per wall millisecond
-        and use_sim_time timers see sim time advance in jumps of that size.
+        /clock's stamps leave as :mod:`pan_tilt_sim.ros.clock_publisher` says;
+        far above 10x real time use_sim_time timers see sim time advance in
+        jumps of about a wall millisecond.
 
         At real_time_factor 0 a batch (about 5 ms of wall time) is cut at the
         stamps, so /clock advances through it; paced, a batch is a few ms of sim
         time run in a fraction of a wall millisecond, so its stamps leave
         together after it, back to back with the JointStates it took (see
-        :class:`~pan_tilt_sim.ros.controller_bindings.JointStateSink`): right
+        :class:`~pan_tilt_sim.ros.state_sinks.HeldSample`): right
         after the thread slept the first DDS publish is the dear one, and the
         ones right after it are cheap.  Up to 10x real time, /clock reaches a stamp before
         anything stamped at or after it leaves.  Nothing is published that nobody
@@ -391,9 +360,8 @@ class SimNode(Node):
         simulation = self.simulation
         features = self.features
         controllers = self.controllers
-        every = self._clock_every
-        clock_wanted = self._clock_readers
-        throttle = self._clock_throttle
+        clock = self.clock_publisher
+        clock_wanted = clock.wanted
         cut_at_stamps = clock_wanted and self._pacer.fast
         while steps > 0:
             # The steps run in chunks that end where something watched is due: a
@@ -403,9 +371,7 @@ class SimNode(Node):
             step = simulation.steps
             chunk = steps
             if cut_at_stamps:
-                to_stamp = every - step % every
-                chunk = min(chunk, to_stamp if throttle.ready()
-                            else to_stamp + every * CLOCK_STAMPS_SKIPPED)
+                chunk = min(chunk, clock.steps_to_stamp(step))
             due = features.steps_until_due(step)
             if due is not None:
                 chunk = min(chunk, due)
@@ -413,37 +379,11 @@ class SimNode(Node):
             self.steps_run += chunk
             steps -= chunk
             if clock_wanted:
-                self._publish_stamps_reached(step, chunk, cut_at_stamps)
+                clock.publish_reached(step, chunk, cut_at_stamps)
             controllers.flush_joint_states()
             features.after_steps()
-        if self._clock_pending:
-            throttle.take()  # counts against the cap too: the next stamps wait for it
-            self._publish_clock()
+        clock.end_batch(simulation.steps)
         controllers.after_steps()
-
-    def _publish_stamps_reached(self, step: int, chunk: int, cut_at_stamps: bool) -> None:
-        """Publish, as tokens allow, the /clock stamps the ``chunk`` steps after ``step`` reached.
-
-        Cut at the stamps (factor 0), a chunk ends at one -- or runs past a few
-        for want of tokens -- and only the newest may leave; paced, each stamp
-        it reached may, oldest first.  One held back leaves at the batch's end.
-        """
-        every = self._clock_every
-        end = step + chunk
-        stamp = step - step % every + every  # the first grid stamp after ``step``
-        if stamp > end:
-            return
-        throttle = self._clock_throttle
-        self._clock_pending = True
-        if cut_at_stamps:
-            if end % every == 0 and throttle.allow():
-                self._publish_clock_at(end)
-            return
-        for grid_steps in range(stamp, end + 1, every):
-            if throttle.allow():
-                self._publish_clock_at(grid_steps)
-            else:
-                self._clock_pending = True
 
     @property
     def paused(self) -> bool:
@@ -486,7 +426,7 @@ class SimNode(Node):
         elif reset_time:
             self.simulation.reset_time()
         self._pacer.restart()
-        self._publish_clock()
+        self.clock_publisher.publish_newest(self.simulation.steps)
         self.features.reset()
         self.features.after_steps()
 
@@ -568,19 +508,9 @@ class SimNode(Node):
         stepping on request, they ask before the batch: a subscriber that the
         publisher has matched gets everything due from the next batch on.
         """
-        self._clock_readers = self._clock_publisher.get_subscription_count() > 0
+        self.clock_publisher.refresh_readers()
         self.controllers.refresh_readers()
         self.features.refresh_readers()
-
-    def _publish_clock(self) -> None:
-        """Publish the newest stamp on the /clock grid (at or before the present sim time)."""
-        steps = self.simulation.steps
-        self._publish_clock_at(steps - steps % self._clock_every)
-
-    def _publish_clock_at(self, grid_steps: int) -> None:
-        self._clock_publisher.publish(
-            clock_message(grid_steps * self.simulation.time_step, self._clock_message))
-        self._clock_pending = False
 
     def _start_controller_manager(self, controllers: ControllersConfig) -> None:
         """Offer ros2_control's controller_manager services, where their messages exist."""

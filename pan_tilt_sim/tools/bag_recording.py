@@ -27,6 +27,7 @@ from pan_tilt_sim.controllers.framework.base import CommandKind
 from pan_tilt_sim.controllers.framework.surface import PRIVATE, StateTopic
 from pan_tilt_sim.controllers.trajectory.trajectory import JointTrajectory
 from pan_tilt_sim.model import naming
+from pan_tilt_sim.ros.clock_publisher import CLOCK_PERIOD_S, clock_period_steps
 from pan_tilt_sim.ros.controller_bindings import STATE_SINKS
 from pan_tilt_sim.ros.recording import Recorder
 from pan_tilt_sim.ros.robot_state import (
@@ -40,7 +41,7 @@ from pan_tilt_sim.ros.robot_state import (
     transform_message,
 )
 from pan_tilt_sim.ros.ros_interfaces import clock_message, stamp
-from pan_tilt_sim.ros.sim_node import CLOCK_PERIOD_S, QUEUE_DEPTH, clock_period_steps
+from pan_tilt_sim.ros.sim_node import QUEUE_DEPTH
 from pan_tilt_sim.sim.engine import Simulation
 
 DEFAULT_QOS = QoSProfile(depth=QUEUE_DEPTH)

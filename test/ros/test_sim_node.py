@@ -12,7 +12,7 @@ from node_harness import PROBE_QUEUE, sim_node, stamp_s
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
 
-from pan_tilt_sim.ros.sim_node import CLOCK_BURST, clock_period_steps
+from pan_tilt_sim.ros.clock_publisher import CLOCK_BURST
 from pan_tilt_sim.sim.physics import pybullet
 
 NS = '/ex_urdf_pan_tilt'
@@ -120,12 +120,6 @@ def test_far_above_real_time_clock_averages_at_most_one_message_per_wall_ms(pan_
     clocks = sum(kind == 'clock' for kind, _ in sent)
     assert clocks > wall_ms / 2  # the cap binds: far more stamps (3000) were reached
     assert clocks <= wall_ms + CLOCK_BURST + 1
-
-
-@pytest.mark.parametrize(('time_step', 'steps'), [
-    (0.001, 10), (0.0005, 20), (0.003, 3), (0.004, 3), (1 / 240, 2), (0.02, 1), (0.1, 1)])
-def test_the_clock_period_is_the_whole_number_of_steps_nearest_10_ms(time_step, steps):
-    assert clock_period_steps(time_step) == steps
 
 
 def test_with_a_3_ms_step_clock_comes_every_9_ms_and_says_so_once(capfd):
@@ -267,7 +261,7 @@ def test_a_tf_reader_ends_chunks_at_the_tf_period():
 def record_publications(node) -> list[tuple[str, float]]:
     """Record (topic kind, stamp) of every /clock and JointState the node publishes."""
     sent: list[tuple[str, float]] = []
-    clock = node._clock_publisher
+    clock = node.clock_publisher.publisher
 
     class Recording:
         def __init__(self, kind, publisher) -> None:
@@ -280,7 +274,7 @@ def record_publications(node) -> list[tuple[str, float]]:
         def __getattr__(self, name):
             return getattr(self._publisher, name)
 
-    node._clock_publisher = Recording('clock', clock)
+    node.clock_publisher.publisher = Recording('clock', clock)
     for _controller, _publisher, sink in node.controllers._state_sinks:
         sink._publisher = Recording('joint_states', sink._publisher)
     return sent

@@ -1,9 +1,10 @@
-"""state_sinks: the sensor broadcasters' and gpio controller's samples as messages.
+"""state_sinks: the controllers' state samples as messages, one held-sample sink per type.
 
 Each message is built from the state topic's fields, filled with a sample
 and held until the node flushes (or the next sample comes first).
 """
 
+import importlib.util
 import math
 
 import pytest
@@ -13,10 +14,14 @@ from rclpy.serialization import deserialize_message, serialize_message
 from sensor_msgs.msg import Imu, Range
 
 from pan_tilt_sim.ros.state_sinks import (
+    DofStateSink,
+    DynamicJointStateSink,
     GroupValuesSink,
     ImuSink,
+    JointStateSink,
     PoseSink,
     RangeSink,
+    TrajectoryStateSink,
     WrenchSink,
 )
 
@@ -104,3 +109,119 @@ def test_gpio_states_name_the_groups_and_interfaces_once_and_copy_the_values():
         ['out', 'in'], ['vacuum']]
     assert message.interface_values[1].values[0] == 0.0
     assert math.isnan(message.interface_values[0].values[1])
+
+
+class PositionsPublisher:
+    """Keeps what each publish() sent, as it was at that moment."""
+
+    def __init__(self) -> None:
+        self.sent: list[tuple[float, list[float]]] = []
+
+    def publish(self, message) -> None:
+        stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+        self.sent.append((round(stamp, 9), list(message.position)))
+
+
+def sample(sink: JointStateSink, time: float, position: float) -> None:
+    sink(time, ['a'], [position], [0.0], [0.0])
+
+
+def test_a_sample_leaves_only_when_flushed_and_only_once():
+    publisher = PositionsPublisher()
+    sink = JointStateSink(publisher, {'names': ['a']})
+    sample(sink, 0.02, 1.5)
+    assert publisher.sent == []
+    sink.flush()
+    sink.flush()
+    assert publisher.sent == [(0.02, [1.5])]
+
+
+def test_a_sample_taken_before_the_flush_pushes_out_the_one_held():
+    publisher = PositionsPublisher()
+    sink = JointStateSink(publisher, {'names': ['a']})
+    sample(sink, 0.02, 1.0)
+    sample(sink, 0.04, 2.0)
+    sample(sink, 0.06, 3.0)
+    sink.flush()
+    assert publisher.sent == [(0.02, [1.0]), (0.04, [2.0]), (0.06, [3.0])]
+
+
+class RecordingDynamicPublisher:
+    """Keeps each DynamicJointState sent, as it was at that moment."""
+
+    def __init__(self) -> None:
+        self.sent: list[tuple] = []
+
+    def publish(self, message) -> None:
+        stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+        self.sent.append((round(stamp, 9), list(message.joint_names),
+                          [(list(value.interface_names), list(value.values))
+                           for value in message.interface_values]))
+
+
+@pytest.mark.skipif(importlib.util.find_spec('control_msgs') is None,
+                    reason='control_msgs is not installed')
+def test_a_dynamic_sample_is_copied_and_held_until_flushed():
+    publisher = RecordingDynamicPublisher()
+    sink = DynamicJointStateSink(publisher, {'joint_names': ('a', 'b'), 'interface_names': (
+        ('position', 'temperature'), ('position',))})
+    values = [[0.5, 21.5], [-0.25]]
+    sink(0.02, values)
+    values[0][0] = 9.0  # the broadcaster reuses its lists
+    sink(0.04, values)
+    assert len(publisher.sent) == 1
+    sink.flush()
+    sink.flush()
+    assert publisher.sent == [
+        (0.02, ['a', 'b'], [(['position', 'temperature'], [0.5, 21.5]), (['position'], [-0.25])]),
+        (0.04, ['a', 'b'], [(['position', 'temperature'], [9.0, 21.5]), (['position'], [-0.25])])]
+
+
+def test_a_dof_state_sample_leaves_as_multi_dof_state_stamped_with_every_field():
+    pytest.importorskip('control_msgs.msg', reason='control_msgs is not installed')
+    sent = []
+
+    class Publisher:
+        def publish(self, message) -> None:
+            stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+            sent.append((round(stamp, 9), [
+                (s.name, s.reference, s.feedback, s.feedback_dot, s.error, s.error_dot,
+                 s.time_step, s.output) for s in message.dof_states]))
+
+    sink = DofStateSink(Publisher(), {'names': ['a', 'b']})
+    sink(0.5, [(1.0, 2.0, 3.0, 4.0, 5.0, 0.001, 7.0), (8.0, 9.0, 0.0, -1.0, 0.0, 0.001, 2.5)])
+    assert sent == []
+    sink(0.501, [(1.5, 2.0, 3.0, 4.0, 5.0, 0.001, 7.0)] * 2)
+    sink.flush()
+    sink.flush()
+    assert sent == [
+        (0.5, [('a', 1.0, 2.0, 3.0, 4.0, 5.0, 0.001, 7.0),
+               ('b', 8.0, 9.0, 0.0, -1.0, 0.0, 0.001, 2.5)]),
+        (0.501, [('a', 1.5, 2.0, 3.0, 4.0, 5.0, 0.001, 7.0),
+                 ('b', 1.5, 2.0, 3.0, 4.0, 5.0, 0.001, 7.0)])]
+
+
+def test_a_trajectory_state_sample_leaves_with_every_field_and_empty_ones_left_empty():
+    pytest.importorskip('control_msgs.msg', reason='control_msgs is not installed')
+    sent = []
+
+    class Publisher:
+        def publish(self, message) -> None:
+            stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+            sent.append((round(stamp, 9), list(message.joint_names), [
+                [list(values) for values in (point.positions, point.velocities,
+                                             point.accelerations, point.effort)]
+                for point in (message.reference, message.feedback, message.error,
+                              message.output)], message.speed_scaling_factor))
+
+    sink = TrajectoryStateSink(Publisher(), {'joint_names': ['a', 'b']})
+    sink(0.25, ([1.0, 2.0], [0.1, 0.2], [0.0, -1.0]), ([0.5, 1.5], [0.3, 0.4]),
+         ([0.5, 0.5], [-0.2, -0.2]), ([], [7.0, 8.0]))
+    assert sent == []
+    sink.flush()
+    sink.flush()
+    assert sent == [(0.25, ['a', 'b'], [
+        [[1.0, 2.0], [0.1, 0.2], [0.0, -1.0], []],
+        [[0.5, 1.5], [0.3, 0.4], [], []],
+        [[0.5, 0.5], [-0.2, -0.2], [], []],
+        [[], [], [], [7.0, 8.0]]], 1.0)]

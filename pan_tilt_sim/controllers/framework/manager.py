@@ -66,6 +66,56 @@ class SkippedController:
     reason: str
 
 
+@dataclasses.dataclass(frozen=True)
+class SwitchPlan:
+    """A switch :meth:`ControllerManager.plan_switch` accepted, ready to be carried out."""
+
+    activate: tuple[str, ...]
+    deactivate: tuple[str, ...]
+    # The active set afterwards.
+    active: frozenset[str]
+    # BEST_EFFORT: one line per controller left out, and why.
+    dropped: tuple[str, ...]
+
+
+@dataclasses.dataclass(frozen=True)
+class _StartPlan:
+    """What start-up loads and activates, decided from the file before anything is loaded."""
+
+    specs: tuple[ControllerSpec, ...]
+    # The names to activate, in order; None: every controller loaded.
+    wanted: tuple[str, ...] | None
+    # The controllers of types the simulator does not have (skipped).
+    unknown: tuple[ControllerSpec, ...]
+    # How the list of names to activate is called in messages.
+    active_name: str
+
+    def leaves_out(self, name: str) -> bool:
+        """Whether start-up may go on without the controller ``name`` (it names others)."""
+        return self.wanted is not None and name not in self.wanted
+
+
+@dataclasses.dataclass(frozen=True)
+class _StartActivation:
+    """The start-up active set, and the controllers left inactive because they are refused."""
+
+    active: frozenset[str]
+    refused: dict[str, str]
+
+
+class _Refusals:
+    """A switch's refusals: STRICT raises the first; BEST_EFFORT collects them all."""
+
+    def __init__(self, strict: bool) -> None:
+        self.strict = strict
+        self.dropped: list[str] = []
+
+    def __call__(self, problem: str) -> None:
+        if self.strict:
+            raise ControllerSwitchError(problem)
+        self.dropped.append(problem)
+
+
 class ControllerManager:
     """The controllers of one file: loaded, configured, and which of them are active."""
 
@@ -111,15 +161,31 @@ class ControllerManager:
 
     def _start(self, specs: Sequence[ControllerSpec], active: Sequence[str] | None,
                active_name: str) -> None:
-        """Load and configure the file's controllers; activate ``active`` (None: all)."""
+        """Load and configure the file's controllers; activate ``active`` (None: all).
+
+        Validate the file, load what it declares, validate the active set, apply it.
+        """
+        plan = self._plan_start(specs, active, active_name)
+        self._load_start(plan)
+        activation = self._plan_start_activation(plan)
+        self.refused = activation.refused
+        self._change_active(set(activation.active), set())
+        self.clock_notes = self._clock_notes(self.configured)
+
+    def _plan_start(self, specs: Sequence[ControllerSpec], active: Sequence[str] | None,
+                    active_name: str) -> _StartPlan:
+        """Return what start-up loads and activates; refuse a file that cannot start.
+
+        Pure: checks the names ``active`` lists and the file's unknown types.
+        """
         names = [spec.name for spec in specs]
-        wanted = None if active is None else list(dict.fromkeys(active))
+        wanted = None if active is None else tuple(dict.fromkeys(active))
         for name in wanted or ():
             if name not in names:
                 raise ControllerConfigError(
                     f"{active_name}: no controller '{name}' in {self._source} "
                     f"(its controllers: {', '.join(names)})")
-        unknown = [spec for spec in specs if not is_known_type(spec.type)]
+        unknown = tuple(spec for spec in specs if not is_known_type(spec.type))
         for spec in unknown:
             if wanted is not None and spec.name in wanted:
                 raise ControllerConfigError(
@@ -132,18 +198,26 @@ class ControllerManager:
                     f"{self._source}: {drivers[0].name}.type: unknown controller type "
                     f"'{drivers[0].type}', and no other controller in the file commands a "
                     f"joint (supported: {', '.join(supported_types())})")
+        return _StartPlan(tuple(specs), wanted, unknown, active_name)
+
+    def _load_start(self, plan: _StartPlan) -> None:
+        """Load, then configure, the plan's controllers of known types; set :attr:`skipped`.
+
+        A controller that fails ends start-up when the plan activates it;
+        otherwise it is skipped, with the reason.
+        """
         failures: dict[str, str] = {}
 
         def fail(spec: ControllerSpec, err: ControllerConfigError) -> None:
-            if wanted is None or spec.name in wanted:
+            if not plan.leaves_out(spec.name):
                 raise err
             failures[spec.name] = f'cannot be loaded: {err}'
 
         # All loaded before any is configured: a preceding controller needs the
         # references of the ones it feeds, wherever the file declares them.
         loaded: list[tuple[ControllerSpec, Controller]] = []
-        for spec in specs:
-            if spec in unknown:
+        for spec in plan.specs:
+            if spec in plan.unknown:
                 continue
             try:
                 controller = self._create(spec.name, spec.type, spec.params, self._source)
@@ -161,16 +235,23 @@ class ControllerManager:
         self.skipped = tuple(
             [SkippedController(spec.name, str(spec.type),
                                'a controller type this simulator does not have')
-             for spec in unknown]
+             for spec in plan.unknown]
             + [SkippedController(spec.name, str(spec.type), failures[spec.name])
-               for spec in specs if spec.name in failures])
+               for spec in plan.specs if spec.name in failures])
+
+    def _plan_start_activation(self, plan: _StartPlan) -> _StartActivation:
+        """Return the start-up active set of the loaded controllers; refuse one that cannot run.
+
+        Pure: a controller the plan activates by default whose activation is
+        refused stays inactive (in the result's ``refused``).
+        """
+        wanted, active_name = plan.wanted, plan.active_name
         active_names = set(self._by_name) if wanted is None else set(wanted)
         refused = {name: refusal for name in self._by_name if name in active_names
                    and (refusal := self.activation_refusal(name)) is not None}
         for name in wanted or ():
             if name in refused:
                 raise ControllerConfigError(f'{active_name}: {refused[name]}')
-        self.refused = refused
         active_names -= set(refused)
         problem = self._problem(active_names)
         if problem is not None:
@@ -199,8 +280,7 @@ class ControllerManager:
         if refusal is not None:
             where = self._source if wanted is None else active_name
             raise ControllerConfigError(f'{where}: {refusal}')
-        self._change_active(active_names, set())
-        self.clock_notes = self._clock_notes(self.configured)
+        return _StartActivation(frozenset(active_names), refused)
 
     @property
     def controllers(self) -> list[Controller]:
@@ -408,14 +488,45 @@ class ControllerManager:
         Activated controllers start from the joints' present state;
         deactivated ones leave their joints with the last command applied.
         """
+        plan = self.plan_switch(activate, deactivate, strict=strict)
+        self._change_active(set(plan.active), set(plan.activate))
+        for listener in self._switch_listeners:
+            listener()
+        return list(plan.dropped)
+
+    def plan_switch(self, activate: Iterable[str] = (), deactivate: Iterable[str] = (), *,
+                    strict: bool = True) -> SwitchPlan:
+        """Return what :meth:`switch` would do, or raise what it would raise; change nothing.
+
+        Its validation step: the controllers left out (BEST_EFFORT), then the
+        resulting active set's joints, chains and hardware.
+        """
+        refuse = _Refusals(strict)
         activate, deactivate = list(dict.fromkeys(activate)), list(dict.fromkeys(deactivate))
-        dropped: list[str] = []
+        self._drop_unloaded(activate, deactivate, refuse)
+        self._drop_by_state(activate, deactivate, refuse)
+        self._drop_broken_chains(activate, deactivate, refuse)
+        names = (self._active_names - set(deactivate)) | set(activate)
+        problem = self._problem(names)
+        if problem is not None:
+            joint, first, second, interface = problem
+            if interface is not None:
+                raise ControllerSwitchError(self._interface_problem(first, joint, interface))
+            raise ControllerSwitchError(
+                f"'{first}' and '{second}' would both claim joint '{joint}'; "
+                'only one active controller can command a joint')
+        chain = self._chain_problem(names)
+        if chain is not None:
+            raise ControllerSwitchError(chain)
+        refusal = self._hardware_refusal(activate, deactivate)
+        if refusal is not None:
+            raise ControllerSwitchError(refusal)
+        return SwitchPlan(tuple(activate), tuple(deactivate), frozenset(names),
+                          tuple(refuse.dropped))
 
-        def refuse(problem: str) -> None:
-            if strict:
-                raise ControllerSwitchError(problem)
-            dropped.append(problem)
-
+    def _drop_unloaded(self, activate: list[str], deactivate: list[str],
+                       refuse: _Refusals) -> None:
+        """Leave out the names no controller is loaded under; refuse a list of only those."""
         for action, names in (('deactivate', deactivate), ('activate', activate)):
             unknown = [name for name in names if name not in self._by_name]
             for name in unknown:
@@ -426,6 +537,10 @@ class ControllerManager:
                     raise ControllerSwitchError(problem)
                 refuse(problem)
             names[:] = [name for name in names if name in self._by_name]
+
+    def _drop_by_state(self, activate: list[str], deactivate: list[str],
+                       refuse: _Refusals) -> None:
+        """Leave out the controllers whose lifecycle state or claims forbid the change."""
         for name in list(deactivate):
             if self._states[name] != ACTIVE:
                 deactivate.remove(name)
@@ -444,8 +559,14 @@ class ControllerManager:
             if refusal is not None:
                 activate.remove(name)
                 refuse(refusal)
-        # The chains, as controller_manager's check_following_controllers_for_activate and
-        # check_preceding_controllers_for_deactivate; leaving one out may fail another.
+
+    def _drop_broken_chains(self, activate: list[str], deactivate: list[str],
+                            refuse: _Refusals) -> None:
+        """Leave out the controllers whose chains the switch would break, until none is left.
+
+        As controller_manager's check_following_controllers_for_activate and
+        check_preceding_controllers_for_deactivate; leaving one out may fail another.
+        """
         changed = True
         while changed:
             changed = False
@@ -461,25 +582,6 @@ class ControllerManager:
                     deactivate.remove(name)
                     changed = True
                     refuse(problem)
-        names = (self._active_names - set(deactivate)) | set(activate)
-        problem = self._problem(names)
-        if problem is not None:
-            joint, first, second, interface = problem
-            if interface is not None:
-                raise ControllerSwitchError(self._interface_problem(first, joint, interface))
-            raise ControllerSwitchError(
-                f"'{first}' and '{second}' would both claim joint '{joint}'; "
-                'only one active controller can command a joint')
-        chain = self._chain_problem(names)
-        if chain is not None:
-            raise ControllerSwitchError(chain)
-        refusal = self._hardware_refusal(activate, deactivate)
-        if refusal is not None:
-            raise ControllerSwitchError(refusal)
-        self._change_active(names, set(activate))
-        for listener in self._switch_listeners:
-            listener()
-        return dropped
 
     def activation_refusal(self, name: str) -> str | None:
         """Return why the loaded controller ``name`` cannot be activated here, or None.

@@ -334,6 +334,24 @@ def test_best_effort_leaves_out_what_strict_refuses(arm):
         manager.switch(activate=['nothing'], strict=False)  # the list names nothing loaded
 
 
+
+def test_planning_a_switch_says_what_it_would_do_and_changes_nothing(arm):
+    manager, _ = arm(active=[JSB, JTC])
+    calls = []
+    manager.add_switch_listener(lambda: calls.append('switched'))
+    plan = manager.plan_switch(activate=[FORWARD_POSITION, FORWARD_POSITION],
+                               deactivate=[JTC, 'nothing'], strict=False)
+    assert plan.activate == (FORWARD_POSITION,) and plan.deactivate == (JTC,)
+    assert plan.active == {FORWARD_POSITION, JSB}
+    assert len(plan.dropped) == 1 and "'nothing'" in plan.dropped[0]
+    assert [c.name for c in manager.active] == [JTC, JSB] and not calls
+    assert manager.state(FORWARD_POSITION) == INACTIVE
+    with pytest.raises(ControllerSwitchError, match="would both claim joint 'joint1'"):
+        manager.plan_switch(activate=[FORWARD_POSITION])
+    assert manager.switch(activate=[FORWARD_POSITION], deactivate=[JTC, 'nothing'],
+                          strict=False) == list(plan.dropped)
+    assert {c.name for c in manager.active} == plan.active and calls == ['switched']
+
 def test_a_deactivated_trajectory_controller_ends_its_goal(arm):
     from pan_tilt_sim.controllers.trajectory.trajectory import JointTrajectory, TrajectoryPoint
     from pan_tilt_sim.controllers.trajectory.trajectory_goal import GoalStatus
