@@ -118,7 +118,10 @@ def test_far_above_real_time_clock_averages_at_most_one_message_per_wall_ms(pan_
     pan_tilt.run_until_sim_time(start + 30.0)
     wall_ms = (time.monotonic() - started) * 1e3
     clocks = sum(kind == 'clock' for kind, _ in sent)
-    assert clocks > wall_ms / 2  # the cap binds: far more stamps (3000) were reached
+    # 30 s of sim time reaches 3000 stamps (one per 10 ms); the cap lets about one per wall
+    # ms through.  On a loaded machine the run may take longer than 3000 ms: then the cap
+    # binds less, and the floor is half of what was reachable instead.
+    assert clocks > min(3000, wall_ms) / 2
     assert clocks <= wall_ms + CLOCK_BURST + 1
 
 
