@@ -32,6 +32,7 @@ DATA = pathlib.Path(__file__).resolve().parents[1] / 'data'
 GZ_ARM = DATA / 'gz_shaped' / 'arm_gz_spawn.launch.py'
 GZ_ROVER = DATA / 'gz_shaped' / 'rover_gz_bridge.launch.py'
 ROVER_BRIDGE = DATA / 'gz_shaped' / 'rover_bridge.yaml'
+ROVER_WORLD = DATA / 'gz_shaped' / 'rover_world.launch.py'  # includes rover_spawn.launch.py
 CLASSIC_ARM = DATA / 'classic_shaped' / 'arm_classic.launch.py'
 ARM_JOINTS = ['shoulder_joint', 'extend_joint', 'wrist_joint']
 TARGET = [0.5, 0.1, 0.3]
@@ -135,3 +136,29 @@ def test_a_bridge_config_gives_the_robots_gz_topics_their_ros_names_and_types(
     assert alive, outputs['parameter_bridge']
     assert 'to hand over its topics' in outputs['sim_node'] or (
         'bridged by' in outputs['parameter_bridge'])
+
+
+def test_a_top_level_file_in_nav2_bringups_shape_brings_its_xacro_world_and_the_spawn_file(
+        monkeypatch, tmp_path):
+    # The world is written by `xacro -o` while gz_sim.launch.py starts; the robot comes
+    # from an included spawn file (Nav2's spawn_tb3.launch.py shape: -string, -R -P -Y).
+    from simulation_interfaces.srv import GetEntities
+
+    urdf = tmp_path / 'rover.urdf'
+    urdf.write_text(plugin_rover_urdf(GZ_DIFF_DRIVE))
+    launch = launch_stand_in.StandInLaunch(
+        launch_stand_in.load(ROVER_WORLD, monkeypatch), tmp_path,
+        {'description_file': str(urdf)})
+    harness = NodeHarness()
+    odometry: list[Odometry] = []
+    harness.probe.create_subscription(Odometry, '/odom', odometry.append, PROBE_QUEUE)
+    try:
+        launch.start_processes()
+        assert launch.wait_for_exit('create', EXIT_BUDGET_S) == 0, launch.output('create')
+        assert harness.spin_until(lambda: odometry), 'no /odom'
+        entities = harness.call(GetEntities, '/gzserver/get_entities', GetEntities.Request())
+    finally:
+        harness.close()
+        outputs = launch.close()
+    assert {'crate', 'rover'} <= set(entities.entities), (entities.entities,
+                                                          outputs['sim_node'])

@@ -5,9 +5,11 @@
 RegisterEventHandler + OnProcessExit, Command, PathJoinSubstitution, PathSubstitution,
 FindPackageShare, FindExecutable, LaunchConfiguration, IfElseSubstitution,
 DeclareLaunchArgument with its choices, IfCondition, UnlessCondition, OpaqueFunction,
-ParameterFile, Shutdown, launch.logging; IncludeLaunchDescription of pan_tilt_sim's own
-launch files -- the Gazebo stand-ins, gz_sim.launch.py and gazebo.launch.py -- is followed
-(their actions carried out in its place, with its launch_arguments), any other is recorded and
+ParameterFile, Shutdown, launch.logging, (Append|Set)EnvironmentVariable, ExecuteProcess (run
+to its end before the nodes start); IncludeLaunchDescription of an installed package's Python
+launch file -- pan_tilt_sim's Gazebo stand-ins gz_sim.launch.py and gazebo.launch.py, or a
+package's in the ament index (Nav2's spawn_tb3.launch.py) -- is followed (its actions carried
+out in its place, with its launch_arguments), one of a package not installed is recorded and
 refused when it would run;
 controller_manager.launch_utils' generate_controllers_spawner_launch_description, whose
 LaunchDescription is carried out in its place), and :class:`StandInLaunch` carries it out as
@@ -50,13 +52,15 @@ from spawner_client import spawner_main
 HERE = pathlib.Path(__file__).resolve().parent
 STAND_IN_MODULES = ('launch', 'launch.actions', 'launch.conditions', 'launch.event_handlers',
                     'launch.launch_description_sources', 'launch.logging',
-                    'launch.substitutions', 'launch_ros',
+                    'launch.substitutions', 'launch.substitutions.command',
+                    'launch.substitutions.find_executable', 'launch_ros',
                     'launch_ros.actions', 'launch_ros.parameter_descriptions',
                     'launch_ros.substitutions', 'controller_manager',
                     'controller_manager.launch_utils')
 # pan_tilt_sim's executables that run as processes here (sim_node has its own start).
 STAND_IN_EXECUTABLES = ('create', 'parameter_bridge', 'image_bridge', 'spawn_entity.py',
                         'ros2_control_node')
+EXECUTE_PROCESS_WAIT_S = 30.0  # an ExecuteProcess (xacro -o world.sdf) runs before the nodes
 PROCESS_EXIT_WAIT_S = 120.0  # for a process an OnProcessExit waits on (create: the robot in)
 SUBSTITUTION = re.compile(r'\$\(var ([A-Za-z0-9_]+)\)')
 # The texts launch reads as a true or false condition (any case); any other is an error.
@@ -103,6 +107,18 @@ class RegisterEventHandler(Recorded):
 
 class OnProcessExit(Recorded):
     """launch.event_handlers.OnProcessExit."""
+
+
+class AppendEnvironmentVariable(Recorded):
+    """launch.actions.AppendEnvironmentVariable: name, value (prepend, separator)."""
+
+
+class SetEnvironmentVariable(Recorded):
+    """launch.actions.SetEnvironmentVariable: name, value."""
+
+
+class ExecuteProcess(Recorded):
+    """launch.actions.ExecuteProcess: ``cmd``, a list of texts or substitutions."""
 
 
 class Shutdown(Recorded):
@@ -232,6 +248,11 @@ def modules() -> dict[str, types.ModuleType]:
     made['launch.actions'].DeclareLaunchArgument = DeclareLaunchArgument
     made['launch.actions'].OpaqueFunction = OpaqueFunction
     made['launch.actions'].Shutdown = Shutdown
+    made['launch.actions'].AppendEnvironmentVariable = AppendEnvironmentVariable
+    made['launch.actions'].SetEnvironmentVariable = SetEnvironmentVariable
+    made['launch.actions'].ExecuteProcess = ExecuteProcess
+    made['launch.substitutions.command'].Command = Command
+    made['launch.substitutions.find_executable'].FindExecutable = FindExecutable
     made['launch.logging'].get_logger = logging.getLogger
     made['launch'].logging = made['launch.logging']
     made['launch.conditions'].IfCondition = IfCondition
@@ -356,6 +377,8 @@ class StandInLaunch:
                  arguments: dict[str, str] | None = None) -> None:
         self.folder = folder
         self.arguments = dict(arguments or {})
+        # What (Append|Set)EnvironmentVariable set, over this process's environment.
+        self.environment: dict[str, str] = {}
         self.actions = self._carry_out(actions)
         self.processes: dict[str, subprocess.Popen] = {}
         self._process_of: dict[int, subprocess.Popen] = {}  # by id() of the Node action
@@ -378,10 +401,15 @@ class StandInLaunch:
             if isinstance(action, IncludeLaunchDescription) and self._holds(action):
                 raise ValueError(f'IncludeLaunchDescription of {action.describe(self.arguments)} '
                                  'is not carried out by the launch stand-in')
+        for action in self.actions:
+            if isinstance(action, ExecuteProcess) and self._holds(action):
+                self._execute(action)
         for node in self.nodes():
             package, executable = node.kwargs['package'], node.kwargs['executable']
             if (package, executable) == ('pan_tilt_sim', 'sim_node'):
-                self.processes['sim_node'] = sim_process.start(*self._ros_args(node))
+                self.processes['sim_node'] = subprocess.Popen(
+                    sim_process.command(*self._ros_args(node)), env=self._environment(),
+                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
                 self._process_of[id(node)] = self.processes['sim_node']
             elif package == 'pan_tilt_sim' and executable in STAND_IN_EXECUTABLES:
                 self._start_stand_in(node)
@@ -389,7 +417,7 @@ class StandInLaunch:
                 command = [sys.executable, str(HERE / 'robot_state_publisher_stand_in.py'),
                            '--ros-args', *self._ros_args(node)]
                 self.processes['robot_state_publisher'] = subprocess.Popen(
-                    command, env=sim_process.environment(), stdout=subprocess.DEVNULL,
+                    command, env=self._environment(), stdout=subprocess.DEVNULL,
                     stderr=subprocess.PIPE, text=True)
 
     def _start_stand_in(self, node: Node) -> None:
@@ -409,10 +437,27 @@ class StandInLaunch:
                    *arguments, '--ros-args', *self._ros_args(node)]
         log = (self.folder / f'{name}.log').open('w')
         self.processes[name] = subprocess.Popen(
-            command, env=sim_process.environment(), stdout=log, stderr=subprocess.STDOUT,
+            command, env=self._environment(), stdout=log, stderr=subprocess.STDOUT,
             text=True)
         self._process_of[id(node)] = self.processes[name]
         self._logs[name] = self.folder / f'{name}.log'
+
+    def _environment(self) -> dict[str, str]:
+        """The environment of a process started now: the launch's variables set."""
+        return {**sim_process.environment(), **self.environment}
+
+    def _execute(self, action: ExecuteProcess) -> None:
+        """Run an ExecuteProcess's ``cmd`` (each item's text, as launch joins a list item).
+
+        It runs to its end (within :data:`EXECUTE_PROCESS_WAIT_S`) before any node
+        starts: a world that ``xacro -o`` writes is there when the simulation reads it.
+        """
+        words = [text(item, self.arguments) for item in action.kwargs['cmd']]
+        words[0] = shutil.which(words[0], path=os.path.dirname(sys.executable)) or words[0]
+        done = subprocess.run(words, env=self._environment(), capture_output=True, text=True,
+                              timeout=EXECUTE_PROCESS_WAIT_S, check=False)
+        if done.returncode != 0:
+            raise ValueError(f'ExecuteProcess {words} exited {done.returncode}: {done.stderr}')
 
     def output(self, name: str) -> str:
         """What the stand-in process ``name`` wrote so far (stdout and stderr)."""
@@ -460,7 +505,8 @@ class StandInLaunch:
             for parameters in perform(spawner.kwargs.get('parameters', []), self.arguments):
                 arguments += ['--param-file', str(self._parameter_file(parameters))]
             try:
-                code = spawner_main(harness, arguments, spawner.kwargs.get('namespace') or '/')
+                namespace = text(spawner.kwargs.get('namespace') or '', self.arguments)
+                code = spawner_main(harness, arguments, '/' + namespace.lstrip('/'))
             except SystemExit as refused:  # its arguments refused, as the program exits
                 code = refused.code
             codes.append(code)
@@ -488,7 +534,9 @@ class StandInLaunch:
         for action in actions:
             if isinstance(action, DeclareLaunchArgument):
                 action.declare(self.arguments)
-            if isinstance(action, IncludeLaunchDescription) and self._is_own(action):
+            if isinstance(action, AppendEnvironmentVariable | SetEnvironmentVariable):
+                self._set_variable(action)
+            if isinstance(action, IncludeLaunchDescription) and self._is_installed(action):
                 if self._holds(action):
                     for name, value in action.kwargs.get('launch_arguments', []):
                         self.arguments[text(name, self.arguments)] = text(value, self.arguments)
@@ -501,19 +549,29 @@ class StandInLaunch:
                 left.append(action)
         return left
 
-    def _is_own(self, action: IncludeLaunchDescription) -> bool:
-        """Whether the include names a launch file of pan_tilt_sim's installed share."""
-        from ament_index_python.packages import (
-            PackageNotFoundError,
-            get_package_share_directory,
-        )
+    def _set_variable(self, action: Recorded) -> None:
+        """Carry out (Append|Set)EnvironmentVariable for the processes started after it."""
+        name = text(action.args[0] if action.args else action.kwargs['name'], self.arguments)
+        value = text(action.args[1] if len(action.args) > 1 else action.kwargs['value'],
+                     self.arguments)
+        old = self.environment.get(name, os.environ.get(name, ''))
+        if isinstance(action, AppendEnvironmentVariable) and old:
+            separator = action.kwargs.get('separator', os.pathsep)
+            value = (value + separator + old if truth(text(
+                action.kwargs.get('prepend', 'false'), self.arguments)) else
+                old + separator + value)
+        self.environment[name] = value
 
-        share = pathlib.Path(get_package_share_directory('pan_tilt_sim')).resolve()
+    def _is_installed(self, action: IncludeLaunchDescription) -> bool:
+        """Whether the include names an installed Python launch file (pan_tilt_sim's or any
+        package's in the ament index): one of a package not installed (ros_gz_sim) is not."""
+        from ament_index_python.packages import PackageNotFoundError
+
         try:
             included = action.path(self.arguments)
         except PackageNotFoundError:  # another package's (ros_gz_sim's, not installed here)
             return False
-        return share in included.resolve().parents
+        return included.suffix == '.py' and included.is_file()
 
     def _holds(self, action: Recorded) -> bool:
         """Whether the action's condition (if any) holds."""
@@ -526,10 +584,12 @@ class StandInLaunch:
 
     def _ros_args(self, node: Node) -> list[str]:
         args = []
-        if node.kwargs.get('name'):
-            args += ['-r', f"__node:={node.kwargs['name']}"]
-        if node.kwargs.get('namespace'):
-            args += ['-r', f"__ns:={node.kwargs['namespace']}"]
+        name = text(node.kwargs.get('name') or '', self.arguments)
+        namespace = text(node.kwargs.get('namespace') or '', self.arguments)
+        if name:
+            args += ['-r', f'__node:={name}']
+        if namespace:  # launch_ros makes a relative namespace absolute
+            args += ['-r', f"__ns:={'/' + namespace.lstrip('/')}"]
         for parameters in perform(node.kwargs.get('parameters', []), self.arguments):
             args += ['--params-file', str(self._parameter_file(parameters))]
         for source, target in node.kwargs.get('remappings', []):

@@ -2,9 +2,10 @@
 
 :func:`server` turns the words of ``gz_args`` into sim_node's start: the world (a
 file, found as gz-sim finds it: the path, then ``GZ_SIM_RESOURCE_PATH``; ``empty.sdf``
-built in, as the ground), ``-r`` (run; without it the simulation starts paused, as
-gz-sim's does), ``-v N`` (sim_node's log level), ``-s`` and ``--headless-rendering``
-(sim_node is always a headless server).  sim_node starts with no robot
+built in, as the ground; a path not there yet is read when sim_node starts), ``-r``
+(run; without it the simulation starts paused, as gz-sim's does), ``-v N`` (sim_node's
+log level), ``-s`` and ``--headless-rendering`` (sim_node is always a headless server).
+sim_node starts with no robot
 (``robot_from_spawn``): ``create`` brings it.  Any other option is named in one
 warning; a world that cannot be found is a :class:`GzArgsError`.
 """
@@ -108,6 +109,10 @@ def find_world(world: str | None, environ: dict[str, str], cwd: pathlib.Path) ->
             return str(candidate.resolve())
     if world in BUILT_IN_WORLDS:
         return BUILT_IN_WORLDS[world]
+    if os.sep in world:
+        # A path gz sim reads when it starts (nav2_bringup's `xacro -o` writes it meanwhile);
+        # sim_node's `world` says so in one line if it is not there by then.
+        return str(candidates[0])
     raise GzArgsError(
         f"gz_args: world '{world}' not found (as a path, nor in {' or '.join(RESOURCE_PATHS)}"
         f"; built in: {', '.join(BUILT_IN_WORLDS)})")

@@ -42,6 +42,15 @@ def test_a_world_that_is_nowhere_is_one_line_naming_it(tmp_path):
         server('-r shapes.sdf', environ={}, cwd=tmp_path)
 
 
+def test_a_world_path_not_written_yet_is_read_when_sim_node_starts(tmp_path):
+    # nav2_bringup's shape: `xacro -o <tmp>.sdf` (an ExecuteProcess) writes the world while
+    # gz sim starts; gz sim reads it then, not when the launch file is read.
+    later = tmp_path / 'nav2_world.sdf'
+    assert server(f'-r -s {later}', environ={}).parameters['world'] == str(later)
+    relative = server('-r worlds/later.sdf', environ={}, cwd=tmp_path).parameters['world']
+    assert relative == str(tmp_path / 'worlds' / 'later.sdf')
+
+
 def test_options_not_honoured_are_named_once_each_with_their_value():
     started = server('-r --physics-engine gz-physics-bullet -z 1000 --seed=3 empty.sdf',
                      environ={})
