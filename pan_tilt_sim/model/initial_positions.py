@@ -20,6 +20,7 @@ from collections.abc import Mapping, Sequence
 
 from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model.robot import RobotModel
+from pan_tilt_sim.model.xml_input import float_or_nan
 
 PARAMETER = 'initial_positions'
 SEPARATOR = ':='
@@ -64,10 +65,7 @@ def parse_initial_positions(entries: Sequence[str]) -> dict[str, float]:
         if not separator or not joint:
             raise ParameterError(
                 f"{FROM_PARAMETER}: '{entry}' is not of the form joint:=value")
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
+        value = float_or_nan(text)
         if not math.isfinite(value):
             raise ParameterError(
                 f"{FROM_PARAMETER}: '{entry}': '{text.strip()}' is not a finite number")

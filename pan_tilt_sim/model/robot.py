@@ -27,6 +27,7 @@ from pan_tilt_sim.model.transforms import (
     quaternion_from_axis_angle,
     rotation_matrix,
 )
+from pan_tilt_sim.model.xml_input import float_or_nan
 
 DEFAULT_AXIS: Vector = (1.0, 0.0, 0.0)  # URDF's default joint axis
 WORLD_LINK = 'world'  # a root link of this name, joined by a fixed joint, welds the robot
@@ -227,10 +228,7 @@ class ControlInterface:
         text that is not a number gives NaN too (an interface of another data
         type, ``data_type="bool"``, holds no number).
         """
-        try:
-            return float(self.params.get(INITIAL_VALUE, 'nan'))
-        except ValueError:
-            return math.nan
+        return float_or_nan(self.params.get(INITIAL_VALUE, 'nan'))
 
 
 @dataclasses.dataclass(frozen=True)

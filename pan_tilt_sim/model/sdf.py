@@ -30,6 +30,7 @@ from pan_tilt_sim.model.transforms import (
     rotate,
     rotation_matrix,
 )
+from pan_tilt_sim.model.xml_input import float_or_nan, parse_root
 
 SDF_ROOT_TAG = 'sdf'
 SUPPORTED_VERSIONS = ('1.4', '1.5', '1.6', '1.7', '1.8', '1.9', '1.10', '1.11')
@@ -90,11 +91,7 @@ def _strip_prolog(text: str) -> str:
 
 def parse_sdf(text: str, source: pathlib.Path) -> ElementTree.Element:
     """Parse SDF text; require an ``<sdf>`` root of a supported version."""
-    try:
-        root = ElementTree.fromstring(text)
-    except ElementTree.ParseError as err:
-        line, _column = err.position
-        raise DescriptionError(f'{source}:{line}: not well-formed XML: {err.msg}') from None
+    root = parse_root(text, source)
     if root.tag != SDF_ROOT_TAG:
         raise DescriptionError(f'{source}: not an SDF: the root element is <{root.tag}>, '
                                f'expected <{SDF_ROOT_TAG}>')
@@ -744,10 +741,7 @@ class ModelConverter:
 
     def float_text(self, text: str, where: str) -> float:
         """Return ``text`` as a finite number, else raise naming ``where``."""
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
+        value = float_or_nan(text)
         if not math.isfinite(value):
             raise self.error(where, f"'{text}' is not a number")
         return value

@@ -33,6 +33,7 @@ from pan_tilt_sim.model.sdf import (
     version_of,
 )
 from pan_tilt_sim.model.transforms import Quaternion, Vector
+from pan_tilt_sim.model.xml_input import float_or_nan
 
 SDF_WORLD_SUFFIXES = ('.sdf', '.world')
 XACRO_SUFFIX = '.xacro'
@@ -288,10 +289,7 @@ class _WorldReader:
         text = (element.findtext(path) or '').strip()
         if not text:
             return None
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
+        value = float_or_nan(text)
         if not math.isfinite(value) or value < 0.0 or (positive and value == 0.0):
             raise self.error(where, f"<{path}>{text}</...> must be a number "
                              f"{'>' if positive else '>='} 0")
@@ -341,7 +339,7 @@ def _is_ground_plane(model: ElementTree.Element) -> bool:
         if plane is None:
             return False
         normal = (plane.findtext('normal') or '0 0 1').split()
-        if [_number(value) for value in normal] != [0.0, 0.0, 1.0]:
+        if [float_or_nan(value) for value in normal] != [0.0, 0.0, 1.0]:
             return False
     return True
 
@@ -352,8 +350,4 @@ def _is_number(text: str) -> bool:
     except ValueError:
         return False
     return True
-
-
-def _number(text: str) -> float:
-    return float(text) if _is_number(text) else math.nan
 

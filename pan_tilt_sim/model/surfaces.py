@@ -25,6 +25,7 @@ import xml.etree.ElementTree as ElementTree
 from collections.abc import Iterable
 
 from pan_tilt_sim.errors import DescriptionError
+from pan_tilt_sim.model.xml_input import float_or_nan
 
 DEFAULT_MU = 1.0  # Gazebo's mu1 and mu2 where the URDF gives none
 DEFAULT_KP = 1e12  # N/m: Gazebo's contact stiffness, effectively rigid
@@ -86,10 +87,7 @@ def read_surfaces(root: ElementTree.Element, source: pathlib.Path,
                 continue
             # Gazebo's URDF parser takes a value attribute before the text (<mu1 value="1"/>).
             text = (element.get('value') or element.text or '').strip()
-            try:
-                value = float(text)
-            except ValueError:
-                value = math.nan
+            value = float_or_nan(text)
             positive = name == 'kp'  # a contact without stiffness holds nothing up
             if not (math.isfinite(value) and (value > 0.0 if positive else value >= 0.0)):
                 raise DescriptionError(

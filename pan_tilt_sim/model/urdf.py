@@ -72,6 +72,7 @@ from pan_tilt_sim.model.sensors import (
 )
 from pan_tilt_sim.model.surfaces import read_surfaces
 from pan_tilt_sim.model.transforms import ZERO_VECTOR, Transform, Vector, quaternion_from_rpy
+from pan_tilt_sim.model.xml_input import float_or_nan, parse_root
 
 URDF_ROOT_TAG = 'robot'
 # Gazebo plugins that run the robot's controllers (ROS 1, Gazebo classic ROS 2, gz).
@@ -102,11 +103,7 @@ RGBA_LENGTH = 4
 
 def parse_xml(urdf_xml: str, source: pathlib.Path) -> ElementTree.Element:
     """Parse URDF text, requiring a ``<robot>`` root."""
-    try:
-        root = ElementTree.fromstring(urdf_xml)
-    except ElementTree.ParseError as err:
-        line, _column = err.position
-        raise DescriptionError(f'{source}:{line}: not well-formed XML: {err.msg}') from None
+    root = parse_root(urdf_xml, source)
     if root.tag != URDF_ROOT_TAG:
         raise DescriptionError(
             f'{source}: not a URDF: the root element is <{root.tag}>, expected <{URDF_ROOT_TAG}> '
@@ -258,10 +255,7 @@ def _check_position_gain(plugins: tuple[ControlPlugin, ...], systems: tuple[Cont
     for place, text in places:
         if text is None:
             continue
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
+        value = float_or_nan(text)
         if not (math.isfinite(value) and value > 0.0):
             raise DescriptionError(f"{source}: {place}: '{text}' must be a number > 0")
 
@@ -337,10 +331,7 @@ class _Reader:
         text = element.get(attribute)
         if text is None:
             return default
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
+        value = float_or_nan(text)
         if not math.isfinite(value):
             raise self.error(owner, f'<{element.tag} {attribute}="{text}"> is not a number')
         return value
@@ -484,10 +475,7 @@ class _Reader:
             text = state.params.get(INITIAL_VALUE)
             if state.name != POSITION or text is None:
                 continue
-            try:
-                initial = float(text)
-            except ValueError:
-                initial = math.nan
+            initial = float_or_nan(text)
             if not math.isfinite(initial):
                 raise DescriptionError(
                     f"{self.source}: <ros2_control name=\"{system}\">: joint '{name}': "
@@ -775,10 +763,7 @@ class _SensorReader:
     # --- values ------------------------------------------------------------------------
 
     def float_text(self, text: str, owner: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
+        value = float_or_nan(text)
         if math.isnan(value):
             raise DescriptionError(f'{self.source}: {owner}: "{text}" is not a number')
         return value

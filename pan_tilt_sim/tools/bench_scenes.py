@@ -123,6 +123,13 @@ class SceneCase:
     accuracy: str = ''
 
 
+def _write(folder: pathlib.Path, name: str, text: str) -> pathlib.Path:
+    """Write ``text`` to ``folder``/``name`` in UTF-8; return the path."""
+    path = folder / name
+    path.write_text(text, encoding='utf-8')
+    return path
+
+
 def rover_urdf(shipped: str) -> str:
     """Return the shipped rover's URDF driven by ros2_control instead of Gazebo plugins.
 
@@ -177,17 +184,15 @@ def _rover_geometry(urdf: str) -> tuple[float, float]:
 def driving_base(share: pathlib.Path, folder: pathlib.Path) -> dict[str, SceneCase]:
     """Write the driving base's files into ``folder``; return its cases (on_ground, base_fixed)."""
     urdf = rover_urdf((share / ROVER_DESCRIPTION).read_text(encoding='utf-8'))
-    description = folder / 'rover.urdf'
-    description.write_text(urdf, encoding='utf-8')
-    controllers = folder / 'rover_controllers.yaml'
-    controllers.write_text(rover_controllers(*_rover_geometry(urdf)), encoding='utf-8')
+    description = _write(folder, 'rover.urdf', urdf)
+    controllers = _write(folder, 'rover_controllers.yaml',
+                         rover_controllers(*_rover_geometry(urdf)))
     twist = TwistStamped()
     twist.twist.linear.x = LINEAR_SPEED
     twist.twist.angular.z = LINEAR_SPEED / CIRCLE_RADIUS
     world = str(share / ROOM_WORLD)
-    few = folder / 'room_10_iterations.sdf'
-    few.write_text(room_sdf(world_from_parameter(world), FEW_SOLVER_ITERATIONS),
-                   encoding='utf-8')
+    few = _write(folder, 'room_10_iterations.sdf',
+                 room_sdf(world_from_parameter(world), FEW_SOLVER_ITERATIONS))
     return {case: SceneCase(description, controllers, {'world': path, 'fixed_base': fixed},
                             {CMD_VEL_TOPIC: twist}, accuracy=accuracy)
             for case, path, fixed, accuracy in (
@@ -327,12 +332,9 @@ def grasp_world() -> str:
 
 def grasp(folder: pathlib.Path) -> dict[str, SceneCase]:
     """Write the grasp's files into ``folder``; return its cases (holding, open)."""
-    description = folder / 'gripper_arm.urdf'
-    description.write_text(gripper_urdf(), encoding='utf-8')
-    controllers = folder / 'gripper_controllers.yaml'
-    controllers.write_text(gripper_controllers(), encoding='utf-8')
-    world = folder / 'grasp_world.yaml'
-    world.write_text(grasp_world(), encoding='utf-8')
+    description = _write(folder, 'gripper_arm.urdf', gripper_urdf())
+    controllers = _write(folder, 'gripper_controllers.yaml', gripper_controllers())
+    world = _write(folder, 'grasp_world.yaml', grasp_world())
     # The lift's setpoint ramps at its velocity limit, so the fingers close on the
     # box long before the lift has risen by a millimetre or two.
     return {case: SceneCase(description, controllers, {'world': str(world)}, {
@@ -446,10 +448,8 @@ def arm_goal(duration: float = ARM_GOAL_S) -> FollowJointTrajectory.Goal:
 
 def ur5e_like(folder: pathlib.Path) -> dict[str, SceneCase]:
     """Write the arm's files into ``folder``; return its case (follow_trajectory)."""
-    description = folder / 'ur5e_like.urdf'
-    description.write_text(ur5e_like_urdf(), encoding='utf-8')
-    controllers = folder / 'ur5e_like_controllers.yaml'
-    controllers.write_text(ur5e_like_controllers(), encoding='utf-8')
+    description = _write(folder, 'ur5e_like.urdf', ur5e_like_urdf())
+    controllers = _write(folder, 'ur5e_like_controllers.yaml', ur5e_like_controllers())
     return {'follow_trajectory': SceneCase(
         description, controllers, {'world': 'empty'}, {}, goals={ARM_ACTION: arm_goal()},
         accuracy='tracking')}
@@ -601,12 +601,9 @@ def sandbox_world(mesh: pathlib.Path) -> str:
 
 def tb3_sandbox(folder: pathlib.Path) -> dict[str, SceneCase]:
     """Write the sandbox's robot, world and wall mesh into ``folder``; return its case (circle)."""
-    description = folder / 'waffle_like.sdf'
-    description.write_text(waffle_sdf(), encoding='utf-8')
-    mesh = folder / 'hexagon.obj'
-    mesh.write_text(hexagon_obj(), encoding='utf-8')
-    world = folder / 'sandbox.sdf'
-    world.write_text(sandbox_world(mesh), encoding='utf-8')
+    description = _write(folder, 'waffle_like.sdf', waffle_sdf())
+    mesh = _write(folder, 'hexagon.obj', hexagon_obj())
+    world = _write(folder, 'sandbox.sdf', sandbox_world(mesh))
     cx, cy = SANDBOX_CIRCLE_CENTRE
     twist = Twist()
     twist.linear.x = SANDBOX_SPEED

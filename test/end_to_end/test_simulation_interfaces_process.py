@@ -7,8 +7,10 @@ QUITTING must work there as in-process.
 
 from __future__ import annotations
 
+import contextlib
 import subprocess
 import sys
+from collections.abc import Iterator
 
 import pytest
 import sim_process
@@ -22,10 +24,34 @@ EXIT_BUDGET_S = 5.0
 Spawn = srv.SpawnEntity.Response
 
 
-def test_a_paused_program_steps_spawns_and_quits_with_exit_code_0():
+@contextlib.contextmanager
+def paused_program() -> Iterator[tuple[subprocess.Popen, NodeHarness]]:
+    """Start sim_node paused on the ground; yield it and a probe; kill it if it still runs."""
     process = sim_process.start('-p', 'paused:=true', '-p', 'world:=ground')
     harness = NodeHarness()
     try:
+        yield process, harness
+    finally:
+        harness.close()
+        if process.poll() is None:
+            process.kill()
+            process.communicate()
+
+
+def quits(client: SimInterfaces, process: subprocess.Popen) -> str:
+    """Ask for QUITTING; check the program ends with code 0 and no traceback; return stderr."""
+    assert client.set_state(State.STATE_QUITTING).result == OK
+    try:
+        _stdout, stderr = process.communicate(timeout=EXIT_BUDGET_S)
+    except subprocess.TimeoutExpired:
+        pytest.fail(f'sim_node did not quit within {EXIT_BUDGET_S} s of QUITTING')
+    assert process.returncode == 0, stderr
+    assert 'Traceback' not in stderr
+    return stderr
+
+
+def test_a_paused_program_steps_spawns_and_quits_with_exit_code_0():
+    with paused_program() as (process, harness):
         clock = []
         harness.probe.create_subscription(Clock, '/clock', clock.append, PROBE_QUEUE)
         client = SimInterfaces(harness)
@@ -45,25 +71,11 @@ def test_a_paused_program_steps_spawns_and_quits_with_exit_code_0():
         assert harness.spin_until(lambda: stamp_s(clock[-1]) >= 2.5)
         assert client.state() == State.STATE_PAUSED
 
-        assert client.set_state(State.STATE_QUITTING).result == OK
-        try:
-            _stdout, stderr = process.communicate(timeout=EXIT_BUDGET_S)
-        except subprocess.TimeoutExpired:
-            pytest.fail(f'sim_node did not quit within {EXIT_BUDGET_S} s of QUITTING')
-    finally:
-        harness.close()
-        if process.poll() is None:
-            process.kill()
-            process.communicate()
-    assert process.returncode == 0, stderr
-    assert 'Traceback' not in stderr
-    assert 'QUITTING' in stderr
+        assert 'QUITTING' in quits(client, process)
 
 
 def test_the_program_refuses_objects_pybullet_would_crash_on_and_goes_on():
-    process = sim_process.start('-p', 'paused:=true', '-p', 'world:=ground')
-    harness = NodeHarness()
-    try:
+    with paused_program() as (process, harness):
         client = SimInterfaces(harness)
         assert client.state() == State.STATE_STOPPED
         for case, (urdf, expected) in UNSPAWNABLE.items():
@@ -74,18 +86,7 @@ def test_the_program_refuses_objects_pybullet_would_crash_on_and_goes_on():
         assert client.spawn('box', resource_string=box_urdf(),
                             at=pose(1.0, 0.0, 0.3)).result.result == OK
         assert client.step(100).result == OK
-        assert client.set_state(State.STATE_QUITTING).result == OK
-        try:
-            _stdout, stderr = process.communicate(timeout=EXIT_BUDGET_S)
-        except subprocess.TimeoutExpired:
-            pytest.fail(f'sim_node did not quit within {EXIT_BUDGET_S} s of QUITTING')
-    finally:
-        harness.close()
-        if process.poll() is None:
-            process.kill()
-            process.communicate()
-    assert process.returncode == 0, stderr
-    assert 'Traceback' not in stderr
+        quits(client, process)
 
 
 def test_a_bad_world_file_ends_the_program_with_one_line_and_exit_code_2(tmp_path):

@@ -14,8 +14,10 @@ import contextlib
 import dataclasses
 import math
 import pathlib
-from collections.abc import Iterator
+import time
+from collections.abc import Callable, Iterator
 
+import pytest
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
 from node_harness import PROBE_QUEUE, sim_node
@@ -23,7 +25,10 @@ from rcl_interfaces.msg import Log
 from sim_interfaces_client import SimInterfaces, position
 from tf2_msgs.msg import TFMessage
 
+from pan_tilt_sim.ros.controller_bindings import WARNING_THROTTLE_S
+
 TIME_STEP = 0.001  # s
+FLOOD_COUNT = 50  # non-finite commands in a burst
 
 
 @dataclasses.dataclass(frozen=True)
@@ -106,3 +111,39 @@ def base_on_sim_node(kind: BaseKind, description: pathlib.Path,
     with sim_node(paused=True, time_step=TIME_STEP, robot_description_file=str(description),
                   controllers_file=str(controllers), world='ground') as sim:
         yield MobileBase(sim, kind)
+
+
+def holonomic_stops_after_the_timeout(base: MobileBase) -> None:
+    """Command a holonomic base 0.2 m/s forward once (timeout 0.2 s); it drives, then stands."""
+    base.command(0.2, 0.0, 0.0)
+    for _ in range(10):  # 0.1 s: within the timeout
+        base.update()
+    assert base.odometry[-1].twist.twist.linear.x == pytest.approx(0.2, rel=0.05)
+    for _ in range(60):
+        base.update()
+    assert base.odometry[-1].twist.twist.linear.x == pytest.approx(0.0, abs=1e-3)
+    where, _, _ = base.true_pose()
+    assert where[0] < 0.2 * 0.4
+
+
+def ignores_non_finite_commands(base: MobileBase,
+                                bad_command: Callable[[float], tuple[float, ...]]) -> None:
+    """Drive a holonomic base at 0.2 m/s, then send a burst of ``bad_command(nan or inf)``.
+
+    Check the base keeps its speed and the controller warns, throttled.
+    """
+    base.command(0.2, 0.0, 0.0)
+    for _ in range(10):
+        base.update()
+    start = time.monotonic()
+    for index in range(FLOOD_COUNT):
+        base.command(*bad_command((math.nan, math.inf, -math.inf)[index % 3]))
+    elapsed = time.monotonic() - start
+    for _ in range(10):
+        base.update()
+    base.sim.drain()
+    assert base.odometry[-1].twist.twist.linear.x == pytest.approx(0.2, rel=0.05)
+    warnings = [entry for entry in base.log if entry.level == Log.WARN
+                and base.kind.controller in entry.msg and 'not finite numbers' in entry.msg]
+    assert warnings, 'no warning at all'
+    assert len(warnings) <= 1 + int(elapsed / WARNING_THROTTLE_S)

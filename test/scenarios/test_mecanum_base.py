@@ -11,20 +11,22 @@ from __future__ import annotations
 
 import contextlib
 import math
-import time
 
 import pytest
 import sim_process
 from control_msgs.msg import MecanumDriveControllerState
-from mobile_base_harness import BaseKind, MobileBase, base_on_sim_node, heading
-from rcl_interfaces.msg import Log
+from mobile_base_harness import (
+    BaseKind,
+    MobileBase,
+    base_on_sim_node,
+    heading,
+    holonomic_stops_after_the_timeout,
+    ignores_non_finite_commands,
+)
 from roller_fixtures import CONTROLLER, REST_HEIGHT, mecanum_parameters, write_mecanum
 
 ROBOT = 'mecanum'
 ODOMETRY = f'/{CONTROLLER}/odometry'
-EXIT_CONFIGURATION_ERROR = 2
-WARNING_THROTTLE_S = 1.0
-FLOOD_COUNT = 50
 # One controller update at the controller_manager's 100 Hz: 10 steps.
 MECANUM = BaseKind(ROBOT, CONTROLLER, ODOMETRY, update_steps=10, holonomic=True,
                    tf=f'/{CONTROLLER}/tf_odometry', log=True,
@@ -92,35 +94,12 @@ def test_a_quarter_turn_on_the_spot_the_odometry_agrees_with_the_true_heading(ba
 
 def test_the_base_stops_once_the_reference_times_out(tmp_path):
     with running_base(tmp_path, reference_timeout=0.2) as base:
-        base.command(0.2, 0.0, 0.0)
-        for _ in range(10):  # 0.1 s: within the timeout
-            base.update()
-        assert base.odometry[-1].twist.twist.linear.x == pytest.approx(0.2, rel=0.05)
-        for _ in range(60):
-            base.update()
-        assert base.odometry[-1].twist.twist.linear.x == pytest.approx(0.0, abs=1e-3)
-        where, _, _ = base.true_pose()
-        assert where[0] < 0.2 * 0.4
+        holonomic_stops_after_the_timeout(base)
 
 
 def test_a_stream_of_non_finite_references_is_ignored_with_a_throttled_warning(base):
-    base.command(0.2, 0.0, 0.0)
-    for _ in range(10):
-        base.update()
-    start = time.monotonic()
-    for index in range(FLOOD_COUNT):
-        bad = (math.nan, math.inf, -math.inf)[index % 3]
-        base.command(0.0, bad, 0.0)
-    elapsed = time.monotonic() - start
-    for _ in range(10):
-        base.update()
-    base.sim.drain()
-    assert base.odometry[-1].twist.twist.linear.x == pytest.approx(0.2, rel=0.05)
+    ignores_non_finite_commands(base, lambda bad: (0.0, bad, 0.0))
     assert abs(base.odometry[-1].twist.twist.linear.y) < 0.01
-    warnings = [entry for entry in base.log if entry.level == Log.WARN
-                and CONTROLLER in entry.msg and 'not finite numbers' in entry.msg]
-    assert warnings, 'no warning at all'
-    assert len(warnings) <= 1 + int(elapsed / WARNING_THROTTLE_S)
 
 
 def test_a_wheel_joint_the_urdf_lacks_stops_start_up_with_one_line_naming_the_parameter(
@@ -129,9 +108,6 @@ def test_a_wheel_joint_the_urdf_lacks_stops_start_up_with_one_line_naming_the_pa
         rear_left_wheel_command_joint_name='rear_lfet_wheel_joint'))
     result = sim_process.run('-p', f'robot_description_file:={description}',
                              '-p', f'controllers_file:={controllers}')
-    assert result.returncode == EXIT_CONFIGURATION_ERROR, result.stderr
-    lines = result.stderr.splitlines()
-    assert len(lines) == 1, result.stderr
-    assert lines[0].startswith('sim_node: error: ')
+    line = sim_process.error_line(result)
     assert (f"{CONTROLLER}.rear_left_wheel_command_joint_name: joint 'rear_lfet_wheel_joint' "
-            'is not a movable joint') in lines[0]
+            'is not a movable joint') in line

@@ -10,20 +10,20 @@ The true pose comes from simulation_interfaces' GetEntityState.
 from __future__ import annotations
 
 import contextlib
-import math
-import time
 
 import pytest
 import sim_process
-from mobile_base_harness import BaseKind, MobileBase, base_on_sim_node
-from rcl_interfaces.msg import Log
+from mobile_base_harness import (
+    BaseKind,
+    MobileBase,
+    base_on_sim_node,
+    holonomic_stops_after_the_timeout,
+    ignores_non_finite_commands,
+)
 from roller_fixtures import CONTROLLER, REST_HEIGHT, omni_parameters, write_omni
 
 ROBOT = 'omni'
 ODOM = f'/{CONTROLLER}/odom'
-EXIT_CONFIGURATION_ERROR = 2
-WARNING_THROTTLE_S = 1.0
-FLOOD_COUNT = 50
 # One controller update at the controller_manager's 100 Hz: 10 steps.
 OMNI = BaseKind(ROBOT, CONTROLLER, ODOM, update_steps=10, holonomic=True, tf='/tf', log=True)
 
@@ -73,35 +73,12 @@ def test_one_metre_sideways_the_odometry_agrees_with_the_true_pose(base):
 
 def test_the_base_stops_once_cmd_vel_times_out(tmp_path):
     with running_base(tmp_path, cmd_vel_timeout=0.2) as base:
-        base.command(0.2, 0.0, 0.0)
-        for _ in range(10):  # 0.1 s: within the timeout
-            base.update()
-        assert base.odometry[-1].twist.twist.linear.x == pytest.approx(0.2, rel=0.05)
-        for _ in range(60):
-            base.update()
-        assert base.odometry[-1].twist.twist.linear.x == pytest.approx(0.0, abs=1e-3)
-        where, _, _ = base.true_pose()
-        assert where[0] < 0.2 * 0.4
+        holonomic_stops_after_the_timeout(base)
 
 
 def test_a_stream_of_non_finite_twists_is_ignored_with_a_throttled_warning(base):
-    base.command(0.2, 0.0, 0.0)
-    for _ in range(10):
-        base.update()
-    start = time.monotonic()
-    for index in range(FLOOD_COUNT):
-        bad = (math.nan, math.inf, -math.inf)[index % 3]
-        base.command(0.0, 0.0, bad)
-    elapsed = time.monotonic() - start
-    for _ in range(10):
-        base.update()
-    base.sim.drain()
-    assert base.odometry[-1].twist.twist.linear.x == pytest.approx(0.2, rel=0.05)
+    ignores_non_finite_commands(base, lambda bad: (0.0, 0.0, bad))
     assert abs(base.odometry[-1].twist.twist.angular.z) < 0.01
-    warnings = [entry for entry in base.log if entry.level == Log.WARN
-                and CONTROLLER in entry.msg and 'not finite numbers' in entry.msg]
-    assert warnings, 'no warning at all'
-    assert len(warnings) <= 1 + int(elapsed / WARNING_THROTTLE_S)
 
 
 def test_a_wheel_joint_the_urdf_lacks_stops_start_up_with_one_line_naming_the_parameter(
@@ -110,8 +87,5 @@ def test_a_wheel_joint_the_urdf_lacks_stops_start_up_with_one_line_naming_the_pa
         wheel_names=['wheel_0_joint', 'wheel_1_joint', 'wheel_3_joint']))
     result = sim_process.run('-p', f'robot_description_file:={description}',
                              '-p', f'controllers_file:={controllers}')
-    assert result.returncode == EXIT_CONFIGURATION_ERROR, result.stderr
-    lines = result.stderr.splitlines()
-    assert len(lines) == 1, result.stderr
-    assert lines[0].startswith('sim_node: error: ')
-    assert f"{CONTROLLER}.wheel_names: joint 'wheel_3_joint' is not a movable joint" in lines[0]
+    line = sim_process.error_line(result)
+    assert f"{CONTROLLER}.wheel_names: joint 'wheel_3_joint' is not a movable joint" in line

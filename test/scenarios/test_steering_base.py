@@ -39,7 +39,6 @@ ODOMETRY = f'/{CONTROLLER}/odometry'
 CAR = BaseKind(ROBOT, CONTROLLER, ODOMETRY, update_steps=10, tf=f'/{CONTROLLER}/tf_odometry',
                state=(SteeringControllerStatus, f'/{CONTROLLER}/controller_state'))
 BAD_COUNT = 20
-EXIT_CONFIGURATION_ERROR = 2
 
 
 def running(folder, type_name: str = ACKERMANN,
@@ -157,7 +156,4 @@ def test_a_steering_joint_the_robot_lacks_stops_start_up_naming_the_parameter(tm
             pass
     result = sim_process.run('-p', f'robot_description_file:={description}',
                              '-p', f'controllers_file:={controllers}', '-p', 'world:=ground')
-    assert result.returncode == EXIT_CONFIGURATION_ERROR, result.stderr
-    lines = result.stderr.splitlines()
-    assert len(lines) == 1 and lines[0].startswith('sim_node: error: '), result.stderr
-    assert problem in lines[0]
+    assert problem in sim_process.error_line(result)

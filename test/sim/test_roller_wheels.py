@@ -64,6 +64,26 @@ def yaw(rotation) -> float:
     return 2.0 * math.atan2(rotation[2], rotation[3])
 
 
+def turns_a_quarter_on_the_spot(simulation) -> None:
+    """Turn the base a quarter on the spot by its odometry; check the true heading agrees."""
+    drive_until(simulation, (0.0, 0.0, 0.5),
+                lambda odometry: odometry.heading >= math.pi / 2)
+    frame = simulation.physics.base_frame()
+    heading = yaw(frame.rotation)
+    assert heading == pytest.approx(math.pi / 2, rel=0.02)
+    assert simulation.controller(CONTROLLER).odometry.heading == pytest.approx(
+        heading, rel=0.02)
+    assert math.hypot(*frame.translation[:2]) < 0.02
+
+
+def wheel_frictions(simulation, joints: list[str]) -> list[float]:
+    """Return PyBullet's lateral friction of each wheel link of ``joints``."""
+    physics = simulation.physics
+    return [pybullet.getDynamicsInfo(physics.body_id, physics.joint_index(joint),
+                                     physicsClientId=physics.client_id)[FRICTION]
+            for joint in joints]
+
+
 def test_one_metre_forward_the_odometry_agrees_with_the_true_pose(tmp_path):
     with mecanum(tmp_path) as simulation:
         drive_until(simulation, (0.2, 0.0, 0.0), lambda odometry: odometry.x >= 1.0)
@@ -88,14 +108,7 @@ def test_one_metre_sideways_the_rollers_let_it_strafe_and_the_odometry_agrees(tm
 
 def test_a_quarter_turn_on_the_spot_the_odometry_agrees_with_the_true_heading(tmp_path):
     with mecanum(tmp_path) as simulation:
-        drive_until(simulation, (0.0, 0.0, 0.5),
-                    lambda odometry: odometry.heading >= math.pi / 2)
-        frame = simulation.physics.base_frame()
-        heading = yaw(frame.rotation)
-        assert heading == pytest.approx(math.pi / 2, rel=0.02)
-        assert simulation.controller(CONTROLLER).odometry.heading == pytest.approx(
-            heading, rel=0.02)
-        assert math.hypot(*frame.translation[:2]) < 0.02
+        turns_a_quarter_on_the_spot(simulation)
 
 
 def test_the_grip_across_the_rollers_is_bounded_by_the_wheels_friction(tmp_path):
@@ -114,15 +127,9 @@ def test_the_grip_across_the_rollers_is_bounded_by_the_wheels_friction(tmp_path)
 
 def test_the_roller_wheels_have_no_pybullet_friction_while_their_controller_is_active(tmp_path):
     with mecanum(tmp_path) as simulation:
-        physics = simulation.physics
-
-        def friction(joint: str) -> float:
-            return pybullet.getDynamicsInfo(physics.body_id, physics.joint_index(joint),
-                                            physicsClientId=physics.client_id)[FRICTION]
-
-        assert [friction(joint) for joint in mecanum_joints()] == [0.0] * 4
+        assert wheel_frictions(simulation, mecanum_joints()) == [0.0] * 4
         simulation.manager.switch(deactivate=[CONTROLLER])
-        assert [friction(joint) for joint in mecanum_joints()] == [1.0] * 4
+        assert wheel_frictions(simulation, mecanum_joints()) == [1.0] * 4
 
 
 
@@ -142,20 +149,9 @@ def test_the_omni_base_drives_one_metre_forward_or_sideways_and_the_odometry_agr
 
 def test_the_omni_base_turns_a_quarter_on_the_spot_and_the_odometry_agrees(tmp_path):
     with omni(tmp_path) as simulation:
-        drive_until(simulation, (0.0, 0.0, 0.5),
-                    lambda odometry: odometry.heading >= math.pi / 2)
-        frame = simulation.physics.base_frame()
-        heading = yaw(frame.rotation)
-        assert heading == pytest.approx(math.pi / 2, rel=0.02)
-        assert simulation.controller(CONTROLLER).odometry.heading == pytest.approx(
-            heading, rel=0.02)
-        assert math.hypot(*frame.translation[:2]) < 0.02
+        turns_a_quarter_on_the_spot(simulation)
 
 
 def test_the_omni_wheels_have_no_pybullet_friction_while_their_controller_is_active(tmp_path):
     with omni(tmp_path) as simulation:
-        physics = simulation.physics
-        frictions = [pybullet.getDynamicsInfo(physics.body_id, physics.joint_index(joint),
-                                              physicsClientId=physics.client_id)[FRICTION]
-                     for joint in omni_joints()]
-        assert frictions == [0.0] * 3
+        assert wheel_frictions(simulation, omni_joints()) == [0.0] * 3

@@ -49,6 +49,26 @@ def _wheel(side: str, y: float) -> str:
       </link>'''
 
 
+def caster(name: str, x: float, y: float, rest_height: float) -> str:
+    """Return a frictionless caster ball ``name`` on ``base_link`` at (``x``, ``y``).
+
+    Its joint is ``<name>_joint``; its lowest point is ``rest_height`` below
+    ``base_link`` (on the ground at rest); ``mu1``/``mu2`` 0: it only carries weight.
+    """
+    return f'''
+      <joint name="{name}_joint" type="fixed">
+        <parent link="base_link"/><child link="{name}"/>
+        <origin xyz="{x} {y} -{rest_height - CASTER_RADIUS}"/>
+      </joint>
+      <link name="{name}">
+        <inertial><mass value="0.1"/>
+          <inertia ixx="0.00003" ixy="0" ixz="0" iyy="0.00003" iyz="0" izz="0.00003"/>
+        </inertial>
+        <collision><geometry><sphere radius="{CASTER_RADIUS}"/></geometry></collision>
+      </link>
+      <gazebo reference="{name}"><mu1>0.0</mu1><mu2>0.0</mu2></gazebo>'''
+
+
 ROS2_DIFF_DRIVE = f'''
   <plugin name="diff_drive" filename="libgazebo_ros_diff_drive.so">
     <left_joint>left_wheel_joint</left_joint><right_joint>right_wheel_joint</right_joint>
@@ -167,17 +187,7 @@ def rover_urdf(name: str = 'rover', *, world_joint: bool = False,
           </link>
           {_wheel('left', half)}
           {_wheel('right', -half)}
-          <joint name="caster_joint" type="fixed">
-            <parent link="base_link"/><child link="caster"/>
-            <origin xyz="-0.1 0 -{REST_HEIGHT - CASTER_RADIUS}"/>
-          </joint>
-          <link name="caster">
-            <inertial><mass value="0.1"/>
-              <inertia ixx="0.00003" ixy="0" ixz="0" iyy="0.00003" iyz="0" izz="0.00003"/>
-            </inertial>
-            <collision><geometry><sphere radius="{CASTER_RADIUS}"/></geometry></collision>
-          </link>
-          <gazebo reference="caster"><mu1>0.0</mu1><mu2>0.0</mu2></gazebo>
+          {caster('caster', -0.1, 0, REST_HEIGHT)}
           <gazebo reference="left_wheel"><mu1>1.0</mu1><mu2>1.0</mu2></gazebo>
           {_ROS2_CONTROL if ros2_control else ''}
           {extra}

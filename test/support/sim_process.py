@@ -18,6 +18,8 @@ import pan_tilt_sim
 PACKAGE_ROOT = pathlib.Path(pan_tilt_sim.__file__).resolve().parents[1]
 # The program's one entry (the console script calls the same main()).
 MODULE_ENTRY = ('-m', 'pan_tilt_sim')
+EXIT_CONFIGURATION_ERROR = 2  # malformed input: sim_node's exit code
+ERROR_PREFIX = 'sim_node: error: '
 DUMP_BUDGET_S = 5.0  # for a process that did not stop to print its threads' stacks
 
 
@@ -41,6 +43,15 @@ def run(*ros_args: str, timeout: float = 30.0) -> subprocess.CompletedProcess:
     """Run sim_node to its end (a start-up error) and return what it did."""
     return subprocess.run(command(*ros_args), env=environment(), capture_output=True,
                           text=True, timeout=timeout, check=False)
+
+
+def error_line(result: subprocess.CompletedProcess) -> str:
+    """Return the one line a start-up error printed, checking it exited 2 and said nothing else."""
+    assert result.returncode == EXIT_CONFIGURATION_ERROR, result.stderr
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith(ERROR_PREFIX), result.stderr
+    return lines[0]
 
 
 def start(*ros_args: str, entry: tuple[str, ...] = MODULE_ENTRY,

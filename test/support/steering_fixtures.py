@@ -31,13 +31,13 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 import yaml
+from mobile_fixtures import caster
 
 WHEEL_RADIUS = 0.05  # m
 WHEELBASE = 0.3  # m from the rear axle to the front axle
 TRACK = 0.25  # m between the wheels of an axle
 AXLE_DROP = 0.025  # m: the axles below the base frame
 REST_HEIGHT = AXLE_DROP + WHEEL_RADIUS  # m: the base frame above the ground at rest
-CASTER_RADIUS = 0.025  # m
 STEER_LIMIT = 0.6  # rad either way
 CONTROLLER = 'steering_controller'
 ACKERMANN = 'ackermann_steering_controller/AckermannSteeringController'
@@ -76,21 +76,6 @@ def _steered_wheel(side: str, y: float) -> str:
       </link>''' + _wheel(f'{prefix}wheel_joint', f'{prefix}wheel', f'{prefix}knuckle', '0 0 0')
 
 
-def _caster(side: str, y: float) -> str:
-    return f'''
-      <joint name="{side}_caster_joint" type="fixed">
-        <parent link="base_link"/><child link="{side}_caster"/>
-        <origin xyz="0 {y} -{REST_HEIGHT - CASTER_RADIUS}"/>
-      </joint>
-      <link name="{side}_caster">
-        <inertial><mass value="0.1"/>
-          <inertia ixx="0.00003" ixy="0" ixz="0" iyy="0.00003" iyz="0" izz="0.00003"/>
-        </inertial>
-        <collision><geometry><sphere radius="{CASTER_RADIUS}"/></geometry></collision>
-      </link>
-      <gazebo reference="{side}_caster"><mu1>0.0</mu1><mu2>0.0</mu2></gazebo>'''
-
-
 def front_steering_joints(front: str) -> list[str]:
     """Return the steering joints of a ``front`` arrangement (right, then left)."""
     return (['front_right_steering_joint', 'front_left_steering_joint'] if front == 'pair'
@@ -119,7 +104,8 @@ def steered_urdf(front: str = 'pair', rear: str = 'pair', driven: Sequence[str] 
                          f'0 {half} -{AXLE_DROP}')]
     else:
         parts += [_wheel('rear_wheel_joint', 'rear_wheel', 'base_link', f'0 0 -{AXLE_DROP}'),
-                  _caster('right', -half), _caster('left', half)]
+                  caster('right_caster', 0, -half, REST_HEIGHT),
+                  caster('left_caster', 0, half, REST_HEIGHT)]
     driven = list(driven) if driven is not None else rear_wheel_joints(rear)
     control = ''.join(
         f'<joint name="{joint}"><command_interface name="position"/>'
