@@ -12,11 +12,12 @@ Design notes: docs/design/sim.md#physicspy.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import pathlib
 import tempfile
 import weakref
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 
 import numpy
 
@@ -24,7 +25,7 @@ from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.base_pose import ORIGIN, BasePose
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.inertials import with_massive_root
-from pan_tilt_sim.model.mimic import follow_leaders, mimic_couplings
+from pan_tilt_sim.model.mimic import MimicCoupling, follow_leaders, mimic_couplings
 from pan_tilt_sim.model.physics_settings import DEFAULT_PHYSICS, PhysicsSettings
 from pan_tilt_sim.model.robot import JointSpec, RobotModel
 from pan_tilt_sim.model.surfaces import Surface
@@ -235,7 +236,8 @@ class Physics:
         if initial_positions is None:
             initial_positions = [joint.initial_position for joint in self._joints]
         self._initial_positions = self._with_mimics(initial_positions)
-        self._drives = _Drives(self, [False] * len(self._joints))
+        self._drives = _Drives(self, [False] * len(self._joints), self._indices,
+                               self._mimics)
         self.reset_joints()
         if not fixed_base:
             apply_surfaces(self._client, self._body, description.model)
@@ -430,7 +432,7 @@ class Physics:
         efforts of the effort-driven joints and the velocity targets of the
         velocity-driven ones, each in joint order.
         """
-        self._drives = _Drives(self, velocity_driven)
+        self._drives = _Drives(self, velocity_driven, self._indices, self._mimics)
 
     def step(self, efforts: Sequence[float], targets: Sequence[float] = (),
              forces: Sequence[float] | None = None) -> list:
@@ -650,180 +652,278 @@ class Physics:
                 maxForce=MIMIC_MAX_FORCE, erp=MIMIC_ERROR_REDUCTION, physicsClientId=self._client)
 
 
+@dataclasses.dataclass(frozen=True)
+class DriveSplit:
+    """The joints (slots in joint order, ascending) each drive kind takes.
+
+    ``velocity``: a velocity motor (the ideal actuator); ``effort``: the
+    rest, split by what their damping and friction need: ``explicit``
+    (PyBullet's own damping), ``implicit`` (implicit damping, force-capped
+    motor: with friction or a mimic coupling), ``damped`` (implicit damping
+    alone, velocity-gain motor), ``frictional`` (friction, no or explicit
+    damping) and ``plain`` (neither damping nor friction).
+    """
+
+    velocity: list[int]
+    effort: list[int]
+    explicit: list[int]
+    implicit: list[int]
+    damped: list[int]
+    frictional: list[int]
+    plain: list[int]
+
+
+def split_drives(joints: Sequence[JointSpec], velocity_driven: Sequence[bool], time_step: float,
+                 smallest_inertias: Callable[[], Sequence[float]],
+                 coupled: Collection[str]) -> DriveSplit:
+    """Sort the joints into drive kinds (:class:`DriveSplit`).
+
+    ``smallest_inertias()`` (each joint's, over the checked poses) is called
+    only if an effort joint has damping; ``coupled``: the names of the joints
+    a mimic coupling joins.  Explicit damping is PyBullet's own, kept where it
+    is far inside its stability bound.  A velocity gain makes the motor a hard
+    constraint that would override a mimic gear's forces, so coupled joints
+    always take the force-capped form.
+    """
+    if len(velocity_driven) != len(joints):
+        raise ValueError(f'{len(velocity_driven)} drives for {len(joints)} joints')
+    velocity = [k for k, driven in enumerate(velocity_driven) if driven]
+    effort = [k for k, driven in enumerate(velocity_driven) if not driven]
+    with_damping = [k for k in effort if joints[k].damping > 0.0]
+    smallest = smallest_inertias() if with_damping else []
+    explicit = [k for k in with_damping
+                if joints[k].damping * time_step <= EXPLICIT_DAMPING_SHARE * smallest[k]]
+    damped = [k for k in with_damping if k not in explicit and joints[k].friction <= 0.0
+              and joints[k].name not in coupled]
+    implicit = [k for k in with_damping if k not in explicit and k not in damped]
+    frictional = [k for k in effort
+                  if joints[k].friction > 0.0 and (joints[k].damping <= 0.0 or k in explicit)]
+    plain = [k for k in effort if joints[k].friction <= 0.0
+             and (joints[k].damping <= 0.0 or k in explicit)]
+    return DriveSplit(velocity, effort, explicit, implicit, damped, frictional, plain)
+
+
+def static_rows(joints: Sequence[JointSpec], split: DriveSplit) -> list[tuple[int, float]]:
+    """Return the motor rows sent once, (slot, force): all at target speed 0.
+
+    Friction-only joints hold with their friction; plain joints, and every
+    velocity joint until its first step, have no motor (force 0).
+    """
+    return [(k, joints[k].friction) for k in split.frictional] + [
+        (k, NO_MOTOR) for k in split.plain + split.velocity]
+
+
+class ImplicitDamping:
+    """Force-capped zero-speed motors: implicit damping with friction or a mimic coupling.
+
+    Each step, the motor of an ``implicit`` joint may resist with at most
+    ``f + d |v_end|``, ``v_end`` being the speed implicit Euler of ``J v' =
+    tau + g - d v - f sgn(v)`` gives at the end of the step; the passive
+    torque ``g`` (gravity, coupling) is read back from the step before.
+    ``slots``: the joints; ``effort_slots``: where their efforts are in the
+    efforts array; ``first_motor``: where their rows start in the motor arrays.
+    """
+
+    def __init__(self, joints: Sequence[JointSpec], slots: Sequence[int],
+                 effort_slots: Sequence[int], first_motor: int) -> None:
+        effort_of = {k: position for position, k in enumerate(effort_slots)}
+        self.slots = list(slots)
+        self._damping = [joints[k].damping for k in slots]
+        # One row per joint, updated in place: [state slot, effort slot, motor slot, J / dt,
+        # d dt / (J + d dt), f, g], g being the torque the joint felt last step besides
+        # ours and the motor's.
+        self._rows = [[k, effort_of[k], first_motor + number, 0.0, 0.0, joints[k].friction, 0.0]
+                      for number, k in enumerate(slots)]
+
+    def __bool__(self) -> bool:
+        return bool(self._rows)
+
+    @property
+    def frictions(self) -> list[float]:
+        """Each joint's Coulomb friction: its motor's force before the first step."""
+        return [row[5] for row in self._rows]
+
+    def refresh(self, inertias: Sequence[float], time_step: float) -> None:
+        """Take the joints' effective inertias (``inertias[slot]``) for the next steps."""
+        for row, damping in zip(self._rows, self._damping, strict=True):
+            inertia = inertias[row[0]]
+            row[3] = inertia / time_step
+            row[4] = damping * time_step / (inertia + damping * time_step)
+
+    def rest(self, gravity: Sequence[float]) -> None:
+        """Start from rest: the passive torque is minus what holding against gravity takes."""
+        for row in self._rows:
+            row[6] = -gravity[row[0]]
+
+    def resist(self, before: Sequence, efforts: Sequence[float], forces: list[float]) -> None:
+        """Write each motor's force cap into ``forces``, from the states ``before`` the step."""
+        for row in self._rows:
+            slot, effort_slot, motor_slot, per_dt, gain, friction, passive = row
+            drive = per_dt * before[slot][STATE_VELOCITY] + efforts[effort_slot] + passive
+            excess = (drive if drive >= 0.0 else -drive) - friction
+            forces[motor_slot] = friction + gain * excess if excess > 0.0 else friction
+
+    def feel(self, before: Sequence, states: Sequence, efforts: Sequence[float]) -> None:
+        """Read back the passive torque each joint felt from ``before`` to ``states``."""
+        for row in self._rows:
+            slot = row[0]
+            state = states[slot]
+            row[6] = (row[3] * (state[STATE_VELOCITY] - before[slot][STATE_VELOCITY])
+                      - state[STATE_MOTOR_TORQUE] - efforts[row[1]])
+
+
+class GainDamping:
+    """Zero-speed motors with velocity gain ``d dt / (J + d dt)``: implicit damping alone.
+
+    Sent again whenever the effective inertias are refreshed; unbounded force.
+    """
+
+    def __init__(self, joints: Sequence[JointSpec], slots: Sequence[int]) -> None:
+        self.slots = list(slots)
+        self._damping = [joints[k].damping for k in slots]
+
+    def __bool__(self) -> bool:
+        return bool(self.slots)
+
+    def gains(self, inertias: Sequence[float], time_step: float) -> list[float]:
+        """Return each joint's velocity gain for the effective ``inertias[slot]``."""
+        return [damping * time_step / (inertias[k] + damping * time_step)
+                for k, damping in zip(self.slots, self._damping, strict=True)]
+
+
+class MotorRows:
+    """The velocity motor rows sent every step: the velocity joints', then implicit damping's.
+
+    ``targets`` and ``forces`` are updated in place; a velocity joint's force
+    starts at its effort limit (at most :data:`UNLIMITED_FORCE`), an
+    implicit-damping joint's at its friction.
+    """
+
+    def __init__(self, joints: Sequence[JointSpec], velocity: Sequence[int],
+                 implicit: ImplicitDamping, indices: Sequence[int]) -> None:
+        self.velocity_count = len(velocity)
+        self.indices = [indices[k] for k in list(velocity) + implicit.slots]
+        count = len(self.indices)
+        self.targets = [0.0] * count
+        self.forces = [min(joints[k].effort_limit, UNLIMITED_FORCE) for k in velocity] + (
+            implicit.frictions)
+        self.zeros = [0.0] * count
+        self.gains = [MOTOR_VELOCITY_GAIN] * count
+
+    def __bool__(self) -> bool:
+        return bool(self.indices)
+
+    def command(self, targets: Sequence[float], forces: Sequence[float] | None) -> None:
+        """Take the velocity joints' ``targets`` and force caps (None: keep the last ones)."""
+        count = self.velocity_count
+        if count:
+            self.targets[:count] = targets
+            if forces is not None:
+                self.forces[:count] = forces
+
+
 class _Drives:
     """The per-step work for one split of the joints into effort- and velocity-driven.
 
-    Motor rows (one PyBullet velocity motor per joint at most):
-
-    * velocity-driven joint: target from the controllers, force = effort limit
-      or the force the step gives, sent every step;
-    * effort joint whose damping is implicit, with friction (or a mimic
-      coupling): target 0, force ``f + d |v_end|`` from the implicit-Euler end
-      speed, sent every step;
-    * effort joint whose damping is implicit, without friction: target 0,
-      velocity gain ``d dt / (J + d dt)``, sent when the inertias are refreshed;
-    * effort joint with friction and no or explicit damping: target 0, force
-      ``f``, sent once;
-    * otherwise: no row.
-
-    Everything the step function touches is bound to locals or to lists that
-    :meth:`restart` and the inertia refresh update in place, so the step
-    reads nothing from ``self``.
+    Composes the drive kinds (:func:`split_drives`): PyBullet's explicit
+    damping and the :func:`static_rows` are sent once here; the
+    :class:`MotorRows` (velocity motors and :class:`ImplicitDamping`) every
+    step; the :class:`GainDamping` rows when the inertias are refreshed.
+    ``indices``: PyBullet's index of each joint; ``mimics``: the robot's
+    mimic couplings.
     """
 
-    def __init__(self, physics: Physics, velocity_driven: Sequence[bool]) -> None:
+    def __init__(self, physics: Physics, velocity_driven: Sequence[bool],
+                 indices: Sequence[int], mimics: Sequence[MimicCoupling]) -> None:
         joints = physics.joints
-        if len(velocity_driven) != len(joints):
-            raise ValueError(f'{len(velocity_driven)} drives for {len(joints)} joints')
         self._physics = physics
-        body, client, indices = physics.body_id, physics.client_id, physics._indices
-        dt = physics.time_step
-        self._dt = dt
-        velocity_slots = [k for k, driven in enumerate(velocity_driven) if driven]
-        effort_slots = [k for k, driven in enumerate(velocity_driven) if not driven]
-        self.velocity_slots = velocity_slots
-        self.effort_slots = effort_slots
-        # Effort joints by what their damping and friction need.  Explicit
-        # damping is PyBullet's own, where it is far inside its stability bound.
-        # A velocity gain makes the motor a hard constraint that would override a
-        # mimic gear's forces, so coupled joints always take the force-capped form.
-        damped = [k for k in effort_slots if joints[k].damping > 0.0]
-        smallest = physics.smallest_inertias() if damped else []
-        explicit = [k for k in damped
-                    if joints[k].damping * dt <= EXPLICIT_DAMPING_SHARE * smallest[k]]
+        body, client, dt = physics.body_id, physics.client_id, physics.time_step
+        self._body, self._client, self._dt = body, client, dt
+        coupled = {name for coupling in mimics for name in (coupling.leader, coupling.follower)}
+        split = split_drives(joints, velocity_driven, dt, physics.smallest_inertias, coupled)
+        self.velocity_slots, self.effort_slots = split.velocity, split.effort
+        self.explicit, self.implicit, self.damped = split.explicit, split.implicit, split.damped
         for k, joint in enumerate(joints):
             pybullet.changeDynamics(body, indices[k], jointDamping=joint.damping
-                                    if k in explicit else 0.0, physicsClientId=client)
-        coupled = {joint for coupling in physics._mimics
-                   for joint in (coupling.leader, coupling.follower)}
-        self._damped = [k for k in damped if k not in explicit and joints[k].friction <= 0.0
-                        and joints[k].name not in coupled]
-        implicit = [k for k in damped if k not in explicit and k not in self._damped]
-        self.explicit, self.implicit, self.damped = explicit, implicit, self._damped
-        frictional = [k for k in effort_slots
-                      if joints[k].friction > 0.0 and (joints[k].damping <= 0.0 or k in explicit)]
-        plain = [k for k in effort_slots if joints[k].friction <= 0.0
-                 and (joints[k].damping <= 0.0 or k in explicit)]
-        # Static rows: friction-only joints hold with their friction, plain
-        # joints (and every velocity joint until its first step) have none.
-        static = [(k, joints[k].friction) for k in frictional] + [
-            (k, NO_MOTOR) for k in plain + velocity_slots]
+                                    if k in split.explicit else 0.0, physicsClientId=client)
+        static = static_rows(joints, split)
         if static:
             count = len(static)
             pybullet.setJointMotorControlArray(
                 body, [indices[k] for k, _ in static], pybullet.VELOCITY_CONTROL,
                 [0.0] * count, [0.0] * count, [force for _, force in static], [0.0] * count,
                 [MOTOR_VELOCITY_GAIN] * count, client)
-        self._damped_indices = [indices[k] for k in self._damped]
-        # Per-step motor rows: velocity joints first, then the implicit ones.
-        motor_indices = [indices[k] for k in velocity_slots + implicit]
-        velocity_count = len(velocity_slots)
-        motor_count = len(motor_indices)
-        motor_targets = [0.0] * motor_count
-        motor_forces = [min(joints[k].effort_limit, UNLIMITED_FORCE) for k in velocity_slots] + [
-            joints[k].friction for k in implicit]
-        motor_zeros = [0.0] * motor_count
-        motor_gains = [MOTOR_VELOCITY_GAIN] * motor_count
-        effort_indices = [indices[k] for k in effort_slots]
-        effort_of = {k: position for position, k in enumerate(effort_slots)}
-        # One row per implicit joint, refreshed in place: [state slot, effort slot,
-        # motor slot, J / dt, d dt / (J + d dt), f, g], g being the torque the joint
-        # felt last step besides ours and the motor's (gravity, coupling).
-        rows = [[k, effort_of[k], velocity_count + number, 0.0, 0.0, joints[k].friction, 0.0]
-                for number, k in enumerate(implicit)]
-        self._rows = rows
-        self._countdown = [0]
-
-        set_motors = pybullet.setJointMotorControlArray
+        self._implicit = ImplicitDamping(joints, split.implicit, split.effort,
+                                         len(split.velocity))
+        self._gain = GainDamping(joints, split.damped)
+        self._gain_indices = [indices[k] for k in split.damped]
+        self._motors = MotorRows(joints, split.velocity, self._implicit, indices)
         # Torques, one step, the states: compiled where the package was built with it;
-        # there, the velocity motors go from C in the same call (drive_motors).
-        effort_step = physics.effort_stepper(effort_indices, motor_indices)
-        drive_motors = getattr(effort_step, 'drive', None)
-        velocity_mode = pybullet.VELOCITY_CONTROL
-        countdown, refresh = self._countdown, self._refresh
-        states_box = [physics.read_states()]
-        self._states_box = states_box
-
+        # there, the velocity motors go from C in the same call (``drive``).
+        self._effort_step = effort_step = physics.effort_stepper(
+            [indices[k] for k in split.effort], self._motors.indices)
+        self._drive_motors = getattr(effort_step, 'drive', None)
+        self._countdown = 0
+        self._states = physics.read_states()
         # Many steps of controller laws in C: only where a step is nothing but the efforts.
         self.run_laws = None
-        if not motor_count and not self._damped:
-            # Nothing to do per step but the efforts: the cheapest step.
+        if not self._motors and not self._gain:
             self.run_laws = getattr(effort_step, 'run_laws', None)
+
             def step(efforts: Sequence[float], targets: Sequence[float] = (),
                      forces: Sequence[float] | None = None) -> Sequence:
                 return effort_step(efforts)
             self.step = step
-            self.restart()
-            return
-
-        def step(efforts: Sequence[float], targets: Sequence[float] = (),
-                 forces: Sequence[float] | None = None) -> list:
-            countdown[0] -= 1
-            if countdown[0] < 0:
-                refresh()
-            before = states_box[0]
-            if motor_count:
-                if velocity_count:
-                    motor_targets[:velocity_count] = targets
-                    if forces is not None:
-                        motor_forces[:velocity_count] = forces
-                for row in rows:
-                    # Implicit Euler of J v' = tau + g - d v - f sgn(v), divided by dt:
-                    # the motor may resist with f plus the damping of the end speed.
-                    slot, effort_slot, motor_slot, per_dt, gain, friction, passive = row
-                    drive = per_dt * before[slot][STATE_VELOCITY] + efforts[effort_slot] + passive
-                    excess = (drive if drive >= 0.0 else -drive) - friction
-                    motor_forces[motor_slot] = (friction + gain * excess if excess > 0.0
-                                                else friction)
-                if drive_motors is not None:
-                    states = drive_motors(efforts, motor_targets, motor_forces, motor_gains)
-                else:
-                    set_motors(body, motor_indices, velocity_mode, motor_zeros, motor_targets,
-                               motor_forces, motor_zeros, motor_gains, client)
-                    states = effort_step(efforts)
-            else:
-                states = effort_step(efforts)
-            for row in rows:
-                slot = row[0]
-                state = states[slot]
-                row[6] = (row[3] * (state[STATE_VELOCITY] - before[slot][STATE_VELOCITY])
-                          - state[STATE_MOTOR_TORQUE] - efforts[row[1]])
-            states_box[0] = states
-            return states
-
-        self.step = step
+        else:
+            self.step = self._motor_step
         self.restart()
+
+    def _motor_step(self, efforts: Sequence[float], targets: Sequence[float] = (),
+                    forces: Sequence[float] | None = None) -> Sequence:
+        """Step with motor rows: the velocity targets, the implicit damping, then the efforts."""
+        self._countdown -= 1
+        if self._countdown < 0:
+            self._refresh()
+        before, motors, implicit = self._states, self._motors, self._implicit
+        if motors:
+            motors.command(targets, forces)
+            implicit.resist(before, efforts, motors.forces)
+            if self._drive_motors is not None:
+                states = self._drive_motors(efforts, motors.targets, motors.forces,
+                                            motors.gains)
+            else:
+                pybullet.setJointMotorControlArray(
+                    self._body, motors.indices, pybullet.VELOCITY_CONTROL, motors.zeros,
+                    motors.targets, motors.forces, motors.zeros, motors.gains, self._client)
+                states = self._effort_step(efforts)
+        else:
+            states = self._effort_step(efforts)
+        implicit.feel(before, states, efforts)
+        self._states = states
+        return states
 
     def restart(self) -> None:
         """Start over from the joints' present state (after a reset, or at the start)."""
-        self._states_box[0] = self._physics.read_states()
-        self._countdown[0] = 0
-        if self._rows:
-            # The passive torque at rest: minus what holding against gravity takes.
-            gravity = self._physics.gravity_torques()
-            for row in self._rows:
-                row[6] = -gravity[row[0]]
+        self._states = self._physics.read_states()
+        self._countdown = 0
+        if self._implicit:
+            self._implicit.rest(self._physics.gravity_torques())
 
     def _refresh(self) -> None:
         """Recompute the effective inertias the implicit damping uses."""
-        self._countdown[0] = INERTIA_REFRESH_STEPS - 1
-        if not self._rows and not self._damped:
+        self._countdown = INERTIA_REFRESH_STEPS - 1
+        if not self._implicit and not self._gain:
             return
-        physics, dt = self._physics, self._dt
-        inertias = physics.effective_inertias()
-        joints = physics.joints
-        for row in self._rows:
-            inertia, damping = inertias[row[0]], joints[row[0]].damping
-            row[3] = inertia / dt
-            row[4] = damping * dt / (inertia + damping * dt)
-        if self._damped:
-            count = len(self._damped)
-            gains = [joints[k].damping * dt / (inertias[k] + joints[k].damping * dt)
-                     for k in self._damped]
+        dt = self._dt
+        inertias = self._physics.effective_inertias()
+        self._implicit.refresh(inertias, dt)
+        if self._gain:
+            gains = self._gain.gains(inertias, dt)
+            count = len(gains)
             pybullet.setJointMotorControlArray(
-                physics.body_id, self._damped_indices, pybullet.VELOCITY_CONTROL,
+                self._body, self._gain_indices, pybullet.VELOCITY_CONTROL,
                 [0.0] * count, [0.0] * count, [UNLIMITED_FORCE] * count, [0.0] * count, gains,
-                physics.client_id)
+                self._client)
 
 
 def health_problem(name: str, state: Sequence[float], cap: float) -> str:

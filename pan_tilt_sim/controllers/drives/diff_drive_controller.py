@@ -25,11 +25,9 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
     DOUBLE,
     INT,
     REQUIRED,
-    STRING,
     STRING_ARRAY,
     Param,
     ParameterSpec,
-    frame_id_prefix,
     gt,
     gt_eq,
     not_empty,
@@ -39,6 +37,7 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
 from pan_tilt_sim.controllers.framework.shared_parameters import (
     odometry_frames,
     same_frames_problem,
+    tf_frame_prefix,
     velocity_limit_params,
     velocity_limiter,
 )
@@ -89,9 +88,7 @@ class DiffDriveController(OdometryOutputs, CommandController):
               'Correction factor of wheel_radius for the left wheels.', (gt(0.0),)),
         Param('right_wheel_radius_multiplier', DOUBLE, 1.0,
               'Correction factor of wheel_radius for the right wheels.', (gt(0.0),)),
-        Param('tf_frame_prefix_enable', BOOL, True, 'Prefix the frame ids with tf_frame_prefix.'),
-        Param('tf_frame_prefix', STRING, '', "The frame ids' prefix; empty: the controller's "
-              'namespace.', (frame_id_prefix(),)),
+        *tf_frame_prefix(),
         *odometry_frames(),
         Param('open_loop', BOOL, False, 'Odometry from the limited command, not the wheels.'),
         Param('position_feedback', BOOL, True, "Odometry from the wheels' positions (else "

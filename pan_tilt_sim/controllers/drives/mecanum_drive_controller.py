@@ -27,7 +27,6 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
     STRING,
     Param,
     ParameterSpec,
-    frame_id_prefix,
     gt,
     gt_eq,
     not_empty,
@@ -37,6 +36,7 @@ from pan_tilt_sim.controllers.framework.shared_parameters import (
     UPDATE_RATE,
     odometry_frames,
     same_frames_problem,
+    tf_frame_prefix,
     update_period,
     velocity_limit_params,
     velocity_limiter,
@@ -168,9 +168,7 @@ class MecanumDriveController(OdometryOutputs, CommandController):
               "lx + ly: the wheels' distances from the centre along x plus along y (m); "
               'upstream accepts 0, which its odometry divides by.', (gt(0.0),),
               read_only=True, example=0.3),
-        Param('tf_frame_prefix_enable', BOOL, True, 'Prefix the frame ids with tf_frame_prefix.'),
-        Param('tf_frame_prefix', STRING, '', "The frame ids' prefix; empty: the controller's "
-              'namespace.', (frame_id_prefix(),), read_only=True),
+        *tf_frame_prefix(prefix_read_only=True),
         FRAMES.base,
         FRAMES.odom,
         Param('enable_odom_tf', BOOL, True, 'Publish odom_frame_id -> base_frame_id on '

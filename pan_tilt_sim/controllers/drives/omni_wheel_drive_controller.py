@@ -30,11 +30,9 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
     BOOL,
     DOUBLE,
     REQUIRED,
-    STRING,
     STRING_ARRAY,
     Param,
     ParameterSpec,
-    frame_id_prefix,
     gt,
     gt_eq,
     names,
@@ -45,6 +43,7 @@ from pan_tilt_sim.controllers.framework.shared_parameters import (
     UPDATE_RATE,
     odometry_frames,
     same_frames_problem,
+    tf_frame_prefix,
     update_period,
 )
 from pan_tilt_sim.controllers.framework.surface import (
@@ -164,10 +163,7 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
               '(m).', (gt(0.0),), read_only=True, example=0.15),
         Param('wheel_radius', DOUBLE, REQUIRED, "The wheels' radius (m).", (gt(0.0),),
               read_only=True, example=0.05),
-        Param('tf_frame_prefix_enable', BOOL, True, 'Prefix the frame ids with tf_frame_prefix.',
-              read_only=True),
-        Param('tf_frame_prefix', STRING, '', "The frame ids' prefix; empty: the controller's "
-              'namespace.', (frame_id_prefix(),), read_only=True),
+        *tf_frame_prefix(enable_read_only=True, prefix_read_only=True),
         *odometry_frames(pose_name='diagonal_covariance.pose',
                          twist_name='diagonal_covariance.twist', read_only=True),
         Param('open_loop', BOOL, False, 'Odometry from the command, not the wheels.',

@@ -22,6 +22,7 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
     Validator,
     fixed_size,
     frame_id,
+    frame_id_prefix,
     gt_eq,
     names,
     not_empty,
@@ -79,6 +80,19 @@ def odometry_frames(*, covariance: Sequence[float] = (0.0,) * COVARIANCE_SIZE,
               'covariance (x, y, z, roll, pitch, yaw).', size, read_only=read_only),
         Param(twist_name, DOUBLE_ARRAY, list(covariance), "Diagonal of the odometry twist's "
               'covariance.', size, read_only=read_only))
+
+
+def tf_frame_prefix(*, enable_read_only: bool = False,
+                    prefix_read_only: bool = False) -> tuple[Param, Param]:
+    """Return ``tf_frame_prefix_enable`` and ``tf_frame_prefix`` (empty: the namespace).
+
+    ``enable_read_only``/``prefix_read_only``: each fixed once configured, as
+    the controller's upstream declares it.
+    """
+    return (Param('tf_frame_prefix_enable', BOOL, True, 'Prefix the frame ids with '
+                  'tf_frame_prefix.', read_only=enable_read_only),
+            Param('tf_frame_prefix', STRING, '', "The frame ids' prefix; empty: the "
+                  "controller's namespace.", (frame_id_prefix(),), read_only=prefix_read_only))
 
 
 def same_frames_problem(params: Mapping[str, Any]) -> str | None:

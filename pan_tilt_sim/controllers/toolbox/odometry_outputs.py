@@ -10,6 +10,7 @@ sink is called with is the controller's own contract: a planar sample
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 from pan_tilt_sim.model.transforms import Transform
@@ -35,3 +36,17 @@ class OdometryOutputs:
     def set_tf_sink(self, sink: TfSink | None) -> None:
         """Where the odom -> base transform goes: ``sink(time, [(parent, child, transform)])``."""
         self._tf_sink = sink
+
+    def publish_planar(self, time: float, x: float, y: float, heading: float, linear: float,
+                       angular: float, frames: tuple[str, str]) -> None:
+        """Send a planar sample to the odometry sink and ``frames`` (parent, child) to ``/tf``.
+
+        For controllers whose odometry sink takes the planar form; the
+        transform is ``(x, y, 0)`` turned by ``heading`` about z.
+        """
+        if self._odometry_sink is not None:
+            self._odometry_sink(time, x, y, heading, linear, angular)
+        if self._tf_sink is not None:
+            pose = Transform((x, y, 0.0), (0.0, 0.0, math.sin(heading / 2.0),
+                                           math.cos(heading / 2.0)))
+            self._tf_sink(time, [(frames[0], frames[1], pose)])

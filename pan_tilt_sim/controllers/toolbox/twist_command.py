@@ -69,6 +69,11 @@ class TwistCommand:
                                    (0.0, 0.0, angular))
         return CommandResult.ACCEPTED
 
+    def planar(self) -> tuple[float, float]:
+        """Return the latest twist's ``(linear.x, angular.z)``; (0, 0) if none was taken."""
+        latest = self.latest
+        return (0.0, 0.0) if latest is None else (latest.linear[0], latest.angular[2])
+
     def problem(self, value: Any, result: CommandResult) -> str:
         """Describe the last refused twist (the command topic's problem callback)."""
         return self._problem

@@ -16,7 +16,6 @@ behaviour per generation: docs/design/gazebo-plugins.md.  Pure Python.
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
@@ -35,11 +34,12 @@ from pan_tilt_sim.controllers.framework.surface import (
     StateTopic,
 )
 from pan_tilt_sim.controllers.toolbox.odometry import Odometry
-from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, TfSink
+from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs
+from pan_tilt_sim.controllers.toolbox.twist_command import TwistCommand
+from pan_tilt_sim.controllers.toolbox.wheel_sides import WheelSides
 from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.model.sensors import ROS1, ROS2, Ros2Names, ros1_resolve
-from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.plugins.framework.elements import (
     UNPLANAR_COVARIANCE,
     Element,
@@ -248,12 +248,10 @@ class GazeboDiffDrive(Plugin, OdometryOutputs, CommandController):
         self._period = 1.0 / plugin.update_rate if plugin.update_rate > 0.0 else 0.0
         self._odometry = Odometry(plugin.wheel_separation[0], plugin.wheel_diameter[0] / 2.0,
                                   plugin.wheel_diameter[0] / 2.0, window=1)
-        self._left: list[JointHandle] = []
-        self._right: list[JointHandle] = []
+        self._wheels = WheelSides(plugin.left_joints, plugin.right_joints)
+        self._command = TwistCommand('cmd_vel')
         self._odometry_sink: PlanarOdometrySink | None = None
-        self._tf_sink: TfSink | None = None
         self._base_state: Callable[[], BaseState] | None = None
-        self._problem = ''
         self.reset()
 
     @property
@@ -298,19 +296,16 @@ class GazeboDiffDrive(Plugin, OdometryOutputs, CommandController):
 
     def configure(self, joints: Mapping[str, JointHandle]) -> None:
         """Bind the wheels' handles, then reset."""
-        self._left = [self.handle(joints, wheel, 'left_joint')
-                      for wheel in self.plugin.left_joints]
-        self._right = [self.handle(joints, wheel, 'right_joint')
-                       for wheel in self.plugin.right_joints]
+        self._wheels.bind(joints, self.handle)
         self.reset()
 
     def reset(self) -> None:
         """No command, the encoder odometry at the origin, the wheels asked to stand."""
-        self._linear = self._angular = 0.0
+        self._command.latest = None
         self._last_update = 0.0
         self._odometry.reset(0.0)
-        self._instructed = [0.0] * len(self._left + self._right)
-        for handle in self._left + self._right:
+        self._instructed = [0.0] * len(self._wheels.all)
+        for handle in self._wheels.all:
             handle.velocity_target = 0.0
             handle.force_limit = self.plugin.max_wheel_torque
 
@@ -318,21 +313,15 @@ class GazeboDiffDrive(Plugin, OdometryOutputs, CommandController):
 
     def set_command(self, value: StampedTwist) -> CommandResult:
         """Take a twist (from the subscription; cheap): refuse non-finite ones."""
-        linear, angular = value.linear[0], value.angular[2]
-        if not (math.isfinite(linear) and math.isfinite(angular)):
-            self._problem = (f'ignored cmd_vel (linear.x {linear!r}, angular.z {angular!r}): '
-                             'not finite numbers')
-            return CommandResult.REJECTED
-        self._linear, self._angular = linear, angular
-        return CommandResult.ACCEPTED
+        return self._command.take(value)
 
     def command_problem(self, value: Any, result: CommandResult) -> str:
         """Describe the last refused twist."""
-        return self._problem
+        return self._command.problem(value, result)
 
     def setpoints(self) -> dict[str, float]:
         """Return each wheel's velocity target (rad/s)."""
-        return {handle.name: handle.velocity_target for handle in self._left + self._right}
+        return self._wheels.setpoints()
 
     @property
     def odometry(self) -> Odometry:
@@ -345,10 +334,11 @@ class GazeboDiffDrive(Plugin, OdometryOutputs, CommandController):
         """Integrate the encoders; at the update rate publish and set the wheels' targets."""
         plugin = self.plugin
         radius = plugin.wheel_diameter[0] / 2.0
-        if plugin.odometry_source == ENCODER and self._left:
-            self._odometry.update_from_travel(self._left[0].velocity * radius * period,
-                                              self._right[0].velocity * radius * period, time)
-        for handle in self._left + self._right:
+        wheels = self._wheels
+        if plugin.odometry_source == ENCODER and wheels.left:
+            self._odometry.update_from_travel(wheels.left[0].velocity * radius * period,
+                                              wheels.right[0].velocity * radius * period, time)
+        for handle in wheels.all:
             handle.force_limit = plugin.max_wheel_torque
         since = time - self._last_update
         if since + DUE_EPSILON < self._period:
@@ -361,10 +351,12 @@ class GazeboDiffDrive(Plugin, OdometryOutputs, CommandController):
         """Set each wheel's velocity target as the plugin does, its ramp included."""
         plugin = self.plugin
         accel = plugin.max_wheel_acceleration
-        for pair, (left, right) in enumerate(zip(self._left, self._right, strict=True)):
+        linear, angular = self._command.planar()
+        wheels = self._wheels
+        for pair, (left, right) in enumerate(zip(wheels.left, wheels.right, strict=True)):
             radius = plugin.wheel_diameter[pair] / 2.0
-            half = self._angular * plugin.wheel_separation[pair] / 2.0
-            desired = (self._linear - half, self._linear + half)
+            half = angular * plugin.wheel_separation[pair] / 2.0
+            desired = (linear - half, linear + half)
             current = (left.velocity * radius, right.velocity * radius)
             reached = all(abs(want - have) < REACHED
                           for want, have in zip(desired, current, strict=True))
@@ -388,11 +380,5 @@ class GazeboDiffDrive(Plugin, OdometryOutputs, CommandController):
     def _publish(self, time: float) -> None:
         if self._odometry_sink is None and self._tf_sink is None:
             return
-        x, y, heading, linear, angular = self._pose_and_twist()
-        if self._odometry_sink is not None:
-            self._odometry_sink(time, x, y, heading, linear, angular)
-        if self._tf_sink is not None:
-            pose = Transform((x, y, 0.0), (0.0, 0.0, math.sin(heading / 2.0),
-                                           math.cos(heading / 2.0)))
-            self._tf_sink(time, [(self.plugin.odometry_frame, self.plugin.robot_base_frame,
-                                  pose)])
+        self.publish_planar(time, *self._pose_and_twist(),
+                            (self.plugin.odometry_frame, self.plugin.robot_base_frame))

@@ -35,15 +35,16 @@ from pan_tilt_sim.controllers.framework.surface import (
     StateTopic,
 )
 from pan_tilt_sim.controllers.toolbox.odometry import Odometry
-from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, TfSink
+from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs
 from pan_tilt_sim.controllers.toolbox.rate_limiter import (
     InvalidLimitsError,
     RateLimiter,
     RateLimits,
 )
+from pan_tilt_sim.controllers.toolbox.twist_command import TwistCommand
+from pan_tilt_sim.controllers.toolbox.wheel_sides import WheelSides
 from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.robot import RobotModel
-from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.plugins.framework.elements import (
     GZ,
     Element,
@@ -214,11 +215,9 @@ class GzDiffDrive(Plugin, OdometryOutputs, CommandController):
                           gz_limiter(plugin.angular_limits, plugin.name, 'angular'))
         self._odometry = Odometry(plugin.wheel_separation, plugin.wheel_radius,
                                   plugin.wheel_radius, ODOMETRY_WINDOW)
-        self._left: list[JointHandle] = []
-        self._right: list[JointHandle] = []
+        self._wheels = WheelSides(plugin.left_joints, plugin.right_joints)
+        self._command = TwistCommand('cmd_vel')
         self._odometry_sink: PlanarOdometrySink | None = None
-        self._tf_sink: TfSink | None = None
-        self._problem = ''
         self.reset()
 
     @property
@@ -249,42 +248,34 @@ class GzDiffDrive(Plugin, OdometryOutputs, CommandController):
 
     def configure(self, joints: Mapping[str, JointHandle]) -> None:
         """Bind the wheels' handles, then reset."""
-        self._left = [self.handle(joints, wheel, 'left_joint')
-                      for wheel in self.plugin.left_joints]
-        self._right = [self.handle(joints, wheel, 'right_joint')
-                       for wheel in self.plugin.right_joints]
+        self._wheels.bind(joints, self.handle)
         self.reset()
 
     def reset(self) -> None:
         """No command, the odometry at the origin of the wheels' present positions."""
-        self._linear = self._angular = 0.0
+        self._command.latest = None
         self._last = [(0.0, 0.0), (0.0, 0.0)]  # the limited (linear, angular) of two steps
         self._last_publish = 0.0
-        left = self._left[0].position if self._left else 0.0
-        right = self._right[0].position if self._right else 0.0
+        wheels = self._wheels
+        left = wheels.left[0].position if wheels.left else 0.0
+        right = wheels.right[0].position if wheels.right else 0.0
         self._odometry.reset(0.0, left, right)
-        for handle in self._left + self._right:
+        for handle in wheels.all:
             handle.velocity_target = 0.0
 
     # --- commands --------------------------------------------------------------------------
 
     def set_command(self, value: StampedTwist) -> CommandResult:
         """Take a twist (from the subscription; cheap): refuse non-finite ones."""
-        linear, angular = value.linear[0], value.angular[2]
-        if not (math.isfinite(linear) and math.isfinite(angular)):
-            self._problem = (f'ignored cmd_vel (linear.x {linear!r}, angular.z {angular!r}): '
-                             'not finite numbers')
-            return CommandResult.REJECTED
-        self._linear, self._angular = linear, angular
-        return CommandResult.ACCEPTED
+        return self._command.take(value)
 
     def command_problem(self, value: Any, result: CommandResult) -> str:
         """Describe the last refused twist."""
-        return self._problem
+        return self._command.problem(value, result)
 
     def setpoints(self) -> dict[str, float]:
         """Return each wheel's velocity target (rad/s)."""
-        return {handle.name: handle.velocity_target for handle in self._left + self._right}
+        return self._wheels.setpoints()
 
     @property
     def odometry(self) -> Odometry:
@@ -298,27 +289,22 @@ class GzDiffDrive(Plugin, OdometryOutputs, CommandController):
         plugin = self.plugin
         (previous_linear, previous_angular), (before_linear, before_angular) = self._last
         linear_limiter, angular_limiter = self._limiters
-        linear, angular = self._linear, self._angular
+        linear, angular = self._command.planar()
         if period > 0.0:
             linear = linear_limiter.limit(linear, previous_linear, before_linear, period)
             angular = angular_limiter.limit(angular, previous_angular, before_angular, period)
         self._last = [(linear, angular), (previous_linear, previous_angular)]
         half = angular * plugin.wheel_separation / 2.0
-        for handle in self._left:
+        wheels = self._wheels
+        for handle in wheels.left:
             handle.velocity_target = (linear - half) / plugin.wheel_radius
-        for handle in self._right:
+        for handle in wheels.right:
             handle.velocity_target = (linear + half) / plugin.wheel_radius
         if time - self._last_publish + DUE_EPSILON < self._period:
             return
         self._last_publish = time
-        if self._left and self._right:
-            self._odometry.update(self._left[0].position, self._right[0].position, time)
+        if wheels.left and wheels.right:
+            self._odometry.update(wheels.left[0].position, wheels.right[0].position, time)
         odometry = self._odometry
-        if self._odometry_sink is not None:
-            self._odometry_sink(time, odometry.x, odometry.y, odometry.heading, odometry.linear,
-                                odometry.angular)
-        if self._tf_sink is not None:
-            pose = Transform((odometry.x, odometry.y, 0.0),
-                             (0.0, 0.0, math.sin(odometry.heading / 2.0),
-                              math.cos(odometry.heading / 2.0)))
-            self._tf_sink(time, [(plugin.frame_id, plugin.child_frame_id, pose)])
+        self.publish_planar(time, odometry.x, odometry.y, odometry.heading, odometry.linear,
+                            odometry.angular, (plugin.frame_id, plugin.child_frame_id))

@@ -79,3 +79,14 @@ def test_twist_references_are_the_three_velocity_interfaces_in_upstreams_order()
                                 'base/angular/z/velocity']
     assert all(isinstance(ref, Reference) and ref.name == name
                for name, ref in references.items())
+
+
+def test_the_planar_command_is_the_latest_twists_or_standing_still():
+    command = TwistCommand('cmd_vel')
+    assert command.planar() == (0.0, 0.0)
+    command.take(twist(1.0, 2.0, 3.0))
+    assert command.planar() == (1.0, 3.0)
+    command.take(twist(math.inf, 0.0, 0.0))  # refused: the last one holds
+    assert command.planar() == (1.0, 3.0)
+    command.latest = None
+    assert command.planar() == (0.0, 0.0)
