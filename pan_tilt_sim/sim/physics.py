@@ -183,29 +183,43 @@ class Physics:
     them.  ``fixed_base`` welds the root link to the world; ``initial_pose``
     places the base (see the module's design notes).  ``warn`` receives
     PyBullet's load messages, one line each.
+
+    With ``world`` (another robot's Physics) the robot is a guest in that
+    robot's client: it owns its body, not the client, and its steps only
+    apply its torques and motors -- the host's step advances the world, and
+    :meth:`take_states` reads the guest's joints after it.  A guest's joint
+    damping is PyBullet's own (no implicit rows: they need the step's states).
     """
 
     def __init__(self, description: RobotDescription, time_step: float, *,
                  gui: bool = False, initial_positions: Sequence[float] | None = None,
                  warn: LogFunction = _ignore, fixed_base: bool = True,
-                 initial_pose: BasePose = ORIGIN) -> None:
+                 initial_pose: BasePose = ORIGIN, world: Physics | None = None) -> None:
         self._description = description
         self._time_step = time_step
         self._fixed_base = fixed_base
         self._workdir = tempfile.TemporaryDirectory(prefix='pan_tilt_sim_')
-        mode = pybullet.GUI if gui else pybullet.DIRECT
-        with quiet_native_output():
-            self._client = pybullet.connect(mode)
-        if self._client < 0:
-            self._workdir.cleanup()
-            raise DescriptionError('PyBullet: cannot connect a physics client')
-        # Disconnects even if nobody calls close(): an owner abandoned half-built
-        # (a signal during start-up) or left behind at interpreter exit.
+        self.is_guest = world is not None
         self._compiled: list[compiled_step.Connection] = []
-        self._disconnect = weakref.finalize(self, _disconnect, self._client, self._compiled)
+        if world is not None:
+            self._client = world.client_id
+            self._disconnect = self._remove_body
+            self._body = -1
+        else:
+            mode = pybullet.GUI if gui else pybullet.DIRECT
+            with quiet_native_output():
+                self._client = pybullet.connect(mode)
+            if self._client < 0:
+                self._workdir.cleanup()
+                raise DescriptionError('PyBullet: cannot connect a physics client')
+            # Disconnects even if nobody calls close(): an owner abandoned half-built
+            # (a signal during start-up) or left behind at interpreter exit.
+            self._disconnect = weakref.finalize(self, _disconnect, self._client, self._compiled)
+        # A guest's joint states after the last world step (see take_states).
+        self._after_step: list = [()]
         try:
             self._body = self._load(description, warn)
-            connection = compiled_step.connect(self._client)
+            connection = None if world is not None else compiled_step.connect(self._client)
             if connection is not None:
                 self._compiled.append(connection)
         except BaseException:
@@ -237,7 +251,8 @@ class Physics:
         # ground's friction 1 leaves each link its own coefficient (PyBullet multiplies them).
         self.ground: int | None = None
         if not fixed_base:
-            self.ground = add_ground_plane(self._client, self._body, [])
+            self.ground = (world.ground if world is not None and world.ground is not None
+                           else add_ground_plane(self._client, self._body, []))
         self._initial_base = self._place_base(initial_pose)
 
     @property
@@ -366,6 +381,18 @@ class Physics:
         send PyBullet the same commands.
         """
         body, client, indices = self._body, self._client, self._indices
+        if self.is_guest:
+            torques, torque_control = pybullet.setJointMotorControlArray, pybullet.TORQUE_CONTROL
+            guest_indices = list(effort_indices)
+            zeros = [0.0] * len(guest_indices)
+            after_step = self._after_step
+
+            def guest_step(efforts: Sequence[float]) -> Sequence:
+                if guest_indices:
+                    torques(body, guest_indices, torque_control, zeros, zeros, efforts, zeros,
+                            zeros, client)
+                return after_step[0]
+            return guest_step
         if self._compiled:
             dofs = [pybullet.getJointInfo(body, index, physicsClientId=client)[4]
                     for index in effort_indices]  # uIndex, as setJointMotorControlArray takes it
@@ -399,6 +426,18 @@ class Physics:
     def read_states(self) -> list:
         """``pybullet.getJointStates`` for the actuated joints: (position, velocity, ...)."""
         return pybullet.getJointStates(self._body, self._indices, self._client)
+
+    def take_states(self) -> list:
+        """Read a guest's joint states after the world stepped (its next step returns them)."""
+        states = self._after_step[0] = pybullet.getJointStates(self._body, self._indices,
+                                                               self._client)
+        return states
+
+    def _remove_body(self) -> None:
+        """Take a guest's body out of the world it shares (its close; the world stays)."""
+        if self._body >= 0:
+            pybullet.removeBody(self._body, physicsClientId=self._client)
+            self._body = -1
 
     @property
     def implicit_damping(self) -> tuple[str, ...]:
@@ -666,8 +705,8 @@ class _Drives:
         # mimic gear's forces, so coupled joints always take the force-capped form.
         damped = [k for k in effort_slots if joints[k].damping > 0.0]
         smallest = physics.smallest_inertias() if damped else []
-        explicit = [k for k in damped
-                    if joints[k].damping * dt <= EXPLICIT_DAMPING_SHARE * smallest[k]]
+        explicit = [k for k in damped if physics.is_guest
+                    or joints[k].damping * dt <= EXPLICIT_DAMPING_SHARE * smallest[k]]
         for k, joint in enumerate(joints):
             pybullet.changeDynamics(body, indices[k], jointDamping=joint.damping
                                     if k in explicit else 0.0, physicsClientId=client)
@@ -767,6 +806,8 @@ class _Drives:
     def restart(self) -> None:
         """Start over from the joints' present state (after a reset, or at the start)."""
         self._states_box[0] = self._physics.read_states()
+        if self._physics.is_guest:
+            self._physics._after_step[0] = self._states_box[0]
         self._countdown[0] = 0
         if self._rows:
             # The passive torque at rest: minus what holding against gravity takes.
