@@ -200,3 +200,37 @@ def test_gz_diff_drive_rovers_take_their_topics_from_their_model_names():
         assert spin_driving(harness, drivers, {'/model/robot2/cmd_vel': SPEED},
                             lambda: x_of(robot2) > 1.3)
         assert abs(x_of(node.simulation)) < 0.01
+
+
+def test_a_second_robot_with_ros2_control_gets_a_controller_manager_of_its_own(tmp_path):
+    from drop_in_fixtures import FORWARD, JSB, MANAGER_YAML
+    from ros2_control_fixtures import write_arm
+    from spawner_client import Spawner
+    from std_msgs.msg import Float64MultiArray
+
+    from pan_tilt_sim.model.description import load_description
+
+    if importlib.util.find_spec('controller_manager_msgs') is None:
+        pytest.skip('controller_manager_msgs is not installed')
+    arm = load_description(write_arm(tmp_path, MANAGER_YAML),
+                           [f"controllers:={tmp_path / 'arm_controllers.yaml'}"]).urdf_xml
+    with world_only() as (harness, node):
+        first = spawn(harness, name='robot1', resource_string=rover(), namespace='robot1')
+        second = spawn(harness, name='arm2', resource_string=arm, namespace='arm2', y=1.0)
+        assert first.result.result == 1 and second.result.result == 1, second
+        sim = SimUnderTest(harness, node)
+        spawner = Spawner(sim, manager='/arm2/controller_manager')
+        assert spawner.spawn(JSB) == 0 and spawner.spawn(FORWARD) == 0
+        assert spawner.controllers()[FORWARD].claimed_interfaces == [
+            'joint1/position', 'joint2/position']
+        arm2 = node.spawned_robots['arm2'].simulation
+        publisher = harness.probe.create_publisher(
+            Float64MultiArray, f'/arm2/{FORWARD}/commands', 10)
+
+        def commanded_and_there() -> bool:
+            publisher.publish(Float64MultiArray(data=[0.5, -0.5]))
+            positions = arm2.joint_positions()
+            return abs(positions['joint1'] - 0.5) < 0.02 and abs(positions['joint2'] + 0.5) < 0.02
+        assert harness.spin_until(commanded_and_there, BUDGET_S)
+        # The first robot's controller manager is another one: arm2's controllers are not there.
+        assert Spawner(sim, manager='/robot1/controller_manager').controllers() == {}
