@@ -140,6 +140,8 @@ class RobotSpawnService:
 
     async def _spawn(self, request, response):
         if self._built and not self._busy and self._more_robot(request):
+            # Its bridge (in its namespace) may have started with its create: wait for it too.
+            await self._bridges_handed_over()
             return self._spawn_robot(request, response, more=True)
         if self._objects is not None:
             return await self._objects(request, response)

@@ -550,7 +550,7 @@ class SimNode(Node):
                     pass
             self.controllers.destroy()
         while self.spawned_robots:
-            self.spawned_robots.popitem()[1].destroy()
+            self.spawned_robots.popitem()[1].destroy(release_topics=False)
         self._destroy_companions()
         if self.simulation_interfaces is not None:
             self.simulation_interfaces.close()

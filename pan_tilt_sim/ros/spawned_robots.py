@@ -130,12 +130,18 @@ class SpawnedRobot:
         """Start its sensors' schedules again."""
         self.sensors.reset()
 
-    def destroy(self) -> None:
-        """Take its topics, services and controller manager away, and its body from the world."""
+    def destroy(self, *, release_topics: bool = True) -> None:
+        """Take its topics, services and controller manager away, and its body from the world.
+
+        ``release_topics`` False: sim_node itself is going, and its topics with it.
+        """
         node = self._node
         if self.bindings is not None:
-            self.bindings.release()
-        if self.sensors is not None:
+            if release_topics:
+                self.bindings.release()
+            else:
+                self.bindings.destroy()
+        if self.sensors is not None and release_topics:
             self.sensors.destroy(node)
         if self.controller_manager is not None:
             if self.controller_manager.executor is not None:

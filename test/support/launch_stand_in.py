@@ -529,7 +529,9 @@ class StandInLaunch:
         if node.kwargs.get('name'):
             args += ['-r', f"__node:={node.kwargs['name']}"]
         if node.kwargs.get('namespace'):
-            args += ['-r', f"__ns:={node.kwargs['namespace']}"]
+            # launch_ros makes a relative namespace absolute (no namespace was pushed here).
+            namespace = str(perform(node.kwargs['namespace'], self.arguments))
+            args += ['-r', f"__ns:=/{namespace.lstrip('/')}"]
         for parameters in perform(node.kwargs.get('parameters', []), self.arguments):
             args += ['--params-file', str(self._parameter_file(parameters))]
         for source, target in node.kwargs.get('remappings', []):
