@@ -234,3 +234,25 @@ def test_a_second_robot_with_ros2_control_gets_a_controller_manager_of_its_own(t
         assert harness.spin_until(commanded_and_there, BUDGET_S)
         # The first robot's controller manager is another one: arm2's controllers are not there.
         assert Spawner(sim, manager='/robot1/controller_manager').controllers() == {}
+
+
+def test_each_rovers_odometry_tf_goes_where_its_plugin_remaps_it():
+    # Nav2's classic multi-robot robots remap /tf into their namespace: robot2 does, robot1 not.
+    if importlib.util.find_spec('tf2_msgs') is None:
+        pytest.skip('tf2_msgs is not installed')
+    from tf2_msgs.msg import TFMessage
+
+    remapped = ROS2_DIFF_DRIVE.replace('<left_joint>',
+                                       '<ros><remapping>/tf:=tf</remapping></ros><left_joint>')
+    with world_only() as (harness, node):
+        spawn(harness, name='robot1', resource_string=rover(), namespace='robot1')
+        second = spawn(harness, name='robot2', resource_string=rover(remapped),
+                       namespace='robot2', y=1.0)
+        assert second.result.result == 1, second
+        sim = SimUnderTest(harness, node)
+        robot2_tf = sim.collect(TFMessage, '/robot2/tf')
+        assert harness.spin_until(lambda: robot2_tf)
+        assert [(t.header.frame_id, t.child_frame_id) for t in robot2_tf[-1].transforms] == [
+            ('odom', 'base_link')]
+        published, _ = sim.own_topics()
+        assert {'/tf', '/robot2/tf'} <= set(published)
