@@ -234,6 +234,13 @@ def test_a_second_robot_with_ros2_control_gets_a_controller_manager_of_its_own(t
         assert harness.spin_until(commanded_and_there, BUDGET_S)
         # The first robot's controller manager is another one: arm2's controllers are not there.
         assert Spawner(sim, manager='/robot1/controller_manager').controllers() == {}
+        # DeleteEntity takes its controller manager away with it.
+        assert ('controller_manager', '/arm2') in node.get_node_names_and_namespaces()
+        response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
+                                srv().DeleteEntity.Request(entity='arm2'))
+        assert response.result.result == 1, response.result.error_message
+        assert harness.spin_until(lambda: ('controller_manager', '/arm2') not in
+                                  node.get_node_names_and_namespaces())
 
 
 def test_each_rovers_odometry_tf_goes_where_its_plugin_remaps_it():
@@ -256,3 +263,20 @@ def test_each_rovers_odometry_tf_goes_where_its_plugin_remaps_it():
             ('odom', 'base_link')]
         published, _ = sim.own_topics()
         assert {'/tf', '/robot2/tf'} <= set(published)
+
+
+def test_a_world_reset_puts_every_robot_back_joints_and_all():
+    from std_srvs.srv import Empty
+
+    with world_only() as (harness, node):
+        two_rovers(harness)
+        robot2 = node.spawned_robots['robot2'].simulation
+        drivers = Drivers(harness)
+        assert spin_driving(harness, drivers, {'/robot2/cmd_vel': SPEED},
+                            lambda: x_of(robot2) > 0.3)
+        assert max(abs(angle) for angle in robot2.joint_positions().values()) > 5.0
+        node.set_paused(True)  # the state right after the reset stays to be read
+        harness.call(Empty, '/reset_simulation')
+        assert robot2.steps == node.simulation.steps == 0  # one clock, back to 0
+        assert abs(x_of(robot2)) < 0.01
+        assert max(abs(angle) for angle in robot2.joint_positions().values()) < 0.1
