@@ -16,7 +16,7 @@ from geometry_msgs.msg import Twist
 from mobile_fixtures import GZ_DIFF_DRIVE, P3D, ROS2_DIFF_DRIVE, rover_urdf
 from node_harness import SimUnderTest
 from sensor_msgs.msg import LaserScan
-from stand_in_fixtures import spawn, srv, world_only
+from stand_in_fixtures import finish, spawn, srv, start, world_only
 
 pytestmark = pytest.mark.skipif(
     importlib.util.find_spec('simulation_interfaces') is None,
@@ -280,3 +280,19 @@ def test_a_world_reset_puts_every_robot_back_joints_and_all():
         assert robot2.steps == node.simulation.steps == 0  # one clock, back to 0
         assert abs(x_of(robot2)) < 0.01
         assert max(abs(angle) for angle in robot2.joint_positions().values()) < 0.1
+
+
+def test_spawn_entity_py_with_a_robot_namespace_brings_a_second_robot(tmp_path):
+    urdf = tmp_path / 'rover.urdf'
+    urdf.write_text(rover())
+    with world_only() as (harness, node):
+        spawn(harness, name='robot1', resource_string=rover(), namespace='robot1')
+        code, output = finish(harness, start('spawn_entity.py', '-entity', 'robot2', '-file',
+                                             str(urdf), '-robot_namespace', 'robot2',
+                                             '-y', '1.0'))
+        assert code == 0, output
+        assert sorted(node.spawned_robots) == ['robot2']
+        _published, subscribed = SimUnderTest(harness, node).own_topics()
+        assert {'/robot1/cmd_vel', '/robot2/cmd_vel'} <= set(subscribed)
+        robot2 = node.spawned_robots['robot2'].simulation
+        assert robot2.base_state()[0][1] == pytest.approx(1.0, abs=1e-3)
