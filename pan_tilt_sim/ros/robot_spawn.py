@@ -208,8 +208,8 @@ class RobotSpawnService:
         pose = request.initial_pose
         if pose.header.frame_id not in WORLD_FRAMES:
             return self._refuse(response, codes.INVALID_POSE,
-                                f"initial_pose frame '{pose.header.frame_id}': with no robot "
-                                "in the world yet, only '' or 'world'")
+                                f"initial_pose frame '{pose.header.frame_id}': a robot is "
+                                "placed in '' or 'world' only")
         position, orientation = pose.pose.position, pose.pose.orientation
         try:
             yaw, tilt = yaw_of(orientation.x, orientation.y, orientation.z, orientation.w)
