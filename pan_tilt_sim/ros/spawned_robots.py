@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from rclpy.node import Node
 
+from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.controller_config import (
     ControllersConfig,
@@ -25,6 +26,7 @@ from pan_tilt_sim.ros.controller_bindings import ControllerBindings
 from pan_tilt_sim.ros.gain_parameters import GainParameters
 from pan_tilt_sim.ros.sensor_publishers import SensorSet
 from pan_tilt_sim.sim.engine import Simulation
+from pan_tilt_sim.sim.world import has_ground
 
 
 def is_robot(description: RobotDescription) -> bool:
@@ -55,6 +57,11 @@ class SpawnedRobot:
             description, controllers, host.time_step, logger=node.get_logger(),
             autostart_controllers=autostart_controllers, fixed_base=fixed_base,
             initial_pose=initial_pose, world=host)
+        if not self.simulation.physics.fixed_base and not has_ground(world):
+            self.simulation.close()
+            raise ParameterError(
+                f"parameter 'world': '{world}' has no ground for the free base of "
+                f"'{description.name}' to stand on")
         self.controller_manager: Node | None = None
         self.bindings: ControllerBindings | None = None
         self.sensors: SensorSet | None = None

@@ -296,3 +296,24 @@ def test_spawn_entity_py_with_a_robot_namespace_brings_a_second_robot(tmp_path):
         assert {'/robot1/cmd_vel', '/robot2/cmd_vel'} <= set(subscribed)
         robot2 = node.spawned_robots['robot2'].simulation
         assert robot2.base_state()[0][1] == pytest.approx(1.0, abs=1e-3)
+
+
+def test_a_free_robot_in_a_world_without_ground_is_refused_and_the_first_runs_on(tmp_path):
+    from drop_in_fixtures import MANAGER_YAML
+    from ros2_control_fixtures import write_arm
+
+    from pan_tilt_sim.model.description import load_description
+
+    arm = load_description(write_arm(tmp_path, MANAGER_YAML),
+                           [f"controllers:={tmp_path / 'arm_controllers.yaml'}"]).urdf_xml
+    with world_only(world='empty') as (harness, node):
+        assert spawn(harness, name='arm', resource_string=arm).result.result == 1
+        bodies = node.features.entities.names()
+        refused = spawn(harness, name='robot2', resource_string=rover(), y=1.0)
+        assert refused.result.result == 4  # RESULT_OPERATION_FAILED
+        assert "'empty' has no ground for the free base of 'robot2'" in (
+            refused.result.error_message)
+        assert node.spawned_robots == {} and node.simulation.guests == []
+        assert node.features.entities.names() == bodies
+        steps = node.simulation.steps
+        assert harness.spin_until(lambda: node.simulation.steps > steps)
