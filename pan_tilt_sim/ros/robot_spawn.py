@@ -139,7 +139,9 @@ class RobotSpawnService:
             'with it')
 
     async def _spawn(self, request, response):
-        if self._built and not self._busy and self._more_robot(request):
+        while self._busy:  # the first robot is being built: this request follows it
+            await self._pause(BRIDGE_POLL_S)
+        if self._built and self._failure is None and self._more_robot(request):
             # Its bridge (in its namespace) may have started with its create: wait for it too.
             await self._bridges_handed_over()
             return self._spawn_robot(request, response, more=True)

@@ -204,6 +204,8 @@ class SimNode(Node):
         self.features.entities.add_robot(robot.name, robot.simulation.physics,
                                          remove=self._remove_robot)
         self.spawned_robots[robot.name] = robot
+        for warning in description.warnings:  # what xacro said, as for the first robot
+            self.get_logger().warning(warning)
         robot.simulation.report_startup()
         self.get_logger().info(
             f"simulating '{robot.name}' from {description.source} too; its topics under "

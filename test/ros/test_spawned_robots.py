@@ -317,3 +317,26 @@ def test_a_free_robot_in_a_world_without_ground_is_refused_and_the_first_runs_on
         assert node.features.entities.names() == bodies
         steps = node.simulation.steps
         assert harness.spin_until(lambda: node.simulation.steps > steps)
+
+
+def test_a_second_robot_asked_for_while_the_first_waits_for_its_bridge_follows_it():
+    from std_msgs.msg import Empty
+
+    from pan_tilt_sim.ros.bridged_topics import ANNOUNCE_TOPIC
+
+    with world_only() as (harness, node):
+        # A bridge that announced itself and has not handed over: the first robot waits.
+        announce = harness.probe.create_publisher(Empty, ANNOUNCE_TOPIC, 1)
+        assert harness.spin_until(lambda: node.bridged_topics.pending())
+        client = harness.probe.create_client(srv().SpawnEntity, '/sim_node/spawn_entity')
+        assert harness.spin_until(client.service_is_ready)
+        futures = [client.call_async(srv().SpawnEntity.Request(
+            name=name, resource_string=rover(), entity_namespace=name))
+            for name in ('robot1', 'robot2')]
+        assert harness.spin_until(lambda: node._robot_spawn._busy)
+        harness.probe.destroy_publisher(announce)  # the bridge went: the robot is built
+        assert harness.spin_until(lambda: all(future.done() for future in futures))
+        assert [future.result().result.result for future in futures] == [1, 1], [
+            future.result().result.error_message for future in futures]
+        assert node.simulation.description.name == 'robot1'
+        assert sorted(node.spawned_robots) == ['robot2']
