@@ -8,11 +8,12 @@ with it: its plugins, its controller manager (``<ros2_control>`` with a
 gz_ros2_control plugin), its sensors, at the request's pose and namespace.  The
 answer follows once it is built, so ``create`` exits when the robot is in.  The
 service stays: a later request whose description is a robot (plugins, sensors or
-``<ros2_control>``) adds one more robot to the world (``build_more``); any other goes
-to the simulation services' SpawnEntity (objects), whose server of that name it
-replaces.  A robot is built once the bridge stand-ins that announced themselves have
-handed over their entries (:mod:`.bridged_topics`), at most :data:`BRIDGE_WAIT_S`
-later.  docs/launch-files.md is the reference.
+``<ros2_control>``) adds one more robot to the world (``build_more``) -- one that comes
+while the first is being built waits for it -- and any other goes to the simulation
+services' SpawnEntity (objects), whose server of that name it replaces.  A robot is
+built once the bridge stand-ins that announced themselves have handed over their
+entries (:mod:`.bridged_topics`), at most :data:`BRIDGE_WAIT_S` later.
+docs/launch-files.md is the reference.
 """
 
 from __future__ import annotations
