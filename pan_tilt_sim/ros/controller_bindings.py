@@ -207,6 +207,12 @@ class ControllerBindings:
         self.actions.clear()
         self._node.destroy_guard_condition(self._attention)
 
+    def release(self) -> None:
+        """Destroy every topic, service and action of the plugins and controllers (a robot goes)."""
+        for name in list(self._entities):
+            self._unbind(name)
+        self.destroy()
+
     # --- entities ------------------------------------------------------------------------------
 
     def _bind(self, controller: Controller) -> None:

@@ -62,6 +62,7 @@ class NodeFeatures:
                                  ground=has_ground(world))
         spawn_world_objects(self.entities, self.world)
         seed = declare_noise_seed(node)
+        self.noise_seed = seed  # spawned robots' sensors draw from it too
         self.sensors = SensorSet(node, simulation, world, namespace_override=sensor_namespace,
                                  seed=seed)
         # The <ros2_control> sensors: their rays meet this world's ground; their noise, this seed.

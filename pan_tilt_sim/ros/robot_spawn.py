@@ -7,10 +7,13 @@ first request's description becomes the robot, as if sim_node had been started
 with it: its plugins, its controller manager (``<ros2_control>`` with a
 gz_ros2_control plugin), its sensors, at the request's pose and namespace.  The
 answer follows once it is built, so ``create`` exits when the robot is in.  The
-service stays: later requests go to the simulation services' SpawnEntity (objects),
-whose own server of that name it replaces.  A robot is built once the bridge stand-ins
-that announced themselves have handed over their entries (:mod:`.bridged_topics`), at
-most :data:`BRIDGE_WAIT_S` later.  docs/launch-files.md is the reference.
+service stays: a later request whose description is a robot (plugins, sensors or
+``<ros2_control>``) adds one more robot to the world (``build_more``) -- one that comes
+while the first is being built waits for it -- and any other goes to the simulation
+services' SpawnEntity (objects), whose server of that name it replaces.  A robot is
+built once the bridge stand-ins that announced themselves have handed over their
+entries (:mod:`.bridged_topics`), at most :data:`BRIDGE_WAIT_S` later.
+docs/launch-files.md is the reference.
 """
 
 from __future__ import annotations
@@ -108,13 +111,18 @@ class RobotSpawnService:
     """
 
     def __init__(self, node: Node, build: Callable[[RobotDescription, Spawn], None],
-                 taken: Iterable[str] = ()) -> None:
+                 taken: Iterable[str] = (),
+                 build_more: Callable[[RobotDescription, Spawn], None] | None = None,
+                 names: Callable[[], Iterable[str]] | None = None,
+                 is_robot: Callable[[RobotDescription], bool] | None = None) -> None:
         found = interfaces()
         if found is None:
             raise ParameterError(
                 f"parameter '{PARAMETER}' is true, but simulation_interfaces is not installed: "
                 'nothing could spawn the robot (scripts/build_interfaces.sh builds it)')
         self._node, self._build, self._taken = node, build, tuple(taken)
+        # Once the first robot is in: more robots (build_more), the world's names (names).
+        self._build_more, self._names, self._is_robot = build_more, names, is_robot
         self._srv = found.srv.SpawnEntity
         self._result = found.msg.Result
         self._built = False
@@ -132,6 +140,12 @@ class RobotSpawnService:
             'with it')
 
     async def _spawn(self, request, response):
+        while self._busy:  # the first robot is being built: this request follows it
+            await self._pause(BRIDGE_POLL_S)
+        if self._built and self._failure is None and self._more_robot(request):
+            # Its bridge (in its namespace) may have started with its create: wait for it too.
+            await self._bridges_handed_over()
+            return self._spawn_robot(request, response, more=True)
         if self._objects is not None:
             return await self._objects(request, response)
         if self._built or self._busy:  # being built, or it failed (sim_node is ending)
@@ -175,7 +189,16 @@ class RobotSpawnService:
         timer = self._node.create_timer(seconds, done)
         return future
 
-    def _spawn_robot(self, request, response):
+    def _more_robot(self, request) -> bool:
+        """Whether a request after the first robot brings one more robot (else an object)."""
+        if self._build_more is None or self._is_robot is None:
+            return False
+        try:
+            return self._is_robot(self._description(request))
+        except ConfigurationError:
+            return False  # the objects' SpawnEntity says what is wrong with it
+
+    def _spawn_robot(self, request, response, *, more: bool = False):
         codes = self._srv.Response
         if not request.uri and not request.resource_string:
             return self._refuse(response, codes.NO_RESOURCE,
@@ -188,8 +211,8 @@ class RobotSpawnService:
         pose = request.initial_pose
         if pose.header.frame_id not in WORLD_FRAMES:
             return self._refuse(response, codes.INVALID_POSE,
-                                f"initial_pose frame '{pose.header.frame_id}': with no robot "
-                                "in the world yet, only '' or 'world'")
+                                f"initial_pose frame '{pose.header.frame_id}': a robot is "
+                                "placed in '' or 'world' only")
         position, orientation = pose.pose.position, pose.pose.orientation
         try:
             yaw, tilt = yaw_of(orientation.x, orientation.y, orientation.z, orientation.w)
@@ -204,7 +227,8 @@ class RobotSpawnService:
             code = (self._result.RESULT_NOT_FOUND if 'no such file' in str(err)
                     or 'unknown package' in str(err) else codes.RESOURCE_PARSE_ERROR)
             return self._refuse(response, code, str(err))
-        name = free_name(request.name or description.name, self._taken, request.allow_renaming)
+        taken = self._names() if more else self._taken
+        name = free_name(request.name or description.name, taken, request.allow_renaming)
         if name is None:
             return self._refuse(response, codes.NAME_NOT_UNIQUE,
                                 f"entity named '{request.name or description.name}' already "
@@ -213,11 +237,19 @@ class RobotSpawnService:
             self._node.get_logger().warning(
                 f"spawning '{name}' upright: its initial roll and pitch ({tilt:.3g} rad off "
                 'vertical) are not simulated, only its yaw')
+        spawn = Spawn(name, BasePose(position.x, position.y, position.z, yaw),
+                      naming.normalize(request.entity_namespace))
+        if more:
+            try:
+                self._build_more(renamed(description, name), spawn)
+            except ConfigurationError as err:  # the robots in the world run on
+                return self._refuse(response, self._result.RESULT_OPERATION_FAILED, str(err))
+            response.result.result = self._result.RESULT_OK
+            response.entity_name = name
+            return response
         self._built = True
         try:
-            self._build(renamed(description, name), Spawn(
-                name, BasePose(position.x, position.y, position.z, yaw),
-                naming.normalize(request.entity_namespace)))
+            self._build(renamed(description, name), spawn)
         except ConfigurationError as err:
             # As for a description file: sim_node ends with this line, after the answer.
             self._failure = err

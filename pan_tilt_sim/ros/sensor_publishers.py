@@ -394,6 +394,13 @@ class SensorSet:
         for publisher in self.publishers:
             publisher.reset()
 
+    def destroy(self, node: Node) -> None:
+        """Destroy every sensor's publishers on ``node`` (its robot left the world)."""
+        for publisher in self.publishers:
+            while publisher._publishers:
+                node.destroy_publisher(publisher._publishers.pop())
+        self.publishers = []
+
 
 def _frame_edge(interface: SensorInterface, model: RobotModel) -> Frame:
     """Return the TF edge placing a sensor's data frame on the link that carries it.

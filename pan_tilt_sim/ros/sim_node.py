@@ -40,6 +40,7 @@ from pan_tilt_sim.ros import (
     robot_spawn,
     services,
     simulation_services,
+    spawned_robots,
     topic_hardware,
     view_feed,
 )
@@ -105,6 +106,8 @@ class SimNode(Node):
         self.viewer = None  # the browser view (viewer:=true), a pan_tilt_sim.ros.viewer.Viewer
         # ros_gz_bridge entries' names and types for the robot's topics (robot_from_spawn).
         self.bridged_topics: bridged_topics.BridgedTopics | None = None
+        # Robots spawned after the first (robot_from_spawn), by entity name.
+        self.spawned_robots: dict[str, spawned_robots.SpawnedRobot] = {}
         super().__init__(NODE_NAME, **kwargs)
         # Named controller_manager (launch's name='controller_manager'), sim_node stands
         # in for ros2_control_node: see the module pan_tilt_sim.ros.drop_in.
@@ -149,7 +152,9 @@ class SimNode(Node):
             self._robot_spawn = robot_spawn.RobotSpawnService(
                 self, lambda description, spawn: self._build_spawned(
                     physics_thread, description, spawn),
-                taken=(entity.name for entity in self._world.entities if entity.name))
+                taken=(entity.name for entity in self._world.entities if entity.name),
+                build_more=self._add_robot, names=lambda: self.features.entities.names(),
+                is_robot=spawned_robots.is_robot)
             return
         if self.settings.robot_description_file:
             self._build(physics_thread, load_description(
@@ -166,6 +171,29 @@ class SimNode(Node):
             self.settings, initial_pose=spawn.pose,
             robot_namespace=spawn.namespace or self.settings.robot_namespace)
         self._build(physics_thread, description, from_topic=True)
+
+    def _add_robot(self, description: RobotDescription, spawn: robot_spawn.Spawn) -> None:
+        """One more robot in the world (its plugins, sensors, controller manager), in our turn."""
+        robot = spawned_robots.SpawnedRobot(
+            self, self.simulation, description, namespace=spawn.namespace,
+            controllers=spawned_robots.controllers_of(description),
+            fixed_base=self.settings.fixed_base,
+            autostart_controllers=self.settings.autostart_controllers,
+            initial_pose=spawn.pose, world=self._world.scenery, reader=self._command_reader,
+            seed=self.features.noise_seed)
+        self.features.entities.add_robot(robot.name, robot.simulation.physics,
+                                         remove=self._remove_robot)
+        self.spawned_robots[robot.name] = robot
+        for warning in description.warnings:  # what xacro said, as for the first robot
+            self.get_logger().warning(warning)
+        robot.simulation.report_startup()
+        self.get_logger().info(
+            f"simulating '{robot.name}' from {description.source} too; its topics under "
+            f"'{robot.namespace or '/'}'")
+
+    def _remove_robot(self, name: str) -> None:
+        """DeleteEntity of a spawned robot: its topics, manager and body go."""
+        self.spawned_robots.pop(name).destroy()
 
     def _build(self, physics_thread: bool, description: RobotDescription, *,
                from_topic: bool = False) -> None:
@@ -360,6 +388,7 @@ class SimNode(Node):
         simulation = self.simulation
         features = self.features
         controllers = self.controllers
+        robots = list(self.spawned_robots.values())
         clock = self.clock_publisher
         clock_wanted = clock.wanted
         cut_at_stamps = clock_wanted and self._pacer.fast
@@ -375,6 +404,10 @@ class SimNode(Node):
             due = features.steps_until_due(step)
             if due is not None:
                 chunk = min(chunk, due)
+            for robot in robots:
+                due = robot.steps_until_due(step)
+                if due is not None:
+                    chunk = min(chunk, due)
             simulation.advance(chunk)
             self.steps_run += chunk
             steps -= chunk
@@ -382,8 +415,13 @@ class SimNode(Node):
                 clock.publish_reached(step, chunk, cut_at_stamps)
             controllers.flush_joint_states()
             features.after_steps()
+            for robot in robots:
+                robot.flush_joint_states()
+                robot.after_steps()
         clock.end_batch(simulation.steps)
         controllers.after_steps()
+        for robot in robots:
+            robot.after_batch()
 
     @property
     def paused(self) -> bool:
@@ -429,6 +467,9 @@ class SimNode(Node):
         self.clock_publisher.publish_newest(self.simulation.steps)
         self.features.reset()
         self.features.after_steps()
+        for robot in self.spawned_robots.values():
+            robot.reset()
+            robot.after_steps()
 
     def destroy_node(self) -> None:
         """Stop the view and the ticking, destroy the controller_manager node, release PyBullet."""
@@ -449,6 +490,8 @@ class SimNode(Node):
                 except RuntimeError:  # rclpy's RCLError: the context went in the meantime
                     pass
             self.controllers.destroy()
+        while self.spawned_robots:
+            self.spawned_robots.popitem()[1].destroy(release_topics=False)
         self._destroy_companions()
         if self.simulation_interfaces is not None:
             self.simulation_interfaces.close()
@@ -511,6 +554,8 @@ class SimNode(Node):
         self.clock_publisher.refresh_readers()
         self.controllers.refresh_readers()
         self.features.refresh_readers()
+        for robot in self.spawned_robots.values():
+            robot.refresh_readers()
 
     def _start_controller_manager(self, controllers: ControllersConfig) -> None:
         """Offer ros2_control's controller_manager services, where their messages exist."""

@@ -137,6 +137,11 @@ class Simulation:
     :attr:`startup_report` until :meth:`report_startup` logs it (the node
     does that once it is completely built, so that a start-up error stays
     the only line); run-time warnings go to ``logger`` at once.
+
+    ``world``: another robot's simulation whose PyBullet world this robot
+    joins, as a guest (:meth:`add_guest`): one physics world, each robot with
+    its own plugins, controllers and sensors, all stepped by the host's
+    :meth:`advance` (docs/design/sim.md#several-robots).
     """
 
     def __init__(self, description: RobotDescription, controllers: ControllersConfig,
@@ -147,8 +152,11 @@ class Simulation:
                  autostart_controllers: bool = True,
                  fixed_base: bool | None = True,
                  initial_pose: BasePose = ORIGIN,
-                 physics_settings: PhysicsSettings = DEFAULT_PHYSICS) -> None:
+                 physics_settings: PhysicsSettings = DEFAULT_PHYSICS,
+                 world: Simulation | None = None) -> None:
         self.description = description
+        # Robots that joined this one's world (add_guest), stepped with it.
+        self.guests: list[Simulation] = []
         self._logger: Logger = logger or logging.getLogger(LOGGER_NAME)
         load_messages: list[str] = list(controllers.warnings)  # the file's dropped blocks
         # The model's Gazebo plugins (drive, joint states, ground truth), read before anything
@@ -165,10 +173,10 @@ class Simulation:
             description, time_step, gui=gui,
             initial_positions=[starts[joint].position for joint in movable],
             warn=load_messages.append, fixed_base=fixed, initial_pose=initial_pose,
-            settings=physics_settings)
+            settings=physics_settings, world=None if world is None else world.physics)
         self._base_report = self._describe_base(why, fixed_base, initial_pose)
         self._time_step = time_step
-        self._steps = 0
+        self._steps = 0 if world is None else world.steps
         try:
             check_startup_stability(self.physics, description)
             model = description.model
@@ -394,6 +402,9 @@ class Simulation:
         way the results are the same to the last bit.  A robot with Gazebo
         plugins (:attr:`plugins`) runs in Python: they have no compiled law.
         """
+        if self.guests:
+            self._advance_world(steps)
+            return
         scheduled = self.manager.scheduled_updates
         dt = self._time_step
         shortest = min((schedule.period for schedule, _ in scheduled), default=math.inf)
@@ -418,6 +429,66 @@ class Simulation:
             python_steps = min(end, stop + 1) - count
             self._advance_python(python_steps)
             count += python_steps
+
+    def add_guest(self, guest: Simulation) -> None:
+        """Step ``guest`` (built with ``world=self``) with this robot from now on."""
+        guest._steps = self._steps
+        self.guests.append(guest)
+
+    def remove_guest(self, guest: Simulation) -> None:
+        """Stop stepping ``guest`` and take its body out of the world (its close)."""
+        self.guests.remove(guest)
+        guest.close()
+
+    def _advance_world(self, steps: int) -> None:
+        """Run ``steps`` steps of every robot in this world, in Python, one world step each.
+
+        Each step every guest reads its joints, updates its plugins and
+        controllers and applies its efforts and motors; then this robot does
+        the same and its physics step advances the world; then each guest
+        takes its joints' new states.
+        """
+        robots = [*self.guests, self]
+        first = self._steps
+        for count in range(first, first + steps):
+            for robot in robots:
+                robot._one_step(count)
+            for guest in self.guests:
+                guest._states = guest.physics.take_states()
+        for robot in robots:
+            robot._steps = first + steps
+            robot._check_health(robot._states)
+
+    def _one_step(self, count: int) -> None:
+        """Step ``count`` of this robot alone: what :meth:`_advance_python` does per step."""
+        states = self._states
+        for handle, state in zip(self._handle_list, states, strict=False):
+            handle.position = state[STATE_POSITION]
+            handle.velocity = state[STATE_VELOCITY]
+        for handle, slot in zip(self._velocity_handles, self._velocity_slots, strict=True):
+            handle.effort = states[slot][STATE_MOTOR_TORQUE]
+        dt = self._time_step
+        time = count * dt
+        for unit in self.plugins:
+            unit.update(time, dt)
+        for update in self.manager.updates:
+            update(time, dt)
+        for schedule, update in self.manager.scheduled_updates:
+            if time + DUE_EPSILON >= schedule.next_due:
+                update(time, dt)
+        efforts, targets, forces = self._efforts, self._targets, self._forces
+        for index, handle in enumerate(self._effort_handles):
+            efforts[index] = handle.effort
+        for index, handle in enumerate(self._velocity_handles):
+            targets[index] = handle.velocity_target
+        for index, handle in self._forced:
+            force = handle.force_limit
+            forces[index] = force if force < UNLIMITED_FORCE else UNLIMITED_FORCE
+        for mover in self._base_movers:
+            velocity = mover.take_base_velocity()
+            if velocity is not None:
+                self.physics.set_base_velocity(*velocity)
+        self._states = self._physics_step(efforts, targets, forces if self._forced else None)
 
     def _compiled_laws(self) -> list[tuple[int, int, list[float]]] | None:
         """Return each step member's law with its slots, or None if one has none."""
@@ -635,6 +706,9 @@ class Simulation:
         self._leaning_since = self._upright_since = None
         self._lean_reported = False
         self.hardware.reset()
+        for guest in self.guests:
+            guest.reset(reset_time=reset_time)
+            guest._steps = self._steps
 
     def reset_time(self) -> None:
         """Sim time back to 0, the joints left where they are; controllers hold them there.
@@ -655,6 +729,8 @@ class Simulation:
         for sensor in self.hardware.interfaces.sensors.values():  # their readings' past is gone
             if sensor.source is not None:
                 sensor.source.reset()
+        for guest in self.guests:
+            guest.reset_time()
 
     def base_state(self) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
         """Return the base's planar pose and twist: (x, y, heading), (forward, left, yaw rate).
@@ -704,7 +780,9 @@ class Simulation:
                 for name, state in zip(self.handles, self._states, strict=True)}
 
     def close(self) -> None:
-        """Release PyBullet."""
+        """Release PyBullet (the guests' bodies first: they live in this robot's client)."""
+        while self.guests:
+            self.guests.pop().close()
         self.hardware.close()
         self.physics.close()
 

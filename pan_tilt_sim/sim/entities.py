@@ -202,6 +202,8 @@ class Entities:
         self._files = itertools.count(1)
         self._entities: dict[str, Entity] = {}
         self._world_file: dict[str, _WorldFileObject] = {}
+        # Robots spawned after the first: what deleting each takes away besides its body.
+        self._robot_removers: dict[str, Callable[[str], None]] = {}
         robot = self._record(robot_name, self._robot, Origin.ROBOT, static=physics.fixed_base,
                              info=EntityInfo(Category.ROBOT, 'the simulated robot'))
         self._entities[robot.name] = robot
@@ -430,9 +432,28 @@ class Entities:
                              f"unknown frame '{frame}' (use '' or 'world', an entity's name, or "
                              'a link of the robot)') from None
 
+    def add_robot(self, name: str, physics: Physics, *, remove: Callable[[str], None]) -> None:
+        """Record one more robot (its own ``physics``, a guest in this world) as an entity.
+
+        Deleting it calls ``remove(name)``, which takes its body out of the world
+        (with its plugins, controllers and topics).
+        """
+        self._entities[name] = self._record(
+            name, physics.body_id, Origin.ROBOT, static=physics.fixed_base,
+            info=EntityInfo(Category.ROBOT, 'a spawned robot'))
+        self._robot_removers[name] = remove
+
     def delete(self, name: str) -> None:
-        """Remove a spawned (or world file) object; KeyError if unknown, else NotDeletableError."""
+        """Remove a spawned (or world file) object or a spawned robot.
+
+        KeyError if unknown; NotDeletableError for the first robot and the scenery.
+        """
         entity = self._entities[name]
+        remover = self._robot_removers.pop(name, None)
+        if remover is not None:
+            del self._entities[name]
+            remover(name)
+            return
         if entity.origin in (Origin.ROBOT, Origin.SCENERY):
             raise NotDeletableError(
                 f"'{name}' is {'the robot' if entity.origin is Origin.ROBOT else 'scenery'}: "

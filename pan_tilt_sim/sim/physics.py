@@ -193,31 +193,48 @@ class Physics:
     them.  ``fixed_base`` welds the root link to the world; ``initial_pose``
     places the base (see the module's design notes).  ``warn`` receives
     PyBullet's load messages, one line each.
+
+    With ``world`` (another robot's Physics) the robot is a guest in that
+    robot's client: it owns its body, not the client, and its steps only
+    apply its torques and motors -- the host's step advances the world, and
+    :meth:`take_states` reads the guest's joints after it.  A guest's joint
+    damping is PyBullet's own (no implicit rows: they need the step's states).
     """
 
     def __init__(self, description: RobotDescription, time_step: float, *,
                  gui: bool = False, initial_positions: Sequence[float] | None = None,
                  warn: LogFunction = _ignore, fixed_base: bool = True,
                  initial_pose: BasePose = ORIGIN,
-                 settings: PhysicsSettings = DEFAULT_PHYSICS) -> None:
+                 settings: PhysicsSettings = DEFAULT_PHYSICS,
+                 world: Physics | None = None) -> None:
         self._description = description
         self._time_step = time_step
         self._fixed_base = fixed_base
         self._workdir = tempfile.TemporaryDirectory(prefix='pan_tilt_sim_')
-        mode = pybullet.GUI if gui else pybullet.DIRECT
-        with quiet_native_output():
-            self._client = pybullet.connect(mode)
-        if self._client < 0:
-            self._workdir.cleanup()
-            raise DescriptionError('PyBullet: cannot connect a physics client')
-        # Disconnects even if nobody calls close(): an owner abandoned half-built
-        # (a signal during start-up) or left behind at interpreter exit.
+        self.is_guest = world is not None
         self._compiled: list[compiled_step.Connection] = []
-        self._disconnect = weakref.finalize(self, _disconnect, self._client, self._compiled)
-        self.apply_settings(settings)
+        if world is not None:
+            self._client = world.client_id
+            self._disconnect = self._remove_body
+            self._body = -1
+            self._settings = world.settings
+        else:
+            mode = pybullet.GUI if gui else pybullet.DIRECT
+            with quiet_native_output():
+                self._client = pybullet.connect(mode)
+            if self._client < 0:
+                self._workdir.cleanup()
+                raise DescriptionError('PyBullet: cannot connect a physics client')
+            # Disconnects even if nobody calls close(): an owner abandoned half-built
+            # (a signal during start-up) or left behind at interpreter exit.
+            self._disconnect = weakref.finalize(self, _disconnect, self._client, self._compiled)
+            # The world's solver settings are the first robot's: a guest leaves them.
+            self.apply_settings(settings)
+        # A guest's joint states after the last world step (see take_states).
+        self._after_step: list = [()]
         try:
             self._body = self._load(description, warn)
-            connection = compiled_step.connect(self._client)
+            connection = None if world is not None else compiled_step.connect(self._client)
             if connection is not None:
                 self._compiled.append(connection)
         except BaseException:
@@ -250,7 +267,8 @@ class Physics:
         # ground's friction 1 leaves each link its own coefficient (PyBullet multiplies them).
         self.ground: int | None = None
         if not fixed_base:
-            self.ground = add_ground_plane(self._client, self._body, [])
+            self.ground = (world.ground if world is not None and world.ground is not None
+                           else add_ground_plane(self._client, self._body, []))
         self._initial_base = self._place_base(initial_pose)
 
     @property
@@ -382,6 +400,18 @@ class Physics:
         in ``VELOCITY_CONTROL``), then the same.
         """
         body, client, indices = self._body, self._client, self._indices
+        if self.is_guest:
+            torques, torque_control = pybullet.setJointMotorControlArray, pybullet.TORQUE_CONTROL
+            guest_indices = list(effort_indices)
+            zeros = [0.0] * len(guest_indices)
+            after_step = self._after_step
+
+            def guest_step(efforts: Sequence[float]) -> Sequence:
+                if guest_indices:
+                    torques(body, guest_indices, torque_control, zeros, zeros, efforts, zeros,
+                            zeros, client)
+                return after_step[0]
+            return guest_step
         if self._compiled:
             def dofs(joints: Sequence[int]) -> list[int]:
                 # uIndex, as setJointMotorControlArray takes it
@@ -418,6 +448,18 @@ class Physics:
     def read_states(self) -> list:
         """``pybullet.getJointStates`` for the actuated joints: (position, velocity, ...)."""
         return pybullet.getJointStates(self._body, self._indices, self._client)
+
+    def take_states(self) -> list:
+        """Read a guest's joint states after the world stepped (its next step returns them)."""
+        states = self._after_step[0] = pybullet.getJointStates(self._body, self._indices,
+                                                               self._client)
+        return states
+
+    def _remove_body(self) -> None:
+        """Take a guest's body out of the world it shares (its close; the world stays)."""
+        if self._body >= 0:
+            pybullet.removeBody(self._body, physicsClientId=self._client)
+            self._body = -1
 
     @property
     def implicit_damping(self) -> tuple[str, ...]:
@@ -675,24 +717,25 @@ class DriveSplit:
 
 def split_drives(joints: Sequence[JointSpec], velocity_driven: Sequence[bool], time_step: float,
                  smallest_inertias: Callable[[], Sequence[float]],
-                 coupled: Collection[str]) -> DriveSplit:
+                 coupled: Collection[str], *, guest: bool = False) -> DriveSplit:
     """Sort the joints into drive kinds (:class:`DriveSplit`).
 
     ``smallest_inertias()`` (each joint's, over the checked poses) is called
     only if an effort joint has damping; ``coupled``: the names of the joints
     a mimic coupling joins.  Explicit damping is PyBullet's own, kept where it
-    is far inside its stability bound.  A velocity gain makes the motor a hard
-    constraint that would override a mimic gear's forces, so coupled joints
-    always take the force-capped form.
+    is far inside its stability bound, and always for a ``guest`` robot (the
+    implicit rows need the world step's states, which a guest reads after it).
+    A velocity gain makes the motor a hard constraint that would override a
+    mimic gear's forces, so coupled joints always take the force-capped form.
     """
     if len(velocity_driven) != len(joints):
         raise ValueError(f'{len(velocity_driven)} drives for {len(joints)} joints')
     velocity = [k for k, driven in enumerate(velocity_driven) if driven]
     effort = [k for k, driven in enumerate(velocity_driven) if not driven]
     with_damping = [k for k in effort if joints[k].damping > 0.0]
-    smallest = smallest_inertias() if with_damping else []
-    explicit = [k for k in with_damping
-                if joints[k].damping * time_step <= EXPLICIT_DAMPING_SHARE * smallest[k]]
+    smallest = smallest_inertias() if with_damping and not guest else []
+    explicit = [k for k in with_damping if guest
+                or joints[k].damping * time_step <= EXPLICIT_DAMPING_SHARE * smallest[k]]
     damped = [k for k in with_damping if k not in explicit and joints[k].friction <= 0.0
               and joints[k].name not in coupled]
     implicit = [k for k in with_damping if k not in explicit and k not in damped]
@@ -840,7 +883,8 @@ class _Drives:
         body, client, dt = physics.body_id, physics.client_id, physics.time_step
         self._body, self._client, self._dt = body, client, dt
         coupled = {name for coupling in mimics for name in (coupling.leader, coupling.follower)}
-        split = split_drives(joints, velocity_driven, dt, physics.smallest_inertias, coupled)
+        split = split_drives(joints, velocity_driven, dt, physics.smallest_inertias, coupled,
+                             guest=physics.is_guest)
         self.velocity_slots, self.effort_slots = split.velocity, split.effort
         self.explicit, self.implicit, self.damped = split.explicit, split.implicit, split.damped
         for k, joint in enumerate(joints):
@@ -905,6 +949,8 @@ class _Drives:
     def restart(self) -> None:
         """Start over from the joints' present state (after a reset, or at the start)."""
         self._states = self._physics.read_states()
+        if self._physics.is_guest:
+            self._physics._after_step[0] = self._states
         self._countdown = 0
         if self._implicit:
             self._implicit.rest(self._physics.gravity_torques())

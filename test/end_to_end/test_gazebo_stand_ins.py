@@ -1,4 +1,4 @@
-"""Gazebo launch files with only package names changed run on sim_node (one robot per world).
+"""Gazebo launch files with only package names changed run on sim_node (several robots too).
 
 Each fixture is written in an upstream shape with ``pan_tilt_sim`` where the Gazebo-side
 package was (test/data/gz_shaped/, test/data/classic_shaped/); the launch stand-in
@@ -15,8 +15,14 @@ import pathlib
 import launch_stand_in
 import pytest
 from builtin_interfaces.msg import Duration
-from geometry_msgs.msg import TwistStamped
-from mobile_fixtures import GZ_DIFF_DRIVE, plugin_rover_urdf
+from geometry_msgs.msg import Twist, TwistStamped
+from mobile_fixtures import (
+    GZ_DIFF_DRIVE,
+    WHEEL_RADIUS,
+    WHEEL_SEPARATION,
+    plugin_rover_urdf,
+    rover_urdf,
+)
 from nav_msgs.msg import Odometry
 from node_harness import PROBE_QUEUE, NodeHarness
 from sensor_msgs.msg import JointState
@@ -34,6 +40,17 @@ GZ_ROVER = DATA / 'gz_shaped' / 'rover_gz_bridge.launch.py'
 ROVER_BRIDGE = DATA / 'gz_shaped' / 'rover_bridge.yaml'
 ROVER_WORLD = DATA / 'gz_shaped' / 'rover_world.launch.py'  # includes rover_spawn.launch.py
 CLASSIC_ARM = DATA / 'classic_shaped' / 'arm_classic.launch.py'
+GZ_TWO_ROVERS = DATA / 'gz_shaped' / 'two_rovers_namespaced.launch.py'
+TWO_ROVERS_BRIDGE = DATA / 'gz_shaped' / 'two_rovers_bridge.yaml'
+# The rover's gz DiffDrive with its topics under the namespace its xacro is given.
+NAMESPACED_DIFF_DRIVE = f'''
+  <plugin filename="gz-sim-diff-drive-system" name="gz::sim::systems::DiffDrive">
+    <left_joint>left_wheel_joint</left_joint><right_joint>right_wheel_joint</right_joint>
+    <wheel_separation>{WHEEL_SEPARATION}</wheel_separation>
+    <wheel_radius>{WHEEL_RADIUS}</wheel_radius>
+    <topic>/$(arg namespace)/cmd_vel</topic><odom_topic>/$(arg namespace)/odometry</odom_topic>
+    <odom_publish_frequency>50</odom_publish_frequency>
+  </plugin>'''
 ARM_JOINTS = ['shoulder_joint', 'extend_joint', 'wrist_joint']
 TARGET = [0.5, 0.1, 0.3]
 REACHED_RAD = 0.02
@@ -162,3 +179,49 @@ def test_a_top_level_file_in_nav2_bringups_shape_brings_its_xacro_world_and_the_
         outputs = launch.close()
     assert {'crate', 'rover'} <= set(entities.entities), (entities.entities,
                                                           outputs['sim_node'])
+
+
+def namespaced_rover_xacro() -> str:
+    """The plugin rover as a xacro taking ``namespace`` (Nav2's TB3 xacro takes it so)."""
+    urdf = rover_urdf('rover', ros2_control=False,
+                      extra=f'<gazebo>{NAMESPACED_DIFF_DRIVE}</gazebo>')
+    return urdf.replace('<robot name="rover">', (
+        '<robot name="rover" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:arg name="namespace" default="robot"/>'))
+
+
+def test_two_robots_in_namespaces_share_one_world_each_driven_on_its_own_cmd_vel(
+        monkeypatch, tmp_path):
+    xacro = tmp_path / 'rover.urdf.xacro'
+    xacro.write_text(namespaced_rover_xacro())
+    launch = launch_stand_in.StandInLaunch(
+        launch_stand_in.load(GZ_TWO_ROVERS, monkeypatch), tmp_path,
+        {'description_file': str(xacro), 'bridge_config': str(TWO_ROVERS_BRIDGE)})
+    harness = NodeHarness()
+    odometry: dict[str, list[Odometry]] = {'robot1': [], 'robot2': []}
+    for robot, received in odometry.items():
+        harness.probe.create_subscription(Odometry, f'/{robot}/odom', received.append,
+                                          PROBE_QUEUE)
+    try:
+        launch.start_processes()
+        for create in ('create', 'create_2'):
+            assert launch.wait_for_exit(create, EXIT_BUDGET_S) == 0, launch.output(create)
+        assert harness.spin_until(lambda: all(odometry.values())), (
+            f'no odometry from {[robot for robot, got in odometry.items() if not got]}')
+        command = harness.probe.create_publisher(Twist, '/robot2/cmd_vel', 10)
+        assert harness.spin_until(lambda: command.get_subscription_count() > 0)
+
+        def driving() -> bool:
+            message = Twist()
+            message.linear.x = DRIVE_SPEED
+            command.publish(message)
+            return odometry['robot2'][-1].pose.pose.position.x > 0.3
+
+        assert harness.spin_until(driving, MOVE_BUDGET_S), (
+            f"robot2 did not drive: {odometry['robot2'][-1].pose.pose.position}")
+        assert abs(odometry['robot1'][-1].pose.pose.position.x) < 0.01
+    finally:
+        harness.close()
+        outputs = launch.close()
+    assert "simulating 'robot2'" in outputs['sim_node']
+    assert 'Traceback' not in outputs['sim_node']  # it ends cleanly with both robots

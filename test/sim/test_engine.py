@@ -161,3 +161,64 @@ def test_the_start_up_report_waits_for_report_startup(tmp_path, repo_root):
                          "joint 'tilt_joint': passive: no active controller",
                          "joint 'tilt_joint' starts at -1.5708: 0 is outside its limits "
                          '[-4.71239, -1.5708]']
+
+
+# --- several robots in one world --------------------------------------------------------
+
+
+def _plugin_rover(name: str, pose):
+    from mobile_fixtures import ROS2_DIFF_DRIVE, rover_urdf
+
+    from pan_tilt_sim.model.base_pose import BasePose
+    from pan_tilt_sim.model.controller_config import load_controllers_config
+    from pan_tilt_sim.model.description import description_from_text
+
+    description = description_from_text(
+        rover_urdf(name, ros2_control=False, extra=f'<gazebo>{ROS2_DIFF_DRIVE}</gazebo>'),
+        f'<{name}>')
+    return description, load_controllers_config([], {}), BasePose(*pose)
+
+
+def _forward(simulation: Simulation, speed: float) -> None:
+    from pan_tilt_sim.controllers.framework.surface import StampedTwist
+
+    simulation.plugins[0].set_command(StampedTwist(0.0, (speed, 0.0, 0.0), (0.0, 0.0, 0.0)))
+
+
+def test_a_guest_robot_shares_the_world_steps_with_its_host_and_collides_with_it():
+    description, controllers, pose = _plugin_rover('robot1', (0.0, 0.0, 0.0, 0.0))
+    with Simulation(description, controllers, 0.001, fixed_base=None,
+                    initial_pose=pose) as host:
+        description, controllers, pose = _plugin_rover('robot2', (-0.8, 0.0, 0.0, 0.0))
+        guest = Simulation(description, controllers, 0.001, fixed_base=None,
+                           initial_pose=pose, world=host)
+        host.add_guest(guest)
+        assert guest.physics.client_id == host.physics.client_id
+        _forward(guest, 0.3)
+        host.advance(4000)  # 4 s at 0.3 m/s: 1.2 m, through robot1's place if nothing stops it
+        assert guest.steps == host.steps == 4000
+        (x2, _, _), _ = guest.base_state()
+        (x1, _, _), _ = host.base_state()
+        assert -0.4 < x2 < x1 - 0.29  # drove up to robot1 (0.3 m long each), never into it
+        guest.reset()
+        assert guest.base_state()[0][0] == pytest.approx(-0.8, abs=1e-3)
+
+
+def test_removing_a_guest_takes_its_body_out_and_the_host_runs_on():
+    import pybullet
+
+    description, controllers, pose = _plugin_rover('robot1', (0.0, 0.0, 0.0, 0.0))
+    with Simulation(description, controllers, 0.001, fixed_base=None,
+                    initial_pose=pose) as host:
+        client = host.physics.client_id
+        bodies = pybullet.getNumBodies(physicsClientId=client)
+        description, controllers, pose = _plugin_rover('robot2', (0.0, 1.0, 0.0, 0.0))
+        guest = Simulation(description, controllers, 0.001, fixed_base=None,
+                           initial_pose=pose, world=host)
+        host.add_guest(guest)
+        assert pybullet.getNumBodies(physicsClientId=client) == bodies + 1
+        host.remove_guest(guest)
+        assert pybullet.getNumBodies(physicsClientId=client) == bodies and not host.guests
+        _forward(host, 0.3)
+        host.advance(1000)
+        assert host.base_state()[0][0] > 0.1

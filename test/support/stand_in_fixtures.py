@@ -50,10 +50,11 @@ def world_only(**parameters) -> Iterator[tuple[NodeHarness, SimNode]]:
 
 def spawn(harness: NodeHarness, *, name: str = '', resource_string: str = '', uri: str = '',
           allow_renaming: bool = False, frame: str = '', x: float = 0.0, y: float = 0.0,
-          yaw: float = 0.0):
+          yaw: float = 0.0, namespace: str = ''):
     """Call SpawnEntity once; return its response."""
     request = srv().SpawnEntity.Request(name=name, resource_string=resource_string, uri=uri,
-                                        allow_renaming=allow_renaming)
+                                        allow_renaming=allow_renaming,
+                                        entity_namespace=namespace)
     request.initial_pose.header.frame_id = frame
     request.initial_pose.pose.position.x, request.initial_pose.pose.position.y = x, y
     request.initial_pose.pose.orientation.z = math.sin(yaw / 2)

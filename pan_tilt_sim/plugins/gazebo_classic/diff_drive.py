@@ -149,6 +149,16 @@ class DiffDrivePlugin:
         names = Ros2Names(self.name, namespace, self.remappings)
         return names.topic(self.command_topic), names.topic(self.odometry_topic)
 
+    def tf_topic(self, override: str = '') -> str:
+        """Return where the odometry TF goes: ``/tf``, or where ``<remapping>/tf:=tf`` puts it.
+
+        As the plugin's TransformBroadcaster does: ``/tf`` is absolute, so only a
+        remapping moves it (Nav2's multi-robot robots remap it into their namespace).
+        """
+        if self.convention == ROS1:
+            return '/tf'
+        return Ros2Names(self.name, override or self.namespace, self.remappings).topic('/tf')
+
     @property
     def pose_covariance(self) -> tuple[float, ...]:
         """The odometry pose covariance's diagonal (x, y, z, roll, pitch, yaw)."""
@@ -289,7 +299,8 @@ class GazeboDiffDrive(Plugin, OdometryOutputs, CommandController):
                                          'pose_covariance_diagonal': plugin.pose_covariance,
                                          'twist_covariance_diagonal': plugin.twist_covariance}))
         if plugin.publish_odom_tf:
-            endpoints.append(StateTopic('/tf', 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
+            endpoints.append(StateTopic(plugin.tf_topic(override), 'tf2_msgs/msg/TFMessage',
+                                        self.set_tf_sink))
         return tuple(endpoints)
 
     # --- lifecycle -------------------------------------------------------------------------

@@ -132,6 +132,18 @@ def test_its_surface_is_the_plugins_topics_and_frames():
     assert [endpoint.name for endpoint in quiet.ros_surface()] == ['/cmd_vel']
 
 
+def test_its_tf_goes_to_slash_tf_unless_remapped_into_its_namespace():
+    remapped, _ = unit(ROS2_DIFF_DRIVE.replace(
+        '<left_joint>', '<ros><namespace>robot2</namespace><remapping>/tf:=tf</remapping>'
+                        '</ros><left_joint>'))
+    names = [endpoint.name for endpoint in remapped.ros_surface()]
+    assert names == ['/robot2/cmd_vel', '/robot2/odom', '/robot2/tf']
+    # Without the remapping /tf is absolute, in any namespace (tf2's broadcaster).
+    plain, _ = unit(ROS2_DIFF_DRIVE.replace(
+        '<left_joint>', '<ros><namespace>robot2</namespace></ros><left_joint>'))
+    assert [endpoint.name for endpoint in plain.ros_surface()][-1] == '/tf'
+
+
 def test_a_reset_drops_the_command_and_the_odometry():
     drive, handles = unit(ROS1_DIFF_DRIVE)
     drive.set_command(twist(0.2, 0.0))

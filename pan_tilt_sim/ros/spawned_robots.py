@@ -1,0 +1,161 @@
+"""Robots spawned into a world that has one already: each with its plugins, sensors, manager.
+
+:class:`SpawnedRobot` is one more robot on sim_node: its own
+:class:`~pan_tilt_sim.sim.engine.Simulation` in the first robot's PyBullet world
+(stepped with it), its Gazebo plugins' and controllers' topics under its
+namespace, its sensors, and a controller manager of its own where its
+description has ``<ros2_control>`` and a gz_ros2_control plugin.  Deleting it
+takes all of that away.  docs/launch-files.md#several-robots is the reference.
+"""
+
+from __future__ import annotations
+
+from rclpy.node import Node
+
+from pan_tilt_sim.errors import ParameterError
+from pan_tilt_sim.model import naming
+from pan_tilt_sim.model.controller_config import (
+    ControllersConfig,
+    controllers_files_for,
+    load_controllers_config,
+)
+from pan_tilt_sim.model.description import RobotDescription
+from pan_tilt_sim.plugins.registry import runs_by_plugins
+from pan_tilt_sim.ros import optional_interfaces
+from pan_tilt_sim.ros.controller_bindings import ControllerBindings
+from pan_tilt_sim.ros.gain_parameters import GainParameters
+from pan_tilt_sim.ros.sensor_publishers import SensorSet
+from pan_tilt_sim.sim.engine import Simulation
+from pan_tilt_sim.sim.world import has_ground
+
+
+def is_robot(description: RobotDescription) -> bool:
+    """Return whether a spawned description is a robot (plugins, sensors, ros2_control)."""
+    model = description.model
+    return bool(model.plugins or model.sensors or model.ros2_control or model.control_plugins)
+
+
+def controllers_of(description: RobotDescription) -> ControllersConfig:
+    """Return the controllers its gz_ros2_control plugin's ``<parameters>`` name (or none)."""
+    return load_controllers_config(controllers_files_for(
+        '', description, runs_by_plugins=runs_by_plugins(description.model)), {})
+
+
+class SpawnedRobot:
+    """One more robot on ``node``, in ``host``'s world, its topics under ``namespace``."""
+
+    def __init__(self, node: Node, host: Simulation, description: RobotDescription, *,
+                 namespace: str, controllers: ControllersConfig, fixed_base: bool | None,
+                 autostart_controllers: bool, initial_pose, world: str,
+                 reader=None, seed: int | None = None) -> None:
+        self.name = description.name
+        self.namespace = naming.resolve_robot_namespace(
+            '', namespace, controllers.namespace, description.plugin_namespace)
+        self._node = node
+        self._host = host
+        self.simulation = Simulation(
+            description, controllers, host.time_step, logger=node.get_logger(),
+            autostart_controllers=autostart_controllers, fixed_base=fixed_base,
+            initial_pose=initial_pose, world=host)
+        if not self.simulation.physics.fixed_base and not has_ground(world):
+            self.simulation.close()
+            raise ParameterError(
+                f"parameter 'world': '{world}' has no ground for the free base of "
+                f"'{description.name}' to stand on")
+        self.controller_manager: Node | None = None
+        self.bindings: ControllerBindings | None = None
+        self.sensors: SensorSet | None = None
+        try:
+            self.simulation.hardware.configure(world=world, seed=seed)
+            # Its controllers' gains are parameters of its own controller manager node.
+            manager_node = self._manager_node(description)
+            self.bindings = ControllerBindings(
+                node, self.simulation, self.topic,
+                GainParameters(manager_node if manager_node is not None else node),
+                actions=optional_interfaces.available('control_msgs'), reader=reader,
+                namespace=self.namespace)
+            if manager_node is not None:
+                self._serve_manager(manager_node, controllers)
+            self.sensors = SensorSet(node, self.simulation, world,
+                                     namespace_override=namespace, seed=seed)
+        except BaseException:
+            self.destroy()
+            raise
+        host.add_guest(self.simulation)
+
+    def topic(self, *names: str) -> str:
+        """Absolute name of a topic of this robot."""
+        return naming.join(self.namespace, *names)
+
+    def _manager_node(self, description: RobotDescription) -> Node | None:
+        if not description.model.ros2_control or not optional_interfaces.available(
+                'controller_manager_msgs'):
+            return None
+        from pan_tilt_sim.ros.controller_manager import NODE_NAME
+
+        plugins = description.model.control_plugins
+        # gz_ros2_control's <controller_manager_name>, else controller_manager.
+        name = (plugins[0].settings.get('controller_manager_name') if plugins else None)
+        self.controller_manager = Node(
+            name or NODE_NAME, namespace=self.namespace or '/', context=self._node.context,
+            use_global_arguments=False, allow_undeclared_parameters=True)
+        return self.controller_manager
+
+    def _serve_manager(self, manager_node: Node, controllers: ControllersConfig) -> None:
+        from pan_tilt_sim.ros.controller_manager import ControllerManagerServices
+
+        self.manager_services = ControllerManagerServices(
+            manager_node, self.bindings, self.simulation.manager,
+            self.simulation.description.model, source=controllers.label)
+        if self._node.executor is not None:
+            self._node.executor.add_node(manager_node)
+
+    # --- what sim_node's batches call ------------------------------------------------------
+
+    def flush_joint_states(self) -> None:
+        """Publish the samples its state topics took."""
+        self.bindings.flush_joint_states()
+
+    def after_steps(self) -> None:
+        """Publish what its sensors have due."""
+        self.sensors.update()
+
+    def after_batch(self) -> None:
+        """After a batch: its controllers' notices and goals."""
+        self.bindings.after_steps()
+
+    def steps_until_due(self, step: int) -> int | None:
+        """Return how many steps after ``step`` a watched sensor is due (None: none)."""
+        due = self.sensors.next_step(step)
+        return None if due is None else due - step
+
+    def refresh_readers(self) -> None:
+        """Let its controllers sample only what is read."""
+        self.bindings.refresh_readers()
+
+    def reset(self) -> None:
+        """Start its sensors' schedules again."""
+        self.sensors.reset()
+
+    def destroy(self, *, release_topics: bool = True) -> None:
+        """Take its topics, services and controller manager away, and its body from the world.
+
+        ``release_topics`` False: sim_node itself is going, and its topics with it.
+        """
+        node = self._node
+        if self.bindings is not None:
+            if release_topics:
+                self.bindings.release()
+            else:
+                self.bindings.destroy()
+        if self.sensors is not None and release_topics:
+            self.sensors.destroy(node)
+        if self.controller_manager is not None:
+            if self.controller_manager.executor is not None:
+                self.controller_manager.executor.remove_node(self.controller_manager)
+            self.controller_manager.destroy_node()
+            self.controller_manager = None
+        if self.simulation in self._host.guests:
+            self._host.remove_guest(self.simulation)
+        else:
+            self.simulation.close()

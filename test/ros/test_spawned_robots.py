@@ -1,0 +1,342 @@
+"""Several robots in one world: each robot spawned after the first gets what the first gets.
+
+Two rovers driven by gazebo_ros diff drive plugins, each with a lidar, spawned into one
+world-only sim_node (robot_from_spawn) in namespaces robot1 and robot2: each drives on
+its own cmd_vel, they collide, robot2's lidar sees robot1, DeleteEntity takes robot2 and
+its topics away, a taken name is refused, and a robot that cannot be simulated is
+refused while robot1 runs on.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+
+import pytest
+from geometry_msgs.msg import Twist
+from mobile_fixtures import GZ_DIFF_DRIVE, P3D, ROS2_DIFF_DRIVE, rover_urdf
+from node_harness import SimUnderTest
+from sensor_msgs.msg import LaserScan
+from stand_in_fixtures import finish, spawn, srv, start, world_only
+
+pytestmark = pytest.mark.skipif(
+    importlib.util.find_spec('simulation_interfaces') is None,
+    reason='simulation_interfaces is not installed')
+
+# A lidar on a mast: the mast (a 4 cm box, inside the lidar's 5 cm range_min) is what
+# the other rover's lidar, at the same height, sees of this one.
+MAST_LIDAR = '''
+  <joint name="lidar_joint" type="fixed">
+    <parent link="base_link"/><child link="lidar_link"/><origin xyz="0.1 0 0.05"/>
+  </joint>
+  <link name="lidar_link">
+    <inertial><mass value="0.05"/>
+      <inertia ixx="0.00001" ixy="0" ixz="0" iyy="0.00001" iyz="0" izz="0.00001"/></inertial>
+    <collision><geometry><box size="0.04 0.04 0.04"/></geometry></collision>
+  </link>
+  <gazebo reference="lidar_link">
+    <sensor type="ray" name="lidar">
+      <update_rate>20</update_rate>
+      <ray><scan><horizontal><samples>91</samples><resolution>1</resolution>
+        <min_angle>-1.5708</min_angle><max_angle>1.5708</max_angle></horizontal></scan>
+        <range><min>0.05</min><max>8.0</max></range></ray>
+      <plugin name="scan" filename="libgazebo_ros_ray_sensor.so">
+        <ros><remapping>~/out:=scan</remapping></ros>
+        <output_type>sensor_msgs/LaserScan</output_type>
+      </plugin>
+    </sensor>
+  </gazebo>'''
+SPEED = 0.3  # m/s forward
+BUDGET_S = 60.0
+
+
+def rover(drive: str = ROS2_DIFF_DRIVE) -> str:
+    return rover_urdf('rover', ros2_control=False,
+                      extra=f'<gazebo>{drive}{P3D}</gazebo>{MAST_LIDAR}')
+
+
+def x_of(simulation) -> float:
+    return simulation.base_state()[0][0]
+
+
+class Drivers:
+    """Twist publishers of the probe, one per cmd_vel topic, sending at every spin."""
+
+    def __init__(self, harness) -> None:
+        self._harness = harness
+        self._publishers = {}
+
+    def drive(self, topic: str, speed: float) -> None:
+        publisher = self._publishers.get(topic)
+        if publisher is None:
+            publisher = self._publishers[topic] = self._harness.probe.create_publisher(
+                Twist, topic, 10)
+        message = Twist()
+        message.linear.x = speed
+        publisher.publish(message)
+
+
+def spin_driving(harness, drivers: Drivers, commands: dict[str, float], condition,
+                 budget_s: float = BUDGET_S) -> bool:
+    """Spin, sending ``commands`` (topic -> speed) each turn, until ``condition()``."""
+    def sent_and_checked() -> bool:
+        for topic, speed in commands.items():
+            drivers.drive(topic, speed)
+        return condition()
+    return harness.spin_until(sent_and_checked, budget_s)
+
+
+def two_rovers(harness, *, robot2_x: float = 0.0, robot2_y: float = 1.0):
+    first = spawn(harness, name='robot1', resource_string=rover(), namespace='robot1')
+    second = spawn(harness, name='robot2', resource_string=rover(), namespace='robot2',
+                   x=robot2_x, y=robot2_y)
+    assert (first.result.result, first.entity_name) == (1, 'robot1'), first
+    assert (second.result.result, second.entity_name) == (1, 'robot2'), second
+
+
+def test_each_rover_drives_on_its_own_cmd_vel():
+    with world_only() as (harness, node):
+        two_rovers(harness)
+        robot1, robot2 = node.simulation, node.spawned_robots['robot2'].simulation
+        assert robot2.physics.client_id == robot1.physics.client_id  # one world
+        drivers = Drivers(harness)
+        assert spin_driving(harness, drivers, {'/robot2/cmd_vel': SPEED},
+                            lambda: x_of(robot2) > 0.3)
+        assert abs(x_of(robot1)) < 0.01  # robot1 had no command
+        assert spin_driving(harness, drivers, {'/robot2/cmd_vel': 0.0, '/robot1/cmd_vel': SPEED},
+                            lambda: x_of(robot1) > 0.3)
+        stopped = x_of(robot2)
+        assert spin_driving(harness, drivers, {'/robot2/cmd_vel': 0.0, '/robot1/cmd_vel': SPEED},
+                            lambda: x_of(robot1) > 0.6)
+        assert abs(x_of(robot2) - stopped) < 0.01
+        # One /clock for the world: both robots at the same sim time.
+        assert robot2.steps == robot1.steps
+
+
+def test_one_driven_into_the_other_is_stopped_by_it_never_passing_through():
+    with world_only() as (harness, node):
+        two_rovers(harness, robot2_x=-0.8, robot2_y=0.0)
+        robot1, robot2 = node.simulation, node.spawned_robots['robot2'].simulation
+        drivers = Drivers(harness)
+        overlaps = []
+
+        def driven_far_enough() -> bool:
+            if x_of(robot2) > x_of(robot1) - 0.29:  # bodies 0.3 m long: overlapping
+                overlaps.append((x_of(robot2), x_of(robot1)))
+            return robot2.time > 5.0  # long enough to drive 1.5 m, through robot1's place
+        assert spin_driving(harness, drivers, {'/robot2/cmd_vel': SPEED}, driven_far_enough)
+        assert not overlaps, overlaps[:3]
+        assert x_of(robot2) > -0.35  # it drove up to robot1, which stopped it (or moved on)
+
+
+def test_robot2s_lidar_sees_robot1():
+    with world_only() as (harness, node):
+        two_rovers(harness, robot2_x=-1.0, robot2_y=0.0)
+        sim = SimUnderTest(harness, node)
+        scans = sim.collect(LaserScan, '/robot2/scan')
+        assert harness.spin_until(lambda: len(scans) >= 2)
+        ahead = scans[-1].ranges[len(scans[-1].ranges) // 2]
+        # robot2's lidar at x -0.9, robot1's mast's near face at x 0.08.
+        assert ahead == pytest.approx(0.98, abs=0.03)
+
+
+def test_delete_entity_takes_robot2_and_its_topics_away():
+    with world_only() as (harness, node):
+        two_rovers(harness)
+        sim = SimUnderTest(harness, node)
+        published, subscribed = sim.own_topics()
+        assert {'/robot2/scan', '/robot2/ground_truth', '/robot2/odom'} <= set(published)
+        assert '/robot2/cmd_vel' in subscribed
+        response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
+                                srv().DeleteEntity.Request(entity='robot2'))
+        assert response.result.result == 1, response.result.error_message
+        published, subscribed = sim.own_topics()
+        assert not [topic for topic in [*published, *subscribed]
+                    if topic.startswith('/robot2/')]
+        assert 'robot2' not in node.spawned_robots and not node.simulation.guests
+        entities = harness.call(srv().GetEntities, '/sim_node/get_entities').entities
+        assert 'robot2' not in entities and 'robot1' in entities
+        drivers = Drivers(harness)  # robot1 runs on
+        assert spin_driving(harness, drivers, {'/robot1/cmd_vel': SPEED},
+                            lambda: x_of(node.simulation) > 0.2)
+
+
+def test_a_taken_name_is_refused_unless_renaming_is_allowed():
+    codes = srv().SpawnEntity.Response
+    with world_only() as (harness, node):
+        two_rovers(harness)
+        taken = spawn(harness, name='robot2', resource_string=rover(), namespace='robot3',
+                      y=2.0)
+        assert taken.result.result == codes.NAME_NOT_UNIQUE
+        assert 'already exists' in taken.result.error_message
+        assert sorted(node.spawned_robots) == ['robot2']
+        renamed = spawn(harness, name='robot2', resource_string=rover(), namespace='robot3',
+                        y=2.0, allow_renaming=True)
+        assert (renamed.result.result, renamed.entity_name) == (1, 'robot2_1')
+        assert sorted(node.spawned_robots) == ['robot2', 'robot2_1']
+
+
+def test_a_robot_that_cannot_be_simulated_is_refused_and_the_others_run_on():
+    with world_only() as (harness, node):
+        two_rovers(harness)
+        # <ros2_control> with no controllers file and no plugin: nothing could drive it.
+        refused = spawn(harness, name='robot3', resource_string=rover_urdf('robot3'),
+                        y=-1.0)
+        assert refused.result.result == 4  # RESULT_OPERATION_FAILED
+        assert 'no controllers file' in refused.result.error_message
+        assert sorted(node.spawned_robots) == ['robot2']
+        assert len(node.simulation.guests) == 1
+        drivers = Drivers(harness)
+        assert spin_driving(harness, drivers, {'/robot2/cmd_vel': SPEED},
+                            lambda: x_of(node.spawned_robots['robot2'].simulation) > 1.2)
+
+
+def test_gz_diff_drive_rovers_take_their_topics_from_their_model_names():
+    with world_only() as (harness, node):
+        for name, y in (('robot1', 0.0), ('robot2', 1.0)):
+            response = spawn(harness, name=name, resource_string=rover(GZ_DIFF_DRIVE), y=y)
+            assert response.result.result == 1, response
+        robot2 = node.spawned_robots['robot2'].simulation
+        drivers = Drivers(harness)
+        assert spin_driving(harness, drivers, {'/model/robot2/cmd_vel': SPEED},
+                            lambda: x_of(robot2) > 1.3)
+        assert abs(x_of(node.simulation)) < 0.01
+
+
+def test_a_second_robot_with_ros2_control_gets_a_controller_manager_of_its_own(tmp_path):
+    from drop_in_fixtures import FORWARD, JSB, MANAGER_YAML
+    from ros2_control_fixtures import write_arm
+    from spawner_client import Spawner
+    from std_msgs.msg import Float64MultiArray
+
+    from pan_tilt_sim.model.description import load_description
+
+    if importlib.util.find_spec('controller_manager_msgs') is None:
+        pytest.skip('controller_manager_msgs is not installed')
+    arm = load_description(write_arm(tmp_path, MANAGER_YAML),
+                           [f"controllers:={tmp_path / 'arm_controllers.yaml'}"]).urdf_xml
+    with world_only() as (harness, node):
+        first = spawn(harness, name='robot1', resource_string=rover(), namespace='robot1')
+        second = spawn(harness, name='arm2', resource_string=arm, namespace='arm2', y=1.0)
+        assert first.result.result == 1 and second.result.result == 1, second
+        sim = SimUnderTest(harness, node)
+        spawner = Spawner(sim, manager='/arm2/controller_manager')
+        assert spawner.spawn(JSB) == 0 and spawner.spawn(FORWARD) == 0
+        assert spawner.controllers()[FORWARD].claimed_interfaces == [
+            'joint1/position', 'joint2/position']
+        arm2 = node.spawned_robots['arm2'].simulation
+        publisher = harness.probe.create_publisher(
+            Float64MultiArray, f'/arm2/{FORWARD}/commands', 10)
+
+        def commanded_and_there() -> bool:
+            publisher.publish(Float64MultiArray(data=[0.5, -0.5]))
+            positions = arm2.joint_positions()
+            return abs(positions['joint1'] - 0.5) < 0.02 and abs(positions['joint2'] + 0.5) < 0.02
+        assert harness.spin_until(commanded_and_there, BUDGET_S)
+        # The first robot's controller manager is another one: arm2's controllers are not there.
+        assert Spawner(sim, manager='/robot1/controller_manager').controllers() == {}
+        # DeleteEntity takes its controller manager away with it.
+        assert ('controller_manager', '/arm2') in node.get_node_names_and_namespaces()
+        response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
+                                srv().DeleteEntity.Request(entity='arm2'))
+        assert response.result.result == 1, response.result.error_message
+        assert harness.spin_until(lambda: ('controller_manager', '/arm2') not in
+                                  node.get_node_names_and_namespaces())
+
+
+def test_each_rovers_odometry_tf_goes_where_its_plugin_remaps_it():
+    # Nav2's classic multi-robot robots remap /tf into their namespace: robot2 does, robot1 not.
+    if importlib.util.find_spec('tf2_msgs') is None:
+        pytest.skip('tf2_msgs is not installed')
+    from tf2_msgs.msg import TFMessage
+
+    remapped = ROS2_DIFF_DRIVE.replace('<left_joint>',
+                                       '<ros><remapping>/tf:=tf</remapping></ros><left_joint>')
+    with world_only() as (harness, node):
+        spawn(harness, name='robot1', resource_string=rover(), namespace='robot1')
+        second = spawn(harness, name='robot2', resource_string=rover(remapped),
+                       namespace='robot2', y=1.0)
+        assert second.result.result == 1, second
+        sim = SimUnderTest(harness, node)
+        robot2_tf = sim.collect(TFMessage, '/robot2/tf')
+        assert harness.spin_until(lambda: robot2_tf)
+        assert [(t.header.frame_id, t.child_frame_id) for t in robot2_tf[-1].transforms] == [
+            ('odom', 'base_link')]
+        published, _ = sim.own_topics()
+        assert {'/tf', '/robot2/tf'} <= set(published)
+
+
+def test_a_world_reset_puts_every_robot_back_joints_and_all():
+    from std_srvs.srv import Empty
+
+    with world_only() as (harness, node):
+        two_rovers(harness)
+        robot2 = node.spawned_robots['robot2'].simulation
+        drivers = Drivers(harness)
+        assert spin_driving(harness, drivers, {'/robot2/cmd_vel': SPEED},
+                            lambda: x_of(robot2) > 0.3)
+        assert max(abs(angle) for angle in robot2.joint_positions().values()) > 5.0
+        node.set_paused(True)  # the state right after the reset stays to be read
+        harness.call(Empty, '/reset_simulation')
+        assert robot2.steps == node.simulation.steps == 0  # one clock, back to 0
+        assert abs(x_of(robot2)) < 0.01
+        assert max(abs(angle) for angle in robot2.joint_positions().values()) < 0.1
+
+
+def test_spawn_entity_py_with_a_robot_namespace_brings_a_second_robot(tmp_path):
+    urdf = tmp_path / 'rover.urdf'
+    urdf.write_text(rover())
+    with world_only() as (harness, node):
+        spawn(harness, name='robot1', resource_string=rover(), namespace='robot1')
+        code, output = finish(harness, start('spawn_entity.py', '-entity', 'robot2', '-file',
+                                             str(urdf), '-robot_namespace', 'robot2',
+                                             '-y', '1.0'))
+        assert code == 0, output
+        assert sorted(node.spawned_robots) == ['robot2']
+        _published, subscribed = SimUnderTest(harness, node).own_topics()
+        assert {'/robot1/cmd_vel', '/robot2/cmd_vel'} <= set(subscribed)
+        robot2 = node.spawned_robots['robot2'].simulation
+        assert robot2.base_state()[0][1] == pytest.approx(1.0, abs=1e-3)
+
+
+def test_a_free_robot_in_a_world_without_ground_is_refused_and_the_first_runs_on(tmp_path):
+    from drop_in_fixtures import MANAGER_YAML
+    from ros2_control_fixtures import write_arm
+
+    from pan_tilt_sim.model.description import load_description
+
+    arm = load_description(write_arm(tmp_path, MANAGER_YAML),
+                           [f"controllers:={tmp_path / 'arm_controllers.yaml'}"]).urdf_xml
+    with world_only(world='empty') as (harness, node):
+        assert spawn(harness, name='arm', resource_string=arm).result.result == 1
+        bodies = node.features.entities.names()
+        refused = spawn(harness, name='robot2', resource_string=rover(), y=1.0)
+        assert refused.result.result == 4  # RESULT_OPERATION_FAILED
+        assert "'empty' has no ground for the free base of 'robot2'" in (
+            refused.result.error_message)
+        assert node.spawned_robots == {} and node.simulation.guests == []
+        assert node.features.entities.names() == bodies
+        steps = node.simulation.steps
+        assert harness.spin_until(lambda: node.simulation.steps > steps)
+
+
+def test_a_second_robot_asked_for_while_the_first_waits_for_its_bridge_follows_it():
+    from std_msgs.msg import Empty
+
+    from pan_tilt_sim.ros.bridged_topics import ANNOUNCE_TOPIC
+
+    with world_only() as (harness, node):
+        # A bridge that announced itself and has not handed over: the first robot waits.
+        announce = harness.probe.create_publisher(Empty, ANNOUNCE_TOPIC, 1)
+        assert harness.spin_until(lambda: node.bridged_topics.pending())
+        client = harness.probe.create_client(srv().SpawnEntity, '/sim_node/spawn_entity')
+        assert harness.spin_until(client.service_is_ready)
+        futures = [client.call_async(srv().SpawnEntity.Request(
+            name=name, resource_string=rover(), entity_namespace=name))
+            for name in ('robot1', 'robot2')]
+        assert harness.spin_until(lambda: node._robot_spawn._busy)
+        harness.probe.destroy_publisher(announce)  # the bridge went: the robot is built
+        assert harness.spin_until(lambda: all(future.done() for future in futures))
+        assert [future.result().result.result for future in futures] == [1, 1], [
+            future.result().result.error_message for future in futures]
+        assert node.simulation.description.name == 'robot1'
+        assert sorted(node.spawned_robots) == ['robot2']
