@@ -416,7 +416,11 @@ class StandInLaunch:
             elif package == 'robot_state_publisher':
                 command = [sys.executable, str(HERE / 'robot_state_publisher_stand_in.py'),
                            '--ros-args', *self._ros_args(node)]
-                self.processes['robot_state_publisher'] = subprocess.Popen(
+                name, number = 'robot_state_publisher', 1
+                while name in self.processes:  # one per robot: each is stopped at the end
+                    number += 1
+                    name = f'robot_state_publisher_{number}'
+                self.processes[name] = subprocess.Popen(
                     command, env=self._environment(), stdout=subprocess.DEVNULL,
                     stderr=subprocess.PIPE, text=True)
 
