@@ -471,8 +471,16 @@ class Simulation:
         time = count * dt
         for unit in self.plugins:
             unit.update(time, dt)
-        for update in self.manager.updates:
-            update(time, dt)
+        if self._every_step:
+            for update in self.manager.updates:
+                update(time, dt)
+        else:  # controllers on their own clocks; the hardware acts on held commands
+            for clock in self._clocks:
+                if count >= clock[0]:
+                    clock[0] = count + clock[1]
+                    clock[3](time, clock[2])
+            for actuate in self.manager.actuations:
+                actuate(dt)
         for schedule, update in self.manager.scheduled_updates:
             if time + DUE_EPSILON >= schedule.next_due:
                 update(time, dt)
