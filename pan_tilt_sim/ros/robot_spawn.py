@@ -48,6 +48,9 @@ TILT_TOLERANCE = 1e-6  # rad of roll or pitch taken as none
 # Wall seconds a spawn waits for announced bridges to hand over (their start-up is ~1 s).
 BRIDGE_WAIT_S = 10.0
 BRIDGE_POLL_S = 0.1
+# Wall seconds a later robot in a bridged world waits for a bridge of its own to appear
+# (Nav2's multi-robot launch starts one per robot, with its create, in its namespace).
+NEW_BRIDGE_WAIT_S = 3.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -127,6 +130,8 @@ class RobotSpawnService:
         self._result = found.msg.Result
         self._built = False
         self._busy = False  # a request is waiting for the bridges
+        self._bridges_seen = 0  # bridges known when the last robot was built
+        self.awaiting_bridge = False  # a later robot's request waits for its bridge to appear
         self._failure: ConfigurationError | None = None
         self._objects: Callable | None = None  # the simulation services' handler, once built
         # Reentrant: an object's spawn awaits its preparation, which other callbacks finish.
@@ -144,6 +149,7 @@ class RobotSpawnService:
             await self._pause(BRIDGE_POLL_S)
         if self._built and self._failure is None and self._more_robot(request):
             # Its bridge (in its namespace) may have started with its create: wait for it too.
+            await self._new_bridge()
             await self._bridges_handed_over()
             return self._spawn_robot(request, response, more=True)
         if self._objects is not None:
@@ -158,6 +164,23 @@ class RobotSpawnService:
             return self._spawn_robot(request, response)
         finally:
             self._busy = False
+
+    async def _new_bridge(self) -> None:
+        """In a world whose robots came with bridges, give a later robot's bridge a moment.
+
+        Waits at most NEW_BRIDGE_WAIT_S for a bridge not seen when the last robot was built;
+        a world without bridges, or one shared bridge, just costs that wait per robot.
+        """
+        bridges = getattr(self._node, 'bridged_topics', None)
+        if bridges is None or not self._bridges_seen:
+            return
+        deadline = time.monotonic() + NEW_BRIDGE_WAIT_S
+        self.awaiting_bridge = True
+        try:
+            while bridges.known() <= self._bridges_seen and time.monotonic() < deadline:
+                await self._pause(BRIDGE_POLL_S)
+        finally:
+            self.awaiting_bridge = False
 
     async def _bridges_handed_over(self) -> None:
         """Wait (at most BRIDGE_WAIT_S) for the bridges in the graph to give their entries."""
@@ -177,6 +200,7 @@ class RobotSpawnService:
             self._node.get_logger().warning(
                 f"{', '.join(pending)} did not hand over its topics within {BRIDGE_WAIT_S:g} s: "
                 'the robot is built without them')
+        self._bridges_seen = bridges.known()
 
     def _pause(self, seconds: float) -> Future:
         """Return a Future done after ``seconds`` of wall time (a one-shot timer completes it)."""

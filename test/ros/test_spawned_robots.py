@@ -340,3 +340,38 @@ def test_a_second_robot_asked_for_while_the_first_waits_for_its_bridge_follows_i
             future.result().result.error_message for future in futures]
         assert node.simulation.description.name == 'robot1'
         assert sorted(node.spawned_robots) == ['robot2']
+
+
+def test_a_later_robot_in_a_bridged_world_waits_for_its_own_bridge_to_appear():
+    # Nav2's multi-robot launch starts each robot's bridge with its create: a later robot's
+    # request can come before its bridge is in the graph, and is built after it hands over.
+    from rclpy.parameter import Parameter
+    from std_msgs.msg import Empty
+
+    from pan_tilt_sim.model.gz_bridge import ROS_TO_GZ, BridgeEntry, encode
+    from pan_tilt_sim.ros import bridged_topics
+
+    def hand_over(bridge: str, entries: list[BridgeEntry]) -> bool:
+        value = encode(bridge, entries)
+        return node.set_parameters([Parameter(bridged_topics.PARAMETER, value=value)])[0].successful
+
+    with world_only() as (harness, node):
+        assert hand_over('/robot1/parameter_bridge', [])
+        first = spawn(harness, name='robot1', resource_string=rover(GZ_DIFF_DRIVE))
+        assert first.result.result == 1, first
+        client = harness.probe.create_client(srv().SpawnEntity, '/sim_node/spawn_entity')
+        assert harness.spin_until(client.service_is_ready)
+        future = client.call_async(srv().SpawnEntity.Request(
+            name='robot2', resource_string=rover(GZ_DIFF_DRIVE)))
+        # robot2's bridge comes after its request: announced, then handing over a rename.
+        assert harness.spin_until(lambda: node._robot_spawn.awaiting_bridge)
+        announce = harness.probe.create_publisher(Empty, bridged_topics.ANNOUNCE_TOPIC, 1)
+        assert harness.spin_until(lambda: node.bridged_topics.pending())
+        assert not future.done(), 'robot2 was built before its bridge handed over'
+        assert hand_over('/probe', [BridgeEntry('/robot2/cmd_vel', '/model/robot2/cmd_vel',
+                                                'geometry_msgs/msg/Twist', 'gz.msgs.Twist',
+                                                ROS_TO_GZ)])
+        harness.probe.destroy_publisher(announce)
+        assert harness.spin_until(future.done)
+        assert future.result().result.result == 1, future.result().result.error_message
+        assert harness.spin_until(lambda: node.count_subscribers('/robot2/cmd_vel') > 0)
