@@ -102,17 +102,18 @@ class BridgedTopics:
     def _resolve(self, topic: str) -> str:
         return self._node.resolve_topic_name(topic)
 
+    def _in_graph(self) -> set[str]:
+        """Return the bridge stand-ins announcing themselves now, by full node name."""
+        return {f"{info.node_namespace.rstrip('/')}/{info.node_name}"
+                for info in self._node.get_publishers_info_by_topic(ANNOUNCE_TOPIC)}
+
     def known(self) -> int:
         """Return how many bridge stand-ins have been seen: handed over, or in the graph now."""
-        bridges = {f"{info.node_namespace.rstrip('/')}/{info.node_name}"
-                   for info in self._node.get_publishers_info_by_topic(ANNOUNCE_TOPIC)}
-        return len(bridges | self._sources)
+        return len(self._in_graph() | self._sources)
 
     def pending(self) -> list[str]:
         """Return the bridge stand-ins in the graph that have not handed their entries over."""
-        bridges = {f"{info.node_namespace.rstrip('/')}/{info.node_name}"
-                   for info in self._node.get_publishers_info_by_topic(ANNOUNCE_TOPIC)}
-        return sorted(bridges - self._sources)
+        return sorted(self._in_graph() - self._sources)
 
     def _entries_of(self, changed: list[Parameter]) -> list[BridgeEntry] | None:
         for parameter in changed:
