@@ -297,3 +297,30 @@ def generate_launch_description():
 def test_a_launch_name_it_does_not_know_is_an_import_error(monkeypatch, tmp_path):
     with pytest.raises(ImportError, match='ForEach'):
         _from_text(monkeypatch, tmp_path, 'from launch.actions import ForEach\n')
+
+
+def test_an_action_whose_condition_does_not_hold_is_not_carried_out(monkeypatch, tmp_path):
+    launch = _from_text(monkeypatch, tmp_path, '''
+from launch import LaunchDescription
+from launch.actions import GroupAction, OpaqueFunction, SetEnvironmentVariable
+from launch.conditions import IfCondition, UnlessCondition
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node, PushRosNamespace
+
+ON = IfCondition(LaunchConfiguration('on'))
+
+
+def generate_launch_description():
+    return LaunchDescription([
+        SetEnvironmentVariable('CHOSEN', 'on', condition=ON),
+        SetEnvironmentVariable('CHOSEN', 'off', condition=UnlessCondition(
+            LaunchConfiguration('on'))),
+        OpaqueFunction(function=lambda context: [Node(
+            package='pan_tilt_sim', executable='sim_node', name='unwanted')], condition=ON),
+        GroupAction([PushRosNamespace('unwanted', condition=ON),
+                     Node(package='pan_tilt_sim', executable='create')]),
+    ])
+''', on='false')
+    (node,) = launch.nodes()
+    assert launch.ros_args(node) == []
+    assert launch.environment == {'CHOSEN': 'off'}

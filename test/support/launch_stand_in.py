@@ -231,8 +231,9 @@ class PythonExpression(Substitution):
     available, as launch's default ``python_modules``)."""
 
 
-# Actions that change what the actions after them in their scope see.
-SCOPE_ACTIONS = (GroupAction, PushRosNamespace, SetRemap, SetParameter, LogInfo)
+# Actions carried out as they are reached: skipped there when their condition does not hold.
+SCOPE_ACTIONS = (GroupAction, PushRosNamespace, SetRemap, SetParameter, LogInfo,
+                 AppendEnvironmentVariable, SetEnvironmentVariable, OpaqueFunction)
 
 
 @dataclasses.dataclass
