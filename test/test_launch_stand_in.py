@@ -16,6 +16,7 @@ import sys
 
 import launch_stand_in
 import pytest
+import yaml
 from launch_stand_in import (
     FindExecutable,
     IfElseSubstitution,
@@ -174,3 +175,152 @@ def test_a_spawner_refusing_its_arguments_exits_2_as_the_program_would(
     launch = StandInLaunch(launch_stand_in.load(path, monkeypatch), tmp_path)
     assert launch.run_spawners(None) == [2]
     assert 'unrecognized arguments: --stopped' in capsys.readouterr().err
+
+
+GROUPED = '''
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument, GroupAction, LogInfo
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node, PushROSNamespace, PushRosNamespace, SetParameter, SetRemap
+
+
+def robot(name):
+    return GroupAction([
+        PushRosNamespace(name),
+        SetRemap(src='/tf', dst='tf'),
+        SetParameter(name='use_sim_time', value=True),
+        Node(package='pan_tilt_sim', executable='create', name='spawn',
+             arguments=['-name', LaunchConfiguration('robot')]),
+        GroupAction([
+            PushROSNamespace(namespace='inner'),
+            Node(package='robot_state_publisher', executable='robot_state_publisher',
+                 namespace='rsp', remappings=[('a', 'b')]),
+        ]),
+        Node(package='robot_state_publisher', executable='robot_state_publisher',
+             namespace='/absolute'),
+    ], launch_configurations={'robot': name})
+
+
+def generate_launch_description():
+    return LaunchDescription([
+        DeclareLaunchArgument('robot', default_value='none'),
+        robot('robot1'),
+        robot('robot2'),
+        Node(package='pan_tilt_sim', executable='sim_node', name='gzserver'),
+        LogInfo(msg=['robot is ', LaunchConfiguration('robot')]),
+    ])
+'''
+
+
+def _from_text(monkeypatch, tmp_path, source: str, **arguments) -> StandInLaunch:
+    path = tmp_path / 'under_test.launch.py'
+    path.write_text(source)
+    return StandInLaunch(launch_stand_in.load(path, monkeypatch), tmp_path, arguments)
+
+
+def test_a_group_scopes_its_configurations_namespace_remaps_and_parameters(
+        monkeypatch, tmp_path):
+    # As nav2_bringup's multi-robot launch: each robot's group sees its own values.
+    launch = _from_text(monkeypatch, tmp_path, GROUPED)
+    seen = [(node.kwargs['executable'], launch.ros_args(node),
+             perform(node.kwargs.get('arguments', []), launch.arguments_of(node)))
+            for node in launch.nodes()]
+    in_group = ['-p', 'use_sim_time:=True', '-r', '/tf:=tf']
+    assert seen == [
+        ('create', ['-r', '__node:=spawn', '-r', '__ns:=/robot1', *in_group],
+         ['-name', 'robot1']),
+        ('robot_state_publisher', ['-r', '__ns:=/robot1/inner/rsp', *in_group, '-r', 'a:=b'],
+         []),
+        ('robot_state_publisher', ['-r', '__ns:=/absolute', *in_group], []),
+        ('create', ['-r', '__node:=spawn', '-r', '__ns:=/robot2', *in_group],
+         ['-name', 'robot2']),
+        ('robot_state_publisher', ['-r', '__ns:=/robot2/inner/rsp', *in_group, '-r', 'a:=b'],
+         []),
+        ('robot_state_publisher', ['-r', '__ns:=/absolute', *in_group], []),
+        ('sim_node', ['-r', '__node:=gzserver'], []),
+    ]
+    assert launch.arguments['robot'] == 'none'  # the groups' values stayed in them
+
+
+def test_a_text_parameter_is_typed_as_launch_ros_types_it(monkeypatch, tmp_path):
+    # tb3_simulation_launch.py gives robot_state_publisher use_sim_time as a launch
+    # configuration's text: launch_ros reads 'True' as a bool.
+    launch = _from_text(monkeypatch, tmp_path, '''
+from launch import LaunchDescription
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node
+
+
+def generate_launch_description():
+    return LaunchDescription([Node(
+        package='robot_state_publisher', executable='robot_state_publisher',
+        parameters=[{'use_sim_time': LaunchConfiguration('use_sim_time', default='True'),
+                     'rate': '2.5', 'frame_prefix': 'robot1/'}])])
+''')
+    (node,) = launch.nodes()
+    arguments = launch.ros_args(node)
+    written = yaml.safe_load(pathlib.Path(arguments[arguments.index('--params-file') + 1])
+                             .read_text())
+    assert written == {'/**': {'ros__parameters': {
+        'use_sim_time': True, 'rate': 2.5, 'frame_prefix': 'robot1/'}}}
+
+
+REFUSED = {
+    'a node it cannot start': (
+        "Node(package='rviz2', executable='rviz2')",
+        "Node(package='rviz2', executable='rviz2') is not started by the launch stand-in"),
+    'a group not forwarding': (
+        'GroupAction([], forwarding=False)',
+        'GroupAction(forwarding=False) is not carried out by the launch stand-in'),
+    'something not an action': (
+        "'just text'", 'str is not a launch action the launch stand-in carries out'),
+}
+
+
+@pytest.mark.parametrize('entry', REFUSED.values(), ids=REFUSED.keys())
+def test_what_it_cannot_carry_out_is_refused_naming_it(monkeypatch, tmp_path, entry):
+    action, message = entry
+    with pytest.raises(ValueError) as refused:
+        launch = _from_text(monkeypatch, tmp_path, f'''
+from launch import LaunchDescription
+from launch.actions import GroupAction
+from launch_ros.actions import Node
+
+
+def generate_launch_description():
+    return LaunchDescription([{action}])
+''')
+        launch.start_processes()
+    assert str(refused.value) == message
+
+
+def test_a_launch_name_it_does_not_know_is_an_import_error(monkeypatch, tmp_path):
+    with pytest.raises(ImportError, match='ForEach'):
+        _from_text(monkeypatch, tmp_path, 'from launch.actions import ForEach\n')
+
+
+def test_an_action_whose_condition_does_not_hold_is_not_carried_out(monkeypatch, tmp_path):
+    launch = _from_text(monkeypatch, tmp_path, '''
+from launch import LaunchDescription
+from launch.actions import GroupAction, OpaqueFunction, SetEnvironmentVariable
+from launch.conditions import IfCondition, UnlessCondition
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node, PushRosNamespace
+
+ON = IfCondition(LaunchConfiguration('on'))
+
+
+def generate_launch_description():
+    return LaunchDescription([
+        SetEnvironmentVariable('CHOSEN', 'on', condition=ON),
+        SetEnvironmentVariable('CHOSEN', 'off', condition=UnlessCondition(
+            LaunchConfiguration('on'))),
+        OpaqueFunction(function=lambda context: [Node(
+            package='pan_tilt_sim', executable='sim_node', name='unwanted')], condition=ON),
+        GroupAction([PushRosNamespace('unwanted', condition=ON),
+                     Node(package='pan_tilt_sim', executable='create')]),
+    ])
+''', on='false')
+    (node,) = launch.nodes()
+    assert launch.ros_args(node) == []
+    assert launch.environment == {'CHOSEN': 'off'}

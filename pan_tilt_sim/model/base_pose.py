@@ -10,7 +10,9 @@ fixed joint, is welded whatever the parameter says, as in Gazebo.
 ``initial_pose`` (x, y, z, yaw: m and rad) places the base: a free base
 rests on the ground, its lowest collision point ``z`` above z = 0 (0:
 standing on it), turned by ``yaw`` about the vertical; a welded base has
-its root link frame at (x, y, z), turned by ``yaw``.
+its root link frame at (x, y, z), turned by ``yaw``.  A spawn request's
+pose (``create -R -P -Y``) also tilts it: ``roll`` and ``pitch``, fixed
+axes, as gz's pose (yaw last).
 """
 
 from __future__ import annotations
@@ -30,12 +32,17 @@ POSE_FIELDS = ('x', 'y', 'z', 'yaw')
 
 @dataclasses.dataclass(frozen=True)
 class BasePose:
-    """The base's start: position (m), height of its lowest point or frame (m), heading (rad)."""
+    """The base's start: position (m), height of its lowest point or frame (m), angles (rad).
+
+    The angles are fixed-axis: roll about x, then pitch about y, then yaw about z.
+    """
 
     x: float = 0.0
     y: float = 0.0
     z: float = 0.0
     yaw: float = 0.0
+    roll: float = 0.0
+    pitch: float = 0.0
 
     @property
     def is_origin(self) -> bool:

@@ -44,7 +44,6 @@ from pan_tilt_sim.ros.simulation_services import interfaces
 PARAMETER = 'robot_from_spawn'
 SERVICE = '~/spawn_entity'  # where simulation_services' default namespace puts it
 WORLD_FRAMES = ('', 'world')
-TILT_TOLERANCE = 1e-6  # rad of roll or pitch taken as none
 # Wall seconds a spawn waits for announced bridges to hand over (their start-up is ~1 s).
 BRIDGE_WAIT_S = 10.0
 BRIDGE_POLL_S = 0.1
@@ -71,16 +70,16 @@ def declare(node: Node) -> bool:
         "brings the robot, with its plugins and controller manager.")
 
 
-def yaw_of(x: float, y: float, z: float, w: float) -> tuple[float, float]:
-    """Return (yaw, tilt) of a quaternion: its heading and how far it leans off vertical (rad)."""
+def roll_pitch_yaw(x: float, y: float, z: float, w: float) -> tuple[float, float, float]:
+    """Return (roll, pitch, yaw) of a quaternion (rad, fixed axes x, y, z: gz's pose angles)."""
     norm = math.sqrt(x * x + y * y + z * z + w * w)
     if not math.isfinite(norm) or norm < 1e-9:
         raise ValueError('the orientation is not a rotation (zero or non-finite quaternion)')
     x, y, z, w = x / norm, y / norm, z / norm, w / norm
+    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
     yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-    # The body's z axis in the world: its angle from vertical is the tilt.
-    up_z = 1.0 - 2.0 * (x * x + y * y)
-    return yaw, math.acos(max(-1.0, min(1.0, up_z)))
+    return roll, pitch, yaw
 
 
 def free_name(wanted: str, taken: Iterable[str], allow_renaming: bool) -> str | None:
@@ -239,7 +238,8 @@ class RobotSpawnService:
                                 "placed in '' or 'world' only")
         position, orientation = pose.pose.position, pose.pose.orientation
         try:
-            yaw, tilt = yaw_of(orientation.x, orientation.y, orientation.z, orientation.w)
+            roll, pitch, yaw = roll_pitch_yaw(orientation.x, orientation.y, orientation.z,
+                                              orientation.w)
         except ValueError as err:
             return self._refuse(response, codes.INVALID_POSE, f'initial_pose: {err}')
         if not all(math.isfinite(value) for value in (position.x, position.y, position.z)):
@@ -257,11 +257,7 @@ class RobotSpawnService:
             return self._refuse(response, codes.NAME_NOT_UNIQUE,
                                 f"entity named '{request.name or description.name}' already "
                                 'exists (allow_renaming is false)')
-        if tilt > TILT_TOLERANCE:
-            self._node.get_logger().warning(
-                f"spawning '{name}' upright: its initial roll and pitch ({tilt:.3g} rad off "
-                'vertical) are not simulated, only its yaw')
-        spawn = Spawn(name, BasePose(position.x, position.y, position.z, yaw),
+        spawn = Spawn(name, BasePose(position.x, position.y, position.z, yaw, roll, pitch),
                       naming.normalize(request.entity_namespace))
         if more:
             try:

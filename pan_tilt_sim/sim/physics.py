@@ -320,7 +320,7 @@ class Physics:
 
     def _place_base(self, pose: BasePose) -> Transform:
         """Put the base at ``pose`` (a free one resting on the ground); return its frame."""
-        rotation = quaternion_from_rpy(0.0, 0.0, pose.yaw)
+        rotation = quaternion_from_rpy(pose.roll, pose.pitch, pose.yaw)
         if self._fixed_base:
             frame = Transform((pose.x, pose.y, pose.z), rotation)
             if not pose.is_origin:

@@ -41,6 +41,8 @@ ROVER_BRIDGE = DATA / 'gz_shaped' / 'rover_bridge.yaml'
 ROVER_WORLD = DATA / 'gz_shaped' / 'rover_world.launch.py'  # includes rover_spawn.launch.py
 CLASSIC_ARM = DATA / 'classic_shaped' / 'arm_classic.launch.py'
 GZ_TWO_ROVERS = DATA / 'gz_shaped' / 'two_rovers_namespaced.launch.py'
+# Nav2's multi-robot top level: a GroupAction per robot including rover_in_namespace.launch.py.
+GZ_TWO_ROVERS_GROUPED = DATA / 'gz_shaped' / 'two_rovers_grouped.launch.py'
 TWO_ROVERS_BRIDGE = DATA / 'gz_shaped' / 'two_rovers_bridge.yaml'
 # The rover's gz DiffDrive with its topics under the namespace its xacro is given.
 NAMESPACED_DIFF_DRIVE = f'''
@@ -190,12 +192,14 @@ def namespaced_rover_xacro() -> str:
         '<xacro:arg name="namespace" default="robot"/>'))
 
 
+@pytest.mark.parametrize('launch_file', [GZ_TWO_ROVERS, GZ_TWO_ROVERS_GROUPED],
+                         ids=['nodes_in_namespaces', 'grouped_includes'])
 def test_two_robots_in_namespaces_share_one_world_each_driven_on_its_own_cmd_vel(
-        monkeypatch, tmp_path):
+        monkeypatch, tmp_path, launch_file):
     xacro = tmp_path / 'rover.urdf.xacro'
     xacro.write_text(namespaced_rover_xacro())
     launch = launch_stand_in.StandInLaunch(
-        launch_stand_in.load(GZ_TWO_ROVERS, monkeypatch), tmp_path,
+        launch_stand_in.load(launch_file, monkeypatch), tmp_path,
         {'description_file': str(xacro), 'bridge_config': str(TWO_ROVERS_BRIDGE)})
     harness = NodeHarness()
     odometry: dict[str, list[Odometry]] = {'robot1': [], 'robot2': []}
@@ -220,6 +224,11 @@ def test_two_robots_in_namespaces_share_one_world_each_driven_on_its_own_cmd_vel
         assert harness.spin_until(driving, MOVE_BUDGET_S), (
             f"robot2 did not drive: {odometry['robot2'][-1].pose.pose.position}")
         assert abs(odometry['robot1'][-1].pose.pose.position.x) < 0.01
+        # Each robot's robot_state_publisher in its namespace.
+        publishers = {('robot_state_publisher', '/robot1'), ('robot_state_publisher', '/robot2')}
+        assert harness.spin_until(
+            lambda: publishers <= set(harness.probe.get_node_names_and_namespaces())), (
+            harness.probe.get_node_names_and_namespaces())
     finally:
         harness.close()
         outputs = launch.close()

@@ -1,38 +1,26 @@
-"""A small stand-in of ROS 2's launch API that runs a ros2_control launch file's shape.
+"""A small stand-in of ROS 2's launch API that runs a ros2_control or Gazebo launch file.
 
-``launch`` and ``launch_ros`` are not on PyPI. :func:`load` runs a launch file's
-``generate_launch_description()`` against stand-in modules that record what it asks for (Node,
-RegisterEventHandler + OnProcessExit, Command, PathJoinSubstitution, PathSubstitution,
-FindPackageShare, FindExecutable, LaunchConfiguration, IfElseSubstitution,
-DeclareLaunchArgument with its choices, IfCondition, UnlessCondition, OpaqueFunction,
-ParameterFile, Shutdown, launch.logging, (Append|Set)EnvironmentVariable, ExecuteProcess (run
-to its end before the nodes start); IncludeLaunchDescription of an installed package's Python
-launch file -- pan_tilt_sim's Gazebo stand-ins gz_sim.launch.py and gazebo.launch.py, or a
-package's in the ament index (Nav2's spawn_tb3.launch.py) -- is followed (its actions carried
-out in its place, with its launch_arguments), one of a package not installed is recorded and
-refused when it would run;
-controller_manager.launch_utils' generate_controllers_spawner_launch_description, whose
-LaunchDescription is carried out in its place), and :class:`StandInLaunch` carries it out as
-launch would: the arguments declared (a default performed, a value outside ``choices``
-refused) and each OpaqueFunction's function called with a context of the arguments so far, its
-actions carried out in its place; then the nodes, as launch_ros would start them:
-
-* ``pan_tilt_sim``'s ``sim_node`` as a process, ``--ros-args -r
-  __node:=<name>`` and its parameters as ``--params-file`` arguments (a dict
-  written to a file under ``/**``, as launch_ros writes one);
-* ``robot_state_publisher`` as the stand-in program of
-  test/support/robot_state_publisher_stand_in.py, with its parameters so;
-* ``pan_tilt_sim``'s Gazebo-side stand-ins (``create``, ``parameter_bridge``,
-  ``ros2_control_node``, ...) as processes, with the node's ``arguments``;
-* ``controller_manager``'s ``spawner`` in-process, playing jazzy's spawner
-  (test/support/spawner_client.py), and each OnProcessExit's actions once it ended --
-  a spawner's, or a stand-in process's (``create`` exits once the robot is in).
+``launch`` and ``launch_ros`` are not on PyPI.  :func:`load` runs a launch file's
+``generate_launch_description()`` against stand-in modules that record what it asks for
+(the names :func:`modules` defines; importing any other is an ImportError).
+:class:`StandInLaunch` carries it out as launch would: arguments declared (``choices``
+checked), OpaqueFunctions called, includes of installed Python launch files followed with
+their launch_arguments (one of a package not installed is refused when it would run),
+GroupAction scoped as launch scopes it (launch configurations, environment,
+PushRosNamespace/PushROSNamespace, SetRemap, SetParameter), ExecuteProcess run to its
+end first; then the nodes as launch_ros starts them: sim_node, pan_tilt_sim's Gazebo-side
+stand-ins (create, parameter_bridge, ...) and robot_state_publisher
+(test/support/robot_state_publisher_stand_in.py) as processes, controller_manager's
+spawner in-process (test/support/spawner_client.py), each OnProcessExit's actions after
+its target ended.  An action it cannot carry out is a ValueError naming it, never skipped.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.util
 import logging
+import math
 import os
 import pathlib
 import re
@@ -213,6 +201,79 @@ class ParameterFile(Recorded):
     """launch_ros ParameterFile: a file; with allow_substs its $(var name) are filled in."""
 
 
+class GroupAction(Recorded):
+    """launch.actions.GroupAction: ``actions``; ``scoped`` (default true), ``forwarding``
+    (only true is carried out), ``launch_configurations`` set for the group."""
+
+
+class PushRosNamespace(Recorded):
+    """launch_ros.actions.PushROSNamespace (alias PushRosNamespace): ``namespace``."""
+
+
+class SetRemap(Recorded):
+    """launch_ros.actions.SetRemap: ``src``, ``dst`` for every node after it in its scope."""
+
+
+class SetParameter(Recorded):
+    """launch_ros.actions.SetParameter: ``name``, ``value`` for every node after it."""
+
+
+class LogInfo(Recorded):
+    """launch.actions.LogInfo: ``msg`` (texts or substitutions), logged when carried out."""
+
+
+class TextSubstitution(Substitution):
+    """launch.substitutions.TextSubstitution: ``text``."""
+
+
+class PythonExpression(Substitution):
+    """launch.substitutions.PythonExpression: the joined texts evaluated (math's names
+    available, as launch's default ``python_modules``)."""
+
+
+# Actions carried out as they are reached: skipped there when their condition does not hold.
+SCOPE_ACTIONS = (GroupAction, PushRosNamespace, SetRemap, SetParameter, LogInfo,
+                 AppendEnvironmentVariable, SetEnvironmentVariable, OpaqueFunction)
+
+
+@dataclasses.dataclass
+class Scope:
+    """What launch keeps in a context's launch configurations for the actions after it.
+
+    ``arguments`` and ``environment`` are the scope's own (a scoped GroupAction's
+    are copies); ``namespace`` (PushRosNamespace's, absolute), ``remaps`` and
+    ``parameters`` are as they stood when an action was reached.
+    """
+
+    arguments: dict[str, str]
+    environment: dict[str, str]
+    namespace: str | None = None
+    remaps: tuple[tuple[str, str], ...] = ()
+    parameters: tuple[tuple[str, str], ...] = ()
+
+    def snapshot(self) -> Scope:
+        """This scope as an action reached now sees it (its dicts shared)."""
+        return dataclasses.replace(self)
+
+
+def prefix_namespace(base: str | None, namespace: str | None) -> str | None:
+    """launch_ros' prefix_namespace: ``namespace`` under ``base`` unless it is absolute."""
+    if base is None and namespace is None:
+        return None
+    if namespace is None:
+        combined = base
+    elif not base or namespace.startswith('/'):
+        combined = namespace
+    else:
+        combined = ('' if base == '/' else base) + '/' + namespace
+    return combined if combined == '/' else combined.rstrip('/')
+
+
+def absolute_namespace(namespace: str | None) -> str | None:
+    """launch_ros' make_namespace_absolute."""
+    return namespace if namespace is None or namespace.startswith('/') else '/' + namespace
+
+
 class FindPackageShare(Substitution):
     """launch_ros.substitutions.FindPackageShare."""
 
@@ -270,6 +331,14 @@ def modules() -> dict[str, types.ModuleType]:
     made['launch.substitutions'].IfElseSubstitution = IfElseSubstitution
     made['launch_ros.actions'].Node = Node
     made['launch_ros.substitutions'].FindPackageShare = FindPackageShare
+    made['launch.actions'].GroupAction = GroupAction
+    made['launch.actions'].LogInfo = LogInfo
+    made['launch.substitutions'].TextSubstitution = TextSubstitution
+    made['launch.substitutions'].PythonExpression = PythonExpression
+    made['launch_ros.actions'].PushROSNamespace = PushRosNamespace
+    made['launch_ros.actions'].PushRosNamespace = PushRosNamespace
+    made['launch_ros.actions'].SetRemap = SetRemap
+    made['launch_ros.actions'].SetParameter = SetParameter
     made['controller_manager.launch_utils'].generate_controllers_spawner_launch_description = (
         generate_controllers_spawner_launch_description)
     return made
@@ -311,6 +380,11 @@ def perform(value: Any, arguments: dict[str, str]) -> Any:
     if isinstance(value, IfElseSubstitution):
         holds = truth(text(value.args[0], arguments))
         return text(value.kwargs['if_value' if holds else 'else_value'], arguments)
+    if isinstance(value, TextSubstitution):
+        return value.kwargs['text'] if 'text' in value.kwargs else value.args[0]
+    if isinstance(value, PythonExpression):
+        return str(eval(text(value.args[0], arguments), {},  # noqa: S307
+                        {'math': math, **vars(math)}))
     if isinstance(value, LaunchConfiguration):
         if value.args[0] not in arguments and 'default' in value.kwargs:
             return text(_as_text(value.kwargs['default']), arguments)
@@ -368,9 +442,9 @@ class StandInLaunch:
     """Carries out a launch description's nodes; :meth:`close` stops the processes.
 
     ``arguments`` are the launch arguments given (``name:=value``); the
-    declarations and OpaqueFunctions are carried out here, in order, so
-    :attr:`actions` holds what they left: the file's own actions with each
-    OpaqueFunction replaced by the actions it returned.
+    declarations, OpaqueFunctions, includes and groups are carried out here, in
+    order, so :attr:`actions` holds what they left, each with the :class:`Scope`
+    it was reached in (the nodes are performed with it).
     """
 
     def __init__(self, actions: list, folder: pathlib.Path,
@@ -379,7 +453,8 @@ class StandInLaunch:
         self.arguments = dict(arguments or {})
         # What (Append|Set)EnvironmentVariable set, over this process's environment.
         self.environment: dict[str, str] = {}
-        self.actions = self._carry_out(actions)
+        self._scope_of: dict[int, Scope] = {}  # by id() of each action left
+        self.actions = self._carry_out(actions, Scope(self.arguments, self.environment))
         self.processes: dict[str, subprocess.Popen] = {}
         self._process_of: dict[int, subprocess.Popen] = {}  # by id() of the Node action
         self._logs: dict[str, pathlib.Path] = {}
@@ -394,13 +469,22 @@ class StandInLaunch:
     def start_processes(self) -> None:
         """Start every node that runs as a process (all but the spawners).
 
-        An included launch file whose condition holds is refused (ValueError):
-        the stand-in runs only this file's nodes.
+        An include of a package not installed whose condition holds, or a node
+        the stand-in cannot start, is refused (ValueError).
         """
         for action in self.actions:
             if isinstance(action, IncludeLaunchDescription) and self._holds(action):
-                raise ValueError(f'IncludeLaunchDescription of {action.describe(self.arguments)} '
-                                 'is not carried out by the launch stand-in')
+                raise ValueError(
+                    f'IncludeLaunchDescription of {action.describe(self.arguments_of(action))} '
+                    'is not carried out by the launch stand-in')
+        for node in self.nodes():
+            package, executable = node.kwargs['package'], node.kwargs['executable']
+            if package not in ('pan_tilt_sim', 'robot_state_publisher') and (
+                    package, executable) != ('controller_manager', 'spawner') or (
+                    package == 'pan_tilt_sim'
+                    and executable not in ('sim_node', *STAND_IN_EXECUTABLES)):
+                raise ValueError(f"Node(package='{package}', executable='{executable}') is not "
+                                 'started by the launch stand-in')
         for action in self.actions:
             if isinstance(action, ExecuteProcess) and self._holds(action):
                 self._execute(action)
@@ -408,20 +492,20 @@ class StandInLaunch:
             package, executable = node.kwargs['package'], node.kwargs['executable']
             if (package, executable) == ('pan_tilt_sim', 'sim_node'):
                 self.processes['sim_node'] = subprocess.Popen(
-                    sim_process.command(*self._ros_args(node)), env=self._environment(),
+                    sim_process.command(*self.ros_args(node)), env=self._environment(node),
                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
                 self._process_of[id(node)] = self.processes['sim_node']
             elif package == 'pan_tilt_sim' and executable in STAND_IN_EXECUTABLES:
                 self._start_stand_in(node)
             elif package == 'robot_state_publisher':
                 command = [sys.executable, str(HERE / 'robot_state_publisher_stand_in.py'),
-                           '--ros-args', *self._ros_args(node)]
+                           '--ros-args', *self.ros_args(node)]
                 name, number = 'robot_state_publisher', 1
                 while name in self.processes:  # one per robot: each is stopped at the end
                     number += 1
                     name = f'robot_state_publisher_{number}'
                 self.processes[name] = subprocess.Popen(
-                    command, env=self._environment(), stdout=subprocess.DEVNULL,
+                    command, env=self._environment(node), stdout=subprocess.DEVNULL,
                     stderr=subprocess.PIPE, text=True)
 
     def _start_stand_in(self, node: Node) -> None:
@@ -436,19 +520,27 @@ class StandInLaunch:
             number += 1
             name = f'{executable}_{number}'
         arguments = [str(item) for item in perform(node.kwargs.get('arguments', []),
-                                                  self.arguments)]
+                                                  self.arguments_of(node))]
         command = [sys.executable, '-m', 'pan_tilt_sim.tools.stand_ins', executable,
-                   *arguments, '--ros-args', *self._ros_args(node)]
+                   *arguments, '--ros-args', *self.ros_args(node)]
         log = (self.folder / f'{name}.log').open('w')
         self.processes[name] = subprocess.Popen(
-            command, env=self._environment(), stdout=log, stderr=subprocess.STDOUT,
+            command, env=self._environment(node), stdout=log, stderr=subprocess.STDOUT,
             text=True)
         self._process_of[id(node)] = self.processes[name]
         self._logs[name] = self.folder / f'{name}.log'
 
-    def _environment(self) -> dict[str, str]:
-        """The environment of a process started now: the launch's variables set."""
-        return {**sim_process.environment(), **self.environment}
+    def _environment(self, action: Recorded) -> dict[str, str]:
+        """The environment of the action's process: the variables its scope set."""
+        return {**sim_process.environment(), **self._scope(action).environment}
+
+    def _scope(self, action: Recorded) -> Scope:
+        """The scope the action was reached in (the top level's for one never reached)."""
+        return self._scope_of.get(id(action)) or Scope(self.arguments, self.environment)
+
+    def arguments_of(self, action: Recorded) -> dict[str, str]:
+        """The launch configurations the action is performed with."""
+        return self._scope(action).arguments
 
     def _execute(self, action: ExecuteProcess) -> None:
         """Run an ExecuteProcess's ``cmd`` (each item's text, as launch joins a list item).
@@ -456,9 +548,9 @@ class StandInLaunch:
         It runs to its end (within :data:`EXECUTE_PROCESS_WAIT_S`) before any node
         starts: a world that ``xacro -o`` writes is there when the simulation reads it.
         """
-        words = [text(item, self.arguments) for item in action.kwargs['cmd']]
+        words = [text(item, self.arguments_of(action)) for item in action.kwargs['cmd']]
         words[0] = shutil.which(words[0], path=os.path.dirname(sys.executable)) or words[0]
-        done = subprocess.run(words, env=self._environment(), capture_output=True, text=True,
+        done = subprocess.run(words, env=self._environment(action), capture_output=True, text=True,
                               timeout=EXECUTE_PROCESS_WAIT_S, check=False)
         if done.returncode != 0:
             raise ValueError(f'ExecuteProcess {words} exited {done.returncode}: {done.stderr}')
@@ -490,6 +582,13 @@ class StandInLaunch:
                     on_exit if isinstance(on_exit, list | tuple) else [on_exit])
         codes = []
         queue = []
+        for actions in handlers.values():
+            for action in actions:
+                if (isinstance(action, Node) and action.kwargs['executable'] != 'spawner'
+                        and self._holds(action)):
+                    raise ValueError(f"OnProcessExit's Node(executable="
+                                     f"'{action.kwargs['executable']}') is not started by the "
+                                     'launch stand-in')
         for target, actions in handlers.items():
             process = self._process_of.get(target)
             if process is None:
@@ -503,14 +602,14 @@ class StandInLaunch:
         queue.extend(self._spawners(self.nodes()))
         while queue:
             spawner = queue.pop(0)
+            given = self.arguments_of(spawner)
             arguments = [str(item) for item in perform(spawner.kwargs.get('arguments', []),
-                                                      self.arguments)]
+                                                      given)]
             # Its own parameter files are --param-files to jazzy's spawner too.
-            for parameters in perform(spawner.kwargs.get('parameters', []), self.arguments):
-                arguments += ['--param-file', str(self._parameter_file(parameters))]
+            for parameters in perform(spawner.kwargs.get('parameters', []), given):
+                arguments += ['--param-file', str(self._parameter_file(parameters, given))]
             try:
-                namespace = text(spawner.kwargs.get('namespace') or '', self.arguments)
-                code = spawner_main(harness, arguments, '/' + namespace.lstrip('/'))
+                code = spawner_main(harness, arguments, self._namespace(spawner) or '/')
             except SystemExit as refused:  # its arguments refused, as the program exits
                 code = refused.code
             codes.append(code)
@@ -527,91 +626,186 @@ class StandInLaunch:
                 errors[name] = self.output(name)
         return errors
 
-    def _carry_out(self, actions: list) -> list:
-        """Declare the arguments and run the OpaqueFunctions in order; return the actions left.
+    def _carry_out(self, actions: list, scope: Scope) -> list:
+        """Carry out the actions in ``scope`` in order; return the actions left, each scoped.
 
-        An include of pan_tilt_sim's own launch files (its condition holding) is
-        followed: its launch_arguments set, as launch sets them, and its actions
-        carried out in its place.
+        An include of an installed Python launch file (its condition holding) is
+        followed: its launch_arguments set in the scope, as launch sets them (an
+        include has no scope of its own), its actions carried out in its place.
+        A GroupAction's actions are carried out in a scope of their own.
         """
         left = []
         for action in actions:
-            if isinstance(action, DeclareLaunchArgument):
-                action.declare(self.arguments)
-            if isinstance(action, AppendEnvironmentVariable | SetEnvironmentVariable):
-                self._set_variable(action)
-            if isinstance(action, IncludeLaunchDescription) and self._is_installed(action):
-                if self._holds(action):
-                    for name, value in action.kwargs.get('launch_arguments', []):
-                        self.arguments[text(name, self.arguments)] = text(value, self.arguments)
-                    left += self._carry_out(_load_file(action.path(self.arguments)))
-            elif isinstance(action, OpaqueFunction):
-                left += self._carry_out(action.run(self.arguments))
-            elif isinstance(action, list):  # a LaunchDescription among the actions
-                left += self._carry_out(action)
-            else:
+            if isinstance(action, list):  # a LaunchDescription among the actions
+                left += self._carry_out(action, scope)
+                continue
+            if not isinstance(action, Recorded):
+                raise ValueError(f'{type(action).__name__} is not a launch action the launch '
+                                 'stand-in carries out')
+            if isinstance(action, SCOPE_ACTIONS) and not self._holds(action, scope.arguments):
+                continue
+            if isinstance(action, DeclareLaunchArgument | AppendEnvironmentVariable
+                          | SetEnvironmentVariable):
+                if isinstance(action, DeclareLaunchArgument):
+                    action.declare(scope.arguments)
+                else:
+                    self._set_variable(action, scope)
+                self._reach(action, scope)
                 left.append(action)
+            elif isinstance(action, IncludeLaunchDescription) and self._is_installed(
+                    action, scope.arguments):
+                if self._holds(action, scope.arguments):
+                    for name, value in action.kwargs.get('launch_arguments', []):
+                        scope.arguments[text(name, scope.arguments)] = text(value,
+                                                                            scope.arguments)
+                    left += self._carry_out(_load_file(action.path(scope.arguments)), scope)
+            elif isinstance(action, OpaqueFunction):
+                left += self._carry_out(action.run(scope.arguments), scope)
+            elif isinstance(action, GroupAction):
+                left += self._carry_out(*self._group(action, scope))
+            elif isinstance(action, PushRosNamespace):
+                pushed = text(action.kwargs.get('namespace', action.args[0] if action.args
+                                                else ''), scope.arguments)
+                scope.namespace = absolute_namespace(prefix_namespace(scope.namespace, pushed))
+            elif isinstance(action, SetRemap):
+                source, target = [text(action.kwargs.get(key, action.args[index] if len(
+                    action.args) > index else ''), scope.arguments)
+                    for index, key in enumerate(('src', 'dst'))]
+                scope.remaps += ((source, target),)
+            elif isinstance(action, SetParameter):
+                name, value = [perform(action.kwargs.get(key, action.args[index] if len(
+                    action.args) > index else ''), scope.arguments)
+                    for index, key in enumerate(('name', 'value'))]
+                scope.parameters += ((''.join(name) if isinstance(name, list) else name,
+                                      ''.join(value) if isinstance(value, list) else str(value)),)
+            elif isinstance(action, LogInfo):
+                logging.getLogger('launch').info(text(action.kwargs.get(
+                    'msg', action.args[0] if action.args else ''), scope.arguments))
+            elif isinstance(action, Node | RegisterEventHandler | ExecuteProcess
+                            | IncludeLaunchDescription):
+                self._reach(action, scope)
+                left.append(action)
+            else:
+                raise ValueError(f'{type(action).__name__} is not carried out by the launch '
+                                 'stand-in')
         return left
 
-    def _set_variable(self, action: Recorded) -> None:
+    def _reach(self, action: Recorded, scope: Scope) -> None:
+        """Keep the scope an action (and a handler's actions) is performed with."""
+        reached = scope.snapshot()
+        self._scope_of[id(action)] = reached
+        if isinstance(action, RegisterEventHandler):
+            handler = action.kwargs.get('event_handler') or action.args[0]
+            if not isinstance(handler, OnProcessExit):
+                raise ValueError(f'RegisterEventHandler of {type(handler).__name__} is not '
+                                 'carried out by the launch stand-in')
+            on_exit = handler.kwargs['on_exit']
+            for later in on_exit if isinstance(on_exit, list | tuple) else [on_exit]:
+                if not isinstance(later, Node):
+                    raise ValueError(f'OnProcessExit of {type(later).__name__} is not '
+                                     'carried out by the launch stand-in')
+                self._scope_of[id(later)] = reached
+
+    def _group(self, action: GroupAction, scope: Scope) -> tuple[list, Scope]:
+        """A GroupAction's actions and the scope they are carried out in, as launch makes it."""
+        actions = action.kwargs.get('actions', action.args[0] if action.args else [])
+        if action.kwargs.get('forwarding', True) is not True:
+            raise ValueError('GroupAction(forwarding=False) is not carried out by the launch '
+                             'stand-in')
+        inner = (dataclasses.replace(scope, arguments=dict(scope.arguments),
+                                     environment=dict(scope.environment))
+                 if action.kwargs.get('scoped', True) else scope)
+        for name, value in (action.kwargs.get('launch_configurations') or {}).items():
+            inner.arguments[text(name, scope.arguments)] = text(value, scope.arguments)
+        return list(actions), inner
+
+    def _set_variable(self, action: Recorded, scope: Scope) -> None:
         """Carry out (Append|Set)EnvironmentVariable for the processes started after it."""
-        name = text(action.args[0] if action.args else action.kwargs['name'], self.arguments)
-        value = text(action.args[1] if len(action.args) > 1 else action.kwargs['value'],
-                     self.arguments)
-        old = self.environment.get(name, os.environ.get(name, ''))
+        given = scope.arguments
+        name = text(action.args[0] if action.args else action.kwargs['name'], given)
+        value = text(action.args[1] if len(action.args) > 1 else action.kwargs['value'], given)
+        old = scope.environment.get(name, os.environ.get(name, ''))
         if isinstance(action, AppendEnvironmentVariable) and old:
             separator = action.kwargs.get('separator', os.pathsep)
             value = (value + separator + old if truth(text(
-                action.kwargs.get('prepend', 'false'), self.arguments)) else
+                action.kwargs.get('prepend', 'false'), given)) else
                 old + separator + value)
-        self.environment[name] = value
+        scope.environment[name] = value
 
-    def _is_installed(self, action: IncludeLaunchDescription) -> bool:
+    def _is_installed(self, action: IncludeLaunchDescription,
+                      arguments: dict[str, str]) -> bool:
         """Whether the include names an installed Python launch file (pan_tilt_sim's or any
         package's in the ament index): one of a package not installed (ros_gz_sim) is not."""
         from ament_index_python.packages import PackageNotFoundError
 
         try:
-            included = action.path(self.arguments)
+            included = action.path(arguments)
         except PackageNotFoundError:  # another package's (ros_gz_sim's, not installed here)
             return False
         return included.suffix == '.py' and included.is_file()
 
-    def _holds(self, action: Recorded) -> bool:
-        """Whether the action's condition (if any) holds."""
-        return perform(action.kwargs.get('condition', True), self.arguments)
+    def _holds(self, action: Recorded, arguments: dict[str, str] | None = None) -> bool:
+        """Whether the action's condition (if any) holds (in its scope unless given one)."""
+        return perform(action.kwargs.get('condition', True),
+                       self.arguments_of(action) if arguments is None else arguments)
 
     def _spawners(self, actions: Iterable) -> list[Node]:
         """The spawner nodes among ``actions`` whose condition holds (others are not run here)."""
         return [action for action in actions if isinstance(action, Node)
                 and action.kwargs['executable'] == 'spawner' and self._holds(action)]
 
-    def _ros_args(self, node: Node) -> list[str]:
-        args = []
-        name = text(node.kwargs.get('name') or '', self.arguments)
-        namespace = text(node.kwargs.get('namespace') or '', self.arguments)
+    def _namespace(self, node: Node) -> str | None:
+        """The node's namespace as launch_ros makes it: its own under its scope's pushed one."""
+        own = node.kwargs.get('namespace')
+        return absolute_namespace(prefix_namespace(
+            self._scope(node).namespace,
+            None if own is None else text(own, self.arguments_of(node))))
+
+    def ros_args(self, node: Node) -> list[str]:
+        """The node's ROS arguments, in launch_ros' order: name, namespace, the scope's
+        parameters, its own, the scope's remaps, its own."""
+        scope, args = self._scope(node), []
+        given = scope.arguments
+        name = text(node.kwargs.get('name') or '', given)
+        namespace = self._namespace(node)
         if name:
             args += ['-r', f'__node:={name}']
-        if namespace:  # launch_ros makes a relative namespace absolute
-            args += ['-r', f"__ns:={'/' + namespace.lstrip('/')}"]
-        for parameters in perform(node.kwargs.get('parameters', []), self.arguments):
-            args += ['--params-file', str(self._parameter_file(parameters))]
-        for source, target in node.kwargs.get('remappings', []):
-            args += ['-r', f'{source}:={target}']
+        if namespace not in (None, '/'):
+            args += ['-r', f'__ns:={namespace}']
+        for parameter, value in scope.parameters:
+            args += ['-p', f'{parameter}:={value}']
+        for parameters in perform(node.kwargs.get('parameters', []), given):
+            args += ['--params-file', str(self._parameter_file(parameters, given))]
+        for source, target in [*scope.remaps, *node.kwargs.get('remappings', [])]:
+            args += ['-r', f'{text(source, given)}:={text(target, given)}']
         return args + [str(item) for item in perform(node.kwargs.get('ros_arguments', []),
-                                                      self.arguments)]
+                                                      given)]
 
-    def _parameter_file(self, parameters: Any) -> pathlib.Path:
+    def _parameter_file(self, parameters: Any, arguments: dict[str, str]) -> pathlib.Path:
         """A file name stays; a dict is written under ``/**``, as launch_ros writes it."""
         self._files += 1
         path = self.folder / f'launch_params_{self._files}.yaml'
         if isinstance(parameters, ParameterFile):
-            text = pathlib.Path(perform(parameters.args[0], self.arguments)).read_text()
+            text = pathlib.Path(perform(parameters.args[0], arguments)).read_text()
             if parameters.kwargs.get('allow_substs'):
-                text = SUBSTITUTION.sub(lambda match: self.arguments[match[1]], text)
+                text = SUBSTITUTION.sub(lambda match: arguments[match[1]], text)
             path.write_text(text)
             return path
         if not isinstance(parameters, dict):
             return pathlib.Path(parameters)
-        path.write_text(yaml.safe_dump({'/**': {'ros__parameters': parameters}}))
+        path.write_text(yaml.safe_dump({'/**': {'ros__parameters': _typed(parameters)}}))
         return path
+
+
+def _typed(value: Any) -> Any:
+    """A dict's text values typed as launch_ros types them: read as YAML, a bool, int or
+    float is taken as such ('True' is true); any other text stays text."""
+    if isinstance(value, dict):
+        return {key: _typed(item) for key, item in value.items()}
+    if isinstance(value, str) and value:
+        try:
+            read = yaml.safe_load(value)
+        except yaml.YAMLError:
+            return value
+        return read if type(read) in (bool, int, float) else value
+    return value

@@ -5,7 +5,7 @@ Arguments as ros_gz_sim's (jazzy): the flags ``-world -file -param -string -topi
 (which win, as there).  The description goes to sim_node's SpawnEntity service
 (:mod:`pan_tilt_sim.tools.stand_ins.spawning`); exit codes as create's: 0 in, 1
 refused, 255 no description.  ``-world`` is not honoured (one world per sim_node):
-a warning names it.  Roll and pitch other than 0 are a warning (sim_node spawns upright).
+a warning names it.  ``-R -P -Y`` are the pose's fixed-axis angles, as gz's.
 """
 
 from __future__ import annotations
@@ -105,9 +105,6 @@ def _create(node, words: list[str]) -> int:
         return 0  # interrupted while waiting for the topic, as create returns
     # A parameter other than 0 wins over its flag, as in create.
     pose = {name: values[name] if values[name] != 0.0 else flags[name] for name in POSE}
-    if pose['R'] or pose['P']:
-        logger.warning(f"-R {pose['R']} -P {pose['P']}: roll and pitch are not honoured "
-                       '(the robot is spawned upright, at its yaw)')
     target = request.initial_pose
     target.header.frame_id = 'world'
     target.pose.position.x, target.pose.position.y, target.pose.position.z = (

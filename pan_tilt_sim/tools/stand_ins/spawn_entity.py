@@ -114,9 +114,6 @@ def _spawn(node, args: argparse.Namespace) -> int:
         except ElementTree.ParseError as err:
             logger.error(f'Invalid XML: {err}')
             return EXIT_FAILED
-    if args.R or args.P:
-        logger.warning(f'-R {args.R} -P {args.P}: roll and pitch are not honoured (the robot '
-                       'is spawned upright, at its yaw)')
     pose = request.initial_pose
     pose.header.frame_id = args.reference_frame
     pose.pose.position.x, pose.pose.position.y, pose.pose.position.z = args.x, args.y, args.z

@@ -7,6 +7,7 @@ program runs); create runs as ``python -m pan_tilt_sim.tools.stand_ins create``.
 from __future__ import annotations
 
 import importlib.util
+import math
 
 import pytest
 from mobile_fixtures import plugin_rover_urdf
@@ -40,17 +41,41 @@ def test_it_exits_0_once_the_robot_is_in_and_a_taken_name_fails_unless_renaming(
     urdf.write_text(plugin_rover_urdf())
     with world_only() as (harness, node):
         code, output = finish(harness, run('-file', str(urdf), '-name', 'rover',
-                                             '-x', '1.5', '-y', '-2', '-Y', '1.0', '-R', '0.2',
+                                             '-x', '1.5', '-y', '-2', '-Y', '1.0',
                                              '-world', 'default'))
         assert code == 0, output
         assert node.simulation is not None and node.simulation.description.name == 'rover'
         (x, y, heading), _twist = node.simulation.base_state()
         assert (x, y, heading) == pytest.approx((1.5, -2.0, 1.0), abs=1e-3)
-        # One warning for each argument not honoured.
+        # One warning for the argument not honoured.
         assert output.count("-world 'default' is not honoured") == 1
-        assert output.count('-R 0.2 -P 0.0: roll and pitch are not honoured') == 1
         code, output = finish(harness, run('-string', urdf.read_text(), '-name', 'rover'))
         assert code == 1 and 'Entity creation failed' in output and 'rover' in output
         code, output = finish(harness, run('-string', urdf.read_text(), '-name', 'rover',
                                              '-allow_renaming', 'true'))
         assert code == 0, output
+
+
+def roll_pitch_yaw(q) -> tuple[float, float, float]:
+    """(roll, pitch, yaw) of a geometry_msgs Quaternion, fixed axes (rad)."""
+    return (math.atan2(2 * (q.w * q.x + q.y * q.z), 1 - 2 * (q.x * q.x + q.y * q.y)),
+            math.asin(2 * (q.w * q.y - q.z * q.x)),
+            math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z)))
+
+
+def test_roll_and_pitch_tilt_the_robot_as_gz_poses_it(tmp_path):
+    # Welded (fixed_base), the root link frame is exactly at the pose create was given.
+    from simulation_interfaces.srv import GetEntityState
+
+    urdf = tmp_path / 'rover.urdf'
+    urdf.write_text(plugin_rover_urdf())
+    with world_only(fixed_base='true') as (harness, node):
+        code, output = finish(harness, run('-file', str(urdf), '-name', 'rover', '-x', '1',
+                                             '-z', '0.5', '-R', '0.1', '-P', '0.3', '-Y', '0.2'))
+        assert code == 0, output
+        assert 'not honoured' not in output
+        state = harness.call(GetEntityState, '/sim_node/get_entity_state',
+                             GetEntityState.Request(entity='rover')).state
+    position = state.pose.position
+    assert (position.x, position.y, position.z) == pytest.approx((1.0, 0.0, 0.5), abs=1e-6)
+    assert roll_pitch_yaw(state.pose.orientation) == pytest.approx((0.1, 0.3, 0.2), abs=1e-6)
