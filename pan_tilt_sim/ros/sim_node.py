@@ -18,7 +18,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 
-from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateController
+from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateBroadcaster
 from pan_tilt_sim.errors import ConfigurationError, ParameterError
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.controller_config import (
@@ -631,7 +631,7 @@ class SimNode(Node):
         if inactive:
             logger.info(f"loaded but inactive (not in 'active_controllers'): "
                         f"{', '.join(inactive)}")
-        every = [c for c in manager.controllers if isinstance(c, JointStateController)]
+        every = [c for c in manager.controllers if isinstance(c, JointStateBroadcaster)]
         broadcasters = [c for c in every if not c.params['use_local_topics']]
         topic = self.topic('joint_states')
         if not broadcasters:
