@@ -79,7 +79,8 @@ class Preparations:
 
     The outcome is handed back through a guard condition, so the Future is
     completed -- and whoever awaits it resumes -- in an executor callback, in
-    its turn between two batches of physics steps.
+    its turn between two batches of physics steps.  The thread starts with
+    the first job: a node that is never asked to spawn runs none.
     """
 
     def __init__(self, node: Node, callback_group: ReentrantCallbackGroup) -> None:
@@ -88,12 +89,15 @@ class Preparations:
         self._guard = node.create_guard_condition(self._deliver, callback_group=callback_group)
         self._thread = threading.Thread(target=self._run, name='spawn_preparation',
                                         daemon=True)
-        self._thread.start()
+        self._starting = threading.Lock()
 
     def submit(self, job: Callable[[], object]) -> Future:
         """Queue ``job``; return the Future of its result (or of the exception it raised)."""
         future = Future()
         self._jobs.put((job, future))
+        with self._starting:
+            if self._thread.ident is None:
+                self._thread.start()
         return future
 
     def close(self) -> None:
