@@ -235,7 +235,7 @@ class SimNode(Node):
         self.features = startup.make_features(
             self, self.simulation, self.robot_namespace, self.settings, world=self._world,
             from_topic=from_topic, is_controller_manager=self.is_controller_manager)
-        self._add_controller_manager(startup.controller_manager(
+        self._add_controller_manager(startup.serve_controller_manager(
             self, self.controllers, self.simulation, controllers, self.settings, self._arguments,
             self.robot_namespace, topic_mode=topic_mode,
             is_controller_manager=self.is_controller_manager))

@@ -159,10 +159,10 @@ def make_features(node: Node, simulation: Simulation, namespace: str, settings: 
         publish_tf_default=not is_controller_manager)
 
 
-def controller_manager(node: Node, bindings: ControllerBindings, simulation: Simulation,
-                       controllers: ControllersConfig, settings: SimParameters,
-                       arguments: RosArguments, namespace: str, *, topic_mode: bool,
-                       is_controller_manager: bool) -> Node | None:
+def serve_controller_manager(node: Node, bindings: ControllerBindings, simulation: Simulation,
+                             controllers: ControllersConfig, settings: SimParameters,
+                             arguments: RosArguments, namespace: str, *, topic_mode: bool,
+                             is_controller_manager: bool) -> Node | None:
     """Offer ros2_control's controller_manager services; return the node that serves them.
 
     ``node`` itself in ros2_control_node's place, else a node of its own the

@@ -8,9 +8,10 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from topic_based_fixtures import topic_based_urdf_file
 
+from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model.description import load_description
 from pan_tilt_sim.model.ros_arguments import parse_ros_arguments
-from pan_tilt_sim.ros import drop_in, parameters, startup, topic_hardware
+from pan_tilt_sim.ros import drop_in, optional_interfaces, parameters, startup, topic_hardware
 from pan_tilt_sim.ros.sim_node import SimNode
 from pan_tilt_sim.share import package_share
 
@@ -98,6 +99,37 @@ def test_without_robot_namespace_the_controllers_file_then_the_plugin_name_it():
                                    is_controller_manager=False) == '/from_yaml'
     assert startup.robot_namespace('/', '', None, 'from_plugin',
                                    is_controller_manager=False) == '/from_plugin'
+
+
+def serve_without_manager_messages(context, monkeypatch, *, autostart: bool,
+                                   topic_mode: bool = False):
+    monkeypatch.setattr(optional_interfaces, 'available',
+                        lambda package: package != 'controller_manager_msgs')
+    node = Node('sim_node', context=context, parameter_overrides=[
+        Parameter('autostart_controllers', value=autostart)])
+    try:
+        # Nothing is bound or simulated: without the messages no step gets that far.
+        return startup.serve_controller_manager(
+            node, None, None, None, settings_of(node), NO_ARGUMENTS, '', topic_mode=topic_mode,
+            is_controller_manager=False)
+    finally:
+        node.destroy_node()
+
+
+def test_without_controller_manager_msgs_no_spawner_could_be_waited_for(context, monkeypatch):
+    with pytest.raises(ParameterError, match="'autostart_controllers' is false, but "
+                       'controller_manager_msgs is not installed'):
+        serve_without_manager_messages(context, monkeypatch, autostart=False)
+
+
+def test_without_controller_manager_msgs_autostarted_controllers_run_unserved(
+        context, monkeypatch):
+    assert serve_without_manager_messages(context, monkeypatch, autostart=True) is None
+
+
+def test_on_topic_based_hardware_the_users_own_controller_manager_serves(context, monkeypatch):
+    assert serve_without_manager_messages(context, monkeypatch, autostart=False,
+                                          topic_mode=True) is None
 
 
 def test_a_step_failing_before_the_threads_start_leaves_no_thread_and_no_publisher(
