@@ -28,7 +28,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from pan_tilt_sim.controllers import CommandController
-from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateController
+from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateBroadcaster
 from pan_tilt_sim.controllers.framework.manager import ACTIVE, INACTIVE, ControllerManager
 from pan_tilt_sim.controllers.framework.registry import CONTROLLER_TYPES, supported_types
 from pan_tilt_sim.errors import ConfigurationError, ControllerConfigError, ControllerSwitchError
@@ -464,7 +464,7 @@ class ControllerManagerServices:
         return joints + list(self._manager.hardware.state_interfaces)
 
     def _state_interfaces_of(self, controller) -> list[str]:
-        if isinstance(controller, JointStateController):
+        if isinstance(controller, JointStateBroadcaster):
             # What it reads that the hardware lists (it reads every measured interface).
             return [f'{joint}/{interface}'
                     for joint, read in controller.state_interfaces().items()

@@ -18,22 +18,14 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 
-from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateController
-from pan_tilt_sim.errors import ConfigurationError, ParameterError
+from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateBroadcaster
+from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.model import naming
-from pan_tilt_sim.model.controller_config import (
-    CONTROLLERS_ARGS,
-    ControllersConfig,
-    controllers_files_for,
-    load_controllers_config,
-    parse_controllers_args,
-)
+from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription, load_description
 from pan_tilt_sim.model.ros_arguments import parse_ros_arguments
-from pan_tilt_sim.plugins.registry import runs_by_plugins
 from pan_tilt_sim.ros import (
     bridged_topics,
-    command_reader,
     drop_in,
     optional_interfaces,
     parameters,
@@ -41,6 +33,7 @@ from pan_tilt_sim.ros import (
     services,
     simulation_services,
     spawned_robots,
+    startup,
     topic_hardware,
     view_feed,
 )
@@ -197,84 +190,80 @@ class SimNode(Node):
 
     def _build(self, physics_thread: bool, description: RobotDescription, *,
                from_topic: bool = False) -> None:
-        """Everything sim_node is, for ``description``; the last step starts the physics."""
-        # Topic-based hardware (topic_based_ros2_control): no YAML controllers run here.
-        self._topic_settings = topic_hardware.declare(self, description)
-        if self._topic_settings is not None:
-            controllers = topic_hardware.controllers_config(self._topic_settings)
-        elif self._manager_settings is not None:
-            controllers, self._arguments = drop_in.manager_controllers(
-                self, self._manager_settings, self._arguments, description)
-        else:
-            controllers = load_controllers_config(
-                controllers_files_for(self.settings.controllers_file, description,
-                                      runs_by_plugins=runs_by_plugins(description.model)),
-                parse_controllers_args(self.settings.controllers_args,
-                                       f"parameter '{CONTROLLERS_ARGS}'"))
-        # ros2_control_node's controllers live in its own namespace, and nowhere else.
-        self.robot_namespace = naming.normalize(self.get_namespace()) if (
-            self.is_controller_manager) else naming.resolve_robot_namespace(
-            self.get_namespace(), self.settings.robot_namespace,
-            controllers.namespace, description.plugin_namespace)
-        world = self._world
-        self.simulation = Simulation(
-            description, controllers, self.settings.time_step, gui=self.settings.gui,
-            active_controllers=(None if self._topic_settings is not None
-                                else self.settings.active_controllers),
-            initial_positions=self.settings.initial_positions, logger=self.get_logger(),
-            autostart_controllers=(self._topic_settings is not None
-                                   or self.settings.autostart_controllers),
-            fixed_base=self.settings.fixed_base, initial_pose=self.settings.initial_pose,
-            physics_settings=self.settings.physics_settings)
-        if self.settings.record:
-            # Before the first publisher: /clock, the state topics and TF are all recorded.
-            self.recorder = Recorder(
-                self.settings.record, clock=lambda: self.simulation.time,
-                sensors=self.settings.record_sensors, warn=self.get_logger().warning)
+        """Build everything sim_node is for ``description``, in the steps of startup.py.
+
+        Each step takes what it uses and returns what it makes, and the node
+        keeps what it makes at once: an error in a later step then releases it
+        (``destroy_node``).  The data passed orders most steps; three orders
+        it does not show:
+
+        * the recorder comes before the first publisher: ``create_publisher``
+          and ``create_subscription`` tee into the bag what they make while it
+          exists, so /clock, the state topics and TF are all recorded;
+        * /clock's first stamp and the features' first samples (t = 0) leave
+          before the ticks are made;
+        * :meth:`_run` is last and starts the threads: every step that can
+          fail has run by then, so a failed start-up leaves no thread running.
+        """
+        choice = startup.choose_controllers(self, description, self.settings,
+                                            self._manager_settings, self._arguments)
+        controllers, self._arguments = choice.config, choice.arguments
+        topic_settings = choice.topic_settings
+        topic_mode = topic_settings is not None
+        self.robot_namespace = startup.robot_namespace(
+            self.get_namespace(), self.settings.robot_namespace, controllers.namespace,
+            description.plugin_namespace, is_controller_manager=self.is_controller_manager)
+        self.simulation = startup.make_simulation(description, controllers, self.settings,
+                                                  topic_mode=topic_mode, logger=self.get_logger())
+        self.recorder = startup.make_recorder(self.settings, self.simulation,
+                                              self.get_logger().warning)
         self._paused = self.settings.paused
         self.steps_run = 0  # physics steps this node has run (never reset; see run_steps)
         self._pacer = Pacer(self.settings.real_time_factor, self.settings.time_step)
         self.clock_publisher = ClockPublisher(
             self.create_publisher(Clock, CLOCK_TOPIC, QUEUE_DEPTH), self.simulation.time_step)
         self.gain_parameters = GainParameters(self)
-        topic_mode = self._topic_settings is not None
-        # With a physics thread, commands have a reader of their own where this rclpy allows
-        # one (else the executor reads them, in their turn).
-        if self.turns is not None:
-            if command_reader.available(self.context):
-                self._command_reader = CommandReader(self.context, self.turns)
-            else:
-                self.get_logger().info(
-                    "command topics are read by the executor: this rclpy's private wait set "
-                    'is not the one pan_tilt_sim.ros.command_reader knows')
-        self.controllers = ControllerBindings(
-            self, self.simulation,
-            topic_hardware.topics(self._topic_settings, self.topic) if topic_mode
-            else self.topic,
-            self.gain_parameters,
-            actions=not topic_mode and optional_interfaces.available('control_msgs'),
-            command_topics=not topic_mode, reader=self._command_reader,
-            namespace=self.robot_namespace)
+        self._command_reader = startup.make_command_reader(self.context, self.turns,
+                                                           self.get_logger())
+        self.controllers = startup.bind_controllers(
+            self, self.simulation, topic_settings, self.gain_parameters, self._command_reader,
+            self.robot_namespace)
         self.topic_hardware = topic_hardware.TopicHardware(
-            self, self._topic_settings, description,
-            self.simulation.controllers) if topic_mode else None
+            self, topic_settings, description, self.simulation.controllers) if topic_mode else None
         # Commands taken per controller (ignored ones included): a cheap health figure.
         self.commands_received = self.controllers.commands_received
-        # Sensors follow an explicit namespace (the node's, or robot_namespace) the
-        # way Gazebo's spawn -robot_namespace moves every plugin; else their plugins'.
-        self.features = NodeFeatures(
-            self, self.simulation, self.robot_namespace, gui=self.settings.gui,
-            sensor_namespace=naming.normalize(self.get_namespace())
-            or naming.normalize(self.settings.robot_namespace),
-            publish_description=not from_topic, world=world,
-            publish_tf_default=not self.is_controller_manager)
-        self._start_controller_manager(controllers)
+        self.features = startup.make_features(
+            self, self.simulation, self.robot_namespace, self.settings, world=self._world,
+            from_topic=from_topic, is_controller_manager=self.is_controller_manager)
+        self._add_controller_manager(startup.serve_controller_manager(
+            self, self.controllers, self.simulation, controllers, self.settings, self._arguments,
+            self.robot_namespace, topic_mode=topic_mode,
+            is_controller_manager=self.is_controller_manager))
         self.clock_publisher.publish_newest(self.simulation.steps)
         self.features.after_steps()  # their first samples at t = 0, as /clock's
+        self._make_ticks()
+        self._offer_services()
+        self._report(description, controllers)
+        self._run()
+
+    def _add_controller_manager(self, manager: Node | None) -> None:
+        """Keep the node serving the controller_manager services; spin it if it is another."""
+        self.controller_manager = manager
+        if manager is None or manager is self:
+            return
+        self.companion_nodes.append(manager)
+        if self.executor is not None:  # built once spinning (the description came late)
+            self.executor.add_node(manager)
+
+    def _make_ticks(self) -> None:
+        """Make the physics thread (not started yet) or the executor's timer that runs the steps."""
         if self.turns is not None:
             self._physics_thread = PhysicsThread(self._on_tick, self._thread_period, self.turns)
         else:
             self._timer = self.create_timer(self._tick_period(), self._on_tick)
+
+    def _offer_services(self) -> None:
+        """Parameter callbacks, gazebo_ros's world services and simulation_interfaces."""
         # Checked in the on-set callback, applied in the post-set one: a change
         # that any callback refuses is applied nowhere.
         self.add_on_set_parameters_callback(self._check_parameters)
@@ -283,6 +272,9 @@ class SimNode(Node):
             self, reset=self.reset, set_paused=self.set_paused)
         # simulation_interfaces (where installed): its own module, its own callback groups.
         self.simulation_interfaces = simulation_services.create(self, self._world_services)
+
+    def _report(self, description: RobotDescription, controllers: ControllersConfig) -> None:
+        """Say once what runs, what is left out and why, and where to find it."""
         self._log_controllers(description, controllers)
         self._log_missing_interfaces()
         # Actuators, start positions, PyBullet's load messages, unstable gains.
@@ -300,12 +292,15 @@ class SimNode(Node):
             self.get_logger().info(
                 f"recording to '{self.recorder.folder}' (rosbag2, MCAP storage"
                 f"{', sensors included' if self.settings.record_sensors else ''})")
+
+    def _run(self) -> None:
+        """Serve the view and start the threads; nothing may fail after the physics thread runs."""
         if self._viewer_settings.enabled:
             self._start_viewer(self._viewer_settings)
         if self._physics_thread is not None:
             if self._command_reader is not None:
                 self._command_reader.start()
-            self._physics_thread.start()  # last: nothing may fail after it runs
+            self._physics_thread.start()
 
     def set_parameters(self, parameter_list: list[Parameter]) -> list[SetParametersResult]:
         """Set parameters; as the controller_manager, a spawner's ``<controller>.type`` too."""
@@ -557,40 +552,6 @@ class SimNode(Node):
         for robot in self.spawned_robots.values():
             robot.refresh_readers()
 
-    def _start_controller_manager(self, controllers: ControllersConfig) -> None:
-        """Offer ros2_control's controller_manager services, where their messages exist."""
-        if self.topic_hardware is not None:
-            return  # the user's own controller_manager runs, on topic-based hardware
-        if not optional_interfaces.available('controller_manager_msgs'):
-            if not self.settings.autostart_controllers:
-                raise ParameterError(
-                    "parameter 'autostart_controllers' is false, but controller_manager_msgs "
-                    'is not installed: no spawner could load a controller '
-                    '(scripts/build_interfaces.sh builds it)')
-            return
-        from pan_tilt_sim.ros.controller_manager import (
-            ControllerManagerNode,
-            ControllerManagerServices,
-        )
-
-        substitutions = parse_controllers_args(self.settings.controllers_args)
-        if self.is_controller_manager:  # this node is the controller_manager
-            ControllerManagerServices(
-                self, self.controllers, self.simulation.manager,
-                self.simulation.description.model, substitutions=substitutions,
-                source=controllers.label, update_rate=round(controllers.update_rate),
-                shared_parameters=lambda name: drop_in.shared_parameters(
-                    self, self._arguments, name))
-            self.controller_manager = self
-            return
-        self.controller_manager = ControllerManagerNode(
-            self.controllers, self.simulation.manager, self.simulation.description.model,
-            self.robot_namespace, context=self.context, substitutions=substitutions,
-            source=controllers.label)
-        self.companion_nodes.append(self.controller_manager)
-        if self.executor is not None:  # built once spinning (the description came late)
-            self.executor.add_node(self.controller_manager)
-
     def _destroy_companions(self) -> None:
         while self.companion_nodes:
             self.companion_nodes.pop().destroy_node()
@@ -631,7 +592,7 @@ class SimNode(Node):
         if inactive:
             logger.info(f"loaded but inactive (not in 'active_controllers'): "
                         f"{', '.join(inactive)}")
-        every = [c for c in manager.controllers if isinstance(c, JointStateController)]
+        every = [c for c in manager.controllers if isinstance(c, JointStateBroadcaster)]
         broadcasters = [c for c in every if not c.params['use_local_topics']]
         topic = self.topic('joint_states')
         if not broadcasters:

@@ -17,7 +17,7 @@ from robot_fixtures import (
     write_text,
 )
 
-from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateController
+from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateBroadcaster
 from pan_tilt_sim.controllers.framework.base import ActuatorKind, Drive
 from pan_tilt_sim.controllers.trajectory.trajectory import JointTrajectory, TrajectoryPoint
 from pan_tilt_sim.errors import ControllerConfigError
@@ -56,7 +56,7 @@ def test_a_gravity_loaded_arm_with_a_plain_ros2_control_yaml_reaches_30_degrees(
         assert positions['joint2'] == pytest.approx(0.0, abs=0.005)
         assert fastest['joint1'] <= 2.0 * 1.001  # the URDF velocity limit
         # It holds there, reporting the torque gravity takes (what the motor applied).
-        broadcaster = next(c for c in sim.controllers if isinstance(c, JointStateController))
+        broadcaster = next(c for c in sim.controllers if isinstance(c, JointStateBroadcaster))
         samples = []
         broadcaster.set_sink(lambda time, names, q, v, efforts: samples.append(list(efforts)))
         sim.advance(1000)

@@ -5,7 +5,7 @@ import math
 import pytest
 from robot_fixtures import LINK_MASS, JointDef, star_robot_urdf, write_text
 
-from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateController
+from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateBroadcaster
 from pan_tilt_sim.errors import ControllerConfigError, DescriptionError
 from pan_tilt_sim.sim.engine import make_simulation
 
@@ -120,7 +120,7 @@ def test_fixed_joints_are_skipped(tmp_path):
     urdf = star_robot_urdf([JointDef('hinge'), JointDef('weld')]).replace(
         'name="weld" type="revolute"', 'name="weld" type="fixed"')
     with simulation(tmp_path, [], {}, urdf=urdf) as sim:
-        broadcaster = next(c for c in sim.controllers if isinstance(c, JointStateController))
+        broadcaster = next(c for c in sim.controllers if isinstance(c, JointStateBroadcaster))
         assert list(sim.joint_positions()) == ['hinge']
         assert broadcaster.names == ['hinge']
 
@@ -196,7 +196,7 @@ def test_mimic_joints_are_back_on_their_leaders_after_reset(tmp_path):
 
 def test_mimic_joints_are_in_joint_states_but_cannot_be_commanded(tmp_path):
     with simulation(tmp_path, MIMIC_JOINTS, {}) as sim:
-        broadcaster = next(c for c in sim.controllers if isinstance(c, JointStateController))
+        broadcaster = next(c for c in sim.controllers if isinstance(c, JointStateBroadcaster))
         assert broadcaster.names == ['leader', 'follower', 'slide', 'slide_twin']
     with pytest.raises(ControllerConfigError,
                        match=r"pos\.joint: joint 'follower' mimics 'leader'"):

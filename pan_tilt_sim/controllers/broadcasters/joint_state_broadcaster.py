@@ -1,4 +1,4 @@
-"""``joint_state_controller/JointStateController`` (ROS 2: joint_state_broadcaster).
+"""The joint_state_broadcaster (ROS 1: ``joint_state_controller/JointStateController``).
 
 Every ``1 / publish_rate`` seconds of sim time it samples the joints' state
 interfaces and hands the samples to its sinks, which the node turns into
@@ -11,7 +11,7 @@ messages stamped with sim time:
   ``publish_dynamic_joint_states`` is false; the node publishes it where
   control_msgs is installed).
 
-Design notes: docs/design/controllers.md#joint_state_controllerpy.
+Design notes: docs/design/controllers.md#joint_state_broadcasterpy.
 """
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ DynamicJointStateSink = Callable[[float, Sequence[Sequence[float]]], None]
 Read = tuple[list[float], int, JointHandle, str]
 
 
-class JointStateController(Controller):
+class JointStateBroadcaster(Controller):
     """Publishes the joints' state interfaces at its rate of sim time."""
 
     type_names = ('joint_state_controller/JointStateController',

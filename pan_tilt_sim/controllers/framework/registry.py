@@ -9,7 +9,7 @@ from pan_tilt_sim.controllers.broadcasters.force_torque_sensor_broadcaster impor
     ForceTorqueSensorBroadcaster,
 )
 from pan_tilt_sim.controllers.broadcasters.imu_sensor_broadcaster import IMUSensorBroadcaster
-from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateController
+from pan_tilt_sim.controllers.broadcasters.joint_state_broadcaster import JointStateBroadcaster
 from pan_tilt_sim.controllers.broadcasters.pose_broadcaster import PoseBroadcaster
 from pan_tilt_sim.controllers.broadcasters.range_sensor_broadcaster import RangeSensorBroadcaster
 from pan_tilt_sim.controllers.commands.forward_command_controller import ForwardCommandController
@@ -54,7 +54,7 @@ from pan_tilt_sim.controllers.trajectory.joint_trajectory_controller import (
 from pan_tilt_sim.errors import ControllerConfigError
 
 CONTROLLER_CLASSES: tuple[type[Controller], ...] = (
-    JointStateController,
+    JointStateBroadcaster,
     JointPositionController,
     JointVelocityController,
     JointEffortController,

@@ -1,4 +1,4 @@
-"""JointStateController / joint_state_broadcaster: what it samples, which joints and interfaces."""
+"""JointStateBroadcaster (ROS 1: joint_state_controller): what it samples, which joints."""
 
 import math
 from collections.abc import Sequence
