@@ -461,6 +461,21 @@ class Physics:
             pybullet.removeBody(self._body, physicsClientId=self._client)
             self._body = -1
 
+    def remove_robot(self) -> None:
+        """Take the robot's body out of a world it hosts; the client and its bodies stay.
+
+        The world goes on without it (its guests, the objects, the ground):
+        afterwards the robot has no joints and no links, and only
+        :meth:`bare_stepper` steps.  A guest leaves through :meth:`close`.
+        """
+        if self.is_guest or self._body < 0:
+            return
+        pybullet.removeBody(self._body, physicsClientId=self._client)
+        self._body = -1
+        self._joints = ()
+        self._indices, self._balls, self._initial_positions = [], [], []
+        self._link_indices, self._dof_indices = {}, {}
+
     @property
     def implicit_damping(self) -> tuple[str, ...]:
         """The effort-driven joints whose URDF damping is applied implicitly (see the module)."""
