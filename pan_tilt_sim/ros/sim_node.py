@@ -171,6 +171,8 @@ class SimNode(Node):
             self.settings, initial_pose=spawn.pose,
             robot_namespace=spawn.namespace or self.settings.robot_namespace)
         self._build(physics_thread, description, from_topic=True)
+        if not self.is_controller_manager:  # Gazebo deletes any model: the world runs on
+            self.features.entities.let_delete(description.name, self._remove_first_robot)
 
     def _add_robot(self, description: RobotDescription, spawn: robot_spawn.Spawn) -> None:
         """One more robot in the world (its plugins, sensors, controller manager), in our turn."""
@@ -194,6 +196,24 @@ class SimNode(Node):
     def _remove_robot(self, name: str) -> None:
         """DeleteEntity of a spawned robot: its topics, manager and body go."""
         self.spawned_robots.pop(name).destroy()
+
+    def _remove_first_robot(self, name: str) -> None:
+        """DeleteEntity of the robot the world began with: what a spawned robot loses, it loses.
+
+        Its topics, services, controller manager, sensors and body go; the world, its
+        clock and the other robots stay (the simulation steps them without it).
+        """
+        self.controllers.release()
+        manager = self.controller_manager
+        if manager is not None and manager is not self:
+            if manager.executor is not None:
+                manager.executor.remove_node(manager)
+            self.companion_nodes.remove(manager)
+            manager.destroy_node()
+            self.controller_manager = None
+        self.features.remove_robot(self)
+        self.simulation.remove_robot()
+        self.get_logger().info(f"'{name}' left the world; the world and its other robots run on")
 
     def _build(self, physics_thread: bool, description: RobotDescription, *,
                from_topic: bool = False) -> None:

@@ -15,6 +15,7 @@ import pytest
 from geometry_msgs.msg import Twist
 from mobile_fixtures import GZ_DIFF_DRIVE, P3D, ROS2_DIFF_DRIVE, rover_urdf
 from node_harness import SimUnderTest
+from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from stand_in_fixtures import finish, spawn, srv, start, world_only
 
@@ -158,6 +159,66 @@ def test_delete_entity_takes_robot2_and_its_topics_away():
         drivers = Drivers(harness)  # robot1 runs on
         assert spin_driving(harness, drivers, {'/robot1/cmd_vel': SPEED},
                             lambda: x_of(node.simulation) > 0.2)
+
+
+def test_delete_entity_takes_the_first_robot_away_and_the_world_runs_on():
+    # Gazebo deletes any model: the one the world began with too.  robot1 holds the world's
+    # PyBullet client; robot2 and /clock run on without it, and a robot spawned later works.
+    with world_only() as (harness, node):
+        two_rovers(harness)
+        sim = SimUnderTest(harness, node)
+        published, subscribed = sim.own_topics()
+        assert {'/robot1/scan', '/robot1/odom'} <= set(published)
+        assert '/robot1/cmd_vel' in subscribed
+        response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
+                                srv().DeleteEntity.Request(entity='robot1'))
+        assert response.result.result == 1, response.result.error_message
+        published, subscribed = sim.own_topics()
+        assert not [topic for topic in [*published, *subscribed]
+                    if topic.startswith('/robot1/')]
+        assert not node.simulation.has_robot
+        entities = harness.call(srv().GetEntities, '/sim_node/get_entities').entities
+        assert 'robot1' not in entities and 'robot2' in entities
+        robot2 = node.spawned_robots['robot2'].simulation
+        drivers = Drivers(harness)
+        assert spin_driving(harness, drivers, {'/robot2/cmd_vel': SPEED},
+                            lambda: x_of(robot2) > 0.3)
+        assert robot2.steps == node.simulation.steps  # one clock, still the world's
+        clocks = sim.collect(Clock, '/clock')
+        assert harness.spin_until(lambda: len(clocks) >= 2)
+        # Its name is free again: a robot spawned under it is a new one, and drives.
+        again = spawn(harness, name='robot1', resource_string=rover(), namespace='robot3',
+                      y=-1.0)
+        assert (again.result.result, again.entity_name) == (1, 'robot1'), again
+        robot3 = node.spawned_robots['robot1'].simulation
+        assert spin_driving(harness, drivers, {'/robot3/cmd_vel': SPEED},
+                            lambda: x_of(robot3) > 0.3)
+
+
+def test_deleting_a_first_robot_with_ros2_control_takes_its_controller_manager(tmp_path):
+    from drop_in_fixtures import MANAGER_YAML
+    from ros2_control_fixtures import write_arm
+
+    from pan_tilt_sim.model.description import load_description
+
+    if importlib.util.find_spec('controller_manager_msgs') is None:
+        pytest.skip('controller_manager_msgs is not installed')
+    arm = load_description(write_arm(tmp_path, MANAGER_YAML),
+                           [f"controllers:={tmp_path / 'arm_controllers.yaml'}"]).urdf_xml
+    with world_only() as (harness, node):
+        first = spawn(harness, name='arm1', resource_string=arm, namespace='arm1')
+        second = spawn(harness, name='robot2', resource_string=rover(), namespace='robot2',
+                       y=1.0)
+        assert first.result.result == 1 and second.result.result == 1, first
+        assert ('controller_manager', '/arm1') in node.get_node_names_and_namespaces()
+        response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
+                                srv().DeleteEntity.Request(entity='arm1'))
+        assert response.result.result == 1, response.result.error_message
+        assert harness.spin_until(lambda: ('controller_manager', '/arm1') not in
+                                  node.get_node_names_and_namespaces())
+        drivers = Drivers(harness)
+        assert spin_driving(harness, drivers, {'/robot2/cmd_vel': SPEED},
+                            lambda: x_of(node.spawned_robots['robot2'].simulation) > 1.3)
 
 
 def test_a_taken_name_is_refused_unless_renaming_is_allowed():
