@@ -230,7 +230,8 @@ class SimNode(Node):
                 controllers_files_for(self.settings.controllers_file, description,
                                       runs_by_plugins=runs_by_plugins(description.model)),
                 parse_controllers_args(self.settings.controllers_args,
-                                       f"parameter '{CONTROLLERS_ARGS}'"))
+                                       f"parameter '{CONTROLLERS_ARGS}'"),
+                manager=description.model.controller_manager_name)
         # ros2_control_node's controllers live in its own namespace, and nowhere else.
         self.robot_namespace = naming.normalize(self.get_namespace()) if (
             self.is_controller_manager) else naming.resolve_robot_namespace(

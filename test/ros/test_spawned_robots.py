@@ -304,6 +304,67 @@ def test_a_second_robot_with_ros2_control_gets_a_controller_manager_of_its_own(t
                                   node.get_node_names_and_namespaces())
 
 
+def named_manager_arm(tmp_path, name: str) -> str:
+    """The two-link arm whose gz_ros2_control plugin names its manager ``name``.
+
+    Its controllers file keys the manager's section by that name, as the real
+    plugin's manager node reads it (update_rate 25 Hz there).
+    """
+    from drop_in_fixtures import MANAGER_YAML
+    from ros2_control_fixtures import write_arm
+
+    from pan_tilt_sim.model.description import load_description
+
+    yaml = MANAGER_YAML.replace('controller_manager:', f'{name}:').replace(
+        'update_rate: 50', 'update_rate: 25')
+    assert f'{name}:' in yaml and 'update_rate: 25' in yaml
+    urdf = load_description(write_arm(tmp_path, yaml),
+                            [f"controllers:={tmp_path / 'arm_controllers.yaml'}"]).urdf_xml
+    return urdf.replace('<parameters>', f'<controller_manager_name>{name}'
+                                        '</controller_manager_name><parameters>', 1)
+
+
+@pytest.mark.parametrize('first', [False, True], ids=['later robot', 'first robot'])
+def test_a_robot_whose_plugin_names_its_manager_gets_that_name_in_its_namespace(tmp_path,
+                                                                              first):
+    from drop_in_fixtures import FORWARD, JSB
+    from spawner_client import Spawner
+
+    if importlib.util.find_spec('controller_manager_msgs') is None:
+        pytest.skip('controller_manager_msgs is not installed')
+    arm = named_manager_arm(tmp_path, 'arm_manager')
+    with world_only() as (harness, node):
+        if not first:
+            spawn(harness, name='robot1', resource_string=rover(), namespace='robot1')
+        second = spawn(harness, name='arm2', resource_string=arm, namespace='arm2', y=1.0)
+        assert second.result.result == 1, second
+        names = node.get_node_names_and_namespaces()
+        assert ('arm_manager', '/arm2') in names
+        assert ('controller_manager', '/arm2') not in names
+        sim = SimUnderTest(harness, node)
+        spawner = Spawner(sim, manager='/arm2/arm_manager')
+        assert spawner.spawn(JSB) == 0 and spawner.spawn(FORWARD) == 0
+        assert sorted(spawner.controllers()) == sorted([JSB, FORWARD])
+        # Its section of the file is the manager's: the update rate comes from there.
+        arm2 = node.simulation if first else node.spawned_robots['arm2'].simulation
+        assert arm2.manager.update_rate == 25
+
+
+def test_a_controller_manager_name_that_is_no_node_name_is_refused_and_the_others_run_on(
+        tmp_path):
+    arm = named_manager_arm(tmp_path, 'arm_manager').replace(
+        '>arm_manager<', '>arm manager<')
+    with world_only() as (harness, node):
+        spawn(harness, name='robot1', resource_string=rover(), namespace='robot1')
+        refused = spawn(harness, name='arm2', resource_string=arm, namespace='arm2', y=1.0)
+        assert refused.result.result != 1
+        assert "<controller_manager_name>: 'arm manager' is not a valid node name" in (
+            refused.result.error_message)
+        assert node.spawned_robots == {}
+        steps = node.simulation.steps
+        assert harness.spin_until(lambda: node.simulation.steps > steps)
+
+
 def test_each_rovers_odometry_tf_goes_where_its_plugin_remaps_it():
     # Nav2's classic multi-robot robots remap /tf into their namespace: robot2 does, robot1 not.
     if importlib.util.find_spec('tf2_msgs') is None:
