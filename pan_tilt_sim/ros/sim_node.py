@@ -154,7 +154,8 @@ class SimNode(Node):
                     physics_thread, description, spawn),
                 taken=(entity.name for entity in self._world.entities if entity.name),
                 build_more=self._add_robot, names=lambda: self.features.entities.names(),
-                is_robot=spawned_robots.is_robot)
+                is_robot=spawned_robots.is_robot,
+                frame_pose=lambda frame: self.features.entities.frame_pose(frame))
             return
         if self.settings.robot_description_file:
             self._build(physics_thread, load_description(

@@ -10,6 +10,7 @@ refused while robot1 runs on.
 from __future__ import annotations
 
 import importlib.util
+import math
 
 import pytest
 from geometry_msgs.msg import Twist
@@ -219,6 +220,35 @@ def test_deleting_a_first_robot_with_ros2_control_takes_its_controller_manager(t
         drivers = Drivers(harness)
         assert spin_driving(harness, drivers, {'/robot2/cmd_vel': SPEED},
                             lambda: x_of(node.spawned_robots['robot2'].simulation) > 1.3)
+
+
+def test_a_later_robot_is_placed_relative_to_the_frame_its_pose_names():
+    # simulation_interfaces: initial_pose's header names a frame known to the simulator, e.g.
+    # an entity spawned earlier.  robot2 is 1 m ahead of robot1 (turned by 90 degrees),
+    # itself turned by 90 degrees: at (0, 1) in the world, facing -x.
+    codes = srv().SpawnEntity.Response
+    with world_only() as (harness, node):
+        first = spawn(harness, name='robot1', resource_string=rover(), namespace='robot1',
+                      yaw=math.pi / 2)
+        assert first.result.result == 1, first
+        second = spawn(harness, name='robot2', resource_string=rover(), namespace='robot2',
+                       frame='robot1', x=1.0, yaw=math.pi / 2)
+        assert second.result.result == 1, second.result.error_message
+        (x, y, heading), _ = node.spawned_robots['robot2'].simulation.base_state()
+        assert (x, y) == (pytest.approx(0.0, abs=1e-3), pytest.approx(1.0, abs=1e-3))
+        assert abs(abs(heading) - math.pi) < 1e-3
+        # A link of the first robot is a frame too; a frame nobody knows is refused.
+        third = spawn(harness, name='robot3', resource_string=rover(), namespace='robot3',
+                      frame='lidar_link', x=-1.0)
+        assert third.result.result == 1, third.result.error_message
+        (x, y, _), _ = node.spawned_robots['robot3'].simulation.base_state()
+        # robot1's lidar_link is 0.1 m ahead of its base (+y in the world); 1 m behind it.
+        assert (x, y) == (pytest.approx(0.0, abs=1e-3), pytest.approx(-0.9, abs=1e-3))
+        unknown = spawn(harness, name='robot4', resource_string=rover(), namespace='robot4',
+                        frame='nowhere')
+        assert unknown.result.result == codes.INVALID_POSE
+        assert "initial_pose frame 'nowhere': no such frame" in unknown.result.error_message
+        assert sorted(node.spawned_robots) == ['robot2', 'robot3']
 
 
 def test_a_taken_name_is_refused_unless_renaming_is_allowed():
