@@ -198,7 +198,7 @@ class SimNode(Node):
         """DeleteEntity of a spawned robot: its topics, manager and body go."""
         self.spawned_robots.pop(name).destroy()
 
-    def _remove_first_robot(self, name: str) -> None:
+    def _remove_first_robot(self, _name: str) -> None:
         """DeleteEntity of the robot the world began with: what a spawned robot loses, it loses.
 
         Its topics, services, controller manager, sensors and body go; the world, its
@@ -214,7 +214,6 @@ class SimNode(Node):
             self.controller_manager = None
         self.features.remove_robot(self)
         self.simulation.remove_robot()
-        self.get_logger().info(f"'{name}' left the world; the world and its other robots run on")
 
     def _build(self, physics_thread: bool, description: RobotDescription, *,
                from_topic: bool = False) -> None:

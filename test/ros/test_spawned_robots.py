@@ -163,6 +163,8 @@ def test_delete_entity_takes_robot2_and_its_topics_away():
 
 
 def test_delete_entity_takes_the_first_robot_away_and_the_world_runs_on():
+    from std_srvs.srv import Empty
+
     # Gazebo deletes any model: the one the world began with too.  robot1 holds the world's
     # PyBullet client; robot2 and /clock run on without it, and a robot spawned later works.
     with world_only() as (harness, node):
@@ -194,6 +196,10 @@ def test_delete_entity_takes_the_first_robot_away_and_the_world_runs_on():
         robot3 = node.spawned_robots['robot1'].simulation
         assert spin_driving(harness, drivers, {'/robot3/cmd_vel': SPEED},
                             lambda: x_of(robot3) > 0.3)
+        node.set_paused(True)  # a world reset puts the robots left back, on one clock
+        harness.call(Empty, '/reset_simulation')
+        assert robot2.steps == robot3.steps == node.simulation.steps == 0
+        assert abs(x_of(robot2)) < 0.01 and abs(x_of(robot3)) < 0.01
 
 
 def test_deleting_a_first_robot_with_ros2_control_takes_its_controller_manager(tmp_path):
