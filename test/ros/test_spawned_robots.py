@@ -2,9 +2,10 @@
 
 Two rovers driven by gazebo_ros diff drive plugins, each with a lidar, spawned into one
 world-only sim_node (robot_from_spawn) in namespaces robot1 and robot2: each drives on
-its own cmd_vel, they collide, robot2's lidar sees robot1, DeleteEntity takes robot2 and
-its topics away, a taken name is refused, and a robot that cannot be simulated is
-refused while robot1 runs on.
+its own cmd_vel, they collide, robot2's lidar sees robot1, DeleteEntity takes either
+robot and its topics away (the world runs on), a later robot's pose may be relative to
+another entity, a plugin's <controller_manager_name> names the robot's manager, a taken
+name is refused, and a robot that cannot be simulated is refused while robot1 runs on.
 """
 
 from __future__ import annotations
