@@ -168,11 +168,12 @@ def test_delete_entity_takes_the_first_robot_away_and_the_world_runs_on():
 
     # Gazebo deletes any model: the one the world began with too.  robot1 holds the world's
     # PyBullet client; robot2 and /clock run on without it, and a robot spawned later works.
-    with world_only() as (harness, node):
+    # sim_node's own camera rides on robot1 (camera.link): it goes with it.
+    with world_only(**{'camera.link': 'lidar_link'}) as (harness, node):
         two_rovers(harness)
         sim = SimUnderTest(harness, node)
         published, subscribed = sim.own_topics()
-        assert {'/robot1/scan', '/robot1/odom'} <= set(published)
+        assert {'/robot1/scan', '/robot1/odom', '/robot1/camera/image_raw'} <= set(published)
         assert '/robot1/cmd_vel' in subscribed
         response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
                                 srv().DeleteEntity.Request(entity='robot1'))
