@@ -261,14 +261,16 @@ NO_CONTROLLERS_FILE = pathlib.Path('(no controllers file)')
 
 def load_controllers_config(paths: pathlib.Path | str | Sequence[pathlib.Path | str],
                             args: Mapping[str, str] | None = None, *,
-                            args_name: str = f"the parameter '{CONTROLLERS_ARGS}'"
-                            ) -> ControllersConfig:
+                            args_name: str = f"the parameter '{CONTROLLERS_ARGS}'",
+                            manager: str = CONTROLLER_MANAGER) -> ControllersConfig:
     """Read the controllers file(s) at ``paths`` (several: read in order, later ones win).
 
     No paths: no controllers (a robot its Gazebo plugins run).
 
     ``args`` are the values of ``$(var name)`` substitutions; ``args_name``
-    says in errors where they come from.
+    says in errors where they come from.  ``manager`` is the controller
+    manager's node name, whose section gives ``update_rate`` (gz_ros2_control's
+    ``<controller_manager_name>``).
     """
     if isinstance(paths, str | os.PathLike):
         paths = [paths]
@@ -279,7 +281,8 @@ def load_controllers_config(paths: pathlib.Path | str | Sequence[pathlib.Path | 
     label = ' + '.join(str(path) for path in paths)
     ros2 = [(path, _ros2_nodes(document, path)) for path, document in documents]
     if all(nodes for _path, nodes in ros2):
-        config = _ros2_control_config([node for _path, nodes in ros2 for node in nodes], label)
+        config = _ros2_control_config([node for _path, nodes in ros2 for node in nodes], label,
+                                      manager)
         warnings = [warning for path, document in documents
                     for warning in _ros2_dropped_blocks(document, path)]
         return dataclasses.replace(config, source=paths[0], sources=tuple(paths),
@@ -545,18 +548,18 @@ def _parameters_of(node: str, patterns: list[tuple[str, dict[str, Any]]],
     return merged
 
 
-def _ros2_control_config(nodes: list[tuple[str, dict[str, Any]]],
-                         path: str) -> ControllersConfig:
+def _ros2_control_config(nodes: list[tuple[str, dict[str, Any]]], path: str,
+                         manager: str = CONTROLLER_MANAGER) -> ControllersConfig:
     patterns, own = _split_nodes(nodes)
 
     def parameters_of(node: str) -> dict[str, Any]:
         return _parameters_of(node, patterns, own)
 
-    update_rate = _update_rate(parameters_of(CONTROLLER_MANAGER), path)
+    update_rate = _update_rate(parameters_of(manager), path, manager)
     # Controllers are declared as `<name>: {type: ...}` entries (normally the
     # controller_manager's), or, since Jazzy, by a `type` among their own parameters.
     declared: dict[str, Any] = {}
-    for node in [CONTROLLER_MANAGER, *own]:
+    for node in [manager, *own]:
         for name, entry in parameters_of(node).items():
             if isinstance(entry, Mapping) and TYPE_FIELD in entry:
                 declared.setdefault(str(name), entry[TYPE_FIELD])
@@ -577,11 +580,11 @@ def _ros2_control_config(nodes: list[tuple[str, dict[str, Any]]],
                              update_rate=update_rate)
 
 
-def _update_rate(manager: Mapping[str, Any], path: str) -> float:
+def _update_rate(manager: Mapping[str, Any], path: str, name: str = CONTROLLER_MANAGER) -> float:
     rate = manager.get(UPDATE_RATE_FIELD, DEFAULT_UPDATE_RATE)
     if isinstance(rate, bool) or not isinstance(rate, int | float) or rate_problem(rate):
         raise ControllerConfigError(
-            f'{path}: {CONTROLLER_MANAGER}.{ROS2_PARAMETERS}.{UPDATE_RATE_FIELD}: '
+            f'{path}: {name}.{ROS2_PARAMETERS}.{UPDATE_RATE_FIELD}: '
             f'{rate!r} must be a number of Hz > 0 whose period 1 / rate is finite')
     return float(rate)
 

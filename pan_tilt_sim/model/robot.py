@@ -34,6 +34,9 @@ WORLD_LINK = 'world'  # a root link of this name, joined by a fixed joint, welds
 UNIT_SCALE: Vector = (1.0, 1.0, 1.0)  # a <mesh> without a scale attribute
 Rgba = tuple[float, float, float, float]  # red, green, blue, alpha, each 0..1
 POSITION_PROPORTIONAL_GAIN = 'position_proportional_gain'
+# gz_ros2_control's element naming its controller manager node, and the name without it.
+CONTROLLER_MANAGER_NAME = 'controller_manager_name'
+DEFAULT_CONTROLLER_MANAGER = 'controller_manager'
 INITIAL_VALUE = 'initial_value'  # the <param> of a ros2_control interface that sets its start
 # How far above the robot's lowest point a wheel's lowest point may be and still touch (m).
 WHEEL_CONTACT_TOLERANCE = 1e-3
@@ -422,6 +425,16 @@ class RobotModel:
         """The namespace the first control plugin gives the robot's topics, if any."""
         return next((plugin.namespace for plugin in self.control_plugins if plugin.namespace),
                     None)
+
+    @property
+    def controller_manager_name(self) -> str:
+        """The controller manager's node name: the control plugin's ``<controller_manager_name>``.
+
+        As gz_ros2_control names it (``controller_manager`` when no plugin sets
+        it); the parser checks that it is a valid node name.
+        """
+        return next((plugin.settings[CONTROLLER_MANAGER_NAME] for plugin in self.control_plugins
+                     if plugin.settings.get(CONTROLLER_MANAGER_NAME)), DEFAULT_CONTROLLER_MANAGER)
 
     @property
     def position_proportional_gain(self) -> float | None:

@@ -25,6 +25,7 @@ from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.plugin_elements import read_plugin_elements
 from pan_tilt_sim.model.rates import rate_problem
 from pan_tilt_sim.model.robot import (
+    CONTROLLER_MANAGER_NAME,
     DEFAULT_AXIS,
     INITIAL_VALUE,
     POSITION_PROPORTIONAL_GAIN,
@@ -149,6 +150,7 @@ def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
                     f"{source}: <ros2_control name=\"{system.name}\">: joint '{joint.name}' is "
                     'not a joint of this robot')
     _check_position_gain(plugins, systems, source)
+    _check_manager_name(plugins, source)
     _check_component_names(systems, source)
     sensors, sensor_warnings = _SensorReader(source, links, joints).read(root)
     return RobotModel(name=name, links=links, joints=joints,
@@ -258,6 +260,16 @@ def _check_position_gain(plugins: tuple[ControlPlugin, ...], systems: tuple[Cont
         value = float_or_nan(text)
         if not (math.isfinite(value) and value > 0.0):
             raise DescriptionError(f"{source}: {place}: '{text}' must be a number > 0")
+
+
+def _check_manager_name(plugins: tuple[ControlPlugin, ...], source: pathlib.Path) -> None:
+    """``controller_manager_name``, where given, must be a ROS node name."""
+    for plugin in plugins:
+        name = plugin.settings.get(CONTROLLER_MANAGER_NAME)
+        if name is not None and not naming.is_valid_name(name):
+            raise DescriptionError(
+                f"{source}: the {plugin.filename} plugin's <{CONTROLLER_MANAGER_NAME}>: "
+                f"'{name}' is not a valid node name ({naming.NAME_RULE})")
 
 
 def _check_component_names(systems: tuple[ControlSystem, ...], source: pathlib.Path) -> None:

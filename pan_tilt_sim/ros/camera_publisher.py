@@ -152,6 +152,11 @@ class CameraPublisher:
         """Images rendered and published so far."""
         return self._frames
 
+    def destroy(self, node: Node) -> None:
+        """Destroy the image and camera info publishers on ``node`` (the robot left)."""
+        node.destroy_publisher(self._image_publisher)
+        node.destroy_publisher(self._info_publisher)
+
     def refresh_readers(self) -> None:
         """Ask whether anybody watches the image or the camera info."""
         self._image_watched = self._image_publisher.get_subscription_count() > 0

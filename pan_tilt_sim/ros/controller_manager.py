@@ -494,8 +494,10 @@ class ControllerManagerNode(Node):
                  model: RobotModel, namespace: str, *, context: Context | None = None,
                  substitutions: Mapping[str, str] | None = None, source: str = '') -> None:
         # Not the process's global arguments: a `-r __node:=...` meant for sim_node
-        # must not rename this node, nor its `-p` parameters land here.
-        super().__init__(NODE_NAME, namespace=namespace or '/', context=context,
+        # must not rename this node, nor its `-p` parameters land here.  Its name is
+        # the control plugin's <controller_manager_name>, as gz_ros2_control names it.
+        super().__init__(model.controller_manager_name, namespace=namespace or '/',
+                         context=context,
                          use_global_arguments=False, allow_undeclared_parameters=True)
         self.manager_services = ControllerManagerServices(
             self, bindings, manager, model, substitutions=substitutions, source=source)

@@ -108,6 +108,14 @@ class NodeFeatures:
         if self.camera is not None:
             self.camera.refresh_readers()
 
+    def remove_robot(self, node: Node) -> None:
+        """Take the robot's sensors', camera's and TF's topics away (it left; the world stays)."""
+        self.sensors.destroy(node)
+        if self.camera is not None:
+            self.camera.destroy(node)
+            self.camera = None
+        self.robot_state.stop()
+
     def close(self) -> None:
         """Release what the features hold beyond the PyBullet client (temporary files)."""
         self.entities.close()

@@ -37,6 +37,7 @@ from pan_tilt_sim.model.description import (
     load_description,
 )
 from pan_tilt_sim.model.resources import resolve_resource
+from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.ros import parameters as params
 from pan_tilt_sim.ros.ros_interfaces import SERVICE_QOS
 from pan_tilt_sim.ros.simulation_services import interfaces
@@ -70,12 +71,17 @@ def declare(node: Node) -> bool:
         "brings the robot, with its plugins and controller manager.")
 
 
-def roll_pitch_yaw(x: float, y: float, z: float, w: float) -> tuple[float, float, float]:
-    """Return (roll, pitch, yaw) of a quaternion (rad, fixed axes x, y, z: gz's pose angles)."""
+def unit_quaternion(x: float, y: float, z: float, w: float) -> tuple[float, float, float, float]:
+    """Return the quaternion normalised; ValueError if it is zero or not finite."""
     norm = math.sqrt(x * x + y * y + z * z + w * w)
     if not math.isfinite(norm) or norm < 1e-9:
         raise ValueError('the orientation is not a rotation (zero or non-finite quaternion)')
-    x, y, z, w = x / norm, y / norm, z / norm, w / norm
+    return x / norm, y / norm, z / norm, w / norm
+
+
+def roll_pitch_yaw(x: float, y: float, z: float, w: float) -> tuple[float, float, float]:
+    """Return (roll, pitch, yaw) of a quaternion (rad, fixed axes x, y, z: gz's pose angles)."""
+    x, y, z, w = unit_quaternion(x, y, z, w)
     roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
     pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
     yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
@@ -116,7 +122,8 @@ class RobotSpawnService:
                  taken: Iterable[str] = (),
                  build_more: Callable[[RobotDescription, Spawn], None] | None = None,
                  names: Callable[[], Iterable[str]] | None = None,
-                 is_robot: Callable[[RobotDescription], bool] | None = None) -> None:
+                 is_robot: Callable[[RobotDescription], bool] | None = None,
+                 frame_pose: Callable[[str], Transform] | None = None) -> None:
         found = interfaces()
         if found is None:
             raise ParameterError(
@@ -125,6 +132,8 @@ class RobotSpawnService:
         self._node, self._build, self._taken = node, build, tuple(taken)
         # Once the first robot is in: more robots (build_more), the world's names (names).
         self._build_more, self._names, self._is_robot = build_more, names, is_robot
+        # A frame's pose in the world (KeyError: none such), for a later robot's initial_pose.
+        self._frame_pose = frame_pose
         self._srv = found.srv.SpawnEntity
         self._result = found.msg.Result
         self._built = False
@@ -232,19 +241,32 @@ class RobotSpawnService:
                                 f"entity_namespace '{request.entity_namespace}' is not a valid "
                                 f'ROS namespace ({naming.NAMESPACE_RULE})')
         pose = request.initial_pose
-        if pose.header.frame_id not in WORLD_FRAMES:
+        frame = pose.header.frame_id
+        if frame not in WORLD_FRAMES and (not more or self._frame_pose is None):
             return self._refuse(response, codes.INVALID_POSE,
-                                f"initial_pose frame '{pose.header.frame_id}': a robot is "
-                                "placed in '' or 'world' only")
+                                f"initial_pose frame '{frame}': the first robot is placed in "
+                                "'' or 'world' only (the world's entities are built with it)")
         position, orientation = pose.pose.position, pose.pose.orientation
         try:
             roll, pitch, yaw = roll_pitch_yaw(orientation.x, orientation.y, orientation.z,
                                               orientation.w)
         except ValueError as err:
             return self._refuse(response, codes.INVALID_POSE, f'initial_pose: {err}')
-        if not all(math.isfinite(value) for value in (position.x, position.y, position.z)):
+        xyz = (position.x, position.y, position.z)
+        if not all(math.isfinite(value) for value in xyz):
             return self._refuse(response, codes.INVALID_POSE,
                                 'initial_pose: the position is not finite')
+        if frame not in WORLD_FRAMES:  # relative to an entity, or a link of the first robot
+            try:
+                reference = self._frame_pose(frame)
+            except KeyError:
+                return self._refuse(response, codes.INVALID_POSE,
+                                    f"initial_pose frame '{frame}': no such frame (use '' or "
+                                    "'world', an entity's name, or a link of the first robot)")
+            placed = reference.then(Transform(xyz, unit_quaternion(
+                orientation.x, orientation.y, orientation.z, orientation.w)))
+            xyz = placed.translation
+            roll, pitch, yaw = roll_pitch_yaw(*placed.rotation)
         try:
             description = self._description(request)
         except ConfigurationError as err:
@@ -257,7 +279,7 @@ class RobotSpawnService:
             return self._refuse(response, codes.NAME_NOT_UNIQUE,
                                 f"entity named '{request.name or description.name}' already "
                                 'exists (allow_renaming is false)')
-        spawn = Spawn(name, BasePose(position.x, position.y, position.z, yaw, roll, pitch),
+        spawn = Spawn(name, BasePose(*xyz, yaw, roll, pitch),
                       naming.normalize(request.entity_namespace))
         if more:
             try:

@@ -185,6 +185,11 @@ class RobotStatePublisher:
             transform_message(*frame, now, message)
         self._sink.tf(self._messages)
 
+    def stop(self) -> None:
+        """Publish no more TF (the robot left the world)."""
+        self._sink = None
+        self._readers = False
+
     def reset(self) -> None:
         """Start the TF schedule again (after sim time was reset or moved)."""
         self._schedule.reset()

@@ -147,7 +147,8 @@ class SimNode(Node):
                     physics_thread, description, spawn),
                 taken=(entity.name for entity in self._world.entities if entity.name),
                 build_more=self._add_robot, names=lambda: self.features.entities.names(),
-                is_robot=spawned_robots.is_robot)
+                is_robot=spawned_robots.is_robot,
+                frame_pose=lambda frame: self.features.entities.frame_pose(frame))
             return
         if self.settings.robot_description_file:
             self._build(physics_thread, load_description(
@@ -164,6 +165,8 @@ class SimNode(Node):
             self.settings, initial_pose=spawn.pose,
             robot_namespace=spawn.namespace or self.settings.robot_namespace)
         self._build(physics_thread, description, from_topic=True)
+        if not self.is_controller_manager:  # Gazebo deletes any model: the world runs on
+            self.features.entities.let_delete(description.name, self._remove_first_robot)
 
     def _add_robot(self, description: RobotDescription, spawn: robot_spawn.Spawn) -> None:
         """One more robot in the world (its plugins, sensors, controller manager), in our turn."""
@@ -187,6 +190,23 @@ class SimNode(Node):
     def _remove_robot(self, name: str) -> None:
         """DeleteEntity of a spawned robot: its topics, manager and body go."""
         self.spawned_robots.pop(name).destroy()
+
+    def _remove_first_robot(self, _name: str) -> None:
+        """DeleteEntity of the robot the world began with: what a spawned robot loses, it loses.
+
+        Its topics, services, controller manager, sensors and body go; the world, its
+        clock and the other robots stay (the simulation steps them without it).
+        """
+        self.controllers.release()
+        manager = self.controller_manager
+        if manager is not None and manager is not self:
+            if manager.executor is not None:
+                manager.executor.remove_node(manager)
+            self.companion_nodes.remove(manager)
+            manager.destroy_node()
+            self.controller_manager = None
+        self.features.remove_robot(self)
+        self.simulation.remove_robot()
 
     def _build(self, physics_thread: bool, description: RobotDescription, *,
                from_topic: bool = False) -> None:

@@ -38,7 +38,8 @@ def is_robot(description: RobotDescription) -> bool:
 def controllers_of(description: RobotDescription) -> ControllersConfig:
     """Return the controllers its gz_ros2_control plugin's ``<parameters>`` name (or none)."""
     return load_controllers_config(controllers_files_for(
-        '', description, runs_by_plugins=runs_by_plugins(description.model)), {})
+        '', description, runs_by_plugins=runs_by_plugins(description.model)), {},
+        manager=description.model.controller_manager_name)
 
 
 class SpawnedRobot:
@@ -91,13 +92,10 @@ class SpawnedRobot:
         if not description.model.ros2_control or not optional_interfaces.available(
                 'controller_manager_msgs'):
             return None
-        from pan_tilt_sim.ros.controller_manager import NODE_NAME
-
-        plugins = description.model.control_plugins
         # gz_ros2_control's <controller_manager_name>, else controller_manager.
-        name = (plugins[0].settings.get('controller_manager_name') if plugins else None)
         self.controller_manager = Node(
-            name or NODE_NAME, namespace=self.namespace or '/', context=self._node.context,
+            description.model.controller_manager_name, namespace=self.namespace or '/',
+            context=self._node.context,
             use_global_arguments=False, allow_undeclared_parameters=True)
         return self.controller_manager
 

@@ -69,7 +69,8 @@ def choose_controllers(node: Node, description: RobotDescription, settings: SimP
     config = load_controllers_config(
         controllers_files_for(settings.controllers_file, description,
                               runs_by_plugins=runs_by_plugins(description.model)),
-        parse_controllers_args(settings.controllers_args, f"parameter '{CONTROLLERS_ARGS}'"))
+        parse_controllers_args(settings.controllers_args, f"parameter '{CONTROLLERS_ARGS}'"),
+        manager=description.model.controller_manager_name)
     return ControllersChoice(config, None, arguments)
 
 

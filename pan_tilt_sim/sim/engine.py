@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import logging
 import math
+import pathlib
 import time as wall_time
 from collections.abc import Mapping, Sequence
 from typing import Protocol
@@ -430,6 +431,42 @@ class Simulation:
             self._advance_python(python_steps)
             count += python_steps
 
+    @property
+    def has_robot(self) -> bool:
+        """Whether the robot is in the world (False once :meth:`remove_robot` took it out)."""
+        return self.physics.body_id >= 0
+
+    def remove_robot(self) -> None:
+        """Take this robot out of the world it hosts; the world, its guests and sim time stay.
+
+        Its plugins, controllers and hardware stop and its body leaves PyBullet;
+        each step then advances the world alone (the guests, the objects), as a
+        Gazebo world runs on when its first model is deleted.  A guest leaves
+        through its host's :meth:`remove_guest` instead.
+        """
+        if not self.has_robot:
+            return
+        self.hardware.close()
+        if self._rollers is not None:
+            self._rollers.release()
+            self._rollers, self._roller_angles = None, {}
+        self.plugins, self._base_movers = [], []
+        self.manager = ControllerManager(ControllersConfig((), pathlib.Path()), {},
+                                         time_step=self._time_step)
+        self.handles, self._handle_list = {}, []
+        self._effort_handles, self._velocity_handles, self._forced = [], [], []
+        self._velocity_slots, self._efforts, self._targets, self._forces = [], [], [], []
+        self._effort_slot, self._state_slot, self._link_readers = {}, {}, {}
+        self._clocks, self._every_step = [], True
+        self.physics.remove_robot()
+        world_step = self.physics.bare_stepper()
+
+        def step(efforts: Sequence[float], targets: Sequence[float] = (),
+                 forces: Sequence[float] | None = None) -> list:
+            world_step()
+            return []
+        self._physics_step, self._run_laws, self._states = step, None, []
+
     def add_guest(self, guest: Simulation) -> None:
         """Step ``guest`` (built with ``world=self``) with this robot from now on."""
         guest._steps = self._steps
@@ -607,7 +644,7 @@ class Simulation:
         And about a free base that tipped over or fell below the ground plane
         (:meth:`_check_base`): the simulation goes on either way.
         """
-        if not self.physics.fixed_base:
+        if not self.physics.fixed_base and self.has_robot:
             self._check_base()
         limit = self._speed_limit
         for handle, state in zip(self._handle_list, states, strict=False):
@@ -700,12 +737,13 @@ class Simulation:
         """Put base and joints back at their start, reset controllers; sim time to 0 if asked."""
         for handle in self._handle_list:
             handle.reset()
-        self.physics.reset_base()
-        self.physics.reset_joints([handle.position for handle in self._handle_list])
-        self._states = self.physics.read_states()
+        if self.has_robot:
+            self.physics.reset_base()
+            self.physics.reset_joints([handle.position for handle in self._handle_list])
+            self._states = self.physics.read_states()
         for controller in [*self.plugins, *self.manager.configured]:
             controller.reset()
-        if self._hold_undriven:  # undriven joints are held again, as at start
+        if self._hold_undriven and self.has_robot:  # undriven joints are held again
             self._driven.clear()
             self._apply_actuators()
         if reset_time:

@@ -443,21 +443,35 @@ class Entities:
             info=EntityInfo(Category.ROBOT, 'a spawned robot'))
         self._robot_removers[name] = remove
 
+    def let_delete(self, name: str, remove: Callable[[str], None]) -> None:
+        """Let DeleteEntity take the first robot ``name`` away, through ``remove(name)``.
+
+        ``remove`` takes its body out of the world (with its plugins, controllers
+        and topics); the world stays.  Without this the first robot stays.
+        """
+        self._robot_removers[name] = remove
+
     def delete(self, name: str) -> None:
         """Remove a spawned (or world file) object or a spawned robot.
 
-        KeyError if unknown; NotDeletableError for the first robot and the scenery.
+        KeyError if unknown; NotDeletableError for the scenery, and for the
+        first robot unless :meth:`let_delete` allowed it.
         """
         entity = self._entities[name]
         remover = self._robot_removers.pop(name, None)
         if remover is not None:
             del self._entities[name]
             remover(name)
+            if entity.body == self._robot:  # the first robot: its links are no frames now
+                self._robot, self._grounded = -1, []
             return
-        if entity.origin in (Origin.ROBOT, Origin.SCENERY):
+        if entity.origin is Origin.ROBOT:
             raise NotDeletableError(
-                f"'{name}' is {'the robot' if entity.origin is Origin.ROBOT else 'scenery'}: "
-                'only spawned objects can be deleted')
+                f"'{name}' is the robot sim_node was started with (robot_description_file or "
+                'the robot_description topic): it stays while sim_node runs; robots and '
+                'objects spawned into the world can be deleted')
+        if entity.origin is Origin.SCENERY:
+            raise NotDeletableError(f"'{name}' is scenery: only spawned objects can be deleted")
         pybullet.removeBody(entity.body, physicsClientId=self._client)
         del self._entities[name]
 

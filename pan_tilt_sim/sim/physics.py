@@ -197,8 +197,8 @@ class Physics:
     With ``world`` (another robot's Physics) the robot is a guest in that
     robot's client: it owns its body, not the client, and its steps only
     apply its torques and motors -- the host's step advances the world, and
-    :meth:`take_states` reads the guest's joints after it.  A guest's joint
-    damping is PyBullet's own (no implicit rows: they need the step's states).
+    :meth:`take_states` reads the guest's joints after it (and what its
+    implicit damping rows felt).
     """
 
     def __init__(self, description: RobotDescription, time_step: float, *,
@@ -453,6 +453,7 @@ class Physics:
         """Read a guest's joint states after the world stepped (its next step returns them)."""
         states = self._after_step[0] = pybullet.getJointStates(self._body, self._indices,
                                                                self._client)
+        self._drives.settle(states)
         return states
 
     def _remove_body(self) -> None:
@@ -460,6 +461,21 @@ class Physics:
         if self._body >= 0:
             pybullet.removeBody(self._body, physicsClientId=self._client)
             self._body = -1
+
+    def remove_robot(self) -> None:
+        """Take the robot's body out of a world it hosts; the client and its bodies stay.
+
+        The world goes on without it (its guests, the objects, the ground):
+        afterwards the robot has no joints and no links, and only
+        :meth:`bare_stepper` steps.  A guest leaves through :meth:`close`.
+        """
+        if self.is_guest or self._body < 0:
+            return
+        pybullet.removeBody(self._body, physicsClientId=self._client)
+        self._body = -1
+        self._joints = ()
+        self._indices, self._balls, self._initial_positions = [], [], []
+        self._link_indices, self._dof_indices = {}, {}
 
     @property
     def implicit_damping(self) -> tuple[str, ...]:
@@ -717,14 +733,13 @@ class DriveSplit:
 
 def split_drives(joints: Sequence[JointSpec], velocity_driven: Sequence[bool], time_step: float,
                  smallest_inertias: Callable[[], Sequence[float]],
-                 coupled: Collection[str], *, guest: bool = False) -> DriveSplit:
+                 coupled: Collection[str]) -> DriveSplit:
     """Sort the joints into drive kinds (:class:`DriveSplit`).
 
     ``smallest_inertias()`` (each joint's, over the checked poses) is called
     only if an effort joint has damping; ``coupled``: the names of the joints
     a mimic coupling joins.  Explicit damping is PyBullet's own, kept where it
-    is far inside its stability bound, and always for a ``guest`` robot (the
-    implicit rows need the world step's states, which a guest reads after it).
+    is far inside its stability bound.
     A velocity gain makes the motor a hard constraint that would override a
     mimic gear's forces, so coupled joints always take the force-capped form.
     """
@@ -733,9 +748,9 @@ def split_drives(joints: Sequence[JointSpec], velocity_driven: Sequence[bool], t
     velocity = [k for k, driven in enumerate(velocity_driven) if driven]
     effort = [k for k, driven in enumerate(velocity_driven) if not driven]
     with_damping = [k for k in effort if joints[k].damping > 0.0]
-    smallest = smallest_inertias() if with_damping and not guest else []
-    explicit = [k for k in with_damping if guest
-                or joints[k].damping * time_step <= EXPLICIT_DAMPING_SHARE * smallest[k]]
+    smallest = smallest_inertias() if with_damping else []
+    explicit = [k for k in with_damping
+                if joints[k].damping * time_step <= EXPLICIT_DAMPING_SHARE * smallest[k]]
     damped = [k for k in with_damping if k not in explicit and joints[k].friction <= 0.0
               and joints[k].name not in coupled]
     implicit = [k for k in with_damping if k not in explicit and k not in damped]
@@ -883,8 +898,7 @@ class _Drives:
         body, client, dt = physics.body_id, physics.client_id, physics.time_step
         self._body, self._client, self._dt = body, client, dt
         coupled = {name for coupling in mimics for name in (coupling.leader, coupling.follower)}
-        split = split_drives(joints, velocity_driven, dt, physics.smallest_inertias, coupled,
-                             guest=physics.is_guest)
+        split = split_drives(joints, velocity_driven, dt, physics.smallest_inertias, coupled)
         self.velocity_slots, self.effort_slots = split.velocity, split.effort
         self.explicit, self.implicit, self.damped = split.explicit, split.implicit, split.damped
         for k, joint in enumerate(joints):
@@ -909,6 +923,7 @@ class _Drives:
         self._drive_motors = getattr(effort_step, 'drive', None)
         self._countdown = 0
         self._states = physics.read_states()
+        self._felt = [0.0] * len(split.effort)  # a guest's last efforts, until settle()
         # Many steps of controller laws in C: only where a step is nothing but the efforts.
         self.run_laws = None
         if not self._motors and not self._gain:
@@ -942,9 +957,18 @@ class _Drives:
                 states = self._effort_step(efforts)
         else:
             states = self._effort_step(efforts)
+        if self._physics.is_guest:  # the host's step comes next: settle() reads it back
+            self._felt[:] = efforts
+            return states
         implicit.feel(before, states, efforts)
         self._states = states
         return states
+
+    def settle(self, states: Sequence) -> None:
+        """Read back what a guest's joints felt in the world step that gave ``states``."""
+        if self._implicit:
+            self._implicit.feel(self._states, states, self._felt)
+        self._states = states
 
     def restart(self) -> None:
         """Start over from the joints' present state (after a reset, or at the start)."""

@@ -166,6 +166,26 @@ def test_ros2_controllers_inherit_the_manager_update_rate(write_yaml):
     assert {spec.params['update_rate'] for spec in specs.values()} == {250.0}
 
 
+def test_a_manager_named_otherwise_takes_its_update_rate_from_its_own_section(write_yaml):
+    # gz_ros2_control's <controller_manager_name>arm_manager: that node reads arm_manager's.
+    path = write_yaml("""\
+        controller_manager:
+          ros__parameters:
+            update_rate: 250
+        arm_manager:
+          ros__parameters:
+            update_rate: 25
+            jsb:
+              type: joint_state_broadcaster/JointStateBroadcaster
+        """)
+    assert load_controllers_config(path, manager='arm_manager').update_rate == 25.0
+    assert load_controllers_config(path).update_rate == 250.0
+    with pytest.raises(ControllerConfigError, match=r'arm_manager\.ros__parameters\.update_rate'):
+        load_controllers_config(write_yaml(ROS2_FILE.replace('controller_manager:', 'arm_manager:')
+                                           .replace('update_rate: 250', 'update_rate: -1')),
+                                manager='arm_manager')
+
+
 def test_ros2_update_rate_defaults_to_ros2_control_default(write_yaml):
     config = load_controllers_config(write_yaml("""
         controller_manager:

@@ -2,19 +2,22 @@
 
 Two rovers driven by gazebo_ros diff drive plugins, each with a lidar, spawned into one
 world-only sim_node (robot_from_spawn) in namespaces robot1 and robot2: each drives on
-its own cmd_vel, they collide, robot2's lidar sees robot1, DeleteEntity takes robot2 and
-its topics away, a taken name is refused, and a robot that cannot be simulated is
-refused while robot1 runs on.
+its own cmd_vel, they collide, robot2's lidar sees robot1, DeleteEntity takes either
+robot and its topics away (the world runs on), a later robot's pose may be relative to
+another entity, a plugin's <controller_manager_name> names the robot's manager, a taken
+name is refused, and a robot that cannot be simulated is refused while robot1 runs on.
 """
 
 from __future__ import annotations
 
 import importlib.util
+import math
 
 import pytest
 from geometry_msgs.msg import Twist
 from mobile_fixtures import GZ_DIFF_DRIVE, P3D, ROS2_DIFF_DRIVE, rover_urdf
 from node_harness import SimUnderTest
+from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from stand_in_fixtures import finish, spawn, srv, start, world_only
 
@@ -160,6 +163,102 @@ def test_delete_entity_takes_robot2_and_its_topics_away():
                             lambda: x_of(node.simulation) > 0.2)
 
 
+def test_delete_entity_takes_the_first_robot_away_and_the_world_runs_on():
+    from std_srvs.srv import Empty
+
+    # Gazebo deletes any model: the one the world began with too.  robot1 holds the world's
+    # PyBullet client; robot2 and /clock run on without it, and a robot spawned later works.
+    # sim_node's own camera rides on robot1 (camera.link): it goes with it.
+    with world_only(**{'camera.link': 'lidar_link'}) as (harness, node):
+        two_rovers(harness)
+        sim = SimUnderTest(harness, node)
+        published, subscribed = sim.own_topics()
+        assert {'/robot1/scan', '/robot1/odom', '/robot1/camera/image_raw'} <= set(published)
+        assert '/robot1/cmd_vel' in subscribed
+        response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
+                                srv().DeleteEntity.Request(entity='robot1'))
+        assert response.result.result == 1, response.result.error_message
+        published, subscribed = sim.own_topics()
+        assert not [topic for topic in [*published, *subscribed]
+                    if topic.startswith('/robot1/')]
+        assert not node.simulation.has_robot
+        entities = harness.call(srv().GetEntities, '/sim_node/get_entities').entities
+        assert 'robot1' not in entities and 'robot2' in entities
+        robot2 = node.spawned_robots['robot2'].simulation
+        drivers = Drivers(harness)
+        assert spin_driving(harness, drivers, {'/robot2/cmd_vel': SPEED},
+                            lambda: x_of(robot2) > 0.3)
+        assert robot2.steps == node.simulation.steps  # one clock, still the world's
+        clocks = sim.collect(Clock, '/clock')
+        assert harness.spin_until(lambda: len(clocks) >= 2)
+        # Its name is free again: a robot spawned under it is a new one, and drives.
+        again = spawn(harness, name='robot1', resource_string=rover(), namespace='robot3',
+                      y=-1.0)
+        assert (again.result.result, again.entity_name) == (1, 'robot1'), again
+        robot3 = node.spawned_robots['robot1'].simulation
+        assert spin_driving(harness, drivers, {'/robot3/cmd_vel': SPEED},
+                            lambda: x_of(robot3) > 0.3)
+        node.set_paused(True)  # a world reset puts the robots left back, on one clock
+        harness.call(Empty, '/reset_simulation')
+        assert robot2.steps == robot3.steps == node.simulation.steps == 0
+        assert abs(x_of(robot2)) < 0.01 and abs(x_of(robot3)) < 0.01
+
+
+def test_deleting_a_first_robot_with_ros2_control_takes_its_controller_manager(tmp_path):
+    from drop_in_fixtures import MANAGER_YAML
+    from ros2_control_fixtures import write_arm
+
+    from pan_tilt_sim.model.description import load_description
+
+    if importlib.util.find_spec('controller_manager_msgs') is None:
+        pytest.skip('controller_manager_msgs is not installed')
+    arm = load_description(write_arm(tmp_path, MANAGER_YAML),
+                           [f"controllers:={tmp_path / 'arm_controllers.yaml'}"]).urdf_xml
+    with world_only() as (harness, node):
+        first = spawn(harness, name='arm1', resource_string=arm, namespace='arm1')
+        second = spawn(harness, name='robot2', resource_string=rover(), namespace='robot2',
+                       y=1.0)
+        assert first.result.result == 1 and second.result.result == 1, first
+        assert ('controller_manager', '/arm1') in node.get_node_names_and_namespaces()
+        response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
+                                srv().DeleteEntity.Request(entity='arm1'))
+        assert response.result.result == 1, response.result.error_message
+        assert harness.spin_until(lambda: ('controller_manager', '/arm1') not in
+                                  node.get_node_names_and_namespaces())
+        drivers = Drivers(harness)
+        assert spin_driving(harness, drivers, {'/robot2/cmd_vel': SPEED},
+                            lambda: x_of(node.spawned_robots['robot2'].simulation) > 1.3)
+
+
+def test_a_later_robot_is_placed_relative_to_the_frame_its_pose_names():
+    # simulation_interfaces: initial_pose's header names a frame known to the simulator, e.g.
+    # an entity spawned earlier.  robot2 is 1 m ahead of robot1 (turned by 90 degrees),
+    # itself turned by 90 degrees: at (0, 1) in the world, facing -x.
+    codes = srv().SpawnEntity.Response
+    with world_only() as (harness, node):
+        first = spawn(harness, name='robot1', resource_string=rover(), namespace='robot1',
+                      yaw=math.pi / 2)
+        assert first.result.result == 1, first
+        second = spawn(harness, name='robot2', resource_string=rover(), namespace='robot2',
+                       frame='robot1', x=1.0, yaw=math.pi / 2)
+        assert second.result.result == 1, second.result.error_message
+        (x, y, heading), _ = node.spawned_robots['robot2'].simulation.base_state()
+        assert (x, y) == (pytest.approx(0.0, abs=1e-3), pytest.approx(1.0, abs=1e-3))
+        assert abs(abs(heading) - math.pi) < 1e-3
+        # A link of the first robot is a frame too; a frame nobody knows is refused.
+        third = spawn(harness, name='robot3', resource_string=rover(), namespace='robot3',
+                      frame='lidar_link', x=-1.0)
+        assert third.result.result == 1, third.result.error_message
+        (x, y, _), _ = node.spawned_robots['robot3'].simulation.base_state()
+        # robot1's lidar_link is 0.1 m ahead of its base (+y in the world); 1 m behind it.
+        assert (x, y) == (pytest.approx(0.0, abs=1e-3), pytest.approx(-0.9, abs=1e-3))
+        unknown = spawn(harness, name='robot4', resource_string=rover(), namespace='robot4',
+                        frame='nowhere')
+        assert unknown.result.result == codes.INVALID_POSE
+        assert "initial_pose frame 'nowhere': no such frame" in unknown.result.error_message
+        assert sorted(node.spawned_robots) == ['robot2', 'robot3']
+
+
 def test_a_taken_name_is_refused_unless_renaming_is_allowed():
     codes = srv().SpawnEntity.Response
     with world_only() as (harness, node):
@@ -241,6 +340,67 @@ def test_a_second_robot_with_ros2_control_gets_a_controller_manager_of_its_own(t
         assert response.result.result == 1, response.result.error_message
         assert harness.spin_until(lambda: ('controller_manager', '/arm2') not in
                                   node.get_node_names_and_namespaces())
+
+
+def named_manager_arm(tmp_path, name: str) -> str:
+    """The two-link arm whose gz_ros2_control plugin names its manager ``name``.
+
+    Its controllers file keys the manager's section by that name, as the real
+    plugin's manager node reads it (update_rate 25 Hz there).
+    """
+    from drop_in_fixtures import MANAGER_YAML
+    from ros2_control_fixtures import write_arm
+
+    from pan_tilt_sim.model.description import load_description
+
+    yaml = MANAGER_YAML.replace('controller_manager:', f'{name}:').replace(
+        'update_rate: 50', 'update_rate: 25')
+    assert f'{name}:' in yaml and 'update_rate: 25' in yaml
+    urdf = load_description(write_arm(tmp_path, yaml),
+                            [f"controllers:={tmp_path / 'arm_controllers.yaml'}"]).urdf_xml
+    return urdf.replace('<parameters>', f'<controller_manager_name>{name}'
+                                        '</controller_manager_name><parameters>', 1)
+
+
+@pytest.mark.parametrize('first', [False, True], ids=['later robot', 'first robot'])
+def test_a_robot_whose_plugin_names_its_manager_gets_that_name_in_its_namespace(tmp_path,
+                                                                              first):
+    from drop_in_fixtures import FORWARD, JSB
+    from spawner_client import Spawner
+
+    if importlib.util.find_spec('controller_manager_msgs') is None:
+        pytest.skip('controller_manager_msgs is not installed')
+    arm = named_manager_arm(tmp_path, 'arm_manager')
+    with world_only() as (harness, node):
+        if not first:
+            spawn(harness, name='robot1', resource_string=rover(), namespace='robot1')
+        second = spawn(harness, name='arm2', resource_string=arm, namespace='arm2', y=1.0)
+        assert second.result.result == 1, second
+        names = node.get_node_names_and_namespaces()
+        assert ('arm_manager', '/arm2') in names
+        assert ('controller_manager', '/arm2') not in names
+        sim = SimUnderTest(harness, node)
+        spawner = Spawner(sim, manager='/arm2/arm_manager')
+        assert spawner.spawn(JSB) == 0 and spawner.spawn(FORWARD) == 0
+        assert sorted(spawner.controllers()) == sorted([JSB, FORWARD])
+        # Its section of the file is the manager's: the update rate comes from there.
+        arm2 = node.simulation if first else node.spawned_robots['arm2'].simulation
+        assert arm2.manager.update_rate == 25
+
+
+def test_a_controller_manager_name_that_is_no_node_name_is_refused_and_the_others_run_on(
+        tmp_path):
+    arm = named_manager_arm(tmp_path, 'arm_manager').replace(
+        '>arm_manager<', '>arm manager<')
+    with world_only() as (harness, node):
+        spawn(harness, name='robot1', resource_string=rover(), namespace='robot1')
+        refused = spawn(harness, name='arm2', resource_string=arm, namespace='arm2', y=1.0)
+        assert refused.result.result != 1
+        assert "<controller_manager_name>: 'arm manager' is not a valid node name" in (
+            refused.result.error_message)
+        assert node.spawned_robots == {}
+        steps = node.simulation.steps
+        assert harness.spin_until(lambda: node.simulation.steps > steps)
 
 
 def test_each_rovers_odometry_tf_goes_where_its_plugin_remaps_it():

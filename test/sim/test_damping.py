@@ -107,3 +107,21 @@ def test_explicit_damping_is_kept_only_far_inside_its_stability_bound(tmp_path, 
     with Physics(wheel(tmp_path, damping=0.1), 0.001) as physics:
         physics.set_drives([True])  # an ideal actuator ignores the joint's damping
         assert physics.implicit_damping == ()
+
+
+@pytest.mark.parametrize('friction', [0.0, 0.005])
+def test_a_guest_robots_wheel_is_damped_implicitly_as_its_hosts_is(tmp_path, friction):
+    # A robot spawned into another's world (a guest) steps with it: its damping rows are
+    # sent before the world step and read back after it, as the host's own are.
+    description = wheel(tmp_path, damping=0.1, friction=friction)
+    with Physics(description, 0.001) as host:
+        guest = Physics(description, 0.001, world=host)
+        assert guest.implicit_damping == host.implicit_damping == ('axle',)
+        guest_speeds, host_speeds = [], []
+        for _ in range(1000):
+            guest.step([0.01])
+            host_speeds.append(host.step([0.01])[0][1])
+            guest_speeds.append(guest.take_states()[0][1])
+        guest.close()
+    assert guest_speeds[-1] == pytest.approx((0.01 - friction) / 0.1, rel=0.01)
+    assert guest_speeds == pytest.approx(host_speeds, rel=1e-6, abs=1e-9)

@@ -222,3 +222,39 @@ def test_removing_a_guest_takes_its_body_out_and_the_host_runs_on():
         _forward(host, 0.3)
         host.advance(1000)
         assert host.base_state()[0][0] > 0.1
+
+
+def test_removing_the_host_robot_leaves_a_world_that_steps_its_guests_and_takes_new_ones():
+    import pybullet
+
+    description, controllers, pose = _plugin_rover('robot1', (0.0, 0.0, 0.0, 0.0))
+    with Simulation(description, controllers, 0.001, fixed_base=None,
+                    initial_pose=pose) as host:
+        client = host.physics.client_id
+        description, controllers, pose = _plugin_rover('robot2', (0.0, 1.0, 0.0, 0.0))
+        guest = Simulation(description, controllers, 0.001, fixed_base=None,
+                           initial_pose=pose, world=host)
+        host.add_guest(guest)
+        bodies = pybullet.getNumBodies(physicsClientId=client)
+        host.advance(10)
+        host.remove_robot()
+        assert not host.has_robot and guest.has_robot
+        assert pybullet.getNumBodies(physicsClientId=client) == bodies - 1
+        assert host.plugins == [] and host.controllers == [] and host.joint_positions() == {}
+        _forward(guest, 0.3)
+        host.advance(1000)
+        assert guest.steps == host.steps == 1010  # one clock for the world, robot or not
+        assert guest.base_state()[0][0] > 0.1
+        host.reset()  # the world back at its start: the guest too
+        assert host.steps == guest.steps == 0
+        assert guest.base_state()[0][0] == pytest.approx(0.0, abs=1e-3)
+        host.remove_guest(guest)  # the world with no robot at all still steps
+        host.advance(5)
+        assert host.steps == 5
+        description, controllers, pose = _plugin_rover('robot3', (1.0, 0.0, 0.0, 0.0))
+        later = Simulation(description, controllers, 0.001, fixed_base=None,
+                           initial_pose=pose, world=host)
+        host.add_guest(later)
+        _forward(later, 0.3)
+        host.advance(1000)
+        assert later.base_state()[0][0] > 1.1

@@ -265,13 +265,26 @@ def test_names_renaming_and_refusals(pan_tilt):
     assert nameless.value.problem is SpawnProblem.RESOURCE_PARSE_ERROR
 
 
-def test_the_robot_and_the_scenery_cannot_be_deleted(pan_tilt):
+def test_the_robot_sim_node_started_with_and_the_scenery_cannot_be_deleted(pan_tilt):
     _simulation, entities = pan_tilt
-    for name in (entities.robot_name, 'target_red'):
-        with pytest.raises(NotDeletableError):
-            entities.delete(name)
+    with pytest.raises(NotDeletableError, match='the robot sim_node was started with'):
+        entities.delete(entities.robot_name)
+    with pytest.raises(NotDeletableError, match='is scenery'):
+        entities.delete('target_red')
     with pytest.raises(KeyError):
         entities.delete('nothing')
+
+
+def test_the_first_robot_goes_through_its_remover_once_let_delete_allowed_it(pan_tilt):
+    simulation, entities = pan_tilt
+    name = entities.robot_name
+    removed = []
+    entities.let_delete(name, lambda gone: (removed.append(gone), simulation.remove_robot()))
+    entities.delete(name)
+    assert removed == [name] and name not in entities.names()
+    with pytest.raises(KeyError):  # its links are no frames any more
+        entities.frame_pose('tilt_link')
+    assert entities.frame_pose('target_red') is not None
 
 
 def test_world_file_objects_survive_delete_spawned_and_come_back_on_restore(pan_tilt, tmp_path):
