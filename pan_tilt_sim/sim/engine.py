@@ -40,6 +40,7 @@ from pan_tilt_sim.model.base_pose import FIXED_BASE, ORIGIN, BasePose
 from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.initial_positions import FROM_DEFAULT, StartPosition, start_positions
+from pan_tilt_sim.model.physics_plan import plan_physics
 from pan_tilt_sim.model.physics_settings import DEFAULT_PHYSICS, PhysicsSettings
 from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.plugins.framework.plugin import Plugin, PluginWorld
@@ -169,11 +170,11 @@ class Simulation:
         gains = plugin_gains(controllers.pid_gains, movable, controllers.label)
         fixed, why = base_is_fixed(fixed_base, description, controllers, active_controllers,
                                    autostart_controllers)
-        self.physics = Physics(
-            description, time_step, gui=gui,
-            initial_positions=[starts[joint].position for joint in movable],
-            warn=load_messages.append, fixed_base=fixed, initial_pose=initial_pose,
-            settings=physics_settings, world=None if world is None else world.physics)
+        plan = plan_physics(description, fixed_base=fixed, initial_pose=initial_pose,
+                            initial_positions=[starts[joint].position for joint in movable])
+        self.physics = Physics.from_plan(
+            plan, time_step, gui=gui, warn=load_messages.append, settings=physics_settings,
+            world=None if world is None else world.physics)
         self._base_report = self._describe_base(why, fixed_base, initial_pose)
         self._time_step = time_step
         self._steps = 0 if world is None else world.steps

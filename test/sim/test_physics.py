@@ -16,15 +16,8 @@ from robot_fixtures import (
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.description import load_description
 from pan_tilt_sim.model.physics_settings import DEFAULT_PHYSICS, PhysicsSettings
-from pan_tilt_sim.model.robot import JointKind, JointSpec
 from pan_tilt_sim.sim.bullet import message_lines
-from pan_tilt_sim.sim.physics import (
-    DEFAULT_VELOCITY_CAP,
-    Physics,
-    engine_parameters,
-    pybullet,
-    velocity_cap,
-)
+from pan_tilt_sim.sim.physics import Physics, engine_parameters, pybullet
 
 
 @pytest.fixture
@@ -137,13 +130,6 @@ def test_pybullets_hidden_drag_is_off(tmp_path):
         for _ in range(2000):
             (coasting,) = physics.step([0.0])
     assert coasting[1] == pytest.approx(kicked[1], rel=1e-9)
-
-
-def test_the_speed_cap_is_twice_the_fastest_velocity_limit_and_never_below_100():
-    def joint(limit):
-        return JointSpec('j', JointKind.REVOLUTE, velocity_limit=limit)
-    assert velocity_cap([joint(2.0), joint(math.inf)]) == DEFAULT_VELOCITY_CAP == 100.0
-    assert velocity_cap([joint(2.0), joint(150.0)]) == 300.0
 
 
 def test_a_joint_may_reach_its_velocity_limit_beyond_pybullets_default_cap(tmp_path):
