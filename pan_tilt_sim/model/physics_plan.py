@@ -67,33 +67,27 @@ class PhysicsPlan:
     """Everything the physics builds a robot from (see the module).
 
     ``urdf`` is the text PyBullet loads (a free base's massless root link given
-    a negligible mass); ``joints`` the actuated joints, the order of every
-    array the physics takes or gives; ``surfaces`` what PyBullet's links get:
-    a welded robot only the URDF's ``<gazebo reference>`` frictions, a free one
-    every link's surface with its contact spring (:meth:`RobotModel.surface`).
+    a negligible mass), ``implicit_cylinders`` whether its cylinders are exact
+    shapes (a free base's wheels roll round) rather than polygon hulls;
+    ``joints`` the actuated joints, the order of every array the physics takes
+    or gives; ``coupled`` the joints a mimic coupling joins (leaders and
+    followers); ``surfaces`` what PyBullet's links get: a welded robot only the
+    URDF's ``<gazebo reference>`` frictions, a free one every link's surface
+    with its contact spring (:meth:`RobotModel.surface`).
     """
 
     source: pathlib.Path
     urdf: str
     fixed_base: bool
+    implicit_cylinders: bool
     joints: tuple[JointSpec, ...]
     mimics: tuple[MimicCoupling, ...]
+    coupled: frozenset[str]
     initial_positions: tuple[float, ...]
     velocity_cap: float
     inertia_poses: tuple[tuple[float, ...], ...]
     surfaces: tuple[LinkSurface, ...]
     base: BasePlacement
-
-    @property
-    def implicit_cylinders(self) -> bool:
-        """Whether PyBullet loads cylinders as exact shapes (a free base's wheels roll round)."""
-        return not self.fixed_base
-
-    @property
-    def coupled(self) -> frozenset[str]:
-        """The names of the joints a mimic coupling joins (leaders and followers)."""
-        return frozenset(name for coupling in self.mimics
-                         for name in (coupling.leader, coupling.follower))
 
     def with_mimics(self, positions: Sequence[float]) -> list[float]:
         """Return joint ``positions`` with every mimic follower put by its leader."""
@@ -167,8 +161,11 @@ def plan_physics(description: RobotDescription, *, fixed_base: bool = True,
             else with_massive_root(description.physics_urdf, model))
     start = tuple(_followed(joints, mimics, initial_positions))
     return PhysicsPlan(
-        source=description.source, urdf=urdf, fixed_base=fixed_base, joints=joints,
-        mimics=mimics, initial_positions=start, velocity_cap=velocity_cap(joints),
+        source=description.source, urdf=urdf, fixed_base=fixed_base,
+        implicit_cylinders=not fixed_base, joints=joints, mimics=mimics,
+        coupled=frozenset(name for coupling in mimics
+                          for name in (coupling.leader, coupling.follower)),
+        initial_positions=start, velocity_cap=velocity_cap(joints),
         inertia_poses=tuple(tuple(pose) for pose in check_poses(joints, start)),
         surfaces=link_surfaces(model, fixed_base),
         base=base_placement(initial_pose, fixed_base))

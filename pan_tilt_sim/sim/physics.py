@@ -4,7 +4,8 @@
 client), so several simulations can live in one process.  The robot is
 loaded with the URDF's inertia (links without ``<inertial>`` come massless,
 see :mod:`pan_tilt_sim.model.inertials`); what PyBullet says while loading
-goes to the log, one line per message.
+goes to the log, one line per message.  What it builds is decided beforehand,
+in a :mod:`~pan_tilt_sim.model.physics_plan`.
 
 Design notes: docs/design/sim.md#physicspy.
 """
@@ -152,6 +153,10 @@ def engine_parameters(settings: PhysicsSettings) -> dict[str, float | int]:
 class Physics:
     """A PyBullet world holding one robot, its base welded to the world or free.
 
+    Built from a :class:`~pan_tilt_sim.model.physics_plan.PhysicsPlan`, which
+    decides everything about the model; the constructor makes one from
+    ``description`` (:func:`~pan_tilt_sim.model.physics_plan.plan_physics`),
+    :meth:`from_plan` takes one made already.
     ``initial_positions`` (one per actuated joint; default: each joint's
     :attr:`~pan_tilt_sim.model.robot.JointSpec.initial_position`) is where
     the joints start and where :meth:`reset_joints` without arguments puts
