@@ -7,8 +7,8 @@ they start (followers where their leaders put them), PyBullet's speed cap, the p
 which effective inertias are checked, the links' contact surfaces and where the base is
 placed.  :class:`pan_tilt_sim.sim.physics.Physics` builds from it in one pass and makes
 no decision about the model itself.  A description the physics cannot take (a mimic
-cycle, a mimic of no movable joint) raises :class:`DescriptionError` here, before
-PyBullet is touched.
+of a joint that does not move) raises :class:`DescriptionError` here, before PyBullet
+is touched.
 
 Design notes: docs/design/sim.md#start-up-path.
 """

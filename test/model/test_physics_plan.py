@@ -65,14 +65,6 @@ def test_a_wrong_number_of_initial_positions_is_refused(tmp_path):
         plan_physics(star(tmp_path, LEADER, FOLLOWER), initial_positions=[0.0])
 
 
-def test_a_mimic_cycle_is_refused_when_the_plan_is_made_naming_the_file(tmp_path):
-    description = star(tmp_path, JointDef('a', mimic=('b', 1.0, 0.0)),
-                       JointDef('b', mimic=('a', 1.0, 0.0)))
-    with pytest.raises(DescriptionError,
-                       match=r'star\.urdf: mimic joints form a cycle: a -> b -> a'):
-        plan_physics(description)
-
-
 def test_a_mimic_of_a_fixed_joint_is_refused_when_the_plan_is_made(tmp_path):
     description = star(tmp_path, JointDef('weld', kind='fixed'),
                        JointDef('a', mimic=('weld', 1.0, 0.0)))
