@@ -15,6 +15,7 @@ from robot_fixtures import (
 
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.model.physics_plan import plan_physics
 from pan_tilt_sim.model.physics_settings import DEFAULT_PHYSICS, PhysicsSettings
 from pan_tilt_sim.sim.bullet import message_lines
 from pan_tilt_sim.sim.physics import Physics, engine_parameters, pybullet
@@ -31,6 +32,16 @@ def test_each_physics_owns_its_own_client(description):
         first.step([50.0, 0.0])
         assert second.read_states()[0][1] == 0.0
     assert not pybullet.isConnected(first.client_id)
+
+
+def test_a_physics_builds_what_its_plan_says(description):
+    plan = plan_physics(description, initial_positions=[0.3, -0.2])
+    with Physics.from_plan(plan, 0.001) as physics:
+        assert physics.plan is plan
+        assert physics.initial_positions == [0.3, -0.2]
+        assert [state[0] for state in physics.read_states()] == pytest.approx([0.3, -0.2])
+        assert physics.velocity_cap == plan.velocity_cap
+        assert physics.fixed_base
 
 
 def test_the_base_is_fixed_and_gravity_points_down(description):
