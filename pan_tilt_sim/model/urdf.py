@@ -135,6 +135,7 @@ def read_model(root: ElementTree.Element, source: pathlib.Path) -> RobotModel:
                 f"{source}: joint '{joint.name}' mimics '{joint.mimic.joint}', "
                 'which is not a joint of this robot')
     _check_tree(links, joints, source)
+    _check_mimic_cycles(joints, source)
     plugins = _control_plugins(root)
     for plugin in plugins:
         namespace = plugin.namespace
@@ -198,6 +199,22 @@ def _check_unique(kind: str, names: list[str], source: pathlib.Path) -> None:
             raise DescriptionError(
                 f"{source}: {kind} '{name}' is declared twice: {kind} names must be unique")
         seen.add(name)
+
+
+def _check_mimic_cycles(joints: tuple[JointSpec, ...], source: pathlib.Path) -> None:
+    """Refuse ``<mimic>`` joints that follow each other round: no position would satisfy them."""
+    leader_of = {joint.name: joint.mimic.joint for joint in joints if joint.mimic is not None}
+    cleared: set[str] = set()
+    for start in leader_of:
+        chain: list[str] = []
+        name = start
+        while name in leader_of and name not in cleared:
+            if name in chain:
+                cycle = ' -> '.join((*chain[chain.index(name):], name))
+                raise DescriptionError(f'{source}: mimic joints form a cycle: {cycle}')
+            chain.append(name)
+            name = leader_of[name]
+        cleared.update(chain)
 
 
 def _check_tree(links: tuple[Link, ...], joints: tuple[JointSpec, ...],

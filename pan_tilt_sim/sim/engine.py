@@ -41,6 +41,7 @@ from pan_tilt_sim.model.base_pose import FIXED_BASE, ORIGIN, BasePose
 from pan_tilt_sim.model.controller_config import ControllersConfig
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.initial_positions import FROM_DEFAULT, StartPosition, start_positions
+from pan_tilt_sim.model.physics_plan import plan_physics
 from pan_tilt_sim.model.physics_settings import DEFAULT_PHYSICS, PhysicsSettings
 from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.plugins.framework.plugin import Plugin, PluginWorld
@@ -160,37 +161,37 @@ class Simulation:
         self.guests: list[Simulation] = []
         self._logger: Logger = logger or logging.getLogger(LOGGER_NAME)
         load_messages: list[str] = list(controllers.warnings)  # the file's dropped blocks
+        model = description.model
         # The model's Gazebo plugins (drive, joint states, ground truth), read before anything
         # is built (a malformed element ends start-up): always active, updated before the
         # controllers; no controller_manager knows them.
-        self.plugins: list[Plugin] = create_plugins(description.model, controllers.label,
+        self.plugins: list[Plugin] = create_plugins(model, controllers.label,
                                                     load_messages.append)
-        starts = start_positions(description.model, initial_positions)
+        # What the physics and the joint handles need of the model, decided before anything
+        # is built (docs/design/sim.md#start-up-path).
+        starts = start_positions(model, initial_positions)
         movable = [joint.name for joint in description.actuated_joints]
         gains = plugin_gains(controllers.pid_gains, movable, controllers.label)
         fixed, why = base_is_fixed(fixed_base, description, controllers, active_controllers,
                                    autostart_controllers)
-        self.physics = Physics(
-            description, time_step, gui=gui,
-            initial_positions=[starts[joint].position for joint in movable],
-            warn=load_messages.append, fixed_base=fixed, initial_pose=initial_pose,
-            settings=physics_settings, world=None if world is None else world.physics)
+        plan = plan_physics(description, fixed_base=fixed, initial_pose=initial_pose,
+                            initial_positions=[starts[joint].position for joint in movable])
+        tracking_gain = model.position_proportional_gain or TRACKING_GAIN
+        self.handles = {
+            joint.name: JointHandle(joint, position, gains.get(joint.name), tracking_gain,
+                                    control=model.control_joint(joint.name))
+            for joint, position in zip(plan.joints, plan.initial_positions, strict=True)}
+        self.physics = Physics.from_plan(
+            plan, time_step, gui=gui, warn=load_messages.append, settings=physics_settings,
+            world=None if world is None else world.physics)
         self._base_report = self._describe_base(why, fixed_base, initial_pose)
         self._time_step = time_step
         self._steps = 0 if world is None else world.steps
         try:
             check_startup_stability(self.physics, description)
-            model = description.model
-            gain = model.position_proportional_gain or TRACKING_GAIN
-            self.handles = {
-                joint.name: JointHandle(joint, position, gains.get(joint.name), gain,
-                                        control=model.control_joint(joint.name))
-                for joint, position in zip(self.physics.joints,
-                                           self.physics.initial_positions, strict=True)}
             # The <ros2_control> sensors and gpios, measured here, read by the controllers.
-            self.hardware = SimulatedHardware(self.physics, description.model,
-                                              lambda: self._steps)
-            self.manager = ControllerManager(controllers, self.handles, description.model,
+            self.hardware = SimulatedHardware(self.physics, model, lambda: self._steps)
+            self.manager = ControllerManager(controllers, self.handles, model,
                                              active=active_controllers,
                                              autostart=autostart_controllers,
                                              hardware=self.hardware.interfaces,

@@ -4,7 +4,8 @@
 client), so several simulations can live in one process.  The robot is
 loaded with the URDF's inertia (links without ``<inertial>`` come massless,
 see :mod:`pan_tilt_sim.model.inertials`); what PyBullet says while loading
-goes to the log, one line per message.
+goes to the log, one line per message.  What it builds is decided beforehand,
+in a :mod:`~pan_tilt_sim.model.physics_plan`.
 
 Design notes: docs/design/sim.md#physicspy.
 """
@@ -24,12 +25,11 @@ import numpy
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.base_pose import ORIGIN, BasePose
 from pan_tilt_sim.model.description import RobotDescription
-from pan_tilt_sim.model.inertials import with_massive_root
-from pan_tilt_sim.model.mimic import MimicCoupling, follow_leaders, mimic_couplings
+from pan_tilt_sim.model.physics_plan import BasePlacement, LinkSurface, PhysicsPlan, plan_physics
 from pan_tilt_sim.model.physics_settings import DEFAULT_PHYSICS, PhysicsSettings
-from pan_tilt_sim.model.robot import JointSpec, RobotModel
+from pan_tilt_sim.model.robot import JointSpec
 from pan_tilt_sim.model.surfaces import Surface
-from pan_tilt_sim.model.transforms import Transform, quaternion_from_rpy
+from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.sim import compiled_step
 from pan_tilt_sim.sim.bullet import (
     captured_native_output,
@@ -51,10 +51,6 @@ STATE_MOTOR_TORQUE = 3
 MIMIC_MAX_FORCE = 1e9
 MIMIC_ERROR_REDUCTION = 0.8
 BASE_LINK_INDEX = -1  # PyBullet's index of a body's base link
-# PyBullet clamps every joint's speed to this (rad/s or m/s); we raise it to
-# twice the fastest URDF velocity limit, never below PyBullet's default.
-DEFAULT_VELOCITY_CAP = 100.0
-VELOCITY_CAP_MARGIN = 2.0
 # A motor force "without limit" (N*m or N): PyBullet needs a finite number.
 UNLIMITED_FORCE = 1e9
 # How often the joints' effective inertias are recomputed for the damping
@@ -63,10 +59,6 @@ INERTIA_REFRESH_STEPS = 100
 # PyBullet's explicit damping is kept where damping * time_step is at most this
 # share of the joint's smallest effective inertia (it diverges at 2).
 EXPLICIT_DAMPING_SHARE = 0.1
-# Poses at which inertias are checked: the start, then every joint at these
-# fractions of its range (0 = lower, 1 = upper), or at these angles without limits.
-RANGE_FRACTIONS = (0.5, 0.25, 0.75)
-FREE_POSES = (0.0, math.pi / 2.0, -math.pi / 2.0)
 BALL_DOFS = 3  # a spherical joint's velocity columns
 NO_MOTOR = 0.0  # force 0 removes a joint's motor row from PyBullet's solver
 MOTOR_VELOCITY_GAIN = 1.0  # a velocity motor that reaches its target in one step if it can
@@ -93,48 +85,6 @@ def _disconnect(client: int, connections: list[compiled_step.Connection]) -> Non
 
 def _ignore(message: str) -> None:
     """Drop ``message`` (the default log function)."""
-
-
-def check_poses(joints: Sequence[JointSpec], start: Sequence[float]) -> list[list[float]]:
-    """Return the poses to check inertias at: the start, then each of RANGE_FRACTIONS."""
-    poses = [list(start)]
-    for number, fraction in enumerate(RANGE_FRACTIONS):
-        pose = []
-        for joint in joints:
-            if joint.has_position_limits and math.isfinite(joint.lower) and math.isfinite(
-                    joint.upper):
-                pose.append(joint.lower + fraction * (joint.upper - joint.lower))
-            else:
-                pose.append(FREE_POSES[number % len(FREE_POSES)])
-        poses.append(pose)
-    return poses
-
-
-def velocity_cap(joints: Sequence[JointSpec]) -> float:
-    """Return the speed cap to give PyBullet: twice the fastest finite limit, at least 100."""
-    limits = [joint.velocity_limit for joint in joints if math.isfinite(joint.velocity_limit)]
-    return max([DEFAULT_VELOCITY_CAP] + [VELOCITY_CAP_MARGIN * limit for limit in limits])
-
-
-def apply_surfaces(client: int, body: int, model: RobotModel) -> None:
-    """Give each link of ``body`` its contact friction and, where the URDF has one, its spring.
-
-    ``model`` is the body's URDF model (link names as PyBullet has them).
-    """
-    base = pybullet.getBodyInfo(body, physicsClientId=client)[0].decode('utf-8')
-    names = [(BASE_LINK_INDEX, base)] + [
-        (index, pybullet.getJointInfo(body, index, physicsClientId=client)[12].decode('utf-8'))
-        for index in range(pybullet.getNumJoints(body, physicsClientId=client))]
-    for index, name in names:
-        surface = model.surface(name)
-        spring = surface.spring
-        if spring is None:
-            pybullet.changeDynamics(body, index, lateralFriction=surface.friction,
-                                    physicsClientId=client)
-        else:
-            pybullet.changeDynamics(body, index, lateralFriction=surface.friction,
-                                    contactStiffness=spring[0], contactDamping=spring[1],
-                                    physicsClientId=client)
 
 
 def free_ball_joints(body: int, client: int) -> list[int]:
@@ -176,6 +126,22 @@ def apply_surface_friction(body: int, links: Mapping[str, int],
                                     physicsClientId=client)
 
 
+def apply_link_surfaces(body: int, links: Mapping[str, int], surfaces: Sequence[LinkSurface],
+                        client: int) -> None:
+    """Give the links of ``body`` (indices by name) their friction and contact spring."""
+    for surface in surfaces:
+        if surface.link not in links:  # a link merged away by a fixed joint has no body
+            continue
+        if surface.spring is None:
+            pybullet.changeDynamics(body, links[surface.link], lateralFriction=surface.friction,
+                                    physicsClientId=client)
+        else:
+            stiffness, damping = surface.spring
+            pybullet.changeDynamics(body, links[surface.link], lateralFriction=surface.friction,
+                                    contactStiffness=stiffness, contactDamping=damping,
+                                    physicsClientId=client)
+
+
 def engine_parameters(settings: PhysicsSettings) -> dict[str, float | int]:
     """Return ``settings`` as ``pybullet.setPhysicsEngineParameter``'s keyword arguments."""
     return {'numSolverIterations': settings.solver_iterations, 'erp': settings.erp,
@@ -187,6 +153,10 @@ def engine_parameters(settings: PhysicsSettings) -> dict[str, float | int]:
 class Physics:
     """A PyBullet world holding one robot, its base welded to the world or free.
 
+    Built from a :class:`~pan_tilt_sim.model.physics_plan.PhysicsPlan`, which
+    decides everything about the model; the constructor makes one from
+    ``description`` (:func:`~pan_tilt_sim.model.physics_plan.plan_physics`),
+    :meth:`from_plan` takes one made already.
     ``initial_positions`` (one per actuated joint; default: each joint's
     :attr:`~pan_tilt_sim.model.robot.JointSpec.initial_position`) is where
     the joints start and where :meth:`reset_joints` without arguments puts
@@ -207,9 +177,28 @@ class Physics:
                  initial_pose: BasePose = ORIGIN,
                  settings: PhysicsSettings = DEFAULT_PHYSICS,
                  world: Physics | None = None) -> None:
-        self._description = description
+        self._build(plan_physics(description, fixed_base=fixed_base,
+                                 initial_positions=initial_positions, initial_pose=initial_pose),
+                    time_step, gui=gui, warn=warn, settings=settings, world=world)
+
+    @classmethod
+    def from_plan(cls, plan: PhysicsPlan, time_step: float, *, gui: bool = False,
+                  warn: LogFunction = _ignore, settings: PhysicsSettings = DEFAULT_PHYSICS,
+                  world: Physics | None = None) -> Physics:
+        """Build the physics of ``plan`` (:func:`~pan_tilt_sim.model.physics_plan.plan_physics`)."""
+        physics = cls.__new__(cls)
+        physics._build(plan, time_step, gui=gui, warn=warn, settings=settings, world=world)
+        return physics
+
+    def _build(self, plan: PhysicsPlan, time_step: float, *, gui: bool, warn: LogFunction,
+               settings: PhysicsSettings, world: Physics | None) -> None:
+        """Build ``plan`` in PyBullet, in one pass: PyBullet calls only, no model decisions."""
+        self._plan = plan
         self._time_step = time_step
-        self._fixed_base = fixed_base
+        self._fixed_base = plan.fixed_base
+        self._joints = plan.joints
+        self._initial_positions = list(plan.initial_positions)
+        self.velocity_cap = plan.velocity_cap
         self._workdir = tempfile.TemporaryDirectory(prefix='pan_tilt_sim_')
         self.is_guest = world is not None
         self._compiled: list[compiled_step.Connection] = []
@@ -233,31 +222,21 @@ class Physics:
         # A guest's joint states after the last world step (see take_states).
         self._after_step: list = [()]
         try:
-            self._body = self._load(description, warn)
+            self._body = self._load(plan, warn)
             connection = None if world is not None else compiled_step.connect(self._client)
             if connection is not None:
                 self._compiled.append(connection)
         except BaseException:
             self.close()
             raise
-        self._joints = description.actuated_joints
         index_of, self._link_indices, self._dof_indices = self._joint_and_link_indices()
         self._indices = [index_of[joint.name] for joint in self._joints]
-        self._mimics = mimic_couplings(self._joints, description.source)
-        self.velocity_cap = velocity_cap(self._joints)
         self._remove_hidden_damping()
         self._balls = free_ball_joints(self._body, self._client)
-        apply_surface_friction(self._body, self._link_indices,
-                               description.model.link_frictions, self._client)
+        apply_link_surfaces(self._body, self._link_indices, plan.surfaces, self._client)
         self._couple_mimic_joints(index_of)
-        if initial_positions is None:
-            initial_positions = [joint.initial_position for joint in self._joints]
-        self._initial_positions = self._with_mimics(initial_positions)
-        self._drives = _Drives(self, [False] * len(self._joints), self._indices,
-                               self._mimics)
+        self._drives = _Drives(self, [False] * len(self._joints), self._indices, plan.coupled)
         self.reset_joints()
-        if not fixed_base:
-            apply_surfaces(self._client, self._body, description.model)
         dynamics = pybullet.getDynamicsInfo(self._body, BASE_LINK_INDEX,
                                             physicsClientId=self._client)
         # PyBullet places a body by its base's centre of mass; the URDF frame is offset by this.
@@ -266,10 +245,15 @@ class Physics:
         # A free robot stands on the ground from the start, every link touching it; the
         # ground's friction 1 leaves each link its own coefficient (PyBullet multiplies them).
         self.ground: int | None = None
-        if not fixed_base:
+        if plan.base.on_ground:
             self.ground = (world.ground if world is not None and world.ground is not None
                            else add_ground_plane(self._client, self._body, []))
-        self._initial_base = self._place_base(initial_pose)
+        self._initial_base = self._place_base(plan.base)
+
+    @property
+    def plan(self) -> PhysicsPlan:
+        """What this physics was built from."""
+        return self._plan
 
     @property
     def fixed_base(self) -> bool:
@@ -318,22 +302,23 @@ class Physics:
             pybullet.resetBaseVelocity(self._body, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0),
                                        physicsClientId=self._client)
 
-    def _place_base(self, pose: BasePose) -> Transform:
-        """Put the base at ``pose`` (a free one resting on the ground); return its frame."""
-        rotation = quaternion_from_rpy(pose.roll, pose.pitch, pose.yaw)
-        if self._fixed_base:
-            frame = Transform((pose.x, pose.y, pose.z), rotation)
-            if not pose.is_origin:
-                self._set_base_frame(frame)
-            return self.base_frame() if pose.is_origin else frame
+    def _place_base(self, placement: BasePlacement) -> Transform:
+        """Put the base where ``placement`` says (a free one resting on the ground); return it."""
+        frame = placement.frame
+        if not placement.on_ground:
+            if placement.as_loaded:
+                return self.base_frame()
+            self._set_base_frame(frame)
+            return frame
         # Held high above the ground plane, the closest points between them give the
         # height of the robot's lowest collision point (meshes included).
-        lifted = Transform((pose.x, pose.y, MEASURING_HEIGHT), rotation)
+        x, y, clearance = frame.translation
+        lifted = Transform((x, y, MEASURING_HEIGHT), frame.rotation)
         self._set_base_frame(lifted)
         points = pybullet.getClosestPoints(self._body, self.ground, MEASURING_RANGE,
                                            physicsClientId=self._client)
         lowest = min((point[CLOSEST_DISTANCE] for point in points), default=MEASURING_HEIGHT)
-        frame = Transform((pose.x, pose.y, MEASURING_HEIGHT - lowest + pose.z), rotation)
+        frame = Transform((x, y, MEASURING_HEIGHT - lowest + clearance), frame.rotation)
         self._set_base_frame(frame)
         return frame
 
@@ -490,7 +475,7 @@ class Physics:
         efforts of the effort-driven joints and the velocity targets of the
         velocity-driven ones, each in joint order.
         """
-        self._drives = _Drives(self, velocity_driven, self._indices, self._mimics)
+        self._drives = _Drives(self, velocity_driven, self._indices, self._plan.coupled)
 
     def step(self, efforts: Sequence[float], targets: Sequence[float] = (),
              forces: Sequence[float] | None = None) -> list:
@@ -534,7 +519,7 @@ class Physics:
 
         Mimic joints go where their leaders put them.
         """
-        positions = self._initial_positions if positions is None else self._with_mimics(
+        positions = self._initial_positions if positions is None else self._plan.with_mimics(
             positions)
         for index, position in zip(self._indices, positions, strict=True):
             pybullet.resetJointState(
@@ -591,9 +576,11 @@ class Physics:
         return [float(inertias[first + self._dof_indices[index]]) for index in self._indices]
 
     def smallest_inertias(self) -> list[float]:
-        """Return each joint's smallest effective inertia over :func:`check_poses`."""
-        poses = check_poses(self._joints, self._initial_positions)
-        inertias = [self.effective_inertias(pose) for pose in poses]
+        """Return each joint's smallest effective inertia over the plan's inertia poses.
+
+        (:func:`~pan_tilt_sim.model.physics_plan.check_poses`.)
+        """
+        inertias = [self.effective_inertias(pose) for pose in self._plan.inertia_poses]
         return [min(values) for values in zip(*inertias, strict=True)]
 
     def gravity_torques(self, positions: Sequence[float] | None = None) -> list[float]:
@@ -641,37 +628,28 @@ class Physics:
     def __exit__(self, *exc_info: object) -> None:
         self.close()
 
-    def _with_mimics(self, positions: Sequence[float]) -> list[float]:
-        if not self._mimics:
-            return list(positions)
-        return list(follow_leaders([joint.name for joint in self._joints], positions,
-                                   self._mimics))
-
-    def _load(self, description: RobotDescription, warn: LogFunction) -> int:
+    def _load(self, plan: PhysicsPlan, warn: LogFunction) -> int:
         client = self._client
         pybullet.setGravity(0.0, 0.0, -STANDARD_GRAVITY, physicsClientId=client)
         pybullet.setTimeStep(self._time_step, physicsClientId=client)
         urdf_path = pathlib.Path(self._workdir.name) / URDF_FILE_NAME
-        # A free base must have a mass, or PyBullet welds it (see model.inertials).
-        urdf_path.write_text(description.physics_urdf if self._fixed_base else
-                             with_massive_root(description.physics_urdf, description.model),
-                             encoding='utf-8')
+        urdf_path.write_text(plan.urdf, encoding='utf-8')
         output: list[str] = []
         try:
             with captured_native_output(output):
                 flags = pybullet.URDF_USE_INERTIA_FROM_FILE
-                if not self._fixed_base:  # wheels: exact cylinders, not polygon hulls
+                if plan.implicit_cylinders:
                     flags |= pybullet.URDF_USE_IMPLICIT_CYLINDER
                 body = pybullet.loadURDF(
-                    str(urdf_path), useFixedBase=self._fixed_base, flags=flags,
+                    str(urdf_path), useFixedBase=plan.fixed_base, flags=flags,
                     physicsClientId=client)
         except pybullet.error as err:
             reasons = '; '.join(message_lines(''.join(output)))
             because = f' ({reasons})' if reasons else ''
             raise DescriptionError(
-                f'{description.source}: PyBullet cannot load the robot: {err}{because}') from None
+                f'{plan.source}: PyBullet cannot load the robot: {err}{because}') from None
         for line in message_lines(''.join(output)):
-            warn(f'PyBullet, loading {description.source.name}: {line}')
+            warn(f'PyBullet, loading {plan.source.name}: {line}')
         return body
 
     def _joint_and_link_indices(self) -> tuple[dict[str, int], dict[str, int], dict[int, int]]:
@@ -700,7 +678,7 @@ class Physics:
 
     def _couple_mimic_joints(self, index_of: dict[str, int]) -> None:
         # A gear constraint keeps q_follower - multiplier * q_leader at offset.
-        for coupling in self._mimics:
+        for coupling in self._plan.mimics:
             constraint = pybullet.createConstraint(
                 self._body, index_of[coupling.follower], self._body, index_of[coupling.leader],
                 pybullet.JOINT_GEAR, (0.0, 0.0, 1.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0),
@@ -887,17 +865,16 @@ class _Drives:
     damping and the :func:`static_rows` are sent once here; the
     :class:`MotorRows` (velocity motors and :class:`ImplicitDamping`) every
     step; the :class:`GainDamping` rows when the inertias are refreshed.
-    ``indices``: PyBullet's index of each joint; ``mimics``: the robot's
-    mimic couplings.
+    ``indices``: PyBullet's index of each joint; ``coupled``: the names of the
+    joints a mimic coupling joins.
     """
 
     def __init__(self, physics: Physics, velocity_driven: Sequence[bool],
-                 indices: Sequence[int], mimics: Sequence[MimicCoupling]) -> None:
+                 indices: Sequence[int], coupled: Collection[str]) -> None:
         joints = physics.joints
         self._physics = physics
         body, client, dt = physics.body_id, physics.client_id, physics.time_step
         self._body, self._client, self._dt = body, client, dt
-        coupled = {name for coupling in mimics for name in (coupling.leader, coupling.follower)}
         split = split_drives(joints, velocity_driven, dt, physics.smallest_inertias, coupled)
         self.velocity_slots, self.effort_slots = split.velocity, split.effort
         self.explicit, self.implicit, self.damped = split.explicit, split.implicit, split.damped

@@ -51,6 +51,10 @@ def _joint(name: str, parent: str, child: str, kind: str = 'revolute', axis: str
             '<limit lower="-3" upper="3" effort="10" velocity="2"/></joint>')
 
 
+def _mimicking(joint: str, leader: str) -> str:
+    return joint.replace('</joint>', f'<mimic joint="{leader}"/></joint>')
+
+
 def _robot(*parts: str) -> str:
     return '<?xml version="1.0"?>\n<robot name="r">\n' + '\n'.join(parts) + '\n</robot>\n'
 
@@ -145,6 +149,10 @@ FILES = {
                                   _joint('j3', 'c', 'b')),
     'cycle_off_nothing.urdf': _robot(*_ABC, _link('d'), _joint('j1', 'a', 'b'),
                                      _joint('j2', 'c', 'd'), _joint('j3', 'd', 'c')),
+    'mimic_cycle.urdf': _robot(*_ABC, _mimicking(_joint('j1', 'a', 'b'), 'j2'),
+                               _mimicking(_joint('j2', 'b', 'c'), 'j1')),
+    'mimic_of_fixed.urdf': _robot(*_ABC, _joint('j1', 'a', 'b', 'fixed'),
+                                  _mimicking(_joint('j2', 'b', 'c'), 'j1')),
     'root_cycle_orphan.urdf': _robot(*_ABC, _joint('j1', 'a', 'b'), _joint('j2', 'b', 'a')),
     'own_parent.urdf': _robot(*_AB, _joint('j1', 'a', 'b'), _joint('j2', 'b', 'b')),
     'joint_twice.urdf': _robot(*_ABC, _joint('j1', 'a', 'b'), _joint('j1', 'b', 'c')),
@@ -327,6 +335,13 @@ CASES = [
     _case('cycle off nothing', {'robot_description_file': '{dir}/cycle_off_nothing.urdf',
                                 'controllers_file': '{dir}/j1_pid.yaml'},
           DescriptionError, '{dir}/cycle_off_nothing.urdf', "'j3', 'j2' form a cycle"),
+    _case('mimic cycle', {'robot_description_file': '{dir}/mimic_cycle.urdf',
+                          'controllers_file': '{dir}/j1_ideal.yaml'},
+          DescriptionError, '{dir}/mimic_cycle.urdf: mimic joints form a cycle: j1 -> j2 -> j1'),
+    _case('mimic of a fixed joint', {'robot_description_file': '{dir}/mimic_of_fixed.urdf',
+                                     'controllers_file': '{dir}/j1_ideal.yaml'},
+          DescriptionError, "{dir}/mimic_of_fixed.urdf: joint 'j2' mimics 'j1', which is not a "
+          'movable joint of this robot'),
     _case('zero axis, PID', {'robot_description_file': '{dir}/zero_axis.urdf',
                              'controllers_file': '{dir}/j1_pid.yaml'},
           DescriptionError, "joint 'j1'", '<axis xyz="0 0 0"> has no direction'),

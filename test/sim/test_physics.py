@@ -15,16 +15,10 @@ from robot_fixtures import (
 
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.model.physics_plan import plan_physics
 from pan_tilt_sim.model.physics_settings import DEFAULT_PHYSICS, PhysicsSettings
-from pan_tilt_sim.model.robot import JointKind, JointSpec
 from pan_tilt_sim.sim.bullet import message_lines
-from pan_tilt_sim.sim.physics import (
-    DEFAULT_VELOCITY_CAP,
-    Physics,
-    engine_parameters,
-    pybullet,
-    velocity_cap,
-)
+from pan_tilt_sim.sim.physics import Physics, engine_parameters, pybullet
 
 
 @pytest.fixture
@@ -38,6 +32,16 @@ def test_each_physics_owns_its_own_client(description):
         first.step([50.0, 0.0])
         assert second.read_states()[0][1] == 0.0
     assert not pybullet.isConnected(first.client_id)
+
+
+def test_a_physics_builds_what_its_plan_says(description):
+    plan = plan_physics(description, initial_positions=[0.3, -0.2])
+    with Physics.from_plan(plan, 0.001) as physics:
+        assert physics.plan is plan
+        assert physics.initial_positions == [0.3, -0.2]
+        assert [state[0] for state in physics.read_states()] == pytest.approx([0.3, -0.2])
+        assert physics.velocity_cap == plan.velocity_cap
+        assert physics.fixed_base
 
 
 def test_the_base_is_fixed_and_gravity_points_down(description):
@@ -137,13 +141,6 @@ def test_pybullets_hidden_drag_is_off(tmp_path):
         for _ in range(2000):
             (coasting,) = physics.step([0.0])
     assert coasting[1] == pytest.approx(kicked[1], rel=1e-9)
-
-
-def test_the_speed_cap_is_twice_the_fastest_velocity_limit_and_never_below_100():
-    def joint(limit):
-        return JointSpec('j', JointKind.REVOLUTE, velocity_limit=limit)
-    assert velocity_cap([joint(2.0), joint(math.inf)]) == DEFAULT_VELOCITY_CAP == 100.0
-    assert velocity_cap([joint(2.0), joint(150.0)]) == 300.0
 
 
 def test_a_joint_may_reach_its_velocity_limit_beyond_pybullets_default_cap(tmp_path):

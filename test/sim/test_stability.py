@@ -20,7 +20,6 @@ from robot_fixtures import (
 from pan_tilt_sim.errors import DescriptionError
 from pan_tilt_sim.sim import compiled_step
 from pan_tilt_sim.sim.engine import make_simulation
-from pan_tilt_sim.sim.physics import check_poses
 from pan_tilt_sim.sim.stability import check_startup_stability, largest_stable_time_step
 
 DT = 0.001
@@ -195,13 +194,6 @@ def test_the_start_up_trial_leaves_no_trace(tmp_path):
     moved = run(0)
     assert moved[0]['shoulder'] != 0.0
     assert run(3) == moved  # to the last bit
-
-
-def test_the_check_poses_cover_the_range_and_free_joints():
-    from pan_tilt_sim.model.robot import JointKind, JointSpec
-    joints = [JointSpec('a', JointKind.REVOLUTE, -1.0, 3.0), JointSpec('b', JointKind.CONTINUOUS)]
-    assert check_poses(joints, [0.5, 0.25]) == [
-        [0.5, 0.25], [1.0, 0.0], [0.0, math.pi / 2], [2.0, -math.pi / 2]]
 
 
 def test_largest_stable_time_step_solves_the_rule():
