@@ -24,7 +24,6 @@ from pan_tilt_sim.controllers.framework.base import (
     ActuatorKind,
     CommandController,
     CommandKind,
-    CommandResult,
     JointHandle,
     Reference,
 )
@@ -41,20 +40,23 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
 )
 from pan_tilt_sim.controllers.framework.shared_parameters import (
     UPDATE_RATE,
+    check_odometry_frames,
     odometry_frames,
-    same_frames_problem,
     update_period,
 )
 from pan_tilt_sim.controllers.framework.surface import (
     CommandTopic,
     Endpoint,
-    StampedTwist,
     StateTopic,
 )
 from pan_tilt_sim.controllers.toolbox.actuator import ARRIVED, SETPOINT_ACCELERATION, ramp
 from pan_tilt_sim.controllers.toolbox.limits import PositionLimits
 from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, OdometrySink, TfSink
-from pan_tilt_sim.model.transforms import Transform
+from pan_tilt_sim.controllers.toolbox.twist_command import (
+    TwistCommand,
+    TwistCommanded,
+    planar_references,
+)
 from pan_tilt_sim.schedule import PeriodicSchedule
 
 VELOCITY, POSITION = 'velocity', 'position'
@@ -180,7 +182,7 @@ class SteeringJoints:
                 -limit if target < -limit else target)
 
 
-class SteeringController(OdometryOutputs, CommandController):
+class SteeringController(OdometryOutputs, TwistCommanded, CommandController):
     """A steered base from a twist: steering angles and wheel speeds out, odometry back.
 
     Subclasses give :attr:`configuration` and build the kinematics from their
@@ -197,13 +199,10 @@ class SteeringController(OdometryOutputs, CommandController):
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
-        same_frames = same_frames_problem(self.params)
-        if same_frames:
-            raise self.error('base_frame_id', same_frames)
+        check_odometry_frames(self)
         self._names = self._joint_lists()
         self._kinematics = self.kinematics()
-        self._references = {f'{name}/linear/{VELOCITY}': Reference(f'{name}/linear/{VELOCITY}'),
-                            f'{name}/angular/{VELOCITY}': Reference(f'{name}/angular/{VELOCITY}')}
+        self._references = planar_references(name)
         self._linear_reference, self._angular_reference = self._references.values()
         self._updates = PeriodicSchedule(update_period(self.params))
         self._traction: list[JointHandle] = []
@@ -213,8 +212,7 @@ class SteeringController(OdometryOutputs, CommandController):
         self._odometry_sink: OdometrySink | None = None
         self._tf_sink: TfSink | None = None
         self._status_sink: StatusSink | None = None
-        self._command: StampedTwist | None = None
-        self._problem = ''
+        self._command = TwistCommand('reference', timeout_field='reference_timeout')
         self.reset()
 
     def _joint_lists(self) -> dict[str, tuple[str, ...]]:
@@ -305,10 +303,8 @@ class SteeringController(OdometryOutputs, CommandController):
         return (
             CommandTopic(f'~/{self.command_topic}', self.command_kind.value, self.set_command,
                          self.command_problem),
-            StateTopic('~/odometry', 'nav_msgs/msg/Odometry', self.set_odometry_sink, {
-                'frame_id': odom, 'child_frame_id': base,
-                'pose_covariance_diagonal': tuple(params['pose_covariance_diagonal']),
-                'twist_covariance_diagonal': tuple(params['twist_covariance_diagonal'])}),
+            self.odometry_topic('~/odometry', (odom, base), params['pose_covariance_diagonal'],
+                                params['twist_covariance_diagonal']),
             StateTopic('~/tf_odometry', 'tf2_msgs/msg/TFMessage', self.set_tf_sink),
             StateTopic('~/controller_state', STATUS_MESSAGE, self.set_status_sink,
                        {'frame_id': odom}),
@@ -334,7 +330,7 @@ class SteeringController(OdometryOutputs, CommandController):
 
     def reset(self) -> None:
         """No reference, odometry at the origin, the wheels asked to stand, the steering held."""
-        self._command = None
+        self._command.latest = None
         self._timed_out = False
         self._time = 0.0
         self._last_update: float | None = None
@@ -353,30 +349,11 @@ class SteeringController(OdometryOutputs, CommandController):
             handle.velocity_target = 0.0
         self._steering.hold()
 
-    # --- commands --------------------------------------------------------------------------
+    # --- commands (set_command, command_problem: TwistCommanded) ----------------------------
 
-    def set_command(self, value: StampedTwist) -> CommandResult:
-        """Take a twist (from the subscription; cheap): refuse non-finite or stale ones."""
-        linear, angular = value.linear[0], value.angular[2]
-        if not (math.isfinite(linear) and math.isfinite(angular)):
-            self._problem = (f'ignored reference (linear.x {linear!r}, angular.z {angular!r}): '
-                             'not finite numbers')
-            return CommandResult.REJECTED
-        now = self._time
-        stamp = value.stamp if value.stamp > 0.0 else now
-        timeout = self.params['reference_timeout']
-        if timeout != 0.0 and now - stamp > timeout:
-            self._problem = (f'ignored reference stamped {stamp:.4f} s: {now - stamp:.4f} s old '
-                             f'at sim time {now:.4f} s, more than reference_timeout '
-                             f'({timeout:g} s)')
-            return CommandResult.REJECTED
-        self._command = StampedTwist(stamp, (linear, 0.0, 0.0), (0.0, 0.0, angular))
+    def twist_taken(self) -> None:
+        """Let a new twist time out again (and say so)."""
         self._timed_out = False
-        return CommandResult.ACCEPTED
-
-    def command_problem(self, value: Any, result: CommandResult) -> str:
-        """Describe the last refused twist."""
-        return self._problem
 
     def setpoints(self) -> dict[str, float]:
         """Return each traction joint's velocity (rad/s) and steering joint's setpoint (rad)."""
@@ -432,14 +409,14 @@ class SteeringController(OdometryOutputs, CommandController):
 
     def _update_references(self, time: float) -> None:
         """Write the newest reference to the references; drop it once it is stale."""
-        command = self._command
+        command = self._command.latest
         if command is None:
             return
         timeout = self.params['reference_timeout']
         if timeout == 0.0:
-            self._command = None
+            self._command.latest = None
         elif time - command.stamp > timeout:
-            self._command = None
+            self._command.latest = None
             if not self._timed_out:
                 self._timed_out = True
                 self.notices.append(f'reference timed out ({timeout:g} s without one at sim '
@@ -466,16 +443,11 @@ class SteeringController(OdometryOutputs, CommandController):
                 [handle.velocity for handle in self._traction_state], steering, period)
 
     def _publish(self, time: float) -> None:
-        kinematics = self._kinematics
-        if self._odometry_sink is not None:
-            self._odometry_sink(time, kinematics.x, kinematics.y, kinematics.heading,
-                                kinematics.linear, kinematics.angular)
-        if self._tf_sink is not None and self.params['enable_odom_tf']:
-            heading = kinematics.heading
-            pose = Transform((kinematics.x, kinematics.y, 0.0),
-                             (0.0, 0.0, math.sin(heading / 2.0), math.cos(heading / 2.0)))
-            self._tf_sink(time, [(self.params['odom_frame_id'], self.params['base_frame_id'],
-                                  pose)])
+        kinematics, params = self._kinematics, self.params
+        self.publish_planar(time, kinematics.x, kinematics.y, kinematics.heading,
+                            kinematics.linear, kinematics.angular,
+                            (params['odom_frame_id'], params['base_frame_id']),
+                            tf=params['enable_odom_tf'])
         if self._status_sink is not None:
             feedback = [handle.position if self.params['position_feedback'] else handle.velocity
                         for handle in self._traction_state]
