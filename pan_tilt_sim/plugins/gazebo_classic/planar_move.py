@@ -36,10 +36,10 @@ from pan_tilt_sim.controllers.framework.surface import (
 from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, TfSink
 from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.robot import RobotModel
-from pan_tilt_sim.model.sensors import ROS1, ROS2, Ros2Names, ros1_resolve
+from pan_tilt_sim.model.sensors import ROS1, ROS2
 from pan_tilt_sim.model.transforms import Vector
+from pan_tilt_sim.plugins.framework.drives import ClassicTopics
 from pan_tilt_sim.plugins.framework.elements import (
-    UNPLANAR_COVARIANCE,
     Element,
     ElementReader,
     ElementSpec,
@@ -80,7 +80,7 @@ ROS1_PLANAR_MOVE_KEYS = {*ROS1_ELEMENTS.names, 'robotNamespace'}
 
 
 @dataclasses.dataclass(frozen=True)
-class PlanarMovePlugin:
+class PlanarMovePlugin(ClassicTopics):
     """One ``gazebo_ros_planar_move`` plugin: the base's planar velocity set from a Twist.
 
     ``update_rate`` (Hz, 0: every step): how often the base's velocity is
@@ -105,20 +105,7 @@ class PlanarMovePlugin:
 
     filename = 'libgazebo_ros_planar_move.so'
 
-    def topics(self, override: str = '') -> tuple[str, str]:
-        """Return the command and odometry topics (absolute), ``override`` as the namespace."""
-        namespace = override or self.namespace
-        if self.convention == ROS1:
-            return (ros1_resolve(namespace, self.command_topic),
-                    ros1_resolve(namespace, self.odometry_topic))
-        names = Ros2Names(self.name, namespace, self.remappings)
-        return names.topic(self.command_topic), names.topic(self.odometry_topic)
-
-    @property
-    def pose_covariance(self) -> tuple[float, ...]:
-        """The odometry pose (and twist) covariance's diagonal (x, y, z, roll, pitch, yaw)."""
-        x, y, yaw = self.covariance
-        return (x, y, UNPLANAR_COVARIANCE, UNPLANAR_COVARIANCE, UNPLANAR_COVARIANCE, yaw)
+    # topics() and pose_covariance (the twist's too): ClassicTopics
 
 
 def read_planar_move(element: PluginElement, model: RobotModel) -> PlanarMovePlugin:
@@ -205,12 +192,9 @@ class GazeboPlanarMove(Plugin, OdometryOutputs, CommandController):
             CommandTopic(command, self.command_kind.value, self.set_command,
                          self.command_problem)]
         if plugin.publish_odom:
-            endpoints.append(StateTopic(odometry, 'nav_msgs/msg/Odometry', self.set_odometry_sink,
-                                        {'frame_id': plugin.odometry_frame,
-                                         'child_frame_id': plugin.robot_base_frame,
-                                         'pose_covariance_diagonal': plugin.pose_covariance,
-                                         'twist_covariance_diagonal': plugin.pose_covariance,
-                                         'spatial': True}))
+            endpoints.append(self.odometry_topic(
+                odometry, (plugin.odometry_frame, plugin.robot_base_frame),
+                plugin.pose_covariance, plugin.pose_covariance, spatial=True))
         if plugin.publish_odom_tf:
             endpoints.append(StateTopic('/tf', 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
         return tuple(endpoints)
