@@ -12,6 +12,7 @@ Design notes: docs/design/controllers.md#steering_controllerspy.
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any, ClassVar
 
@@ -39,6 +40,7 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
     unique,
 )
 from pan_tilt_sim.controllers.framework.shared_parameters import (
+    UNSET_OR_LENGTH,
     UPDATE_RATE,
     check_odometry_frames,
     odometry_frames,
@@ -65,6 +67,7 @@ TRACTION_STATE, STEERING_STATE = 'traction_joints_state_names', 'steering_joints
 # upstream's default covariance diagonals
 FRAMES = odometry_frames(covariance=(0.0, 7.0, 14.0, 21.0, 28.0, 35.0))
 MAX_JOINTS = 4  # upstream's size_lt<5> on every joint list
+EPSILON = sys.float_info.epsilon  # a length at most this is "not set", as upstream
 STATUS_MESSAGE = 'control_msgs/msg/SteeringControllerStatus'
 # Sinks besides the planar odometry and tf (toolbox.odometry_outputs): status(time,
 # traction positions, traction velocities, traction commands, steering positions, steering
@@ -125,6 +128,22 @@ def library_parameters(traction: list[str], steering: list[str]) -> tuple[Param,
         Param('position_feedback', BOOL, False, "Odometry from the traction joints' positions "
               '(else their velocities).'),
         UPDATE_RATE,    )
+
+
+# The Ackermann and tricycle types declare these alike upstream; the bicycle type's radius
+# entries are singular and read-only, its own.
+TRACTION_TRACK_WIDTH = Param('traction_track_width', DOUBLE, 0.0, 'Distance between the '
+                             'traction wheels (m).', example=0.3, validators=UNSET_OR_LENGTH)
+WHEELS_RADIUS = 'traction_wheels_radius'
+WHEELS_RADIUS_DEPRECATED = ('front_wheels_radius', 'rear_wheels_radius')
+
+
+def wheels_radius_parameters() -> tuple[Param, ...]:
+    """Return ``traction_wheels_radius`` and its deprecated ``front_``/``rear_wheels_radius``."""
+    return (Param(WHEELS_RADIUS, DOUBLE, 0.0, 'Radius of the traction wheels (m).',
+                  example=0.05, validators=UNSET_OR_LENGTH),
+            *(Param(name, DOUBLE, 0.0, f"Deprecated: use '{WHEELS_RADIUS}'.",
+                    validators=UNSET_OR_LENGTH) for name in WHEELS_RADIUS_DEPRECATED))
 
 
 # (deprecated name, the name it stands for with front_steering, without it)
@@ -258,6 +277,17 @@ class SteeringController(OdometryOutputs, TwistCommanded, CommandController):
     def kinematics(self) -> SteeringKinematics:
         """Return the type's kinematics from its geometry parameters (subclasses)."""
         raise NotImplementedError
+
+    def traction_radius(self, name: str = WHEELS_RADIUS,
+                        deprecated: Sequence[str] = WHEELS_RADIUS_DEPRECATED) -> float:
+        """Return the ``name`` radius (m), or a deprecated one that is set (with a warning)."""
+        params = self.params
+        radius = params[name]
+        for field in deprecated:
+            if params[field] > 0.0:
+                self.deprecated(field, f"'{name}'")
+                radius = params[field]
+        return radius
 
     # --- what it claims and exports --------------------------------------------------------
 
