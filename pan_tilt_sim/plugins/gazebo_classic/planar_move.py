@@ -18,22 +18,21 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Callable, Mapping
-from typing import Any, ClassVar
+from typing import ClassVar
 
 from pan_tilt_sim.controllers.framework.base import (
     Actuator,
     CommandController,
     CommandKind,
-    CommandResult,
     JointHandle,
 )
 from pan_tilt_sim.controllers.framework.surface import (
     CommandTopic,
     Endpoint,
-    StampedTwist,
     StateTopic,
 )
 from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, TfSink
+from pan_tilt_sim.controllers.toolbox.twist_command import TwistCommand, TwistCommanded
 from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.model.sensors import ROS1, ROS2
@@ -144,7 +143,7 @@ def read_planar_move(element: PluginElement, model: RobotModel) -> PlanarMovePlu
     return plugin
 
 
-class GazeboPlanarMove(Plugin, OdometryOutputs, CommandController):
+class GazeboPlanarMove(Plugin, OdometryOutputs, TwistCommanded, CommandController):
     """One ``gazebo_ros_planar_move`` plugin: a Twist sets the base's planar velocity."""
 
     filenames = frozenset({'gazebo_ros_planar_move'})
@@ -170,7 +169,7 @@ class GazeboPlanarMove(Plugin, OdometryOutputs, CommandController):
         self._odometry_sink: SpatialOdometrySink | None = None
         self._tf_sink: TfSink | None = None
         self._base_motion: Callable[[], BaseMotion] | None = None
-        self._problem = ''
+        self._command = TwistCommand('cmd_vel', sideways=True)
         self._time = 0.0
         self.reset()
 
@@ -207,27 +206,19 @@ class GazeboPlanarMove(Plugin, OdometryOutputs, CommandController):
 
     def reset(self) -> None:
         """No command; both rates start again from sim time 0."""
+        self._command.latest = None
         self._twist = (0.0, 0.0, 0.0)
         self._received = 0.0
         self._last_update = self._last_publish = 0.0
         self._pending: tuple[Vector, Vector] | None = None
 
-    # --- commands --------------------------------------------------------------------------
+    # --- commands (set_command, command_problem: TwistCommanded) ----------------------------
 
-    def set_command(self, value: StampedTwist) -> CommandResult:
-        """Take a twist (from the subscription; cheap): refuse non-finite ones."""
-        x, y, angular = value.linear[0], value.linear[1], value.angular[2]
-        if not all(math.isfinite(number) for number in (x, y, angular)):
-            self._problem = (f'ignored cmd_vel (linear.x {x!r}, linear.y {y!r}, angular.z '
-                             f'{angular!r}): not finite numbers')
-            return CommandResult.REJECTED
-        self._twist = (x, y, angular)
+    def twist_taken(self) -> None:
+        """Put the taken twist in force; ROS 1's cmdTimeout counts from now."""
+        latest = self._command.latest
+        self._twist = (latest.linear[0], latest.linear[1], latest.angular[2])
         self._received = self._time
-        return CommandResult.ACCEPTED
-
-    def command_problem(self, value: Any, result: CommandResult) -> str:
-        """Describe the last refused twist."""
-        return self._problem
 
     def setpoints(self) -> dict[str, float]:
         """None: no joint is commanded."""
