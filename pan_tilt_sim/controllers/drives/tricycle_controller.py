@@ -11,7 +11,10 @@ import math
 from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
-from pan_tilt_sim.controllers.drives.steering.steering_controllers import SteeringJoints
+from pan_tilt_sim.controllers.drives.steering.steering_controllers import (
+    SteeredOnOwnClock,
+    SteeringJoints,
+)
 from pan_tilt_sim.controllers.drives.steering.steering_odometry import (
     Configuration,
     SteeringKinematics,
@@ -160,12 +163,11 @@ def _limit(group: str, name: str, unit: str) -> Param:
                  f'({unit}, a magnitude for both directions); NaN: none.', finite=False)
 
 
-class TricycleController(OdometryOutputs, TwistCommanded, CommandController):
+class TricycleController(SteeredOnOwnClock, OdometryOutputs, TwistCommanded, CommandController):
     """Drives a tricycle's steered and driven wheel from a twist; publishes its odometry."""
 
     type_names = ('tricycle_controller/TricycleController',)
     drives_base: ClassVar[bool] = True
-    own_clock: ClassVar[bool] = True  # the kinematics at update_rate, the steering every step
     command_topic = 'cmd_vel'
     command_kind = CommandKind.TWIST_STAMPED
     parameters = ParameterSpec([
@@ -304,10 +306,6 @@ class TricycleController(OdometryOutputs, TwistCommanded, CommandController):
 
     # --- commands (set_command, command_problem: TwistCommanded) ----------------------------
 
-    def twist_taken(self) -> None:
-        """Let a new twist time out again (and say so)."""
-        self._timed_out = False
-
     def setpoints(self) -> dict[str, float]:
         """Return the wheel's commanded velocity (rad/s) and the steering setpoint (rad)."""
         wanted = {}
@@ -344,14 +342,7 @@ class TricycleController(OdometryOutputs, TwistCommanded, CommandController):
 
     # --- the step ---------------------------------------------------------------------------
 
-    def update(self, time: float, period: float) -> None:
-        """At the update rate: command, odometry, limits, joints; every step: the steering."""
-        self._time = time
-        if self._updates.take(time):
-            last = self._last_update
-            self._last_update = time
-            self._control(time, self._updates.period if last is None else time - last)
-        self._steering.track(period)
+    # update(): SteeredOnOwnClock; one upstream update: command, odometry, limits, joints.
 
     def _control(self, time: float, period: float) -> None:
         linear, angular = self._current_command(time)

@@ -201,7 +201,41 @@ class SteeringJoints:
                 -limit if target < -limit else target)
 
 
-class SteeringController(OdometryOutputs, TwistCommanded, CommandController):
+class SteeredOnOwnClock:
+    """Mixin of the controllers that steer: control at the update rate, steering every step.
+
+    An instance has ``_updates`` (its update schedule), ``_last_update``
+    (None before the first), ``_steering`` (:class:`SteeringJoints`),
+    ``_timed_out`` and ``_control(time, interval)``: one upstream update over
+    ``interval`` s (the schedule's period the first time).
+    """
+
+    own_clock: ClassVar[bool] = True
+    _updates: PeriodicSchedule
+    _last_update: float | None
+    _steering: SteeringJoints
+    _time: float
+    _timed_out: bool
+
+    def update(self, time: float, period: float) -> None:
+        """At the update rate: one upstream update (``_control``); every step: the steering."""
+        self._time = time
+        if self._updates.take(time):
+            last = self._last_update
+            self._last_update = time
+            self._control(time, self._updates.period if last is None else time - last)
+        self._steering.track(period)
+
+    def _control(self, time: float, period: float) -> None:
+        raise NotImplementedError
+
+    def twist_taken(self) -> None:
+        """Let a new twist time out again (and say so)."""
+        self._timed_out = False
+
+
+class SteeringController(SteeredOnOwnClock, OdometryOutputs, TwistCommanded,
+                         CommandController):
     """A steered base from a twist: steering angles and wheel speeds out, odometry back.
 
     Subclasses give :attr:`configuration` and build the kinematics from their
@@ -210,7 +244,6 @@ class SteeringController(OdometryOutputs, TwistCommanded, CommandController):
 
     chainable = True
     drives_base: ClassVar[bool] = True
-    own_clock: ClassVar[bool] = True  # the kinematics at update_rate, the steering every step
     command_topic = 'reference'
     command_kind = CommandKind.TWIST_STAMPED
     configuration: ClassVar[Configuration]
@@ -381,10 +414,6 @@ class SteeringController(OdometryOutputs, TwistCommanded, CommandController):
 
     # --- commands (set_command, command_problem: TwistCommanded) ----------------------------
 
-    def twist_taken(self) -> None:
-        """Let a new twist time out again (and say so)."""
-        self._timed_out = False
-
     def setpoints(self) -> dict[str, float]:
         """Return each traction joint's velocity (rad/s) and steering joint's setpoint (rad)."""
         wanted = {handle.name: handle.velocity_target for handle in self._traction}
@@ -406,14 +435,7 @@ class SteeringController(OdometryOutputs, TwistCommanded, CommandController):
 
     # --- the step ---------------------------------------------------------------------------
 
-    def update(self, time: float, period: float) -> None:
-        """At the update rate: reference, odometry, commands, messages; every step: steering."""
-        self._time = time
-        if self._updates.take(time):
-            last = self._last_update
-            self._last_update = time
-            self._control(time, self._updates.period if last is None else time - last)
-        self._steering.track(period)
+    # update(): SteeredOnOwnClock; one upstream update: reference, odometry, commands, messages.
 
     def _control(self, time: float, period: float) -> None:
         """One upstream update: take the reference, update odometry, command the joints."""
