@@ -104,6 +104,24 @@ def heading(odometry: Odometry) -> float:
     return 2.0 * math.atan2(q.z, q.w)
 
 
+def running(kind: BaseKind, write: Callable[..., tuple[pathlib.Path, pathlib.Path]],
+            parameters: Callable[..., dict], folder: pathlib.Path,
+            **drive: object) -> contextlib.AbstractContextManager[MobileBase]:
+    """Run the base ``write`` puts in ``folder``, its controller given ``parameters(**drive)``."""
+    return base_on_sim_node(kind, *write(folder, parameters(**drive)))
+
+
+def free_base_topics(base: MobileBase, rest_height: float) -> tuple[dict, dict]:
+    """Check the base is free, standing at the origin ``rest_height`` m up; return its topics.
+
+    The topics are sim_node's own (published, subscribed), each name to its type.
+    """
+    assert not base.node.simulation.physics.fixed_base
+    where, _, _ = base.true_pose()
+    assert where == pytest.approx((0.0, 0.0, rest_height), abs=1e-6)
+    return base.sim.own_topics()
+
+
 @contextlib.contextmanager
 def base_on_sim_node(kind: BaseKind, description: pathlib.Path,
                      controllers: pathlib.Path) -> Iterator[MobileBase]:

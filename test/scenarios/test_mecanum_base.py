@@ -9,7 +9,7 @@ true pose comes from simulation_interfaces' GetEntityState.
 
 from __future__ import annotations
 
-import contextlib
+import functools
 import math
 
 import pytest
@@ -17,11 +17,11 @@ import sim_process
 from control_msgs.msg import MecanumDriveControllerState
 from mobile_base_harness import (
     BaseKind,
-    MobileBase,
-    base_on_sim_node,
+    free_base_topics,
     heading,
     holonomic_stops_after_the_timeout,
     ignores_non_finite_commands,
+    running,
 )
 from roller_fixtures import CONTROLLER, REST_HEIGHT, mecanum_parameters, write_mecanum
 
@@ -33,9 +33,8 @@ MECANUM = BaseKind(ROBOT, CONTROLLER, ODOMETRY, update_steps=10, holonomic=True,
                    state=(MecanumDriveControllerState, f'/{CONTROLLER}/controller_state'))
 
 
-def running_base(folder, **drive) -> contextlib.AbstractContextManager[MobileBase]:
-    """Run the mecanum base on sim_node, its controller given ``drive`` parameters."""
-    return base_on_sim_node(MECANUM, *write_mecanum(folder, mecanum_parameters(**drive)))
+# running_base(folder, **drive): the base on sim_node, its controller given ``drive``.
+running_base = functools.partial(running, MECANUM, write_mecanum, mecanum_parameters)
 
 
 @pytest.fixture
@@ -46,10 +45,7 @@ def base(tmp_path):
 
 
 def test_the_base_is_free_and_the_topics_are_upstreams(base):
-    assert not base.node.simulation.physics.fixed_base
-    where, _, _ = base.true_pose()
-    assert where == pytest.approx((0.0, 0.0, REST_HEIGHT), abs=1e-6)
-    published, subscribed = base.sim.own_topics()
+    published, subscribed = free_base_topics(base, REST_HEIGHT)
     assert subscribed[f'/{CONTROLLER}/reference'] == 'geometry_msgs/msg/TwistStamped'
     assert published[ODOMETRY] == 'nav_msgs/msg/Odometry'
     assert published[f'/{CONTROLLER}/tf_odometry'] == 'tf2_msgs/msg/TFMessage'

@@ -9,16 +9,16 @@ The true pose comes from simulation_interfaces' GetEntityState.
 
 from __future__ import annotations
 
-import contextlib
+import functools
 
 import pytest
 import sim_process
 from mobile_base_harness import (
     BaseKind,
-    MobileBase,
-    base_on_sim_node,
+    free_base_topics,
     holonomic_stops_after_the_timeout,
     ignores_non_finite_commands,
+    running,
 )
 from roller_fixtures import CONTROLLER, REST_HEIGHT, omni_parameters, write_omni
 
@@ -28,9 +28,8 @@ ODOM = f'/{CONTROLLER}/odom'
 OMNI = BaseKind(ROBOT, CONTROLLER, ODOM, update_steps=10, holonomic=True, tf='/tf', log=True)
 
 
-def running_base(folder, **drive) -> contextlib.AbstractContextManager[MobileBase]:
-    """Run the omni base on sim_node, its controller given ``drive`` parameters."""
-    return base_on_sim_node(OMNI, *write_omni(folder, omni_parameters(**drive)))
+# running_base(folder, **drive): the base on sim_node, its controller given ``drive``.
+running_base = functools.partial(running, OMNI, write_omni, omni_parameters)
 
 
 @pytest.fixture
@@ -41,10 +40,7 @@ def base(tmp_path):
 
 
 def test_the_base_is_free_and_the_topics_are_upstreams(base):
-    assert not base.node.simulation.physics.fixed_base
-    where, _, _ = base.true_pose()
-    assert where == pytest.approx((0.0, 0.0, REST_HEIGHT), abs=1e-6)
-    published, subscribed = base.sim.own_topics()
+    published, subscribed = free_base_topics(base, REST_HEIGHT)
     assert subscribed[f'/{CONTROLLER}/cmd_vel'] == 'geometry_msgs/msg/TwistStamped'
     assert published[ODOM] == 'nav_msgs/msg/Odometry'
     assert published['/tf'] == 'tf2_msgs/msg/TFMessage'

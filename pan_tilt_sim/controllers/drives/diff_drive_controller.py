@@ -16,7 +16,6 @@ from pan_tilt_sim.controllers.framework.base import (
     ActuatorKind,
     CommandController,
     CommandKind,
-    CommandResult,
     JointHandle,
     Reference,
 )
@@ -35,18 +34,14 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
     unique,
 )
 from pan_tilt_sim.controllers.framework.shared_parameters import (
+    check_odometry_frames,
     odometry_frames,
-    same_frames_problem,
+    prefixed_frames,
     tf_frame_prefix,
     velocity_limit_params,
     velocity_limiter,
 )
-from pan_tilt_sim.controllers.framework.surface import (
-    CommandTopic,
-    Endpoint,
-    StampedTwist,
-    StateTopic,
-)
+from pan_tilt_sim.controllers.framework.surface import CommandTopic, Endpoint, StateTopic
 from pan_tilt_sim.controllers.toolbox.odometry import Odometry
 from pan_tilt_sim.controllers.toolbox.odometry_outputs import (
     OdometryOutputs,
@@ -55,17 +50,22 @@ from pan_tilt_sim.controllers.toolbox.odometry_outputs import (
     TwistSink,
 )
 from pan_tilt_sim.controllers.toolbox.rate_limiter import InvalidLimitsError, RateLimiter
+from pan_tilt_sim.controllers.toolbox.twist_command import (
+    TwistCommand,
+    TwistCommanded,
+    planar_references,
+)
+from pan_tilt_sim.controllers.toolbox.wheel_sides import feedback_interfaces
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.model import ros1_diff_drive
-from pan_tilt_sim.model.transforms import Transform
 from pan_tilt_sim.schedule import PeriodicSchedule
 
 LEFT, RIGHT = 'left_wheel_names', 'right_wheel_names'
-VELOCITY, POSITION = 'velocity', 'position'
+VELOCITY = 'velocity'
 LIMIT_GROUPS = ('linear.x', 'angular.z')
 
 
-class DiffDriveController(OdometryOutputs, CommandController):
+class DiffDriveController(OdometryOutputs, TwistCommanded, CommandController):
     """Drives a differential base from a twist and publishes its odometry, as ros2_controllers."""
 
     type_names = ('diff_drive_controller/DiffDriveController',)
@@ -127,13 +127,10 @@ class DiffDriveController(OdometryOutputs, CommandController):
         both = [wheel for wheel in left if wheel in right]
         if both:
             raise self.error(RIGHT, f"'{both[0]}' is also one of {LEFT}")
-        same_frames = same_frames_problem(self.params)
-        if same_frames:
-            raise self.error('base_frame_id', same_frames)
+        check_odometry_frames(self)
         self._left_names, self._right_names = tuple(left), tuple(right)
         self._limiters = tuple(self._limiter(group) for group in LIMIT_GROUPS)
-        self._references = {f'{name}/linear/{VELOCITY}': Reference(f'{name}/linear/{VELOCITY}'),
-                            f'{name}/angular/{VELOCITY}': Reference(f'{name}/angular/{VELOCITY}')}
+        self._references = planar_references(name)
         self._linear_reference, self._angular_reference = self._references.values()
         self._odometry = Odometry(*self._geometry(), self.params['velocity_rolling_window_size'])
         self._publishing = PeriodicSchedule(1.0 / self.params['publish_rate'])
@@ -148,8 +145,8 @@ class DiffDriveController(OdometryOutputs, CommandController):
         self._odometry_sink: OdometrySink | None = None
         self._tf_sink: TfSink | None = None
         self._twist_sink: TwistSink | None = None
-        self._command: StampedTwist | None = None
-        self._problem = ''
+        self._command = TwistCommand('cmd_vel', timeout_field='cmd_vel_timeout',
+                                     stale_at_timeout=True)
         self.reset()
 
     def error(self, field: str, problem: str) -> ControllerConfigError:
@@ -184,10 +181,7 @@ class DiffDriveController(OdometryOutputs, CommandController):
 
     def state_interfaces(self) -> dict[str, tuple[str, ...]]:
         """Return the feedback each wheel is read by (none in open loop)."""
-        if self.params['open_loop']:
-            return {}
-        feedback = POSITION if self.params['position_feedback'] else VELOCITY
-        return {wheel: (feedback,) for wheel in self.joint_names}
+        return feedback_interfaces(self.joint_names, self.params)
 
     def actuators(self) -> dict[str, Actuator]:
         """Return the ideal velocity actuator for every wheel that is a joint (not a reference)."""
@@ -203,13 +197,7 @@ class DiffDriveController(OdometryOutputs, CommandController):
 
     def frame_ids(self) -> tuple[str, str]:
         """Return the odometry frame and the base frame, prefixed as upstream prefixes them."""
-        prefix = ''
-        if self.params['tf_frame_prefix_enable']:
-            prefix = self.params['tf_frame_prefix'] or self.node_namespace
-            if not prefix.endswith('/'):
-                prefix += '/'
-            prefix = prefix.removeprefix('/')
-        return prefix + self.params['odom_frame_id'], prefix + self.params['base_frame_id']
+        return prefixed_frames(self.params, self.node_namespace)
 
     def ros_surface(self) -> tuple[Endpoint, ...]:
         """Return ``~/cmd_vel`` in; ``~/odom``, ``/tf`` and ``~/cmd_vel_out`` out as configured."""
@@ -218,10 +206,8 @@ class DiffDriveController(OdometryOutputs, CommandController):
         endpoints: list[Endpoint] = [
             CommandTopic(f'~/{self.command_topic}', self.command_kind.value, self.set_command,
                          self.command_problem),
-            StateTopic('~/odom', 'nav_msgs/msg/Odometry', self.set_odometry_sink, {
-                'frame_id': odom, 'child_frame_id': base,
-                'pose_covariance_diagonal': tuple(params['pose_covariance_diagonal']),
-                'twist_covariance_diagonal': tuple(params['twist_covariance_diagonal'])})]
+            self.odometry_topic('~/odom', (odom, base), params['pose_covariance_diagonal'],
+                                params['twist_covariance_diagonal'])]
         if params['enable_odom_tf']:
             endpoints.append(StateTopic('/tf', 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
         if params['publish_limited_velocity']:
@@ -264,7 +250,7 @@ class DiffDriveController(OdometryOutputs, CommandController):
 
     def reset(self) -> None:
         """No command, references NaN, odometry at the origin, wheel joints asked to stand."""
-        self._command = None
+        self._command.latest = None
         self._timed_out = False
         self._time = 0.0
         self._linear_reference.value = math.nan
@@ -294,28 +280,7 @@ class DiffDriveController(OdometryOutputs, CommandController):
                 else:
                     output.velocity_target = velocity
 
-    # --- commands --------------------------------------------------------------------------
-
-    def set_command(self, value: StampedTwist) -> CommandResult:
-        """Take a twist (from the subscription; cheap): refuse non-finite or stale ones."""
-        linear, angular = value.linear[0], value.angular[2]
-        if not (math.isfinite(linear) and math.isfinite(angular)):
-            self._problem = (f'ignored cmd_vel (linear.x {linear!r}, angular.z {angular!r}): '
-                             'not finite numbers')
-            return CommandResult.REJECTED
-        now = self._time
-        stamp = value.stamp if value.stamp > 0.0 else now
-        timeout = self.params['cmd_vel_timeout']
-        if timeout > 0.0 and now - stamp >= timeout:
-            self._problem = (f'ignored cmd_vel stamped {stamp:.4f} s: {now - stamp:.4f} s old at '
-                             f'sim time {now:.4f} s, more than cmd_vel_timeout ({timeout:g} s)')
-            return CommandResult.REJECTED
-        self._command = StampedTwist(stamp, (linear, 0.0, 0.0), (0.0, 0.0, angular))
-        return CommandResult.ACCEPTED
-
-    def command_problem(self, value: Any, result: CommandResult) -> str:
-        """Describe the last refused twist."""
-        return self._problem
+    # --- commands (set_command, command_problem: TwistCommanded) ----------------------------
 
     def setpoints(self) -> dict[str, float]:
         """Return each wheel's commanded velocity (rad/s), by wheel name."""
@@ -359,7 +324,7 @@ class DiffDriveController(OdometryOutputs, CommandController):
 
     def _update_references(self, time: float) -> None:
         """Write the newest command to the references; zeros once it is stale (braking)."""
-        command = self._command
+        command = self._command.latest
         if command is None:
             return
         timeout = self.params['cmd_vel_timeout']
@@ -401,12 +366,5 @@ class DiffDriveController(OdometryOutputs, CommandController):
         if not self._publishing.take(time):
             return
         odometry = self._odometry
-        if self._odometry_sink is not None:
-            self._odometry_sink(time, odometry.x, odometry.y, odometry.heading, odometry.linear,
-                                odometry.angular)
-        if self._tf_sink is not None:
-            odom, base = self.frame_ids()
-            heading = odometry.heading
-            pose = Transform((odometry.x, odometry.y, 0.0),
-                             (0.0, 0.0, math.sin(heading / 2.0), math.cos(heading / 2.0)))
-            self._tf_sink(time, [(odom, base, pose)])
+        self.publish_planar(time, odometry.x, odometry.y, odometry.heading, odometry.linear,
+                            odometry.angular, self.frame_ids())

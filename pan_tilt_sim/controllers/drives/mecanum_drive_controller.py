@@ -16,7 +16,6 @@ from pan_tilt_sim.controllers.framework.base import (
     ActuatorKind,
     CommandController,
     CommandKind,
-    CommandResult,
     JointHandle,
     Reference,
 )
@@ -34,23 +33,27 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
 from pan_tilt_sim.controllers.framework.shared_parameters import (
     COVARIANCE_SIZE,
     UPDATE_RATE,
+    check_odometry_frames,
     odometry_frames,
-    same_frames_problem,
+    prefixed_frames,
     tf_frame_prefix,
     update_period,
     velocity_limit_params,
     velocity_limiter,
 )
-from pan_tilt_sim.controllers.framework.surface import (
-    CommandTopic,
-    Endpoint,
-    StampedTwist,
-    StateTopic,
+from pan_tilt_sim.controllers.framework.surface import CommandTopic, Endpoint, StateTopic
+from pan_tilt_sim.controllers.toolbox.odometry_outputs import (
+    OdometryOutputs,
+    SpatialOdometrySink,
+    TfSink,
 )
-from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs
 from pan_tilt_sim.controllers.toolbox.rate_limiter import InvalidLimitsError
-from pan_tilt_sim.controllers.toolbox.twist_command import TwistCommand, twist_references
-from pan_tilt_sim.model.transforms import Transform
+from pan_tilt_sim.controllers.toolbox.twist_command import (
+    TwistCommand,
+    TwistCommanded,
+    twist_references,
+)
+from pan_tilt_sim.controllers.toolbox.wheel_sides import velocity_targets
 from pan_tilt_sim.schedule import DUE_EPSILON, PeriodicSchedule
 
 VELOCITY = 'velocity'
@@ -63,28 +66,12 @@ LIMIT_GROUPS = ('linear.x', 'linear.y', 'angular.z')
 ROLLER_ANGLES = {'front_left': math.pi / 4.0, 'front_right': -math.pi / 4.0,
                  'rear_right': math.pi / 4.0, 'rear_left': -math.pi / 4.0}
 MIN_INTERVAL = 1e-4  # s: odometry updates closer together than this are skipped, as upstream
-# Sinks: odometry(time, pose, linear xyz, angular xyz); tf(time, frames);
-# state(time, wheel velocities in WHEELS order, reference (vx, vy, wz)).
-OdometrySink = Callable[[float, Transform, Sequence[float], Sequence[float]], None]
-TfSink = Callable[[float, list[tuple[str, str, Transform]]], None]
+# Sinks besides odometry and tf (toolbox.odometry_outputs): state(time, wheel velocities in
+# WHEELS order, reference (vx, vy, wz)).
 StateSink = Callable[[float, Sequence[float], Sequence[float]], None]
 # Upstream's defaults: 0.1 on both covariance diagonals; the frames fixed once configured.
 FRAMES = odometry_frames(covariance=(0.1,) * COVARIANCE_SIZE, read_only=True)
 
-
-def frame_prefix(params: Mapping[str, Any], namespace: str) -> str:
-    """Return the frame id prefix: ``tf_frame_prefix`` or the namespace, ending in '/'."""
-    if not params['tf_frame_prefix_enable']:
-        return ''
-    prefix = params['tf_frame_prefix'] or namespace
-    if not prefix.endswith('/'):
-        prefix += '/'
-    return prefix.removeprefix('/')
-
-
-def yaw_transform(x: float, y: float, heading: float) -> Transform:
-    """Return the planar pose (m, m, rad) as a transform."""
-    return Transform((x, y, 0.0), (0.0, 0.0, math.sin(heading / 2.0), math.cos(heading / 2.0)))
 
 
 def _wheel_params(position: str) -> tuple[Param, Param]:
@@ -144,7 +131,7 @@ class MecanumOdometry:
         return True
 
 
-class MecanumDriveController(OdometryOutputs, CommandController):
+class MecanumDriveController(OdometryOutputs, TwistCommanded, CommandController):
     """Drives a four-wheel mecanum base from a body twist, as ros2_controllers."""
 
     type_names = ('mecanum_drive_controller/MecanumDriveController',)
@@ -181,9 +168,7 @@ class MecanumDriveController(OdometryOutputs, CommandController):
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
-        same_frames = same_frames_problem(self.params)
-        if same_frames:
-            raise self.error('base_frame_id', same_frames)
+        check_odometry_frames(self)
         params = self.params
         self._command_names = tuple(params[f'{wheel}_wheel_command_joint_name']
                                     for wheel in WHEELS)
@@ -217,7 +202,7 @@ class MecanumDriveController(OdometryOutputs, CommandController):
         self._commands: list[JointHandle | Reference] = []
         self._command_handles: list[JointHandle] = []
         self._states: list[JointHandle] = []
-        self._odometry_sink: OdometrySink | None = None
+        self._odometry_sink: SpatialOdometrySink | None = None
         self._tf_sink: TfSink | None = None
         self._state_sink: StateSink | None = None
         self._command = TwistCommand('reference', sideways=True,
@@ -265,8 +250,7 @@ class MecanumDriveController(OdometryOutputs, CommandController):
 
     def frame_ids(self) -> tuple[str, str]:
         """Return the odometry frame and the base frame, prefixed as upstream prefixes them."""
-        prefix = frame_prefix(self.params, self.node_namespace)
-        return prefix + self.params['odom_frame_id'], prefix + self.params['base_frame_id']
+        return prefixed_frames(self.params, self.node_namespace)
 
     def ros_surface(self) -> tuple[Endpoint, ...]:
         """Return ``~/reference`` in; ``~/odometry``, ``~/tf_odometry``, ``~/controller_state``."""
@@ -275,10 +259,8 @@ class MecanumDriveController(OdometryOutputs, CommandController):
         endpoints: list[Endpoint] = [
             CommandTopic(f'~/{self.command_topic}', self.command_kind.value, self.set_command,
                          self.command_problem),
-            StateTopic('~/odometry', 'nav_msgs/msg/Odometry', self.set_odometry_sink, {
-                'frame_id': odom, 'child_frame_id': base, 'spatial': True,
-                'pose_covariance_diagonal': tuple(params['pose_covariance_diagonal']),
-                'twist_covariance_diagonal': tuple(params['twist_covariance_diagonal'])})]
+            self.odometry_topic('~/odometry', (odom, base), params['pose_covariance_diagonal'],
+                                params['twist_covariance_diagonal'], spatial=True)]
         if params['enable_odom_tf']:
             endpoints.append(StateTopic('~/tf_odometry', 'tf2_msgs/msg/TFMessage',
                                         self.set_tf_sink))
@@ -331,19 +313,11 @@ class MecanumDriveController(OdometryOutputs, CommandController):
             else:
                 target.velocity_target = 0.0
 
-    # --- commands --------------------------------------------------------------------------
-
-    def set_command(self, value: StampedTwist) -> CommandResult:
-        """Take a reference twist: refuse non-finite or already stale ones."""
-        return self._command.take(value, self._time, self.params['reference_timeout'])
-
-    def command_problem(self, value: Any, result: CommandResult) -> str:
-        """Describe the last refused twist."""
-        return self._command.problem(value, result)
+    # --- commands (set_command, command_problem: TwistCommanded) ----------------------------
 
     def setpoints(self) -> dict[str, float]:
         """Return each command joint's commanded velocity (rad/s)."""
-        return {handle.name: handle.velocity_target for handle in self._command_handles}
+        return velocity_targets(self._command_handles)
 
     @property
     def odometry(self) -> MecanumOdometry:
@@ -426,13 +400,8 @@ class MecanumDriveController(OdometryOutputs, CommandController):
     def _publish(self, time: float, measured: Sequence[float],
                  references: Sequence[float]) -> None:
         odometry = self._odometry
-        if self._odometry_sink is not None or self._tf_sink is not None:
-            pose = yaw_transform(odometry.x, odometry.y, odometry.heading)
-            if self._odometry_sink is not None:
-                self._odometry_sink(time, pose, (odometry.linear_x, odometry.linear_y, 0.0),
-                                    (0.0, 0.0, odometry.angular))
-            if self._tf_sink is not None:
-                odom, base = self.frame_ids()
-                self._tf_sink(time, [(odom, base, pose)])
+        self.publish_spatial(time, odometry.x, odometry.y, odometry.heading,
+                             (odometry.linear_x, odometry.linear_y), odometry.angular,
+                             self.frame_ids())
         if self._state_sink is not None:
             self._state_sink(time, measured, references)

@@ -11,18 +11,11 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
-from pan_tilt_sim.controllers.drives.mecanum_drive_controller import (
-    OdometrySink,
-    TfSink,
-    frame_prefix,
-    yaw_transform,
-)
 from pan_tilt_sim.controllers.framework.base import (
     Actuator,
     ActuatorKind,
     CommandController,
     CommandKind,
-    CommandResult,
     JointHandle,
     Reference,
 )
@@ -41,8 +34,9 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
 )
 from pan_tilt_sim.controllers.framework.shared_parameters import (
     UPDATE_RATE,
+    check_odometry_frames,
     odometry_frames,
-    same_frames_problem,
+    prefixed_frames,
     tf_frame_prefix,
     update_period,
 )
@@ -52,12 +46,21 @@ from pan_tilt_sim.controllers.framework.surface import (
     StampedTwist,
     StateTopic,
 )
-from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs
-from pan_tilt_sim.controllers.toolbox.twist_command import TwistCommand, twist_references
+from pan_tilt_sim.controllers.toolbox.odometry_outputs import (
+    OdometryOutputs,
+    SpatialOdometrySink,
+    TfSink,
+)
+from pan_tilt_sim.controllers.toolbox.twist_command import (
+    TwistCommand,
+    TwistCommanded,
+    twist_references,
+)
+from pan_tilt_sim.controllers.toolbox.wheel_sides import feedback_interfaces, velocity_targets
 from pan_tilt_sim.schedule import DUE_EPSILON, PeriodicSchedule
 
 WHEEL_NAMES = 'wheel_names'
-VELOCITY, POSITION = 'velocity', 'position'
+VELOCITY = 'velocity'
 MIN_WHEELS = 3
 OMNI_ROLLERS = math.pi / 2.0  # rad: an omni wheel's rollers roll along its axis
 MIN_INTERVAL = 1e-6  # s: odometry updates closer together than this are skipped, as upstream
@@ -145,7 +148,7 @@ class OmniOdometry:
             math.sin(after) - math.sin(before))
 
 
-class OmniWheelDriveController(OdometryOutputs, CommandController):
+class OmniWheelDriveController(OdometryOutputs, TwistCommanded, CommandController):
     """Drives a base on three or more omni wheels from a twist, as ros2_controllers."""
 
     type_names = ('omni_wheel_drive_controller/OmniWheelDriveController',)
@@ -179,9 +182,7 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
-        same_frames = same_frames_problem(self.params)
-        if same_frames:
-            raise self.error('base_frame_id', same_frames)
+        check_odometry_frames(self)
         params = self.params
         self._wheel_names = tuple(params[WHEEL_NAMES])
         if len(self._wheel_names) < MIN_WHEELS:
@@ -198,7 +199,7 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
                             for i in range(len(self._wheel_names))]
         self._schedule = PeriodicSchedule(update_period(params))
         self._wheels: list[JointHandle] = []
-        self._odometry_sink: OdometrySink | None = None
+        self._odometry_sink: SpatialOdometrySink | None = None
         self._tf_sink: TfSink | None = None
         self._command = TwistCommand('cmd_vel', sideways=True, timeout_field='cmd_vel_timeout',
                                      stale_at_timeout=True)
@@ -217,10 +218,7 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
 
     def state_interfaces(self) -> dict[str, tuple[str, ...]]:
         """Return the feedback each wheel is read by (none in open loop)."""
-        if self.params['open_loop']:
-            return {}
-        feedback = POSITION if self.params['position_feedback'] else VELOCITY
-        return {wheel: (feedback,) for wheel in self._wheel_names}
+        return feedback_interfaces(self._wheel_names, self.params)
 
     def actuators(self) -> dict[str, Actuator]:
         """Return the ideal velocity actuator for every wheel."""
@@ -243,8 +241,7 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
 
     def frame_ids(self) -> tuple[str, str]:
         """Return the odometry frame and the base frame, prefixed as upstream prefixes them."""
-        prefix = frame_prefix(self.params, self.node_namespace)
-        return prefix + self.params['odom_frame_id'], prefix + self.params['base_frame_id']
+        return prefixed_frames(self.params, self.node_namespace)
 
     def ros_surface(self) -> tuple[Endpoint, ...]:
         """Return ``~/cmd_vel`` in; ``~/odom`` and, with ``enable_odom_tf``, ``/tf`` out."""
@@ -253,10 +250,8 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
         endpoints: list[Endpoint] = [
             CommandTopic(f'~/{self.command_topic}', self.command_kind.value, self.set_command,
                          self.command_problem),
-            StateTopic('~/odom', 'nav_msgs/msg/Odometry', self.set_odometry_sink, {
-                'frame_id': odom, 'child_frame_id': base, 'spatial': True,
-                'pose_covariance_diagonal': tuple(covariance['pose']),
-                'twist_covariance_diagonal': tuple(covariance['twist'])})]
+            self.odometry_topic('~/odom', (odom, base), covariance['pose'], covariance['twist'],
+                                spatial=True)]
         if self.params['enable_odom_tf']:
             endpoints.append(StateTopic('/tf', 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
         return tuple(endpoints)
@@ -286,19 +281,11 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
         for handle in self._wheels:
             handle.velocity_target = 0.0
 
-    # --- commands --------------------------------------------------------------------------
-
-    def set_command(self, value: StampedTwist) -> CommandResult:
-        """Take a twist: refuse non-finite or already stale ones."""
-        return self._command.take(value, self._time, self.params['cmd_vel_timeout'])
-
-    def command_problem(self, value: Any, result: CommandResult) -> str:
-        """Describe the last refused twist."""
-        return self._command.problem(value, result)
+    # --- commands (set_command, command_problem: TwistCommanded) ----------------------------
 
     def setpoints(self) -> dict[str, float]:
         """Return each wheel's commanded velocity (rad/s)."""
-        return {handle.name: handle.velocity_target for handle in self._wheels}
+        return velocity_targets(self._wheels)
 
     @property
     def odometry(self) -> OmniOdometry:
@@ -360,12 +347,6 @@ class OmniWheelDriveController(OdometryOutputs, CommandController):
 
     def _publish(self, time: float) -> None:
         odometry = self._odometry
-        if self._odometry_sink is None and self._tf_sink is None:
-            return
-        pose = yaw_transform(odometry.x, odometry.y, odometry.heading)
-        if self._odometry_sink is not None:
-            self._odometry_sink(time, pose, (odometry.linear_x, odometry.linear_y, 0.0),
-                                (0.0, 0.0, odometry.angular))
-        if self._tf_sink is not None:
-            odom, base = self.frame_ids()
-            self._tf_sink(time, [(odom, base, pose)])
+        self.publish_spatial(time, odometry.x, odometry.y, odometry.heading,
+                             (odometry.linear_x, odometry.linear_y), odometry.angular,
+                             self.frame_ids())

@@ -11,7 +11,10 @@ import math
 from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
-from pan_tilt_sim.controllers.drives.steering.steering_controllers import SteeringJoints
+from pan_tilt_sim.controllers.drives.steering.steering_controllers import (
+    SteeredOnOwnClock,
+    SteeringJoints,
+)
 from pan_tilt_sim.controllers.drives.steering.steering_odometry import (
     Configuration,
     SteeringKinematics,
@@ -21,7 +24,6 @@ from pan_tilt_sim.controllers.framework.base import (
     ActuatorKind,
     CommandController,
     CommandKind,
-    CommandResult,
     JointHandle,
 )
 from pan_tilt_sim.controllers.framework.parameter_spec import (
@@ -38,19 +40,18 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
 )
 from pan_tilt_sim.controllers.framework.shared_parameters import (
     UPDATE_RATE,
+    check_odometry_frames,
     odometry_frames,
-    same_frames_problem,
     update_period,
 )
 from pan_tilt_sim.controllers.framework.surface import (
     CommandTopic,
     Endpoint,
     Service,
-    StampedTwist,
     StateTopic,
 )
 from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, OdometrySink, TfSink
-from pan_tilt_sim.model.transforms import Transform
+from pan_tilt_sim.controllers.toolbox.twist_command import TwistCommand, TwistCommanded
 from pan_tilt_sim.schedule import PeriodicSchedule
 
 TRACTION, STEERING = 'traction_joint_name', 'steering_joint_name'
@@ -162,12 +163,11 @@ def _limit(group: str, name: str, unit: str) -> Param:
                  f'({unit}, a magnitude for both directions); NaN: none.', finite=False)
 
 
-class TricycleController(OdometryOutputs, CommandController):
+class TricycleController(SteeredOnOwnClock, OdometryOutputs, TwistCommanded, CommandController):
     """Drives a tricycle's steered and driven wheel from a twist; publishes its odometry."""
 
     type_names = ('tricycle_controller/TricycleController',)
     drives_base: ClassVar[bool] = True
-    own_clock: ClassVar[bool] = True  # the kinematics at update_rate, the steering every step
     command_topic = 'cmd_vel'
     command_kind = CommandKind.TWIST_STAMPED
     parameters = ParameterSpec([
@@ -204,9 +204,7 @@ class TricycleController(OdometryOutputs, CommandController):
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
-        same_frames = same_frames_problem(self.params)
-        if same_frames:
-            raise self.error('base_frame_id', same_frames)
+        check_odometry_frames(self)
         params = self.params
         try:
             self._traction_limiter = TractionLimiter(params['traction'])
@@ -228,8 +226,7 @@ class TricycleController(OdometryOutputs, CommandController):
         self._odometry_sink: OdometrySink | None = None
         self._tf_sink: TfSink | None = None
         self._ackermann_sink: AckermannSink | None = None
-        self._command: StampedTwist | None = None
-        self._problem = ''
+        self._command = TwistCommand('cmd_vel')
         self.reset()
 
     # --- what it claims ---------------------------------------------------------------------
@@ -261,10 +258,8 @@ class TricycleController(OdometryOutputs, CommandController):
         endpoints: list[Endpoint] = [
             CommandTopic(f'~/{self.command_topic}', self.command_kind.value, self.set_command,
                          self.command_problem),
-            StateTopic('~/odom', 'nav_msgs/msg/Odometry', self.set_odometry_sink, {
-                'frame_id': odom, 'child_frame_id': base,
-                'pose_covariance_diagonal': tuple(params['pose_covariance_diagonal']),
-                'twist_covariance_diagonal': tuple(params['twist_covariance_diagonal'])}),
+            self.odometry_topic('~/odom', (odom, base), params['pose_covariance_diagonal'],
+                                params['twist_covariance_diagonal']),
             Service('~/reset_odometry', 'std_srvs/srv/Empty', self.reset_odometry)]
         if params['enable_odom_tf']:
             endpoints.append(StateTopic('/tf', 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
@@ -291,7 +286,7 @@ class TricycleController(OdometryOutputs, CommandController):
 
     def reset(self) -> None:
         """No command, odometry at the origin, the wheel asked to stand, the steering held."""
-        self._command = None
+        self._command.latest = None
         self._timed_out = False
         self._time = 0.0
         self._last_update: float | None = None
@@ -309,23 +304,7 @@ class TricycleController(OdometryOutputs, CommandController):
             self._traction.velocity_target = 0.0
         self._steering.command([0.0])
 
-    # --- commands --------------------------------------------------------------------------
-
-    def set_command(self, value: StampedTwist) -> CommandResult:
-        """Take a twist (from the subscription; cheap): refuse non-finite ones."""
-        linear, angular = value.linear[0], value.angular[2]
-        if not (math.isfinite(linear) and math.isfinite(angular)):
-            self._problem = (f'ignored cmd_vel (linear.x {linear!r}, angular.z {angular!r}): '
-                             'not finite numbers')
-            return CommandResult.REJECTED
-        stamp = value.stamp if value.stamp > 0.0 else self._time
-        self._command = StampedTwist(stamp, (linear, 0.0, 0.0), (0.0, 0.0, angular))
-        self._timed_out = False
-        return CommandResult.ACCEPTED
-
-    def command_problem(self, value: Any, result: CommandResult) -> str:
-        """Describe the last refused twist."""
-        return self._problem
+    # --- commands (set_command, command_problem: TwistCommanded) ----------------------------
 
     def setpoints(self) -> dict[str, float]:
         """Return the wheel's commanded velocity (rad/s) and the steering setpoint (rad)."""
@@ -363,14 +342,7 @@ class TricycleController(OdometryOutputs, CommandController):
 
     # --- the step ---------------------------------------------------------------------------
 
-    def update(self, time: float, period: float) -> None:
-        """At the update rate: command, odometry, limits, joints; every step: the steering."""
-        self._time = time
-        if self._updates.take(time):
-            last = self._last_update
-            self._last_update = time
-            self._control(time, self._updates.period if last is None else time - last)
-        self._steering.track(period)
+    # update(): SteeredOnOwnClock; one upstream update: command, odometry, limits, joints.
 
     def _control(self, time: float, period: float) -> None:
         linear, angular = self._current_command(time)
@@ -401,7 +373,7 @@ class TricycleController(OdometryOutputs, CommandController):
 
     def _current_command(self, time: float) -> tuple[float, float]:
         """Return the command's (linear, angular); zero before the first and once stale."""
-        command = self._command
+        command = self._command.latest
         if command is None:
             return 0.0, 0.0
         timeout = self.params['cmd_vel_timeout'] / 1000.0
@@ -414,16 +386,7 @@ class TricycleController(OdometryOutputs, CommandController):
         return command.linear[0], command.angular[2]
 
     def _publish(self, time: float) -> None:
-        odometry = self._odometry
-        if self._odometry_sink is not None:
-            if self.params['odom_only_twist']:
-                self._odometry_sink(time, 0.0, 0.0, 0.0, odometry.linear, odometry.angular)
-            else:
-                self._odometry_sink(time, odometry.x, odometry.y, odometry.heading,
-                                    odometry.linear, odometry.angular)
-        if self._tf_sink is not None:
-            heading = odometry.heading
-            pose = Transform((odometry.x, odometry.y, 0.0),
-                             (0.0, 0.0, math.sin(heading / 2.0), math.cos(heading / 2.0)))
-            self._tf_sink(time, [(self.params['odom_frame_id'], self.params['base_frame_id'],
-                                  pose)])
+        odometry, params = self._odometry, self.params
+        self.publish_planar(time, odometry.x, odometry.y, odometry.heading, odometry.linear,
+                            odometry.angular, (params['odom_frame_id'], params['base_frame_id']),
+                            twist_only=params['odom_only_twist'])

@@ -11,6 +11,7 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any, NamedTuple
 
+from pan_tilt_sim.controllers.framework.base import Controller
 from pan_tilt_sim.controllers.framework.parameter_spec import (
     BOOL,
     DOUBLE,
@@ -106,6 +107,29 @@ def same_frames_problem(params: Mapping[str, Any]) -> str | None:
         return (f"'{base}' is odom_frame_id too: the odom -> base transform needs two "
                 'different frames')
     return None
+
+
+def check_odometry_frames(controller: Controller) -> None:
+    """Raise the controller's error on ``base_frame_id`` if it is ``odom_frame_id`` too."""
+    problem = same_frames_problem(controller.params)
+    if problem:
+        raise controller.error('base_frame_id', problem)
+
+
+def prefixed_frames(params: Mapping[str, Any], namespace: str) -> tuple[str, str]:
+    """Return ``odom_frame_id`` and ``base_frame_id`` with the prefix upstream gives them.
+
+    With ``tf_frame_prefix_enable``: ``tf_frame_prefix``, or the controller's
+    node ``namespace`` if that is empty, ending in one '/' and without a
+    leading one.
+    """
+    prefix = ''
+    if params['tf_frame_prefix_enable']:
+        prefix = params['tf_frame_prefix'] or namespace
+        if not prefix.endswith('/'):
+            prefix += '/'
+        prefix = prefix.removeprefix('/')
+    return prefix + params['odom_frame_id'], prefix + params['base_frame_id']
 
 
 def pid_gains(prefix: str) -> tuple[Param, ...]:

@@ -1,16 +1,18 @@
 """A drive's body-twist command: taken from its topic, refused when not finite or stale.
 
-Drive controllers (mecanum, omni wheel) and the Gazebo diff-drive plugins take
-a ``geometry_msgs`` twist on a command topic.  :class:`TwistCommand` keeps the
+The drive controllers and the Gazebo diff-drive plugins take a
+``geometry_msgs`` twist on a command topic.  :class:`TwistCommand` keeps the
 last accepted one, planar and stamped, and says why the last refused one was
-refused (the command topic's problem callback).  :func:`twist_references`
-makes the ``<name>/linear/x/velocity`` ... reference interfaces a chainable
-drive exports.  Pure Python.
+refused (the command topic's problem callback); :class:`TwistCommanded`
+gives a unit the two topic callbacks over it.  :func:`twist_references` and
+:func:`planar_references` make the reference interfaces a chainable drive
+exports.  Pure Python.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
 from pan_tilt_sim.controllers.framework.base import CommandResult, Reference
@@ -23,6 +25,12 @@ TWIST_AXES = ('linear/x', 'linear/y', 'angular/z')
 def twist_references(controller: str) -> dict[str, Reference]:
     """Return ``<controller>/linear/x/velocity``, ``.../linear/y/...``, ``.../angular/z/...``."""
     names = [f'{controller}/{axis}/velocity' for axis in TWIST_AXES]
+    return {name: Reference(name) for name in names}
+
+
+def planar_references(controller: str) -> dict[str, Reference]:
+    """Return ``<controller>/linear/velocity`` and ``<controller>/angular/velocity``."""
+    names = [f'{controller}/{axis}/velocity' for axis in ('linear', 'angular')]
     return {name: Reference(name) for name in names}
 
 
@@ -77,3 +85,31 @@ class TwistCommand:
     def problem(self, value: Any, result: CommandResult) -> str:
         """Describe the last refused twist (the command topic's problem callback)."""
         return self._problem
+
+
+class TwistCommanded:
+    """Mixin of the units whose command topic feeds a :class:`TwistCommand`, ``_command``.
+
+    A twist goes stale after the parameter its ``timeout_field`` names (s of
+    sim time; none: never), counted from the unit's last update, ``_time``.
+    """
+
+    _command: TwistCommand
+    _time: float = 0.0
+    params: Mapping[str, Any]
+
+    def set_command(self, value: StampedTwist) -> CommandResult:
+        """Take a twist (from the subscription; cheap): refuse non-finite or stale ones."""
+        command = self._command
+        timeout = self.params[command.timeout_field] if command.timeout_field else 0.0
+        result = command.take(value, self._time, timeout)
+        if result is CommandResult.ACCEPTED:
+            self.twist_taken()
+        return result
+
+    def twist_taken(self) -> None:
+        """Do nothing; a unit may react to a taken twist here (from the subscription: cheap)."""
+
+    def command_problem(self, value: Any, result: CommandResult) -> str:
+        """Describe the last refused twist."""
+        return self._command.problem(value, result)

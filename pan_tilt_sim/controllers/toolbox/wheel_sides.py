@@ -2,18 +2,37 @@
 
 The Gazebo diff-drive plugins (classic's and gz-sim's) drive their wheels
 by side: :class:`WheelSides` binds the named joints' handles and reports
-their velocity targets (the plugins' setpoints).  Pure Python.
+their velocity targets (the plugins' setpoints).  :func:`feedback_interfaces`
+says what the drive controllers' wheel odometry reads.  Pure Python.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 from pan_tilt_sim.controllers.framework.base import JointHandle
 
 # handle(joints, joint, field): the controller's checked handle of ``joint``,
 # ``field`` naming the setting that lists it (Controller.handle).
 HandleLookup = Callable[[Mapping[str, JointHandle], str, str], JointHandle]
+
+
+def feedback_interfaces(wheels: Sequence[str],
+                        params: Mapping[str, Any]) -> dict[str, tuple[str, ...]]:
+    """Return the state interface each wheel is read by: none with ``open_loop``.
+
+    Else ``position`` with ``position_feedback``, ``velocity`` without.
+    """
+    if params['open_loop']:
+        return {}
+    feedback = 'position' if params['position_feedback'] else 'velocity'
+    return {wheel: (feedback,) for wheel in wheels}
+
+
+def velocity_targets(handles: Sequence[JointHandle]) -> dict[str, float]:
+    """Return each handle's velocity target (rad/s), by joint."""
+    return {handle.name: handle.velocity_target for handle in handles}
 
 
 class WheelSides:
@@ -42,4 +61,4 @@ class WheelSides:
 
     def setpoints(self) -> dict[str, float]:
         """Return each bound wheel's velocity target (rad/s)."""
-        return {handle.name: handle.velocity_target for handle in self.left + self.right}
+        return velocity_targets(self.left + self.right)

@@ -16,32 +16,25 @@ behaviour per generation: docs/design/gazebo-plugins.md.  Pure Python.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable, Mapping
-from typing import Any, ClassVar
+from collections.abc import Callable
 
 from pan_tilt_sim.controllers.framework.base import (
     Actuator,
     ActuatorKind,
-    CommandController,
-    CommandKind,
-    CommandResult,
-    JointHandle,
 )
 from pan_tilt_sim.controllers.framework.surface import (
     CommandTopic,
     Endpoint,
-    StampedTwist,
     StateTopic,
 )
 from pan_tilt_sim.controllers.toolbox.odometry import Odometry
-from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs
 from pan_tilt_sim.controllers.toolbox.twist_command import TwistCommand
 from pan_tilt_sim.controllers.toolbox.wheel_sides import WheelSides
 from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.robot import RobotModel
-from pan_tilt_sim.model.sensors import ROS1, ROS2, Ros2Names, ros1_resolve
+from pan_tilt_sim.model.sensors import ROS1, ROS2, Ros2Names
+from pan_tilt_sim.plugins.framework.drives import ClassicTopics, WheeledDrive
 from pan_tilt_sim.plugins.framework.elements import (
-    UNPLANAR_COVARIANCE,
     Element,
     ElementReader,
     ElementSpec,
@@ -53,7 +46,6 @@ from pan_tilt_sim.plugins.framework.elements import (
 from pan_tilt_sim.plugins.framework.plugin import (
     BaseState,
     PlanarOdometrySink,
-    Plugin,
     PluginWorld,
 )
 from pan_tilt_sim.schedule import DUE_EPSILON
@@ -100,7 +92,7 @@ ROS1_DIFF_DRIVE_KEYS = {*ROS1_ELEMENTS.names, 'robotNamespace'}
 
 
 @dataclasses.dataclass(frozen=True)
-class DiffDrivePlugin:
+class DiffDrivePlugin(ClassicTopics):
     """One ``gazebo_ros_diff_drive`` plugin: wheels, geometry, limits, topics and frames.
 
     ``left_joints[i]`` and ``right_joints[i]`` are wheel pair i, with
@@ -136,19 +128,6 @@ class DiffDrivePlugin:
         """Every wheel, left ones first."""
         return self.left_joints + self.right_joints
 
-    def topics(self, override: str = '') -> tuple[str, str]:
-        """Return the command and odometry topics (absolute), ``override`` as the namespace.
-
-        ``override`` (sim_node's namespace or ``robot_namespace``) replaces the
-        plugin's, as spawn's ``-robot_namespace`` does in Gazebo.
-        """
-        namespace = override or self.namespace
-        if self.convention == ROS1:
-            return (ros1_resolve(namespace, self.command_topic),
-                    ros1_resolve(namespace, self.odometry_topic))
-        names = Ros2Names(self.name, namespace, self.remappings)
-        return names.topic(self.command_topic), names.topic(self.odometry_topic)
-
     def tf_topic(self, override: str = '') -> str:
         """Return where the odometry TF goes: ``/tf``, or where ``<remapping>/tf:=tf`` puts it.
 
@@ -158,12 +137,6 @@ class DiffDrivePlugin:
         if self.convention == ROS1:
             return '/tf'
         return Ros2Names(self.name, override or self.namespace, self.remappings).topic('/tf')
-
-    @property
-    def pose_covariance(self) -> tuple[float, ...]:
-        """The odometry pose covariance's diagonal (x, y, z, roll, pitch, yaw)."""
-        x, y, yaw = self.covariance
-        return (x, y, UNPLANAR_COVARIANCE, UNPLANAR_COVARIANCE, UNPLANAR_COVARIANCE, yaw)
 
     @property
     def twist_covariance(self) -> tuple[float, ...]:
@@ -234,13 +207,11 @@ def _ros1_diff_drive(reader: ElementReader) -> DiffDrivePlugin:
         namespace=reader.ros1_namespace())
 
 
-class GazeboDiffDrive(Plugin, OdometryOutputs, CommandController):
+class GazeboDiffDrive(WheeledDrive):
     """One ``gazebo_ros_diff_drive`` plugin: a Twist in, wheel velocities out, odometry back."""
 
     filenames = frozenset({'gazebo_ros_diff_drive'})
     filename = DiffDrivePlugin.filename
-    drives_base: ClassVar[bool] = True
-    command_kind = CommandKind.TWIST
 
     @classmethod
     def read(cls, element: PluginElement, model: RobotModel) -> DiffDrivePlugin:
@@ -263,11 +234,6 @@ class GazeboDiffDrive(Plugin, OdometryOutputs, CommandController):
         self._odometry_sink: PlanarOdometrySink | None = None
         self._base_state: Callable[[], BaseState] | None = None
         self.reset()
-
-    @property
-    def joint_names(self) -> tuple[str, ...]:
-        """The wheels, left then right."""
-        return self.plugin.joint_names
 
     def actuators(self) -> dict[str, Actuator]:
         """Return the ideal velocity actuator, its force limit the wheel torque, per wheel."""
@@ -293,22 +259,15 @@ class GazeboDiffDrive(Plugin, OdometryOutputs, CommandController):
             CommandTopic(command, self.command_kind.value, self.set_command,
                          self.command_problem)]
         if plugin.publish_odom:
-            endpoints.append(StateTopic(odometry, 'nav_msgs/msg/Odometry', self.set_odometry_sink,
-                                        {'frame_id': plugin.odometry_frame,
-                                         'child_frame_id': plugin.robot_base_frame,
-                                         'pose_covariance_diagonal': plugin.pose_covariance,
-                                         'twist_covariance_diagonal': plugin.twist_covariance}))
+            endpoints.append(self.odometry_topic(
+                odometry, (plugin.odometry_frame, plugin.robot_base_frame),
+                plugin.pose_covariance, plugin.twist_covariance))
         if plugin.publish_odom_tf:
             endpoints.append(StateTopic(plugin.tf_topic(override), 'tf2_msgs/msg/TFMessage',
                                         self.set_tf_sink))
         return tuple(endpoints)
 
     # --- lifecycle -------------------------------------------------------------------------
-
-    def configure(self, joints: Mapping[str, JointHandle]) -> None:
-        """Bind the wheels' handles, then reset."""
-        self._wheels.bind(joints, self.handle)
-        self.reset()
 
     def reset(self) -> None:
         """No command, the encoder odometry at the origin, the wheels asked to stand."""
@@ -320,24 +279,7 @@ class GazeboDiffDrive(Plugin, OdometryOutputs, CommandController):
             handle.velocity_target = 0.0
             handle.force_limit = self.plugin.max_wheel_torque
 
-    # --- commands --------------------------------------------------------------------------
-
-    def set_command(self, value: StampedTwist) -> CommandResult:
-        """Take a twist (from the subscription; cheap): refuse non-finite ones."""
-        return self._command.take(value)
-
-    def command_problem(self, value: Any, result: CommandResult) -> str:
-        """Describe the last refused twist."""
-        return self._command.problem(value, result)
-
-    def setpoints(self) -> dict[str, float]:
-        """Return each wheel's velocity target (rad/s)."""
-        return self._wheels.setpoints()
-
-    @property
-    def odometry(self) -> Odometry:
-        """The encoder odometry (pose and twist in the odometry frame)."""
-        return self._odometry
+    # --- commands, setpoints, odometry (the encoder's): WheeledDrive ------------------------
 
     # --- the step ---------------------------------------------------------------------------
 

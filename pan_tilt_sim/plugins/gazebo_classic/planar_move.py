@@ -18,28 +18,27 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Callable, Mapping
-from typing import Any, ClassVar
+from typing import ClassVar
 
 from pan_tilt_sim.controllers.framework.base import (
     Actuator,
     CommandController,
     CommandKind,
-    CommandResult,
     JointHandle,
 )
 from pan_tilt_sim.controllers.framework.surface import (
     CommandTopic,
     Endpoint,
-    StampedTwist,
     StateTopic,
 )
 from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, TfSink
+from pan_tilt_sim.controllers.toolbox.twist_command import TwistCommand, TwistCommanded
 from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.robot import RobotModel
-from pan_tilt_sim.model.sensors import ROS1, ROS2, Ros2Names, ros1_resolve
+from pan_tilt_sim.model.sensors import ROS1, ROS2
 from pan_tilt_sim.model.transforms import Vector
+from pan_tilt_sim.plugins.framework.drives import ClassicTopics
 from pan_tilt_sim.plugins.framework.elements import (
-    UNPLANAR_COVARIANCE,
     Element,
     ElementReader,
     ElementSpec,
@@ -80,7 +79,7 @@ ROS1_PLANAR_MOVE_KEYS = {*ROS1_ELEMENTS.names, 'robotNamespace'}
 
 
 @dataclasses.dataclass(frozen=True)
-class PlanarMovePlugin:
+class PlanarMovePlugin(ClassicTopics):
     """One ``gazebo_ros_planar_move`` plugin: the base's planar velocity set from a Twist.
 
     ``update_rate`` (Hz, 0: every step): how often the base's velocity is
@@ -105,20 +104,7 @@ class PlanarMovePlugin:
 
     filename = 'libgazebo_ros_planar_move.so'
 
-    def topics(self, override: str = '') -> tuple[str, str]:
-        """Return the command and odometry topics (absolute), ``override`` as the namespace."""
-        namespace = override or self.namespace
-        if self.convention == ROS1:
-            return (ros1_resolve(namespace, self.command_topic),
-                    ros1_resolve(namespace, self.odometry_topic))
-        names = Ros2Names(self.name, namespace, self.remappings)
-        return names.topic(self.command_topic), names.topic(self.odometry_topic)
-
-    @property
-    def pose_covariance(self) -> tuple[float, ...]:
-        """The odometry pose (and twist) covariance's diagonal (x, y, z, roll, pitch, yaw)."""
-        x, y, yaw = self.covariance
-        return (x, y, UNPLANAR_COVARIANCE, UNPLANAR_COVARIANCE, UNPLANAR_COVARIANCE, yaw)
+    # topics() and pose_covariance (the twist's too): ClassicTopics
 
 
 def read_planar_move(element: PluginElement, model: RobotModel) -> PlanarMovePlugin:
@@ -157,7 +143,7 @@ def read_planar_move(element: PluginElement, model: RobotModel) -> PlanarMovePlu
     return plugin
 
 
-class GazeboPlanarMove(Plugin, OdometryOutputs, CommandController):
+class GazeboPlanarMove(Plugin, OdometryOutputs, TwistCommanded, CommandController):
     """One ``gazebo_ros_planar_move`` plugin: a Twist sets the base's planar velocity."""
 
     filenames = frozenset({'gazebo_ros_planar_move'})
@@ -183,7 +169,7 @@ class GazeboPlanarMove(Plugin, OdometryOutputs, CommandController):
         self._odometry_sink: SpatialOdometrySink | None = None
         self._tf_sink: TfSink | None = None
         self._base_motion: Callable[[], BaseMotion] | None = None
-        self._problem = ''
+        self._command = TwistCommand('cmd_vel', sideways=True)
         self._time = 0.0
         self.reset()
 
@@ -205,12 +191,9 @@ class GazeboPlanarMove(Plugin, OdometryOutputs, CommandController):
             CommandTopic(command, self.command_kind.value, self.set_command,
                          self.command_problem)]
         if plugin.publish_odom:
-            endpoints.append(StateTopic(odometry, 'nav_msgs/msg/Odometry', self.set_odometry_sink,
-                                        {'frame_id': plugin.odometry_frame,
-                                         'child_frame_id': plugin.robot_base_frame,
-                                         'pose_covariance_diagonal': plugin.pose_covariance,
-                                         'twist_covariance_diagonal': plugin.pose_covariance,
-                                         'spatial': True}))
+            endpoints.append(self.odometry_topic(
+                odometry, (plugin.odometry_frame, plugin.robot_base_frame),
+                plugin.pose_covariance, plugin.pose_covariance, spatial=True))
         if plugin.publish_odom_tf:
             endpoints.append(StateTopic('/tf', 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
         return tuple(endpoints)
@@ -223,27 +206,19 @@ class GazeboPlanarMove(Plugin, OdometryOutputs, CommandController):
 
     def reset(self) -> None:
         """No command; both rates start again from sim time 0."""
+        self._command.latest = None
         self._twist = (0.0, 0.0, 0.0)
         self._received = 0.0
         self._last_update = self._last_publish = 0.0
         self._pending: tuple[Vector, Vector] | None = None
 
-    # --- commands --------------------------------------------------------------------------
+    # --- commands (set_command, command_problem: TwistCommanded) ----------------------------
 
-    def set_command(self, value: StampedTwist) -> CommandResult:
-        """Take a twist (from the subscription; cheap): refuse non-finite ones."""
-        x, y, angular = value.linear[0], value.linear[1], value.angular[2]
-        if not all(math.isfinite(number) for number in (x, y, angular)):
-            self._problem = (f'ignored cmd_vel (linear.x {x!r}, linear.y {y!r}, angular.z '
-                             f'{angular!r}): not finite numbers')
-            return CommandResult.REJECTED
-        self._twist = (x, y, angular)
+    def twist_taken(self) -> None:
+        """Put the taken twist in force; ROS 1's cmdTimeout counts from now."""
+        latest = self._command.latest
+        self._twist = (latest.linear[0], latest.linear[1], latest.angular[2])
         self._received = self._time
-        return CommandResult.ACCEPTED
-
-    def command_problem(self, value: Any, result: CommandResult) -> str:
-        """Describe the last refused twist."""
-        return self._problem
 
     def setpoints(self) -> dict[str, float]:
         """None: no joint is commanded."""

@@ -17,25 +17,17 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Mapping
-from typing import Any, ClassVar
 
 from pan_tilt_sim.controllers.framework.base import (
     Actuator,
     ActuatorKind,
-    CommandController,
-    CommandKind,
-    CommandResult,
-    JointHandle,
 )
 from pan_tilt_sim.controllers.framework.surface import (
     CommandTopic,
     Endpoint,
-    StampedTwist,
     StateTopic,
 )
 from pan_tilt_sim.controllers.toolbox.odometry import Odometry
-from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs
 from pan_tilt_sim.controllers.toolbox.rate_limiter import (
     InvalidLimitsError,
     RateLimiter,
@@ -45,6 +37,7 @@ from pan_tilt_sim.controllers.toolbox.twist_command import TwistCommand
 from pan_tilt_sim.controllers.toolbox.wheel_sides import WheelSides
 from pan_tilt_sim.model.plugin_elements import PluginElement
 from pan_tilt_sim.model.robot import RobotModel
+from pan_tilt_sim.plugins.framework.drives import WheeledDrive
 from pan_tilt_sim.plugins.framework.elements import (
     GZ,
     Element,
@@ -57,7 +50,7 @@ from pan_tilt_sim.plugins.framework.elements import (
     joints_by_name,
     root_link,
 )
-from pan_tilt_sim.plugins.framework.plugin import PlanarOdometrySink, Plugin, PluginWorld
+from pan_tilt_sim.plugins.framework.plugin import PlanarOdometrySink, PluginWorld
 from pan_tilt_sim.schedule import DUE_EPSILON
 
 ODOMETRY_WINDOW = 10  # updates in the odometry twist's rolling mean (gz-math's default)
@@ -189,14 +182,12 @@ def gz_limiter(limits: tuple[float, ...], name: str, group: str) -> RateLimiter:
         raise ValueError(f"system '{name}': {group} limits: {err}") from None
 
 
-class GzDiffDrive(Plugin, OdometryOutputs, CommandController):
+class GzDiffDrive(WheeledDrive):
     """One gz-sim DiffDrive system: a Twist in, wheel velocities out, odometry back."""
 
     filenames = GZ_DIFF_DRIVE_FILES
     system_names = GZ_DIFF_DRIVE_NAMES
     filename = GzDiffDrivePlugin.filename
-    drives_base: ClassVar[bool] = True
-    command_kind = CommandKind.TWIST
 
     @classmethod
     def read(cls, element: PluginElement, model: RobotModel) -> GzDiffDrivePlugin:
@@ -220,11 +211,6 @@ class GzDiffDrive(Plugin, OdometryOutputs, CommandController):
         self._odometry_sink: PlanarOdometrySink | None = None
         self.reset()
 
-    @property
-    def joint_names(self) -> tuple[str, ...]:
-        """The wheels, left then right."""
-        return self.plugin.joint_names
-
     def actuators(self) -> dict[str, Actuator]:
         """Return the ideal velocity actuator per wheel (within the joint's effort limit)."""
         return {wheel: Actuator(ActuatorKind.IDEAL_VELOCITY, self.name)
@@ -238,18 +224,11 @@ class GzDiffDrive(Plugin, OdometryOutputs, CommandController):
         return (
             CommandTopic(plugin.command_topic, self.command_kind.value, self.set_command,
                          self.command_problem),
-            StateTopic(plugin.odometry_topic, 'nav_msgs/msg/Odometry', self.set_odometry_sink,
-                       {'frame_id': plugin.frame_id, 'child_frame_id': plugin.child_frame_id,
-                        'pose_covariance_diagonal': (0.0,) * 6,
-                        'twist_covariance_diagonal': (0.0,) * 6}),
+            self.odometry_topic(plugin.odometry_topic, (plugin.frame_id, plugin.child_frame_id),
+                                (0.0,) * 6, (0.0,) * 6),
             StateTopic(plugin.tf_topic, 'tf2_msgs/msg/TFMessage', self.set_tf_sink))
 
     # --- lifecycle -------------------------------------------------------------------------
-
-    def configure(self, joints: Mapping[str, JointHandle]) -> None:
-        """Bind the wheels' handles, then reset."""
-        self._wheels.bind(joints, self.handle)
-        self.reset()
 
     def reset(self) -> None:
         """No command, the odometry at the origin of the wheels' present positions."""
@@ -263,24 +242,7 @@ class GzDiffDrive(Plugin, OdometryOutputs, CommandController):
         for handle in wheels.all:
             handle.velocity_target = 0.0
 
-    # --- commands --------------------------------------------------------------------------
-
-    def set_command(self, value: StampedTwist) -> CommandResult:
-        """Take a twist (from the subscription; cheap): refuse non-finite ones."""
-        return self._command.take(value)
-
-    def command_problem(self, value: Any, result: CommandResult) -> str:
-        """Describe the last refused twist."""
-        return self._command.problem(value, result)
-
-    def setpoints(self) -> dict[str, float]:
-        """Return each wheel's velocity target (rad/s)."""
-        return self._wheels.setpoints()
-
-    @property
-    def odometry(self) -> Odometry:
-        """The wheel odometry (pose and twist in ``frame_id``)."""
-        return self._odometry
+    # --- commands, setpoints, odometry (in frame_id): WheeledDrive ---------------------------
 
     # --- the step ---------------------------------------------------------------------------
 

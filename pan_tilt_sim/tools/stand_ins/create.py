@@ -14,6 +14,7 @@ import math
 import sys
 
 from pan_tilt_sim.tools.stand_ins.flags import FlagError, parse_flags
+from pan_tilt_sim.tools.stand_ins.launcher import exit_with, run_node
 from pan_tilt_sim.tools.stand_ins.spawning import call_spawn, description_from_topic
 
 NODE_NAME = 'ros_gz_sim'
@@ -38,27 +39,12 @@ def quaternion(roll: float, pitch: float, yaw: float) -> tuple[float, float, flo
 
 def main(argv: list[str] | None = None) -> None:
     """Run create with ``argv`` (program name first); exit with create's code."""
-    sys.exit(run(sys.argv if argv is None else argv))
+    exit_with(run, argv)
 
 
 def run(argv: list[str]) -> int:
     """Spawn as create does; return the exit code."""
-    import rclpy
-    from rclpy.executors import ExternalShutdownException
-    from rclpy.utilities import remove_ros_args
-
-    rclpy.init(args=argv)
-    try:
-        node = rclpy.create_node(NODE_NAME)
-        try:
-            return _create(node, remove_ros_args(argv)[1:])
-        finally:
-            node.destroy_node()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        return 0
-    finally:
-        if rclpy.ok():
-            rclpy.shutdown()
+    return run_node(argv, NODE_NAME, _create)
 
 
 def _create(node, words: list[str]) -> int:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import sys
 
 from pan_tilt_sim.model.gz_bridge import GZ_TO_ROS, BridgeEntry
+from pan_tilt_sim.tools.stand_ins.launcher import exit_with, run_node
 
 NODE_NAME = 'ros_gz_image'
 EXIT_USAGE = 255
@@ -20,41 +21,30 @@ USAGE = ('Bridge a collection of Gazebo Transport image topics to ROS using imag
 
 def main(argv: list[str] | None = None) -> None:
     """Run image_bridge with ``argv`` (program name first)."""
-    sys.exit(run(sys.argv if argv is None else argv))
+    exit_with(run, argv)
 
 
 def run(argv: list[str]) -> int:
     """Bridge as image_bridge does; return the exit code (0 when stopped)."""
-    import rclpy
-    from rclpy.executors import ExternalShutdownException
-    from rclpy.utilities import remove_ros_args
-
     if len(argv) < 2:
         sys.stderr.write(USAGE)
         return EXIT_USAGE
-    rclpy.init(args=argv)
-    try:
-        node = rclpy.create_node(NODE_NAME)
-        try:
-            from pan_tilt_sim.tools.stand_ins.bridging import absolute, announce, hand_over
+    return run_node(argv, NODE_NAME, _bridge)
 
-            announce(node)
 
-            qos = node.declare_parameter('qos', 'default').value
-            if qos not in QOS_CHOICES:
-                node.get_logger().error(
-                    f'Invalid QoS profile {qos} specified. Using default profile.')
-            node.get_logger().warning(
-                "image_transport's compressed and theora topics are not made: raw images only")
-            entries = [absolute(node, BridgeEntry(topic, topic, 'sensor_msgs/msg/Image',
-                                                  'gz.msgs.Image', GZ_TO_ROS), False)
-                       for topic in remove_ros_args(argv)[1:]]
-            code = hand_over(node, entries)
-            return 0 if code is None else code
-        finally:
-            node.destroy_node()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        return 0
-    finally:
-        if rclpy.ok():
-            rclpy.shutdown()
+def _bridge(node, topics: list[str]) -> int:
+    from pan_tilt_sim.tools.stand_ins.bridging import absolute, announce, hand_over
+
+    announce(node)
+
+    qos = node.declare_parameter('qos', 'default').value
+    if qos not in QOS_CHOICES:
+        node.get_logger().error(
+            f'Invalid QoS profile {qos} specified. Using default profile.')
+    node.get_logger().warning(
+        "image_transport's compressed and theora topics are not made: raw images only")
+    entries = [absolute(node, BridgeEntry(topic, topic, 'sensor_msgs/msg/Image',
+                                          'gz.msgs.Image', GZ_TO_ROS), False)
+               for topic in topics]
+    code = hand_over(node, entries)
+    return 0 if code is None else code

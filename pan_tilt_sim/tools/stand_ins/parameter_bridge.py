@@ -15,6 +15,7 @@ import pathlib
 import sys
 
 from pan_tilt_sim.model.gz_bridge import BridgeEntry, BridgeError, parse_argument, read_config
+from pan_tilt_sim.tools.stand_ins.launcher import exit_with, run_node
 
 NODE_NAME = 'ros_gz_bridge'
 EXIT_USAGE = 255  # parameter_bridge's return -1
@@ -26,30 +27,15 @@ USAGE = ('Bridge a collection of ROS2 and Gazebo Transport topics and services.\
 
 def main(argv: list[str] | None = None) -> None:
     """Run parameter_bridge with ``argv`` (program name first)."""
-    sys.exit(run(sys.argv if argv is None else argv))
+    exit_with(run, argv)
 
 
 def run(argv: list[str]) -> int:
     """Bridge as parameter_bridge does; return the exit code (0 when stopped)."""
-    import rclpy
-    from rclpy.executors import ExternalShutdownException
-    from rclpy.utilities import remove_ros_args
-
     if len(argv) < 2:
         sys.stdout.write(USAGE)
         return EXIT_USAGE
-    rclpy.init(args=argv)
-    try:
-        node = rclpy.create_node(NODE_NAME)
-        try:
-            return _bridge(node, remove_ros_args(argv)[1:])
-        finally:
-            node.destroy_node()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        return 0
-    finally:
-        if rclpy.ok():
-            rclpy.shutdown()
+    return run_node(argv, NODE_NAME, _bridge)
 
 
 def _bridge(node, arguments: list[str]) -> int:

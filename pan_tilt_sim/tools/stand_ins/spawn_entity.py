@@ -15,6 +15,7 @@ import sys
 import xml.etree.ElementTree as ElementTree
 
 from pan_tilt_sim.tools.stand_ins.create import quaternion
+from pan_tilt_sim.tools.stand_ins.launcher import exit_with, run_node
 from pan_tilt_sim.tools.stand_ins.spawning import call_spawn, description_from_topic, spin_for
 
 NODE_NAME = 'spawn_entity'
@@ -47,35 +48,22 @@ def parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> None:
     """Run spawn_entity.py with ``argv`` (program name first); exit 0 spawned, 1 not."""
-    sys.exit(run(sys.argv if argv is None else argv))
+    exit_with(run, argv)
 
 
 def run(argv: list[str]) -> int:
     """Spawn as spawn_entity.py does; return the exit code."""
-    import rclpy
-    from rclpy.executors import ExternalShutdownException
     from rclpy.utilities import remove_ros_args
 
     args = parser().parse_args(remove_ros_args(argv)[1:])  # exits 2 on bad arguments
-    rclpy.init(args=argv)
-    try:
-        node = rclpy.create_node(NODE_NAME)
-        try:
-            node.get_logger().info('Spawn Entity started')
-            return _spawn(node, args)
-        finally:
-            node.destroy_node()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        return 0
-    finally:
-        if rclpy.ok():
-            rclpy.shutdown()
+    return run_node(argv, NODE_NAME, lambda node, _words: _spawn(node, args))
 
 
 def _spawn(node, args: argparse.Namespace) -> int:
     from simulation_interfaces.srv import SpawnEntity
 
     logger = node.get_logger()
+    logger.info('Spawn Entity started')
     for name, given in (('-gazebo_namespace', args.gazebo_namespace), ('-wait', args.wait),
                         ('-b', args.bond)):
         if given:

@@ -11,48 +11,24 @@ from __future__ import annotations
 import math
 
 import pytest
+from holonomic_drive import DT, NAME, configured, run, twist
 from roller_fixtures import MECANUM_LX, MECANUM_LY, WHEEL_RADIUS, mecanum_joints, mecanum_parameters
 
 from pan_tilt_sim.controllers import JointHandle
 from pan_tilt_sim.controllers.drives.mecanum_drive_controller import MecanumDriveController
 from pan_tilt_sim.controllers.framework import registry
 from pan_tilt_sim.controllers.framework.base import ActuatorKind, CommandResult, Reference
-from pan_tilt_sim.controllers.framework.surface import CommandTopic, StampedTwist, StateTopic
+from pan_tilt_sim.controllers.framework.surface import CommandTopic, StateTopic
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.model.robot import JointKind, JointSpec
 
-DT = 0.01  # the controller's update period at 100 Hz
-NAME = 'base_controller'
 FL, FR, RR, RL = mecanum_joints()
-
-
-def twist(vx: float, vy: float, wz: float, stamp: float = 0.0) -> StampedTwist:
-    """Return a TwistStamped value: linear.x, linear.y and angular.z."""
-    return StampedTwist(stamp, (vx, vy, 0.0), (0.0, 0.0, wz))
 
 
 def controller(**overrides) -> tuple[MecanumDriveController, dict[str, JointHandle]]:
     """Return a configured controller of the four wheels, and the wheels' handles."""
-    handles = {name: JointHandle(JointSpec(name, JointKind.CONTINUOUS))
-               for name in mecanum_joints()}
-    drive = MecanumDriveController(NAME, mecanum_parameters(update_rate=100.0, **overrides),
-                                   'mecanum.yaml')
-    drive.configure(handles)
-    return drive, handles
-
-
-def run(drive: MecanumDriveController, handles: dict[str, JointHandle], seconds: float,
-        start: float = 0.0, command: StampedTwist | None = None) -> float:
-    """Update ``drive`` for ``seconds``; ideal wheels turn as commanded; return the end time."""
-    steps = round(seconds / DT)
-    for step in range(steps):
-        time = start + step * DT
-        if command is not None:
-            assert drive.set_command(command._replace(stamp=time)) is CommandResult.ACCEPTED
-        drive.update(time, DT)
-        for handle in handles.values():
-            handle.velocity = handle.velocity_target
-    return start + steps * DT
+    parameters = mecanum_parameters(update_rate=100.0, **overrides)
+    return configured(MecanumDriveController, parameters, mecanum_joints(), 'mecanum.yaml')
 
 
 def targets(handles: dict[str, JointHandle]) -> list[float]:

@@ -11,49 +11,24 @@ from __future__ import annotations
 import math
 
 import pytest
+from holonomic_drive import DT, NAME, configured, run, twist
 from roller_fixtures import OMNI_RADIUS, WHEEL_RADIUS, omni_joints, omni_parameters
 
 from pan_tilt_sim.controllers import JointHandle
 from pan_tilt_sim.controllers.drives.omni_wheel_drive_controller import OmniWheelDriveController
 from pan_tilt_sim.controllers.framework import registry
 from pan_tilt_sim.controllers.framework.base import ActuatorKind, CommandResult
-from pan_tilt_sim.controllers.framework.surface import CommandTopic, StampedTwist, StateTopic
+from pan_tilt_sim.controllers.framework.surface import CommandTopic, StateTopic
 from pan_tilt_sim.errors import ControllerConfigError
 from pan_tilt_sim.model.robot import JointKind, JointSpec
 
-DT = 0.01  # the controller's update period at 100 Hz
-NAME = 'base_controller'
 ROOT3 = math.sqrt(3.0)
-
-
-def twist(vx: float, vy: float, wz: float, stamp: float = 0.0) -> StampedTwist:
-    """Return a TwistStamped value: linear.x, linear.y and angular.z."""
-    return StampedTwist(stamp, (vx, vy, 0.0), (0.0, 0.0, wz))
 
 
 def controller(**overrides) -> tuple[OmniWheelDriveController, dict[str, JointHandle]]:
     """Return a configured controller of the three wheels, and the wheels' handles."""
-    handles = {name: JointHandle(JointSpec(name, JointKind.CONTINUOUS))
-               for name in omni_joints()}
-    drive = OmniWheelDriveController(NAME, omni_parameters(update_rate=100.0, **overrides),
-                                     'omni.yaml')
-    drive.configure(handles)
-    return drive, handles
-
-
-def run(drive: OmniWheelDriveController, handles: dict[str, JointHandle], seconds: float,
-        start: float = 0.0, command: StampedTwist | None = None) -> float:
-    """Update ``drive`` for ``seconds``; ideal wheels turn as commanded; return the end time."""
-    steps = round(seconds / DT)
-    for step in range(steps):
-        time = start + step * DT
-        if command is not None:
-            assert drive.set_command(command._replace(stamp=time)) is CommandResult.ACCEPTED
-        drive.update(time, DT)
-        for handle in handles.values():
-            handle.velocity = handle.velocity_target
-            handle.position += handle.velocity_target * DT
-    return start + steps * DT
+    parameters = omni_parameters(update_rate=100.0, **overrides)
+    return configured(OmniWheelDriveController, parameters, omni_joints(), 'omni.yaml')
 
 
 def targets(handles: dict[str, JointHandle]) -> list[float]:

@@ -86,7 +86,10 @@ def test_ros1_the_command_times_out_after_cmd_timeout():
 def test_a_non_finite_twist_is_refused_and_a_reset_drops_the_command():
     mover = unit()
     mover.set_command(twist(0.2, 0.0, 0.0))
-    assert mover.set_command(twist(0.0, math.inf, 0.0)) is CommandResult.REJECTED
+    bad = twist(0.0, math.inf, 0.0)
+    assert mover.set_command(bad) is CommandResult.REJECTED
+    assert mover.command_problem(bad, CommandResult.REJECTED) == (
+        'ignored cmd_vel (linear.x 0.0, linear.y inf, angular.z 0.0): not finite numbers')
     assert mover.command == (0.2, 0.0, 0.0)
     mover.reset()
     assert mover.command == (0.0, 0.0, 0.0)

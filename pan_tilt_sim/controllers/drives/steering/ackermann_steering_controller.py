@@ -15,11 +15,12 @@ with a warning, as upstream.
 
 from __future__ import annotations
 
-import sys
-
 from pan_tilt_sim.controllers.drives.steering.steering_controllers import (
+    EPSILON,
+    TRACTION_TRACK_WIDTH,
     SteeringController,
     library_parameters,
+    wheels_radius_parameters,
 )
 from pan_tilt_sim.controllers.drives.steering.steering_odometry import (
     Configuration,
@@ -33,8 +34,6 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
     gt,
 )
 from pan_tilt_sim.controllers.framework.shared_parameters import UNSET_OR_LENGTH
-
-EPSILON = sys.float_info.epsilon  # a length at most this is "not set", as upstream
 
 
 class AckermannSteeringController(SteeringController):
@@ -54,28 +53,17 @@ class AckermannSteeringController(SteeringController):
         Param('rear_wheel_track', DOUBLE, 0.0, "Deprecated: use 'traction_track_width' or "
               "'steering_track_width'.",
               validators=UNSET_OR_LENGTH),
-        Param('traction_track_width', DOUBLE, 0.0, 'Distance between the traction wheels (m).',
-              example=0.3,
-              validators=UNSET_OR_LENGTH),
+        TRACTION_TRACK_WIDTH,
         Param('wheelbase', DOUBLE, REQUIRED, 'Distance between the front and rear axles (m).',
               (gt(0.0),), example=0.5),
-        Param('traction_wheels_radius', DOUBLE, 0.0, 'Radius of the traction wheels (m).',
-              example=0.05,
-              validators=UNSET_OR_LENGTH),
-        Param('front_wheels_radius', DOUBLE, 0.0, "Deprecated: use 'traction_wheels_radius'.",
-              validators=UNSET_OR_LENGTH),
-        Param('rear_wheels_radius', DOUBLE, 0.0, "Deprecated: use 'traction_wheels_radius'.",
-              validators=UNSET_OR_LENGTH),
+        *wheels_radius_parameters(),
     ])
+
     def kinematics(self) -> SteeringKinematics:
         """Return Ackermann kinematics from the (deprecation-mapped) geometry parameters."""
         params = self.params
-        radius = params['traction_wheels_radius']
+        radius = self.traction_radius()
         traction, steering = params['traction_track_width'], params['steering_track_width']
-        for deprecated in ('front_wheels_radius', 'rear_wheels_radius'):
-            if params[deprecated] > 0.0:
-                self.deprecated(deprecated, "'traction_wheels_radius'")
-                radius = params[deprecated]
         front = params['front_steering']
         if params['front_wheel_track'] > 0.0:
             self.deprecated('front_wheel_track', "'traction_track_width' or "

@@ -53,11 +53,8 @@ class BicycleSteeringController(SteeringController):
     def kinematics(self) -> SteeringKinematics:
         """Return bicycle kinematics from the (deprecation-mapped) geometry parameters."""
         params = self.params
-        radius = params['traction_wheel_radius']
-        for deprecated in ('front_wheel_radius', 'rear_wheel_radius'):
-            if params[deprecated] > 0.0:
-                self.deprecated(deprecated, "'traction_wheel_radius'")
-                radius = params[deprecated]
+        radius = self.traction_radius('traction_wheel_radius',
+                                      ('front_wheel_radius', 'rear_wheel_radius'))
         if radius <= 0.0:
             raise self.error('traction_wheel_radius', 'not set (or not > 0): cannot configure '
                                                       'odometry')

@@ -12,6 +12,7 @@ Design notes: docs/design/controllers.md#steering_controllerspy.
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any, ClassVar
 
@@ -24,7 +25,6 @@ from pan_tilt_sim.controllers.framework.base import (
     ActuatorKind,
     CommandController,
     CommandKind,
-    CommandResult,
     JointHandle,
     Reference,
 )
@@ -40,21 +40,25 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
     unique,
 )
 from pan_tilt_sim.controllers.framework.shared_parameters import (
+    UNSET_OR_LENGTH,
     UPDATE_RATE,
+    check_odometry_frames,
     odometry_frames,
-    same_frames_problem,
     update_period,
 )
 from pan_tilt_sim.controllers.framework.surface import (
     CommandTopic,
     Endpoint,
-    StampedTwist,
     StateTopic,
 )
 from pan_tilt_sim.controllers.toolbox.actuator import ARRIVED, SETPOINT_ACCELERATION, ramp
 from pan_tilt_sim.controllers.toolbox.limits import PositionLimits
 from pan_tilt_sim.controllers.toolbox.odometry_outputs import OdometryOutputs, OdometrySink, TfSink
-from pan_tilt_sim.model.transforms import Transform
+from pan_tilt_sim.controllers.toolbox.twist_command import (
+    TwistCommand,
+    TwistCommanded,
+    planar_references,
+)
 from pan_tilt_sim.schedule import PeriodicSchedule
 
 VELOCITY, POSITION = 'velocity', 'position'
@@ -63,6 +67,7 @@ TRACTION_STATE, STEERING_STATE = 'traction_joints_state_names', 'steering_joints
 # upstream's default covariance diagonals
 FRAMES = odometry_frames(covariance=(0.0, 7.0, 14.0, 21.0, 28.0, 35.0))
 MAX_JOINTS = 4  # upstream's size_lt<5> on every joint list
+EPSILON = sys.float_info.epsilon  # a length at most this is "not set", as upstream
 STATUS_MESSAGE = 'control_msgs/msg/SteeringControllerStatus'
 # Sinks besides the planar odometry and tf (toolbox.odometry_outputs): status(time,
 # traction positions, traction velocities, traction commands, steering positions, steering
@@ -125,6 +130,22 @@ def library_parameters(traction: list[str], steering: list[str]) -> tuple[Param,
         UPDATE_RATE,    )
 
 
+# The Ackermann and tricycle types declare these alike upstream; the bicycle type's radius
+# entries are singular and read-only, its own.
+TRACTION_TRACK_WIDTH = Param('traction_track_width', DOUBLE, 0.0, 'Distance between the '
+                             'traction wheels (m).', example=0.3, validators=UNSET_OR_LENGTH)
+WHEELS_RADIUS = 'traction_wheels_radius'
+WHEELS_RADIUS_DEPRECATED = ('front_wheels_radius', 'rear_wheels_radius')
+
+
+def wheels_radius_parameters() -> tuple[Param, ...]:
+    """Return ``traction_wheels_radius`` and its deprecated ``front_``/``rear_wheels_radius``."""
+    return (Param(WHEELS_RADIUS, DOUBLE, 0.0, 'Radius of the traction wheels (m).',
+                  example=0.05, validators=UNSET_OR_LENGTH),
+            *(Param(name, DOUBLE, 0.0, f"Deprecated: use '{WHEELS_RADIUS}'.",
+                    validators=UNSET_OR_LENGTH) for name in WHEELS_RADIUS_DEPRECATED))
+
+
 # (deprecated name, the name it stands for with front_steering, without it)
 DEPRECATED_JOINTS = (
     ('front_wheels_names', STEERING, TRACTION),
@@ -180,7 +201,41 @@ class SteeringJoints:
                 -limit if target < -limit else target)
 
 
-class SteeringController(OdometryOutputs, CommandController):
+class SteeredOnOwnClock:
+    """Mixin of the controllers that steer: control at the update rate, steering every step.
+
+    An instance has ``_updates`` (its update schedule), ``_last_update``
+    (None before the first), ``_steering`` (:class:`SteeringJoints`),
+    ``_timed_out`` and ``_control(time, interval)``: one upstream update over
+    ``interval`` s (the schedule's period the first time).
+    """
+
+    own_clock: ClassVar[bool] = True
+    _updates: PeriodicSchedule
+    _last_update: float | None
+    _steering: SteeringJoints
+    _time: float
+    _timed_out: bool
+
+    def update(self, time: float, period: float) -> None:
+        """At the update rate: one upstream update (``_control``); every step: the steering."""
+        self._time = time
+        if self._updates.take(time):
+            last = self._last_update
+            self._last_update = time
+            self._control(time, self._updates.period if last is None else time - last)
+        self._steering.track(period)
+
+    def _control(self, time: float, period: float) -> None:
+        raise NotImplementedError
+
+    def twist_taken(self) -> None:
+        """Let a new twist time out again (and say so)."""
+        self._timed_out = False
+
+
+class SteeringController(SteeredOnOwnClock, OdometryOutputs, TwistCommanded,
+                         CommandController):
     """A steered base from a twist: steering angles and wheel speeds out, odometry back.
 
     Subclasses give :attr:`configuration` and build the kinematics from their
@@ -189,7 +244,6 @@ class SteeringController(OdometryOutputs, CommandController):
 
     chainable = True
     drives_base: ClassVar[bool] = True
-    own_clock: ClassVar[bool] = True  # the kinematics at update_rate, the steering every step
     command_topic = 'reference'
     command_kind = CommandKind.TWIST_STAMPED
     configuration: ClassVar[Configuration]
@@ -197,13 +251,10 @@ class SteeringController(OdometryOutputs, CommandController):
 
     def __init__(self, name: str, params: Mapping[str, Any], source: str = '') -> None:
         super().__init__(name, params, source)
-        same_frames = same_frames_problem(self.params)
-        if same_frames:
-            raise self.error('base_frame_id', same_frames)
+        check_odometry_frames(self)
         self._names = self._joint_lists()
         self._kinematics = self.kinematics()
-        self._references = {f'{name}/linear/{VELOCITY}': Reference(f'{name}/linear/{VELOCITY}'),
-                            f'{name}/angular/{VELOCITY}': Reference(f'{name}/angular/{VELOCITY}')}
+        self._references = planar_references(name)
         self._linear_reference, self._angular_reference = self._references.values()
         self._updates = PeriodicSchedule(update_period(self.params))
         self._traction: list[JointHandle] = []
@@ -213,8 +264,7 @@ class SteeringController(OdometryOutputs, CommandController):
         self._odometry_sink: OdometrySink | None = None
         self._tf_sink: TfSink | None = None
         self._status_sink: StatusSink | None = None
-        self._command: StampedTwist | None = None
-        self._problem = ''
+        self._command = TwistCommand('reference', timeout_field='reference_timeout')
         self.reset()
 
     def _joint_lists(self) -> dict[str, tuple[str, ...]]:
@@ -261,6 +311,17 @@ class SteeringController(OdometryOutputs, CommandController):
         """Return the type's kinematics from its geometry parameters (subclasses)."""
         raise NotImplementedError
 
+    def traction_radius(self, name: str = WHEELS_RADIUS,
+                        deprecated: Sequence[str] = WHEELS_RADIUS_DEPRECATED) -> float:
+        """Return the ``name`` radius (m), or a deprecated one that is set (with a warning)."""
+        params = self.params
+        radius = params[name]
+        for field in deprecated:
+            if params[field] > 0.0:
+                self.deprecated(field, f"'{name}'")
+                radius = params[field]
+        return radius
+
     # --- what it claims and exports --------------------------------------------------------
 
     @property
@@ -305,10 +366,8 @@ class SteeringController(OdometryOutputs, CommandController):
         return (
             CommandTopic(f'~/{self.command_topic}', self.command_kind.value, self.set_command,
                          self.command_problem),
-            StateTopic('~/odometry', 'nav_msgs/msg/Odometry', self.set_odometry_sink, {
-                'frame_id': odom, 'child_frame_id': base,
-                'pose_covariance_diagonal': tuple(params['pose_covariance_diagonal']),
-                'twist_covariance_diagonal': tuple(params['twist_covariance_diagonal'])}),
+            self.odometry_topic('~/odometry', (odom, base), params['pose_covariance_diagonal'],
+                                params['twist_covariance_diagonal']),
             StateTopic('~/tf_odometry', 'tf2_msgs/msg/TFMessage', self.set_tf_sink),
             StateTopic('~/controller_state', STATUS_MESSAGE, self.set_status_sink,
                        {'frame_id': odom}),
@@ -334,7 +393,7 @@ class SteeringController(OdometryOutputs, CommandController):
 
     def reset(self) -> None:
         """No reference, odometry at the origin, the wheels asked to stand, the steering held."""
-        self._command = None
+        self._command.latest = None
         self._timed_out = False
         self._time = 0.0
         self._last_update: float | None = None
@@ -353,30 +412,7 @@ class SteeringController(OdometryOutputs, CommandController):
             handle.velocity_target = 0.0
         self._steering.hold()
 
-    # --- commands --------------------------------------------------------------------------
-
-    def set_command(self, value: StampedTwist) -> CommandResult:
-        """Take a twist (from the subscription; cheap): refuse non-finite or stale ones."""
-        linear, angular = value.linear[0], value.angular[2]
-        if not (math.isfinite(linear) and math.isfinite(angular)):
-            self._problem = (f'ignored reference (linear.x {linear!r}, angular.z {angular!r}): '
-                             'not finite numbers')
-            return CommandResult.REJECTED
-        now = self._time
-        stamp = value.stamp if value.stamp > 0.0 else now
-        timeout = self.params['reference_timeout']
-        if timeout != 0.0 and now - stamp > timeout:
-            self._problem = (f'ignored reference stamped {stamp:.4f} s: {now - stamp:.4f} s old '
-                             f'at sim time {now:.4f} s, more than reference_timeout '
-                             f'({timeout:g} s)')
-            return CommandResult.REJECTED
-        self._command = StampedTwist(stamp, (linear, 0.0, 0.0), (0.0, 0.0, angular))
-        self._timed_out = False
-        return CommandResult.ACCEPTED
-
-    def command_problem(self, value: Any, result: CommandResult) -> str:
-        """Describe the last refused twist."""
-        return self._problem
+    # --- commands (set_command, command_problem: TwistCommanded) ----------------------------
 
     def setpoints(self) -> dict[str, float]:
         """Return each traction joint's velocity (rad/s) and steering joint's setpoint (rad)."""
@@ -399,14 +435,7 @@ class SteeringController(OdometryOutputs, CommandController):
 
     # --- the step ---------------------------------------------------------------------------
 
-    def update(self, time: float, period: float) -> None:
-        """At the update rate: reference, odometry, commands, messages; every step: steering."""
-        self._time = time
-        if self._updates.take(time):
-            last = self._last_update
-            self._last_update = time
-            self._control(time, self._updates.period if last is None else time - last)
-        self._steering.track(period)
+    # update(): SteeredOnOwnClock; one upstream update: reference, odometry, commands, messages.
 
     def _control(self, time: float, period: float) -> None:
         """One upstream update: take the reference, update odometry, command the joints."""
@@ -432,14 +461,14 @@ class SteeringController(OdometryOutputs, CommandController):
 
     def _update_references(self, time: float) -> None:
         """Write the newest reference to the references; drop it once it is stale."""
-        command = self._command
+        command = self._command.latest
         if command is None:
             return
         timeout = self.params['reference_timeout']
         if timeout == 0.0:
-            self._command = None
+            self._command.latest = None
         elif time - command.stamp > timeout:
-            self._command = None
+            self._command.latest = None
             if not self._timed_out:
                 self._timed_out = True
                 self.notices.append(f'reference timed out ({timeout:g} s without one at sim '
@@ -466,16 +495,11 @@ class SteeringController(OdometryOutputs, CommandController):
                 [handle.velocity for handle in self._traction_state], steering, period)
 
     def _publish(self, time: float) -> None:
-        kinematics = self._kinematics
-        if self._odometry_sink is not None:
-            self._odometry_sink(time, kinematics.x, kinematics.y, kinematics.heading,
-                                kinematics.linear, kinematics.angular)
-        if self._tf_sink is not None and self.params['enable_odom_tf']:
-            heading = kinematics.heading
-            pose = Transform((kinematics.x, kinematics.y, 0.0),
-                             (0.0, 0.0, math.sin(heading / 2.0), math.cos(heading / 2.0)))
-            self._tf_sink(time, [(self.params['odom_frame_id'], self.params['base_frame_id'],
-                                  pose)])
+        kinematics, params = self._kinematics, self.params
+        self.publish_planar(time, kinematics.x, kinematics.y, kinematics.heading,
+                            kinematics.linear, kinematics.angular,
+                            (params['odom_frame_id'], params['base_frame_id']),
+                            tf=params['enable_odom_tf'])
         if self._status_sink is not None:
             feedback = [handle.position if self.params['position_feedback'] else handle.velocity
                         for handle in self._traction_state]

@@ -11,11 +11,12 @@ wheel.  The deprecated ``wheel_track`` and ``front_wheels_radius`` /
 
 from __future__ import annotations
 
-import sys
-
 from pan_tilt_sim.controllers.drives.steering.steering_controllers import (
+    EPSILON,
+    TRACTION_TRACK_WIDTH,
     SteeringController,
     library_parameters,
+    wheels_radius_parameters,
 )
 from pan_tilt_sim.controllers.drives.steering.steering_odometry import (
     Configuration,
@@ -30,8 +31,6 @@ from pan_tilt_sim.controllers.framework.parameter_spec import (
 )
 from pan_tilt_sim.controllers.framework.shared_parameters import UNSET_OR_LENGTH
 
-EPSILON = sys.float_info.epsilon  # a length at most this is "not set", as upstream
-
 
 class TricycleSteeringController(SteeringController):
     """Tricycle steering: one steered joint, two driven wheels on an axle."""
@@ -43,28 +42,16 @@ class TricycleSteeringController(SteeringController):
         *library_parameters(['joint1', 'joint3'], ['joint2']),
         Param('wheel_track', DOUBLE, 0.0, "Deprecated: use 'traction_track_width'.",
               validators=UNSET_OR_LENGTH),
-        Param('traction_track_width', DOUBLE, 0.0, 'Distance between the traction wheels (m).',
-              example=0.3,
-              validators=UNSET_OR_LENGTH),
+        TRACTION_TRACK_WIDTH,
         Param('wheelbase', DOUBLE, REQUIRED, 'Distance between the steered wheel and the '
               'traction axle (m).', (gt(0.0),), example=0.5),
-        Param('traction_wheels_radius', DOUBLE, 0.0, 'Radius of the traction wheels (m).',
-              example=0.05,
-              validators=UNSET_OR_LENGTH),
-        Param('front_wheels_radius', DOUBLE, 0.0, "Deprecated: use 'traction_wheels_radius'.",
-              validators=UNSET_OR_LENGTH),
-        Param('rear_wheels_radius', DOUBLE, 0.0, "Deprecated: use 'traction_wheels_radius'.",
-              validators=UNSET_OR_LENGTH),
+        *wheels_radius_parameters(),
     ])
 
     def kinematics(self) -> SteeringKinematics:
         """Return tricycle kinematics from the (deprecation-mapped) geometry parameters."""
         params = self.params
-        radius, track = params['traction_wheels_radius'], params['traction_track_width']
-        for deprecated in ('front_wheels_radius', 'rear_wheels_radius'):
-            if params[deprecated] > 0.0:
-                self.deprecated(deprecated, "'traction_wheels_radius'")
-                radius = params[deprecated]
+        radius, track = self.traction_radius(), params['traction_track_width']
         if params['wheel_track'] > 0.0:
             self.deprecated('wheel_track', "'traction_track_width'")
             track = params['wheel_track']
