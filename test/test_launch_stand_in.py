@@ -324,3 +324,49 @@ def generate_launch_description():
     (node,) = launch.nodes()
     assert launch.ros_args(node) == []
     assert launch.environment == {'CHOSEN': 'off'}
+
+
+ON_SHUTDOWN = '''
+import os
+import pathlib
+
+from launch import LaunchDescription
+from launch.actions import OpaqueFunction, RegisterEventHandler
+from launch.conditions import IfCondition
+from launch.event_handlers import OnShutdown
+from launch.substitutions import LaunchConfiguration
+
+
+def generate_launch_description():
+    world_sdf = LaunchConfiguration('world')
+    notes = LaunchConfiguration('notes')
+
+    def note(text):
+        def write(context):
+            with pathlib.Path(notes.perform(context)).open('a') as file:
+                file.write(text + chr(10))
+
+        return OpaqueFunction(function=write)
+
+    return LaunchDescription([
+        # nav2_bringup's shape: its temporary world file goes when the launch ends.
+        RegisterEventHandler(event_handler=OnShutdown(on_shutdown=[
+            OpaqueFunction(function=lambda context: os.remove(world_sdf.perform(context)))])),
+        RegisterEventHandler(OnShutdown(
+            on_shutdown=lambda event, context: note(f'{event.reason} {event.due_to_sigint}'))),
+        RegisterEventHandler(OnShutdown(on_shutdown=note('not registered')),
+                             condition=IfCondition('false')),
+    ])
+'''
+
+
+def test_on_shutdown_actions_run_when_the_launch_ends_as_launch_runs_them(
+        monkeypatch, tmp_path):
+    world, notes = tmp_path / 'world.sdf', tmp_path / 'notes.txt'
+    world.write_text('<sdf/>')
+    launch = _from_text(monkeypatch, tmp_path, ON_SHUTDOWN, world=str(world), notes=str(notes))
+    launch.start_processes()
+    assert world.exists() and not notes.exists()  # not before the end
+    launch.close()
+    assert not world.exists()
+    assert notes.read_text() == 'ctrl-c (SIGINT) True\n'

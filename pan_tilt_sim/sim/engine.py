@@ -337,8 +337,11 @@ class Simulation:
         frame = self.physics.initial_base_frame
         x, y, z = frame.translation
         if not self.physics.fixed_base:
+            # A tilted spawn (create -R -P) names its roll and pitch too, in create's order.
+            angles = ''.join(f'{name} {value:.4g} ' for name, value in (
+                ('roll', pose.roll), ('pitch', pose.pitch)) if value)
             return (INFO, f'base: free on the ground ({why}); its root link starts at '
-                          f'x {x:.4g} y {y:.4g} z {z:.4g} m, yaw {pose.yaw:.4g} rad')
+                          f'x {x:.4g} y {y:.4g} z {z:.4g} m, {angles}yaw {pose.yaw:.4g} rad')
         if asked is False:
             return (WARNING, f'base: welded to the world although {FIXED_BASE} is false: {why}')
         return None

@@ -16,12 +16,17 @@ import signal
 import sys
 import time
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 os.environ.setdefault('OPENBLAS_NUM_THREADS', '1')  # as sim_node does (pan_tilt_sim.__main__)
 
 import rclpy  # noqa: E402 (after the line above: the message package loads numpy)
 from rclpy.qos import QoSProfile  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
+
+if TYPE_CHECKING:
+    from rclpy.node import Node
+    from rclpy.publisher import Publisher
 
 PERIOD_S = 0.02
 
@@ -35,11 +40,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     rclpy.init(args=[])
     node = rclpy.create_node('pan_tilt_bench_bare_publisher')
     publisher = node.create_publisher(JointState, args.topic, QoSProfile(depth=1))
-    message = JointState()
     try:
-        while rclpy.ok():
-            publisher.publish(message)
-            time.sleep(PERIOD_S)
+        publish_until_stopped(node, publisher, JointState())
     except KeyboardInterrupt:
         pass
     finally:
@@ -47,6 +49,24 @@ def main(argv: Sequence[str] | None = None) -> None:
 
         node.destroy_node()
         shut_down_ros()  # rclpy's signal handler may have shut the context down meanwhile
+
+
+def publish_until_stopped(node: Node, publisher: Publisher, message: JointState) -> None:
+    """Publish ``message`` every PERIOD_S until ``node``'s context is shut down (SIGINT).
+
+    rclpy's SIGINT handler shuts the context down from its own thread: a publish that
+    comes right after it fails with RCLError, which is the stop, not an error.
+    """
+    from rclpy.impl.implementation_singleton import rclpy_implementation
+
+    while rclpy.ok(context=node.context):
+        try:
+            publisher.publish(message)
+        except rclpy_implementation.RCLError:
+            if rclpy.ok(context=node.context):
+                raise
+            return
+        time.sleep(PERIOD_S)
 
 
 if __name__ == '__main__':

@@ -171,8 +171,10 @@ def test_a_top_level_file_in_nav2_bringups_shape_brings_its_xacro_world_and_the_
     harness = NodeHarness()
     odometry: list[Odometry] = []
     harness.probe.create_subscription(Odometry, '/odom', odometry.append, PROBE_QUEUE)
+    world = pathlib.Path(launch.arguments['gz_args'].split()[-1])  # the file xacro writes
     try:
         launch.start_processes()
+        assert world.is_file()
         assert launch.wait_for_exit('create', EXIT_BUDGET_S) == 0, launch.output('create')
         assert harness.spin_until(lambda: odometry), 'no /odom'
         entities = harness.call(GetEntities, '/gzserver/get_entities', GetEntities.Request())
@@ -181,6 +183,7 @@ def test_a_top_level_file_in_nav2_bringups_shape_brings_its_xacro_world_and_the_
         outputs = launch.close()
     assert {'crate', 'rover'} <= set(entities.entities), (entities.entities,
                                                           outputs['sim_node'])
+    assert not world.exists()  # its OnShutdown removed it, as nav2_bringup's does
 
 
 def namespaced_rover_xacro() -> str:

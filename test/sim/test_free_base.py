@@ -91,16 +91,27 @@ def test_an_arm_stays_welded_as_before(tmp_path):
 
 def test_the_initial_pose_places_the_base_and_lifts_its_lowest_point(tmp_path):
     pose = BasePose(1.0, -2.0, 0.0, math.pi / 2)
-    with rover(tmp_path, initial_pose=pose) as simulation:
+    log = Log()
+    with rover(tmp_path, initial_pose=pose, log=log) as simulation:
         frame = simulation.physics.base_frame()
         assert frame.translation == pytest.approx((1.0, -2.0, REST_HEIGHT), abs=1e-9)
         assert yaw(frame.rotation) == pytest.approx(math.pi / 2)
+    assert any(line.endswith(f'its root link starts at x 1 y -2 z {REST_HEIGHT:.4g} m, '
+                             'yaw 1.571 rad') for line in log.infos), log.infos
     with rover(tmp_path, initial_pose=BasePose(z=0.1)) as simulation:
         assert simulation.physics.base_frame().translation[2] == pytest.approx(
             REST_HEIGHT + 0.1)
         simulation.advance(1000)  # it drops onto the ground
         assert simulation.physics.base_frame().translation[2] == pytest.approx(
             REST_HEIGHT, abs=1e-3)
+
+
+def test_the_start_up_line_names_a_tilted_spawns_roll_and_pitch(tmp_path):
+    log = Log()
+    with rover(tmp_path, initial_pose=BasePose(roll=0.1, pitch=-0.2, yaw=0.5), log=log):
+        pass
+    (line,) = [line for line in log.infos if line.startswith('base: free on the ground')]
+    assert line.endswith(' m, roll 0.1 pitch -0.2 yaw 0.5 rad'), line
 
 
 def test_the_wheels_drive_the_base_straight_and_the_odometry_agrees(tmp_path):

@@ -12,7 +12,8 @@ end first; then the nodes as launch_ros starts them: sim_node, pan_tilt_sim's Ga
 stand-ins (create, parameter_bridge, ...) and robot_state_publisher
 (test/support/robot_state_publisher_stand_in.py) as processes, controller_manager's
 spawner in-process (test/support/spawner_client.py), each OnProcessExit's actions after
-its target ended.  An action it cannot carry out is a ValueError naming it, never skipped.
+its target ended, each OnShutdown's when it is closed (as at Ctrl-C).  An action it cannot
+carry out is a ValueError naming it, never skipped.
 """
 
 from __future__ import annotations
@@ -95,6 +96,18 @@ class RegisterEventHandler(Recorded):
 
 class OnProcessExit(Recorded):
     """launch.event_handlers.OnProcessExit."""
+
+
+class OnShutdown(Recorded):
+    """launch.event_handlers.OnShutdown: ``on_shutdown``, actions or ``f(event, context)``."""
+
+
+@dataclasses.dataclass(frozen=True)
+class ShutdownEvent:
+    """launch.events.Shutdown, as an OnShutdown callable is given it."""
+
+    reason: str = 'reason not given'
+    due_to_sigint: bool = False
 
 
 class AppendEnvironmentVariable(Recorded):
@@ -324,6 +337,7 @@ def modules() -> dict[str, types.ModuleType]:
     made['launch.substitutions'].PathSubstitution = PathSubstitution
     made['launch_ros.parameter_descriptions'].ParameterFile = ParameterFile
     made['launch.event_handlers'].OnProcessExit = OnProcessExit
+    made['launch.event_handlers'].OnShutdown = OnShutdown
     made['launch.substitutions'].Command = Command
     made['launch.substitutions'].PathJoinSubstitution = PathJoinSubstitution
     made['launch.substitutions'].LaunchConfiguration = LaunchConfiguration
@@ -577,6 +591,8 @@ class StandInLaunch:
         for action in self.actions:
             if isinstance(action, RegisterEventHandler) and self._holds(action):
                 handler = action.kwargs.get('event_handler') or action.args[0]
+                if not isinstance(handler, OnProcessExit):
+                    continue
                 on_exit = handler.kwargs['on_exit']
                 handlers[id(handler.kwargs['target_action'])] = (
                     on_exit if isinstance(on_exit, list | tuple) else [on_exit])
@@ -618,13 +634,35 @@ class StandInLaunch:
         return codes
 
     def close(self) -> dict[str, str]:
-        """Stop every process (SIGINT); return what each wrote on stderr (a stand-in: all)."""
-        errors = {}
-        for name, process in self.processes.items():
-            _ended, errors[name] = sim_process.stop(process, 10.0)
-            if name in self._logs:
-                errors[name] = self.output(name)
+        """End the launch as Ctrl-C ends it: the OnShutdown handlers' actions, then every
+        process stopped (SIGINT); return what each wrote on stderr (a stand-in: all)."""
+        try:
+            self._shut_down(ShutdownEvent(reason='ctrl-c (SIGINT)', due_to_sigint=True))
+        finally:
+            errors = {}
+            for name, process in self.processes.items():
+                _ended, errors[name] = sim_process.stop(process, 10.0)
+                if name in self._logs:
+                    errors[name] = self.output(name)
         return errors
+
+    def _shut_down(self, event: ShutdownEvent) -> None:
+        """Carry out each OnShutdown's actions whose registration's condition holds, the
+        latest registered first (launch puts a new handler in front).  Their processes are
+        not started: launch starts none once it is shutting down."""
+        registered = [action for action in self.actions
+                      if isinstance(action, RegisterEventHandler) and self._holds(action)]
+        for action in reversed(registered):
+            handler = action.kwargs.get('event_handler') or action.args[0]
+            if not isinstance(handler, OnShutdown):
+                continue
+            scope = self._scope(action)
+            actions = handler.kwargs['on_shutdown']
+            if callable(actions):
+                actions = actions(event, LaunchContext(scope.arguments))
+            if actions is not None:
+                self._carry_out(list(actions) if isinstance(actions, list | tuple)
+                                else [actions], scope)
 
     def _carry_out(self, actions: list, scope: Scope) -> list:
         """Carry out the actions in ``scope`` in order; return the actions left, each scoped.
@@ -696,6 +734,8 @@ class StandInLaunch:
         self._scope_of[id(action)] = reached
         if isinstance(action, RegisterEventHandler):
             handler = action.kwargs.get('event_handler') or action.args[0]
+            if isinstance(handler, OnShutdown):
+                return  # its actions are carried out in this scope when the launch ends
             if not isinstance(handler, OnProcessExit):
                 raise ValueError(f'RegisterEventHandler of {type(handler).__name__} is not '
                                  'carried out by the launch stand-in')

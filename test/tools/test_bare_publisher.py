@@ -28,3 +28,13 @@ def test_publishes_joint_state_on_its_topic_until_interrupted():
         harness.close()
     assert ended, stderr
     assert process.returncode == 0, stderr
+
+
+def test_a_sigint_between_its_check_and_its_publish_stops_it_cleanly():
+    from interrupting import interrupted_after_check
+
+    result = interrupted_after_check(
+        'from pan_tilt_sim.tools.bare_publisher import publish_until_stopped\n'
+        'from sensor_msgs.msg import JointState\n',
+        "publish_until_stopped(node, node.create_publisher(JointState, 'bare', 1), JointState())")
+    assert (result.returncode, result.stdout) == (0, 'returned\n'), result.stderr

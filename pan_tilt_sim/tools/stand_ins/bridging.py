@@ -13,7 +13,7 @@ import sys
 from rclpy.node import Node
 
 from pan_tilt_sim.model.gz_bridge import BridgeEntry, encode
-from pan_tilt_sim.tools.stand_ins.spawning import find_spawn_service, spin_for
+from pan_tilt_sim.tools.stand_ins.spawning import find_spawn_service, spin_for, spin_once
 
 EXIT_REFUSED = 2
 SPIN_PERIOD_S = 1.0
@@ -67,18 +67,26 @@ def hand_over(node: Node, entries: list[BridgeEntry]) -> int | None:
     simulation = service.rsplit('/', 1)[0]
     client = AsyncParameterClient(node, simulation)
     if not spin_for(node, 30.0, client.services_are_ready):
+        if not rclpy.ok(context=node.context):
+            return 0  # stopped while waiting, as the bridge exits when interrupted
         logger.error(f'{simulation} has no parameter services: nothing bridged')
         return EXIT_REFUSED
     future = client.set_parameters([Parameter(
         'gz_bridge', Parameter.Type.STRING_ARRAY,
         encode(node.get_fully_qualified_name(), entries))])
-    spin_for(node, 30.0, future.done)
+    if not spin_for(node, 30.0, future.done) and not rclpy.ok(context=node.context):
+        return 0
     results = future.result().results if future.done() and future.result() else []
     if not results or not results[0].successful:
         reason = results[0].reason if results else 'no answer'
         sys.stderr.write(f'{node.get_name()}: {simulation} refused the bridge: {reason}\n')
         return EXIT_REFUSED
     logger.info(f'{len(entries)} topics bridged by {simulation} itself')
-    while rclpy.ok(context=node.context):
-        rclpy.spin_once(node, timeout_sec=SPIN_PERIOD_S)
+    stay_until_stopped(node)
     return None
+
+
+def stay_until_stopped(node: Node) -> None:
+    """Spin ``node`` until its context is shut down (SIGINT), as the bridge's ``rclcpp::spin``."""
+    while spin_once(node, SPIN_PERIOD_S):
+        pass

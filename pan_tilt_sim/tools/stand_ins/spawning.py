@@ -22,13 +22,34 @@ DESCRIPTION_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
 SPIN_SLICE_S = 0.1
 
 
-def spin_for(node: Node, seconds: float, done: Callable[[], bool]) -> bool:
-    """Spin ``node`` until ``done()`` or ``seconds`` have passed; return ``done()``."""
-    import rclpy
+def spin_once(node: Node, timeout_sec: float) -> bool:
+    """Spin ``node`` once (up to ``timeout_sec`` s); False once its context is shut down.
 
+    rclpy's SIGINT handler shuts the context down from its own thread, so it can land
+    between an ``ok()`` check and the wait; rclpy then raises ExternalShutdownException
+    or RCLError (context not valid).  Either is the stop, not an error.
+    """
+    import rclpy
+    from rclpy.executors import ExternalShutdownException
+    from rclpy.impl.implementation_singleton import rclpy_implementation
+
+    if not rclpy.ok(context=node.context):
+        return False
+    try:
+        rclpy.spin_once(node, timeout_sec=timeout_sec)
+    except (ExternalShutdownException, rclpy_implementation.RCLError):
+        if rclpy.ok(context=node.context):
+            raise
+        return False
+    return True
+
+
+def spin_for(node: Node, seconds: float, done: Callable[[], bool]) -> bool:
+    """Spin ``node`` until ``done()``, ``seconds`` passed or it is stopped; return ``done()``."""
     deadline = time.monotonic() + seconds
-    while not done() and rclpy.ok(context=node.context) and time.monotonic() < deadline:
-        rclpy.spin_once(node, timeout_sec=min(SPIN_SLICE_S, max(0.0, deadline - time.monotonic())))
+    while not done() and time.monotonic() < deadline:
+        if not spin_once(node, min(SPIN_SLICE_S, max(0.0, deadline - time.monotonic()))):
+            break
     return done()
 
 

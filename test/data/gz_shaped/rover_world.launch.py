@@ -2,8 +2,9 @@
 
 The world is a ``.sdf.xacro`` that an ExecuteProcess (``xacro -o``) writes to a
 temporary file while gz_sim.launch.py, included with that file in ``gz_args``,
-starts the simulation; the robot comes from rover_spawn.launch.py (Nav2's
-spawn_tb3.launch.py shape), included with the pose and namespace.
+starts the simulation, and an OnShutdown handler removes when the launch ends; the
+robot comes from rover_spawn.launch.py (Nav2's spawn_tb3.launch.py shape), included
+with the pose and namespace.
 """
 
 import os
@@ -16,8 +17,11 @@ from launch.actions import (
     DeclareLaunchArgument,
     ExecuteProcess,
     IncludeLaunchDescription,
+    OpaqueFunction,
+    RegisterEventHandler,
 )
 from launch.conditions import IfCondition
+from launch.event_handlers import OnShutdown
 from launch.launch_description_sources import PythonLaunchDescriptionSource
 from launch.substitutions import LaunchConfiguration
 
@@ -50,4 +54,6 @@ def generate_launch_description():
                               'robot_name': 'rover',
                               'robot_file': LaunchConfiguration('description_file'),
                               'x_pose': '-2.00', 'y_pose': '-0.50'}.items()),
+        RegisterEventHandler(event_handler=OnShutdown(on_shutdown=[
+            OpaqueFunction(function=lambda _: os.remove(world_sdf))])),
     ])
