@@ -490,17 +490,26 @@ class ControllerManagerServices:
 class ControllerManagerNode(Node):
     """The controller_manager as a node of its own in sim_node's process (see the module)."""
 
-    def __init__(self, bindings: ControllerBindings, manager: ControllerManager,
-                 model: RobotModel, namespace: str, *, context: Context | None = None,
-                 substitutions: Mapping[str, str] | None = None, source: str = '') -> None:
+    def __init__(self, model: RobotModel, namespace: str, *,
+                 context: Context | None = None) -> None:
         # Not the process's global arguments: a `-r __node:=...` meant for sim_node
         # must not rename this node, nor its `-p` parameters land here.  Its name is
         # the control plugin's <controller_manager_name>, as gz_ros2_control names it.
         super().__init__(model.controller_manager_name, namespace=namespace or '/',
                          context=context,
                          use_global_arguments=False, allow_undeclared_parameters=True)
+        self._model = model
+        self.manager_services: ControllerManagerServices | None = None
+
+    def serve(self, bindings: ControllerBindings, manager: ControllerManager, *,
+              substitutions: Mapping[str, str] | None = None, source: str = '') -> None:
+        """Offer the services for ``manager``'s controllers.
+
+        Apart from the constructor: a spawned robot's gain parameters live on
+        this node, and its controllers are bound with them before this.
+        """
         self.manager_services = ControllerManagerServices(
-            self, bindings, manager, model, substitutions=substitutions, source=source)
+            self, bindings, manager, self._model, substitutions=substitutions, source=source)
 
     @property
     def update_rate(self) -> int:

@@ -29,6 +29,29 @@ from pan_tilt_sim.sim.entities import Entities, spawn_world_objects
 from pan_tilt_sim.sim.world import build_world, has_ground
 
 
+def require_ground(simulation: Simulation, world: str) -> None:
+    """Refuse a free base in a world (``world`` parameter's scenery) with no ground."""
+    if not simulation.physics.fixed_base and not has_ground(world):
+        raise ParameterError(
+            f"parameter 'world': '{world}' has no ground for the free base of "
+            f"'{simulation.description.name}' to stand on: use 'ground' or 'targets', or weld "
+            f"the base with {FIXED_BASE}:=true")
+
+
+def robot_sensors(node: Node, simulation: Simulation, world: str, namespace_override: str,
+                  seed: int | None) -> SensorSet:
+    """Publish one robot's URDF/SDF sensors; its <ros2_control> sensors see ``world`` too.
+
+    ``namespace_override`` ('' for none) moves every sensor's topics, as
+    spawn's -robot_namespace does; ``seed`` draws their noise (None: the OS's).
+    """
+    sensors = SensorSet(node, simulation, world, namespace_override=namespace_override,
+                        seed=seed)
+    # The <ros2_control> sensors: their rays meet this world's ground; their noise, this seed.
+    simulation.hardware.configure(world=world, seed=seed)
+    return sensors
+
+
 class NodeFeatures:
     """robot_description, TF and camera of one simulated robot, on ``node``.
 
@@ -46,11 +69,7 @@ class NodeFeatures:
         # The world parameter's value, when the caller has read it already.
         self.world = world if world is not None else declare_world(node)
         world = self.world.scenery
-        if not simulation.physics.fixed_base and not has_ground(world):
-            raise ParameterError(
-                f"parameter 'world': '{world}' has no ground for the free base of "
-                f"'{description.name}' to stand on: use 'ground' or 'targets', or weld the "
-                f"base with {FIXED_BASE}:=true")
+        require_ground(simulation, world)
         urdf_cameras = any(sensor.kind in (SensorKind.CAMERA, SensorKind.DEPTH)
                            for sensor in model.sensors)
         settings = declare_camera(node, model.link_names, urdf_cameras)
@@ -63,10 +82,7 @@ class NodeFeatures:
         spawn_world_objects(self.entities, self.world)
         seed = declare_noise_seed(node)
         self.noise_seed = seed  # spawned robots' sensors draw from it too
-        self.sensors = SensorSet(node, simulation, world, namespace_override=sensor_namespace,
-                                 seed=seed)
-        # The <ros2_control> sensors: their rays meet this world's ground; their noise, this seed.
-        simulation.hardware.configure(world=world, seed=seed)
+        self.sensors = robot_sensors(node, simulation, world, sensor_namespace, seed)
         self.camera: CameraPublisher | None = None
         static = list(self.sensors.static_frames)
         if settings is not None:

@@ -172,9 +172,7 @@ class SimNode(Node):
         """One more robot in the world (its plugins, sensors, controller manager), in our turn."""
         robot = spawned_robots.SpawnedRobot(
             self, self.simulation, description, namespace=spawn.namespace,
-            controllers=spawned_robots.controllers_of(description),
-            fixed_base=self.settings.fixed_base,
-            autostart_controllers=self.settings.autostart_controllers,
+            controllers=spawned_robots.controllers_of(description), settings=self.settings,
             initial_pose=spawn.pose, world=self._world.scenery, reader=self._command_reader,
             seed=self.features.noise_seed)
         self.features.entities.add_robot(robot.name, robot.simulation.physics,

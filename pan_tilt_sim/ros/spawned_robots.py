@@ -10,23 +10,27 @@ takes all of that away.  docs/launch-files.md#several-robots is the reference.
 
 from __future__ import annotations
 
+import dataclasses
+
 from rclpy.node import Node
 
-from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model import naming
+from pan_tilt_sim.model.base_pose import BasePose
 from pan_tilt_sim.model.controller_config import (
     ControllersConfig,
     controllers_files_for,
     load_controllers_config,
 )
 from pan_tilt_sim.model.description import RobotDescription
+from pan_tilt_sim.model.ros_arguments import RosArguments
 from pan_tilt_sim.plugins.registry import runs_by_plugins
-from pan_tilt_sim.ros import optional_interfaces
+from pan_tilt_sim.ros import optional_interfaces, startup
 from pan_tilt_sim.ros.controller_bindings import ControllerBindings
+from pan_tilt_sim.ros.features import require_ground, robot_sensors
 from pan_tilt_sim.ros.gain_parameters import GainParameters
+from pan_tilt_sim.ros.parameters import SimParameters
 from pan_tilt_sim.ros.sensor_publishers import SensorSet
 from pan_tilt_sim.sim.engine import Simulation
-from pan_tilt_sim.sim.world import has_ground
 
 
 def is_robot(description: RobotDescription) -> bool:
@@ -42,43 +46,56 @@ def controllers_of(description: RobotDescription) -> ControllersConfig:
         manager=description.model.controller_manager_name)
 
 
+def later_robot_settings(settings: SimParameters, initial_pose: BasePose) -> SimParameters:
+    """Return sim_node's settings as a later robot takes them, placed at ``initial_pose``.
+
+    Not the ones that name the first robot's controllers and joints
+    (``active_controllers``, ``initial_positions``, ``controllers_args``).
+    """
+    return dataclasses.replace(settings, initial_pose=initial_pose, active_controllers=None,
+                               initial_positions={}, controllers_args=())
+
+
 class SpawnedRobot:
-    """One more robot on ``node``, in ``host``'s world, its topics under ``namespace``."""
+    """One more robot on ``node``, in ``host``'s world, its topics under ``namespace``.
+
+    ``settings`` are sim_node's (``fixed_base``, ``autostart_controllers``);
+    the robot stands at ``initial_pose``.
+    """
 
     def __init__(self, node: Node, host: Simulation, description: RobotDescription, *,
-                 namespace: str, controllers: ControllersConfig, fixed_base: bool | None,
-                 autostart_controllers: bool, initial_pose, world: str,
-                 reader=None, seed: int | None = None) -> None:
+                 namespace: str, controllers: ControllersConfig, settings: SimParameters,
+                 initial_pose: BasePose, world: str, reader=None,
+                 seed: int | None = None) -> None:
         self.name = description.name
-        self.namespace = naming.resolve_robot_namespace(
-            '', namespace, controllers.namespace, description.plugin_namespace)
+        self.namespace = startup.robot_namespace(
+            '', namespace, controllers.namespace, description.plugin_namespace,
+            is_controller_manager=False)
         self._node = node
         self._host = host
-        self.simulation = Simulation(
-            description, controllers, host.time_step, logger=node.get_logger(),
-            autostart_controllers=autostart_controllers, fixed_base=fixed_base,
-            initial_pose=initial_pose, world=host)
-        if not self.simulation.physics.fixed_base and not has_ground(world):
-            self.simulation.close()
-            raise ParameterError(
-                f"parameter 'world': '{world}' has no ground for the free base of "
-                f"'{description.name}' to stand on")
+        settings = later_robot_settings(settings, initial_pose)
+        self.simulation = startup.make_simulation(
+            description, controllers, settings, topic_mode=False, logger=node.get_logger(),
+            world=host)
         self.controller_manager: Node | None = None
         self.bindings: ControllerBindings | None = None
         self.sensors: SensorSet | None = None
         try:
-            self.simulation.hardware.configure(world=world, seed=seed)
+            require_ground(self.simulation, world)
             # Its controllers' gains are parameters of its own controller manager node.
             manager_node = self._manager_node(description)
-            self.bindings = ControllerBindings(
-                node, self.simulation, self.topic,
-                GainParameters(manager_node if manager_node is not None else node),
-                actions=optional_interfaces.available('control_msgs'), reader=reader,
-                namespace=self.namespace)
+            self.bindings = startup.bind_controllers(
+                node, self.simulation, None,
+                GainParameters(manager_node if manager_node is not None else node), reader,
+                self.namespace)
             if manager_node is not None:
-                self._serve_manager(manager_node, controllers)
-            self.sensors = SensorSet(node, self.simulation, world,
-                                     namespace_override=namespace, seed=seed)
+                startup.serve_controller_manager(
+                    node, self.bindings, self.simulation, controllers, settings, RosArguments(),
+                    self.namespace, topic_mode=False, is_controller_manager=False,
+                    manager_node=manager_node)
+                if node.executor is not None:
+                    node.executor.add_node(manager_node)
+            self.sensors = robot_sensors(node, self.simulation, world, namespace, seed)
         except BaseException:
             self.destroy()
             raise
@@ -92,21 +109,12 @@ class SpawnedRobot:
         if not description.model.ros2_control or not optional_interfaces.available(
                 'controller_manager_msgs'):
             return None
+        from pan_tilt_sim.ros.controller_manager import ControllerManagerNode
+
         # gz_ros2_control's <controller_manager_name>, else controller_manager.
-        self.controller_manager = Node(
-            description.model.controller_manager_name, namespace=self.namespace or '/',
-            context=self._node.context,
-            use_global_arguments=False, allow_undeclared_parameters=True)
+        self.controller_manager = ControllerManagerNode(
+            description.model, self.namespace, context=self._node.context)
         return self.controller_manager
-
-    def _serve_manager(self, manager_node: Node, controllers: ControllersConfig) -> None:
-        from pan_tilt_sim.ros.controller_manager import ControllerManagerServices
-
-        self.manager_services = ControllerManagerServices(
-            manager_node, self.bindings, self.simulation.manager,
-            self.simulation.description.model, source=controllers.label)
-        if self._node.executor is not None:
-            self._node.executor.add_node(manager_node)
 
     # --- what sim_node's batches call ------------------------------------------------------
 

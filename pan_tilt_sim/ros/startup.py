@@ -90,10 +90,16 @@ def robot_namespace(node_namespace: str, parameter: str, controllers_namespace: 
 
 
 def make_simulation(description: RobotDescription, controllers: ControllersConfig,
-                    settings: SimParameters, *, topic_mode: bool, logger) -> Simulation:
-    """Load the robot into PyBullet with its controllers (topic-based hardware: all active)."""
+                    settings: SimParameters, *, topic_mode: bool, logger,
+                    world: Simulation | None = None) -> Simulation:
+    """Load the robot into PyBullet with its controllers (topic-based hardware: all active).
+
+    ``world``: a robot's simulation whose world this one joins, and whose
+    time step it takes (its GUI and solver settings are that world's).
+    """
     return Simulation(
-        description, controllers, settings.time_step, gui=settings.gui,
+        description, controllers, settings.time_step if world is None else world.time_step,
+        gui=settings.gui, world=world,
         active_controllers=None if topic_mode else settings.active_controllers,
         initial_positions=settings.initial_positions, logger=logger,
         autostart_controllers=topic_mode or settings.autostart_controllers,
@@ -163,12 +169,15 @@ def make_features(node: Node, simulation: Simulation, namespace: str, settings: 
 def serve_controller_manager(node: Node, bindings: ControllerBindings, simulation: Simulation,
                              controllers: ControllersConfig, settings: SimParameters,
                              arguments: RosArguments, namespace: str, *, topic_mode: bool,
-                             is_controller_manager: bool) -> Node | None:
+                             is_controller_manager: bool,
+                             manager_node: Node | None = None) -> Node | None:
     """Offer ros2_control's controller_manager services; return the node that serves them.
 
     ``node`` itself in ros2_control_node's place, else a node of its own the
-    caller spins and destroys with ``node``; None on topic-based hardware
-    (the user's own controller_manager runs) or without controller_manager_msgs.
+    caller spins and destroys with ``node`` (``manager_node``, a
+    :class:`ControllerManagerNode` made beforehand, or a new one); None on
+    topic-based hardware (the user's own controller_manager runs) or without
+    controller_manager_msgs.
     """
     if topic_mode:
         return None
@@ -192,6 +201,9 @@ def serve_controller_manager(node: Node, bindings: ControllerBindings, simulatio
             update_rate=round(controllers.update_rate),
             shared_parameters=lambda name: drop_in.shared_parameters(node, arguments, name))
         return node
-    return ControllerManagerNode(
-        bindings, simulation.manager, simulation.description.model, namespace,
-        context=node.context, substitutions=substitutions, source=controllers.label)
+    if manager_node is None:
+        manager_node = ControllerManagerNode(simulation.description.model, namespace,
+                                             context=node.context)
+    manager_node.serve(bindings, simulation.manager, substitutions=substitutions,
+                       source=controllers.label)
+    return manager_node

@@ -336,7 +336,10 @@ class CommandSender:
 
 @dataclasses.dataclass(frozen=True)
 class EntityView:
-    """An entity other than the robot: where its root link is, its joints, its description."""
+    """An entity other than the first robot: where its root link is, its joints, its description.
+
+    A robot spawned after the first is one too, with its own description and joints.
+    """
 
     pose: Transform
     positions: Mapping[str, float]
@@ -350,29 +353,39 @@ class Snapshot:
     time: float
     paused: bool
     real_time_factor: float
-    robot_pose: Transform
+    robot_pose: Transform | None  # None: the robot the world began with was deleted
     positions: Mapping[str, float]  # the robot's movable joints
     entities: Mapping[str, EntityView]
     sliders: tuple[Slider, ...]
 
 
 def take_snapshot(node: Any) -> Snapshot:
-    """Return sim_node's simulation as it is now (call it through :class:`SimulationAccess`)."""
+    """Return sim_node's simulation as it is now (call it through :class:`SimulationAccess`).
+
+    The first robot (gone once DeleteEntity took it) apart; every other
+    entity, later robots with their descriptions and joints, in ``entities``.
+    """
     simulation = node.simulation
     entities = node.features.entities
-    robot = entities.robot_name
+    robot = entities.robot_name if simulation.has_robot else None
+    later_robots = node.spawned_robots
     views = {}
     for name in entities.names():
         if name == robot:
             continue
-        entity = entities.get(name)
+        later = later_robots.get(name)
+        if later is not None:
+            views[name] = EntityView(entities.state(name).pose,
+                                     later.simulation.joint_positions(),
+                                     later.simulation.description)
+            continue
         views[name] = EntityView(entities.state(name).pose, entities.joint_positions(name),
-                                 entity.description)
+                                 entities.get(name).description)
     sliders = () if node.topic_hardware is not None else position_sliders(
         simulation.manager.active, simulation.description.model, node.topic)
     return Snapshot(time=simulation.time, paused=node.paused,
                     real_time_factor=node.real_time_factor,
-                    robot_pose=entities.state(robot).pose,
+                    robot_pose=None if robot is None else entities.state(robot).pose,
                     positions=simulation.joint_positions(), entities=views, sliders=sliders)
 
 

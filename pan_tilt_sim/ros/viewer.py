@@ -70,6 +70,7 @@ SLIDER_STEP = 0.001  # rad or m
 CAMERA_DISTANCE = 3.0  # the browser's camera starts this many robot sizes away
 MIN_ROBOT_SIZE = 0.3  # m: a smaller robot is viewed as if it were this big
 JPEG_QUALITY = 80
+ROBOT_ROOT = '/robot'  # the scene root of the robot the world began with
 
 
 def import_viser() -> Any:
@@ -191,7 +192,7 @@ class Viewer:
         self._sliders: dict[str, Any] = {}
         self._slider_specs: tuple[Slider, ...] = ()
         self._slider_folder: Any = None
-        self._images: dict[str, Any] = {}
+        self._images: dict[str, tuple[Any, Any]] = {}  # camera -> (folder, image)
         self._clouds: dict[str, Any] = {}
         self._shown: dict[str, Any] = {}  # the last message drawn, by topic
         self._status: Any = None
@@ -267,13 +268,13 @@ class Viewer:
         self._latest = snapshot
         if not self._built:
             self._build(snapshot)
-        wanted = self._show_sensors.value and bool(self.taps.topics)
+        # The sensors tapped are the first robot's: none to show once it was deleted.
+        wanted = (self._show_sensors.value and bool(self.taps.topics)
+                  and snapshot.robot_pose is not None)
         if wanted != self.taps.watching:
             self.access.call(lambda: self.taps.watch(wanted))
-        poses = frame_poses(self._model, snapshot.positions, snapshot.robot_pose,
-                            self._extra_frames)
         with self.server.atomic():
-            self._bodies['/robot'].move(poses)
+            poses = self._move_robot(snapshot)
             self._move_entities(snapshot)
             self._draw_sensors(poses)
             self._update_controls(snapshot)
@@ -306,8 +307,31 @@ class Viewer:
             self._show_frames = gui.add_checkbox('Link frames', False)
             self._show_frames.on_update(lambda _event: self._apply_show_frames())
             self._show_sensors = gui.add_checkbox('Lidar points and camera images', True)
-        self._bodies['/robot'] = _Body(scene, '/robot', self._model, meshes, False)
+        self._bodies[ROBOT_ROOT] = _Body(scene, ROBOT_ROOT, self._model, meshes, False)
         self._built = True
+
+    def _move_robot(self, snapshot: Snapshot) -> dict[str, Transform]:
+        """Move the first robot's links; take them away once it was deleted.
+
+        Returns where its links and extra frames are (none once deleted).
+        """
+        if snapshot.robot_pose is None:
+            robot = self._bodies.pop(ROBOT_ROOT, None)
+            if robot is not None:
+                robot.remove()
+                for folder, _image in self._images.values():  # its cameras' last images
+                    folder.remove()
+                self._images.clear()
+            return {}
+        poses = frame_poses(self._model, snapshot.positions, snapshot.robot_pose,
+                            self._extra_frames)
+        self._bodies[ROBOT_ROOT].move(poses)
+        return poses
+
+    @property
+    def drawn(self) -> list[str]:
+        """The scene roots of the bodies drawn: '/robot' and '/objects/<entity>'."""
+        return list(self._bodies)
 
     def _apply_show_frames(self) -> None:
         for body in self._bodies.values():
@@ -374,13 +398,14 @@ class Viewer:
         pixels = image_pixels(message)
         if pixels is None:
             return
-        handle = self._images.get(name)
-        if handle is None:
-            with self.server.gui.add_folder(f'Camera: {name}'):
-                self._images[name] = self.server.gui.add_image(
-                    pixels, format='jpeg', jpeg_quality=JPEG_QUALITY)
+        shown = self._images.get(name)
+        if shown is None:
+            folder = self.server.gui.add_folder(f'Camera: {name}')
+            with folder:
+                self._images[name] = (folder, self.server.gui.add_image(
+                    pixels, format='jpeg', jpeg_quality=JPEG_QUALITY))
         else:
-            handle.image = pixels
+            shown[1].image = pixels
 
     def _draw_points(self, name: str, points: np.ndarray, pose: Transform | None) -> None:
         if pose is None:

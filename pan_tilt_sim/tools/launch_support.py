@@ -28,6 +28,7 @@ from pan_tilt_sim.model.controller_config import (
     parse_controllers_args,
 )
 from pan_tilt_sim.model.description import load_description
+from pan_tilt_sim.model.robot import DEFAULT_CONTROLLER_MANAGER
 from pan_tilt_sim.model.topic_based import topic_based_system
 from pan_tilt_sim.plugins.registry import runs_by_plugins
 from pan_tilt_sim.ros.runner import PARENT_PID_VARIABLE
@@ -41,10 +42,12 @@ TRUE_WORDS = ('true', '1', 'yes', 'on')
 
 @dataclasses.dataclass(frozen=True)
 class RobotSetup:
-    """The processed URDF and the namespace of the robot's topics."""
+    """The processed URDF, the namespace of the robot's topics and its manager's node name."""
 
     urdf_xml: str
     namespace: str
+    # The control plugin's <controller_manager_name>, as sim_node names its manager.
+    manager: str = DEFAULT_CONTROLLER_MANAGER
 
     def topic(self, *names: str) -> str:
         """Absolute name of a topic of the robot."""
@@ -90,6 +93,7 @@ def robot_setup(model: str, controllers: str = '', xacro_args: Sequence[str] = (
                 controllers_args: Sequence[str] = ()) -> RobotSetup:
     """Load the model and controllers as sim_node does (in the root namespace)."""
     description = load_description(model, xacro_args)
+    manager = description.model.controller_manager_name
     controllers_namespace = None
     if topic_based_system(description.model) is None:  # topic-based hardware runs no YAML
         files = controllers_files_for(controllers, description,
@@ -97,11 +101,11 @@ def robot_setup(model: str, controllers: str = '', xacro_args: Sequence[str] = (
                                       runs_by_plugins=runs_by_plugins(description.model))
         config = load_controllers_config(
             files, parse_controllers_args(controllers_args, "launch argument 'controllers_args'"),
-            args_name="the launch argument 'controllers_args'")
+            args_name="the launch argument 'controllers_args'", manager=manager)
         controllers_namespace = config.namespace
     namespace = naming.resolve_robot_namespace(
         ROOT_NAMESPACE, robot_namespace, controllers_namespace, description.plugin_namespace)
-    return RobotSetup(description.urdf_xml, namespace)
+    return RobotSetup(description.urdf_xml, namespace, manager)
 
 
 def sim_node_parameters(model: str, controllers: str, *, real_time_factor: float,
@@ -159,8 +163,12 @@ def sim_node_parameters(model: str, controllers: str, *, real_time_factor: float
 
 
 def controller_manager_name(setup: RobotSetup) -> str:
-    """Return sim_node's controller_manager: ``controller_manager`` in the robot's namespace."""
-    return setup.topic('controller_manager')
+    """Return sim_node's controller_manager in the robot's namespace.
+
+    Named as gz_ros2_control names it: the plugin's ``<controller_manager_name>``,
+    else ``controller_manager``.
+    """
+    return setup.topic(setup.manager)
 
 
 def spawner_arguments(setup: RobotSetup, controllers: Sequence[str]) -> list[str]:

@@ -2,10 +2,12 @@
 
 The sliders' commands (which joints get one, on which topic, in which
 message), the sensors' messages as points and pixels, where each frame is,
-and the view's parameters and address check.
+the view's parameters and address check, and what a snapshot holds of
+several robots, the first deleted too.
 """
 
 import array
+import importlib.util
 import math
 import socket
 
@@ -41,6 +43,7 @@ from pan_tilt_sim.ros.view_feed import (
     position_sliders,
     scan_points,
     slider_range,
+    take_snapshot,
 )
 from pan_tilt_sim.share import package_share
 
@@ -226,3 +229,40 @@ def test_bad_viewer_parameters_are_refused(overrides, expected):
         node.destroy_node()
     finally:
         rclpy.try_shutdown(context=context)
+
+
+
+needs_spawning = pytest.mark.skipif(importlib.util.find_spec('simulation_interfaces') is None,
+                                    reason='simulation_interfaces is not installed')
+
+
+@needs_spawning
+def test_a_later_robot_is_drawn_with_its_own_description_and_joints():
+    from stand_in_fixtures import two_rovers, world_only
+
+    with world_only() as (harness, node):
+        two_rovers(harness)
+        robot2 = node.spawned_robots['robot2'].simulation
+        snapshot = take_snapshot(node)
+        assert snapshot.robot_pose.translation[1] == pytest.approx(0.0, abs=0.05)
+        assert 'robot1' not in snapshot.entities  # the first robot is the snapshot's own
+        drawn = snapshot.entities['robot2']
+        assert drawn.description is robot2.description
+        assert drawn.positions == robot2.joint_positions() != {}
+        assert drawn.pose.translation[1] == pytest.approx(1.0, abs=0.05)
+
+
+@needs_spawning
+def test_a_deleted_first_robot_leaves_the_snapshot_and_the_later_one_stays_in_place():
+    from stand_in_fixtures import srv, two_rovers, world_only
+
+    with world_only() as (harness, node):
+        two_rovers(harness)
+        response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
+                                srv().DeleteEntity.Request(entity='robot1'))
+        assert response.result.result == 1, response.result.error_message
+        snapshot = take_snapshot(node)
+        assert snapshot.robot_pose is None
+        assert (dict(snapshot.positions), snapshot.sliders) == ({}, ())
+        assert 'robot1' not in snapshot.entities
+        assert snapshot.entities['robot2'].pose.translation[1] == pytest.approx(1.0, abs=0.05)

@@ -1,11 +1,14 @@
 """The browser view of an in-process sim_node (viewer:=true): served, idle, fed, controlled.
 
+Several robots: a later one is drawn, and a deleted first robot leaves the view.
+
 A "browser" here is a websocket client speaking viser's protocol version,
 reading whatever the server sends; the real browser is in
 ``test/end_to_end/test_viewer_browser.py``.  The node runs on the test's
 executor, so every wait spins it, bounded.
 """
 
+import importlib.util
 import threading
 import urllib.request
 
@@ -164,3 +167,26 @@ def test_a_port_in_use_ends_start_up_with_one_line_before_the_simulation_starts(
     assert len(lines) == 1, result.stderr
     assert f"parameter 'viewer.port': port {port} on 127.0.0.1 is in use" in lines[0]
     assert 'simulating' not in result.stdout + result.stderr
+
+
+@pytest.mark.skipif(importlib.util.find_spec('simulation_interfaces') is None,
+                    reason='simulation_interfaces is not installed')
+def test_a_later_robot_is_drawn_and_a_deleted_first_robot_leaves_the_view():
+    from stand_in_fixtures import srv, two_rovers, world_only
+
+    with world_only(viewer=True, **{'viewer.port': 0}) as (harness, node):
+        two_rovers(harness)
+        viewer = node.viewer
+        browser = FakeBrowser(viewer.settings.port)
+        try:
+            assert harness.spin_until(
+                lambda: {'/robot', '/objects/robot2'} <= set(viewer.drawn), BUDGET_S)
+            response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
+                                    srv().DeleteEntity.Request(entity='robot1'))
+            assert response.result.result == 1, response.result.error_message
+            assert harness.spin_until(lambda: '/robot' not in viewer.drawn, BUDGET_S)
+            frames = viewer.frames  # and the view goes on, robot2 in it
+            assert harness.spin_until(lambda: viewer.frames > frames + 2, BUDGET_S)
+            assert '/objects/robot2' in viewer.drawn
+        finally:
+            browser.close()

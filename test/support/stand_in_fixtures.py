@@ -3,6 +3,7 @@
 * :func:`world_only` -- a SimNode as gz_sim.launch.py starts it (``robot_from_spawn``,
   no controller active until spawned), real_time_factor 0, on a harness;
 * :func:`spawn` -- one SpawnEntity call (never resent: a second call is a second spawn);
+* :func:`two_rovers` -- robot1 (the world's first robot) and robot2, each a driven rover;
 * :func:`start` / :func:`finish` -- a stand-in program (``python -m
   pan_tilt_sim.tools.stand_ins NAME``) and its end, the harness spun meanwhile.
 """
@@ -67,6 +68,16 @@ def spawn(harness: NodeHarness, *, name: str = '', resource_string: str = '', ur
         return future.result()
     finally:
         harness.probe.destroy_client(client)
+
+
+def two_rovers(harness: NodeHarness) -> None:
+    """Spawn rovers robot1 (the world's first robot, at y = 0) and robot2 (at y = 1)."""
+    from mobile_fixtures import ROS2_DIFF_DRIVE, rover_urdf
+
+    rover = rover_urdf('rover', ros2_control=False, extra=f'<gazebo>{ROS2_DIFF_DRIVE}</gazebo>')
+    for name, y in (('robot1', 0.0), ('robot2', 1.0)):
+        response = spawn(harness, name=name, resource_string=rover, namespace=name, y=y)
+        assert response.result.result == 1, response.result.error_message
 
 
 def start(name: str, *arguments: str) -> subprocess.Popen:

@@ -287,6 +287,20 @@ def test_the_spawner_names_the_controller_manager_in_the_robots_namespace():
     assert parameters['autostart_controllers'] is False and 'active_controllers' not in parameters
 
 
+def test_the_spawner_names_the_manager_the_control_plugin_names(tmp_path):
+    # gz_ros2_control's <controller_manager_name>arm_manager: sim_node's manager is
+    # <ns>/arm_manager, and that node's section of the file lists the controllers.
+    from drop_in_fixtures import JSB, MANAGER_YAML
+
+    xacro = write_arm(tmp_path, MANAGER_YAML.replace('controller_manager:', 'arm_manager:'))
+    xacro.write_text(xacro.read_text().replace(
+        '<parameters>', '<controller_manager_name>arm_manager</controller_manager_name>'
+        '<parameters>', 1))
+    setup = robot_setup(str(xacro), robot_namespace='arm')
+    assert controller_manager_name(setup) == '/arm/arm_manager'
+    assert spawner_arguments(setup, [JSB]) == [JSB, '--controller-manager', '/arm/arm_manager']
+
+
 def test_paused_is_passed_only_when_asked_for():
     assert 'paused' not in sim_node_parameters('m.urdf', '', real_time_factor=1.0,
                                                world='targets', gui=False)
