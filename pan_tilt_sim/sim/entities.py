@@ -207,6 +207,7 @@ class Entities:
         robot = self._record(robot_name, self._robot, Origin.ROBOT, static=physics.fixed_base,
                              info=EntityInfo(Category.ROBOT, 'the simulated robot'))
         self._entities[robot.name] = robot
+        self._robot_name = robot.name
         if physics.ground is not None:  # a free robot's: the physics made it
             self._ground = physics.ground
         for name, body in (targets or {}).items():
@@ -219,8 +220,12 @@ class Entities:
 
     @property
     def robot_name(self) -> str:
-        """The robot's entity name (its URDF ``<robot name>``)."""
-        return next(iter(self._entities))
+        """The first robot's entity name (its URDF ``<robot name>``), deleted or not.
+
+        Once DeleteEntity took it away the name names no entity (``name in entities``
+        is False); it never names another one.
+        """
+        return self._robot_name
 
     @property
     def has_ground(self) -> bool:

@@ -285,6 +285,8 @@ def test_the_first_robot_goes_through_its_remover_once_let_delete_allowed_it(pan
     with pytest.raises(KeyError):  # its links are no frames any more
         entities.frame_pose('tilt_link')
     assert entities.frame_pose('target_red') is not None
+    # Its name names no entity now, never the next one (a cube drawn as the robot).
+    assert entities.robot_name == name and entities.robot_name not in entities
 
 
 def test_world_file_objects_survive_delete_spawned_and_come_back_on_restore(pan_tilt, tmp_path):
