@@ -35,15 +35,19 @@ def srv():
 
 
 @contextlib.contextmanager
-def world_only(**parameters) -> Iterator[tuple[NodeHarness, SimNode]]:
-    """A SimNode as gz_sim.launch.py starts it, on a harness (real_time_factor 0 unless given)."""
+def world_only(namespace: str = '', **parameters) -> Iterator[tuple[NodeHarness, SimNode]]:
+    """A SimNode as gz_sim.launch.py starts it, on a harness (real_time_factor 0 unless given).
+
+    ``namespace``: the node's (its services are ``<namespace>/sim_node/...``).
+    """
     parameters.setdefault('real_time_factor', 0.0)
     parameters.setdefault('autostart_controllers', False)  # the spawners activate them
     parameters['robot_from_spawn'] = True
     harness = NodeHarness()
     try:
-        node = harness.add(SimNode(context=harness.context, parameter_overrides=[
-            Parameter(name, value=value) for name, value in parameters.items()]))
+        overrides = [Parameter(name, value=value) for name, value in parameters.items()]
+        node = harness.add(SimNode(context=harness.context, namespace=namespace,
+                                   parameter_overrides=overrides))
         yield harness, node
     finally:
         harness.close()

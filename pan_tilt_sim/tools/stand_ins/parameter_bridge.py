@@ -6,11 +6,14 @@ Arguments ``topic@ros_type(@|[|])gz_type`` and the node's parameters (``config_f
 ``ros_gz_bridge`` reads them.  The entries go to the running sim_node
 (:mod:`pan_tilt_sim.tools.stand_ins.bridging`); the stand-in stays until stopped.  A
 malformed entry or a type pair ros_gz_bridge cannot convert exits 2 with one line
-naming it.  Service bridges and ``lazy`` are named in a warning (not honoured).
+naming it.  Service bridges are named in a warning (not honoured).  ``lazy`` is
+taken silently: sim_node's own endpoints are the ROS ends, so it changes nothing a ROS
+node sees (docs/launch-files.md says why).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import pathlib
 import sys
 
@@ -57,13 +60,11 @@ def _bridge(node, arguments: list[str]) -> int:
                 logger.warning(f"service bridge '{argument}' is not honoured (sim_node serves "
                                'no gz services)')
                 continue
-            entries.append(parsed)
+            entries.append(dataclasses.replace(parsed, lazy=lazy))  # the node's, as upstream
         if config_file:
             entries += read_config(pathlib.Path(config_file))
     except BridgeError as err:
         sys.stderr.write(f'parameter_bridge: {err}\n')
         return EXIT_BAD_ENTRY
-    if lazy or any(entry.lazy for entry in entries):
-        logger.warning('lazy is not honoured: sim_node publishes its topics anyway')
     code = hand_over(node, [absolute(node, entry, expand) for entry in entries])
     return 0 if code is None else code

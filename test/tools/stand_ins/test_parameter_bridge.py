@@ -66,6 +66,34 @@ def test_its_entries_rename_the_robots_topics_and_it_stays_until_stopped():
         assert code == 0, output
 
 
+def test_lazy_is_taken_without_a_warning_and_a_subscriber_gets_the_messages(tmp_path):
+    # ros_gz_bridge's lazy saves the bridge's copying; sim_node copies nothing, so a ROS
+    # subscriber sees what it sees without lazy, and nothing is warned about.
+    from nav_msgs.msg import Odometry
+
+    config = tmp_path / 'bridge.yaml'
+    config.write_text('- ros_topic_name: rover_odom\n  gz_topic_name: /model/rover/odometry\n'
+                      '  ros_type_name: nav_msgs/msg/Odometry\n  gz_type_name: gz.msgs.Odometry\n'
+                      '  direction: GZ_TO_ROS\n  lazy: true\n')
+    with world_only() as (harness, node):
+        process = run('/clock@rosgraph_msgs/msg/Clock[gz.msgs.Clock', '--ros-args',
+                      '-p', 'lazy:=true', '-p', f'config_file:={config}')
+        try:
+            assert harness.spin_until(
+                lambda: node.bridged_topics.pending() == [] and node.bridged_topics._sources,
+                BUDGET_S), 'the bridge never handed over'
+            odometry: list = []
+            harness.probe.create_subscription(Odometry, '/rover_odom', odometry.append, 10)
+            response = spawn(harness, resource_string=plugin_rover_urdf(GZ_DIFF_DRIVE))
+            assert response.result.result == 1
+            assert harness.spin_until(lambda: len(odometry) >= 3, BUDGET_S), 'no odometry'
+        finally:
+            process.send_signal(signal.SIGINT)
+            code, output = finish(harness, process)
+        assert code == 0, output
+        assert output.count('(Lazy 1)') == 2 and 'not honoured' not in output, output
+
+
 def test_a_rename_after_the_robot_is_in_is_refused_naming_the_topic():
     with world_only() as (harness, node):
         assert spawn(harness, resource_string=plugin_rover_urdf(GZ_DIFF_DRIVE)).result.result == 1
