@@ -16,7 +16,7 @@ copies: the gz name stays and the messages are copied to and from the ROS name.
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
@@ -121,6 +121,14 @@ class BridgedTopics:
     def pending(self) -> list[str]:
         """Return the bridge stand-ins in the graph that have not handed their entries over."""
         return sorted(self._in_graph() - self._sources)
+
+    def names_any(self, topics: Iterable[str]) -> bool:
+        """Return whether a handed-over entry's gz topic is one of ``topics`` (absolute).
+
+        A topic sim_node has already (another robot's too, ``/tf`` say) does not count:
+        its entry may be another robot's bridge's.
+        """
+        return any(topic in self._entries and topic not in self._created for topic in topics)
 
     def _entries_of(self, changed: list[Parameter]) -> list[BridgeEntry] | None:
         for parameter in changed:
