@@ -5,21 +5,24 @@ sim_node publishes and subscribes its robot's gz topics on ROS under their gz na
 stand-ins set the ``gz_bridge`` parameter (entries of
 :mod:`pan_tilt_sim.model.gz_bridge`); a topic created afterwards whose name is an
 entry's gz topic is created under the entry's ROS name, and a subscription under its
-ROS type where sim_node's converts (TwistStamped and Twist).  A spawned robot is
-built once every bridge announced on :data:`ANNOUNCE_TOPIC` has handed over (see
-:mod:`.robot_spawn`); entries that would rename or retype a topic that exists
-already are refused.  No message is copied: the simulation's own endpoints move.
+ROS type where sim_node's converts (TwistStamped and Twist): the simulation's own
+endpoints move, no message is copied.  A spawned robot is built once every bridge
+announced on :data:`ANNOUNCE_TOPIC` has handed over (see :mod:`.robot_spawn`); an
+entry for a topic that exists already (its bridge came late: start-up order and
+discovery are not in the launch file's hands) is relayed instead, as ros_gz_bridge
+copies: the gz name stays and the messages are copied to and from the ROS name.
 """
 
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.qos import QoSProfile
 
 from pan_tilt_sim.model.gz_bridge import BridgeEntry, BridgeError, decode
 
@@ -59,6 +62,9 @@ class BridgedTopics:
         self._node = node
         self._entries: dict[str, BridgeEntry] = {}  # by gz topic, absolute
         self._created: dict[str, str] = {}  # topic as sim_node names it -> its type name
+        self._published: set[str] = set()  # those of them sim_node publishes (else reads)
+        # Entries that came after their topic: (gz topic, ROS topic) -> the relay's endpoints.
+        self.relays: dict[tuple[str, str], tuple[Any, Any]] = {}
         self._sources: set[str] = set()  # the bridges that handed their entries over
         node.declare_parameter(PARAMETER, Parameter.Type.STRING_ARRAY, ParameterDescriptor(
             description="ros_gz_bridge entries ('gz_topic|ros_topic|ros_type|gz_type|"
@@ -71,6 +77,7 @@ class BridgedTopics:
         """Return the type and name to create sim_node's publisher of ``topic`` with."""
         resolved = self._resolve(topic)
         self._created[resolved] = type_name(message_type)
+        self._published.add(resolved)
         entry = self._entries.get(resolved)
         if entry is None or not entry.to_ros:
             return message_type, topic
@@ -115,6 +122,14 @@ class BridgedTopics:
         """Return the bridge stand-ins in the graph that have not handed their entries over."""
         return sorted(self._in_graph() - self._sources)
 
+    def names_any(self, topics: Iterable[str]) -> bool:
+        """Return whether a handed-over entry's gz topic is one of ``topics`` (absolute).
+
+        A topic sim_node has already (another robot's too, ``/tf`` say) does not count:
+        its entry may be another robot's bridge's.
+        """
+        return any(topic in self._entries and topic not in self._created for topic in topics)
+
     def _entries_of(self, changed: list[Parameter]) -> list[BridgeEntry] | None:
         for parameter in changed:
             if parameter.name == PARAMETER:
@@ -128,13 +143,12 @@ class BridgedTopics:
             return SetParametersResult(successful=False, reason=str(err))
         for entry in entries or ():
             created = self._created.get(entry.gz_topic)
-            renamed = entry.ros_topic != entry.gz_topic or (
-                entry.ros_type != created and _converter(entry.ros_type, created) is not None)
-            if created is not None and renamed:
+            retyped = (entry.ros_topic == entry.gz_topic and entry.ros_type != created
+                       and _converter(entry.ros_type, created) is not None)
+            if created is not None and retyped:  # no relay on one name with two types
                 return SetParametersResult(successful=False, reason=(
                     f"'{entry.gz_topic}' exists already as {created}: it cannot become "
-                    f"'{entry.ros_topic}' ({entry.ros_type}) now; start the bridge before the "
-                    'robot is spawned'))
+                    f'{entry.ros_type} now; start the bridge before the robot is spawned'))
         return SetParametersResult(successful=True)
 
     def _apply(self, changed: list[Parameter]) -> None:
@@ -144,3 +158,49 @@ class BridgedTopics:
                 self._sources.add(source)
                 for entry in entries:
                     self._entries[entry.gz_topic] = entry
+                    if entry.gz_topic in self._created:
+                        self._relay(entry)
+
+    def _relay(self, entry: BridgeEntry) -> None:
+        """Copy an existing topic's messages to (or from) the entry's ROS name and type."""
+        gz_topic, ros_topic = entry.gz_topic, entry.ros_topic
+        sim_type = self._created[gz_topic]
+        published = gz_topic in self._published
+        # On its own name a topic keeps its type (a retype is refused): nothing to copy.
+        if ((gz_topic, ros_topic) in self.relays or ros_topic == gz_topic
+                or not (entry.to_ros if published else entry.from_ros)):
+            return
+        node, sim_class = self._node, message_class(sim_type)
+        convert = (None if entry.ros_type == sim_type
+                   else _converter(entry.ros_type, sim_type))
+        if entry.ros_type != sim_type and (published or convert is None):
+            node.get_logger().warning(
+                f"gz_bridge: '{gz_topic}' is {sim_type}, not {entry.ros_type}: the type stays")
+        qos = self._qos(gz_topic, published)
+        # rclpy's own create_*: these endpoints are not the simulation's, nothing renames them.
+        if published:
+            out = Node.create_publisher(node, sim_class, ros_topic, qos)
+            into = Node.create_subscription(node, sim_class, gz_topic, out.publish, qos)
+        else:
+            out = Node.create_publisher(node, sim_class, gz_topic, qos)
+            if convert is None:
+                into = Node.create_subscription(node, sim_class, ros_topic, out.publish, qos)
+            else:
+                into = Node.create_subscription(
+                    node, message_class(entry.ros_type), ros_topic,
+                    lambda message: out.publish(convert(message)), qos)
+        self.relays[(gz_topic, ros_topic)] = (into, out)
+        node.get_logger().info(
+            f"gz_bridge: '{gz_topic}' existed before its bridge handed over: its messages are "
+            f"copied {'to' if published else 'from'} '{ros_topic}'")
+
+    def _qos(self, gz_topic: str, published: bool) -> QoSProfile:
+        """Return a QoS with the reliability and durability of sim_node's ``gz_topic``."""
+        node = self._node
+        infos = (node.get_publishers_info_by_topic(gz_topic) if published
+                 else node.get_subscriptions_info_by_topic(gz_topic))
+        for info in infos:
+            if (info.node_name, info.node_namespace) == (node.get_name(), node.get_namespace()):
+                return QoSProfile(depth=10, reliability=info.qos_profile.reliability,
+                                  durability=info.qos_profile.durability)
+        return QoSProfile(depth=10)

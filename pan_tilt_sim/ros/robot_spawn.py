@@ -12,7 +12,9 @@ service stays: a later request whose description is a robot (plugins, sensors or
 while the first is being built waits for it -- and any other goes to the simulation
 services' SpawnEntity (objects), whose server of that name it replaces.  A robot is
 built once the bridge stand-ins that announced themselves have handed over their
-entries (:mod:`.bridged_topics`), at most :data:`BRIDGE_WAIT_S` later.
+entries (:mod:`.bridged_topics`), at most :data:`BRIDGE_WAIT_S` later; in a world
+whose robots came with bridges, a later robot first waits for a bridge of its own
+(:meth:`RobotSpawnService._new_bridge`).
 docs/launch-files.md is the reference.
 """
 
@@ -49,7 +51,8 @@ WORLD_FRAMES = ('', 'world')
 BRIDGE_WAIT_S = 10.0
 BRIDGE_POLL_S = 0.1
 # Wall seconds a later robot in a bridged world waits for a bridge of its own to appear
-# (Nav2's multi-robot launch starts one per robot, with its create, in its namespace).
+# (Nav2's multi-robot launch starts one per robot, with its create, in its namespace),
+# unless a bridge's entries name its topics already.
 NEW_BRIDGE_WAIT_S = 3.0
 
 
@@ -123,7 +126,9 @@ class RobotSpawnService:
                  build_more: Callable[[RobotDescription, Spawn], None] | None = None,
                  names: Callable[[], Iterable[str]] | None = None,
                  is_robot: Callable[[RobotDescription], bool] | None = None,
-                 frame_pose: Callable[[str], Transform] | None = None) -> None:
+                 frame_pose: Callable[[str], Transform] | None = None,
+                 own_topics: Callable[[RobotDescription, str], Iterable[str]] | None = None,
+                 ) -> None:
         found = interfaces()
         if found is None:
             raise ParameterError(
@@ -134,6 +139,9 @@ class RobotSpawnService:
         self._build_more, self._names, self._is_robot = build_more, names, is_robot
         # A frame's pose in the world (KeyError: none such), for a later robot's initial_pose.
         self._frame_pose = frame_pose
+        # A later robot's topics before bridges rename them, from its description and the
+        # request's namespace: what its own bridge's entries name.
+        self._own_topics = own_topics
         self._srv = found.srv.SpawnEntity
         self._result = found.msg.Result
         self._built = False
@@ -155,9 +163,10 @@ class RobotSpawnService:
     async def _spawn(self, request, response):
         while self._busy:  # the first robot is being built: this request follows it
             await self._pause(BRIDGE_POLL_S)
-        if self._built and self._failure is None and self._more_robot(request):
+        more = self._more_robot(request) if self._built and self._failure is None else None
+        if more is not None:
             # Its bridge (in its namespace) may have started with its create: wait for it too.
-            await self._new_bridge()
+            await self._new_bridge(request, more)
             await self._bridges_handed_over()
             return self._spawn_robot(request, response, more=True)
         if self._objects is not None:
@@ -173,22 +182,34 @@ class RobotSpawnService:
         finally:
             self._busy = False
 
-    async def _new_bridge(self) -> None:
+    async def _new_bridge(self, request, description: RobotDescription) -> None:
         """In a world whose robots came with bridges, give a later robot's bridge a moment.
 
-        Waits at most NEW_BRIDGE_WAIT_S for a bridge not seen when the last robot was built;
-        a world without bridges, or one shared bridge, just costs that wait per robot.
+        Ends once a bridge not seen when the last robot was built appears, or a handed-over
+        entry names one of the robot's topics (its bridge came first, or one bridge serves
+        every robot); else after NEW_BRIDGE_WAIT_S (a bridge after that gets relays).
         """
         bridges = getattr(self._node, 'bridged_topics', None)
         if bridges is None or not self._bridges_seen:
             return
+        topics = self._topics_of(request, description)
         deadline = time.monotonic() + NEW_BRIDGE_WAIT_S
         self.awaiting_bridge = True
         try:
-            while bridges.known() <= self._bridges_seen and time.monotonic() < deadline:
+            while (bridges.known() <= self._bridges_seen and not bridges.names_any(topics)
+                   and time.monotonic() < deadline):
                 await self._pause(BRIDGE_POLL_S)
         finally:
             self.awaiting_bridge = False
+
+    def _topics_of(self, request, description: RobotDescription) -> set[str]:
+        """Return the topics the robot of ``request`` will have (none known: empty)."""
+        if self._own_topics is None or self._names is None:
+            return set()
+        name = free_name(request.name or description.name, self._names(),
+                         request.allow_renaming) or description.name
+        return set(self._own_topics(renamed(description, name),
+                                    naming.normalize(request.entity_namespace)))
 
     async def _bridges_handed_over(self) -> None:
         """Wait (at most BRIDGE_WAIT_S) for the bridges in the graph to give their entries."""
@@ -221,14 +242,15 @@ class RobotSpawnService:
         timer = self._node.create_timer(seconds, done)
         return future
 
-    def _more_robot(self, request) -> bool:
-        """Whether a request after the first robot brings one more robot (else an object)."""
+    def _more_robot(self, request) -> RobotDescription | None:
+        """Return the robot a request after the first one brings (None: it is an object)."""
         if self._build_more is None or self._is_robot is None:
-            return False
+            return None
         try:
-            return self._is_robot(self._description(request))
+            description = self._description(request)
         except ConfigurationError:
-            return False  # the objects' SpawnEntity says what is wrong with it
+            return None  # the objects' SpawnEntity says what is wrong with it
+        return description if self._is_robot(description) else None
 
     def _spawn_robot(self, request, response, *, more: bool = False):
         codes = self._srv.Response

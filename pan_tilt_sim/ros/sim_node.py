@@ -148,7 +148,8 @@ class SimNode(Node):
                 taken=(entity.name for entity in self._world.entities if entity.name),
                 build_more=self._add_robot, names=lambda: self.features.entities.names(),
                 is_robot=spawned_robots.is_robot,
-                frame_pose=lambda frame: self.features.entities.frame_pose(frame))
+                frame_pose=lambda frame: self.features.entities.frame_pose(frame),
+                own_topics=spawned_robots.own_topics)
             return
         if self.settings.robot_description_file:
             self._build(physics_thread, load_description(

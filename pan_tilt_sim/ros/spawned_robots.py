@@ -14,6 +14,8 @@ import dataclasses
 
 from rclpy.node import Node
 
+from pan_tilt_sim.controllers.framework.surface import PRIVATE, CommandTopic, StateTopic
+from pan_tilt_sim.errors import ConfigurationError
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.base_pose import BasePose
 from pan_tilt_sim.model.controller_config import (
@@ -23,7 +25,8 @@ from pan_tilt_sim.model.controller_config import (
 )
 from pan_tilt_sim.model.description import RobotDescription
 from pan_tilt_sim.model.ros_arguments import RosArguments
-from pan_tilt_sim.plugins.registry import runs_by_plugins
+from pan_tilt_sim.model.sensors import sensor_interface
+from pan_tilt_sim.plugins.registry import create_plugins, runs_by_plugins
 from pan_tilt_sim.ros import optional_interfaces, startup
 from pan_tilt_sim.ros.controller_bindings import ControllerBindings
 from pan_tilt_sim.ros.features import require_ground, robot_sensors
@@ -54,6 +57,35 @@ def later_robot_settings(settings: SimParameters, initial_pose: BasePose) -> Sim
     """
     return dataclasses.replace(settings, initial_pose=initial_pose, active_controllers=None,
                                initial_positions={}, controllers_args=())
+def own_topics(description: RobotDescription, namespace: str) -> set[str]:
+    """Return the topics its plugins and sensors will have, before any bridge renames them.
+
+    ``namespace`` is the spawn request's (as :class:`SpawnedRobot` takes it).  Names
+    only: nothing is created.  A description that cannot be read has none here (its
+    build says what is wrong).
+    """
+    try:
+        controllers = controllers_of(description)
+        plugins = create_plugins(description.model)
+    except ConfigurationError:
+        return set()
+    robot = naming.resolve_robot_namespace('', namespace, controllers.namespace,
+                                           description.plugin_namespace)
+    topics = set()
+    for plugin in plugins:
+        plugin.node_namespace = naming.join(robot)  # as ControllerBindings sets it
+        for endpoint in plugin.ros_surface():
+            if not isinstance(endpoint, (CommandTopic, StateTopic)):
+                continue
+            name = endpoint.name
+            if name.startswith(PRIVATE):
+                topics.add(naming.join(robot, plugin.name, name[len(PRIVATE):]))
+            else:
+                topics.add(name if name.startswith('/') else naming.join(robot, name))
+    model = description.model
+    for sensor in model.sensors:
+        topics.update(sensor_interface(sensor, model.name, namespace).topics.values())
+    return topics
 
 
 class SpawnedRobot:

@@ -9,7 +9,10 @@ from __future__ import annotations
 import importlib.util
 
 import pytest
+from geometry_msgs.msg import TwistStamped
 from mobile_fixtures import GZ_DIFF_DRIVE, plugin_rover_urdf
+from nav_msgs.msg import Odometry
+from node_harness import PROBE_QUEUE
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from stand_in_fixtures import BUILD_BUDGET_S, SERVICE, spawn, srv, world_only
@@ -22,6 +25,7 @@ pytestmark = pytest.mark.skipif(
     reason='simulation_interfaces is not installed')
 
 HELD_S = 1.0
+DRIVE_SPEED = 0.3  # m/s
 ENTRIES = ['/model/rover/odometry|/odom|nav_msgs/msg/Odometry|gz.msgs.Odometry|GZ_TO_ROS',
            '/model/rover/cmd_vel|/cmd_vel|geometry_msgs/msg/TwistStamped|gz.msgs.Twist|'
            'ROS_TO_GZ']
@@ -56,14 +60,38 @@ def test_a_spawn_waits_for_an_announced_bridge_whose_entries_then_name_the_topic
         assert reader.topic_type == 'geometry_msgs/msg/TwistStamped'
 
 
-def test_entries_that_would_move_an_existing_topic_are_refused_and_others_taken():
+def test_entries_that_come_after_the_robot_copy_its_topics_to_and_from_their_ros_names():
+    # The bridge's hand-over came late (its start, or sim_node's discovery of it, after the
+    # spawn): the robot's topics exist under their gz names, and are relayed.
     with world_only() as (harness, node):
-
-
         assert spawn(harness, resource_string=plugin_rover_urdf(GZ_DIFF_DRIVE)).result.result == 1
-        refused = set_bridge(harness, ['/probe', ENTRIES[0]])
+        assert set_bridge(harness, ['/probe', *ENTRIES]).successful
+        odometry: list[Odometry] = []
+        harness.probe.create_subscription(Odometry, '/odom', odometry.append, PROBE_QUEUE)
+        assert harness.spin_until(lambda: odometry), harness.probe.get_topic_names_and_types()
+        command = harness.probe.create_publisher(TwistStamped, '/cmd_vel', 10)
+        assert harness.spin_until(lambda: command.get_subscription_count() > 0), (
+            'nobody reads /cmd_vel as TwistStamped')
+
+        def driving() -> bool:
+            message = TwistStamped()
+            message.twist.linear.x = DRIVE_SPEED
+            command.publish(message)
+            return odometry[-1].twist.twist.linear.x > 0.5 * DRIVE_SPEED
+
+        assert harness.spin_until(driving), odometry[-1].twist.twist
+        assert sorted(node.bridged_topics.relays) == [('/model/rover/cmd_vel', '/cmd_vel'),
+                                                      ('/model/rover/odometry', '/odom')]
+
+
+def test_an_entry_that_would_retype_an_existing_topic_on_its_name_is_refused_others_taken():
+    with world_only() as (harness, node):
+        assert spawn(harness, resource_string=plugin_rover_urdf(GZ_DIFF_DRIVE)).result.result == 1
+        refused = set_bridge(harness, [
+            '/probe', '/model/rover/cmd_vel|/model/rover/cmd_vel|geometry_msgs/msg/TwistStamped|'
+            'gz.msgs.Twist|ROS_TO_GZ'])
         assert not refused.successful
-        assert "'/model/rover/odometry' exists already" in refused.reason
+        assert "'/model/rover/cmd_vel' exists already" in refused.reason
         assert set_bridge(harness, [
             '/probe', '/model/rover/odometry|/model/rover/odometry|nav_msgs/msg/Odometry|'
             'gz.msgs.Odometry|GZ_TO_ROS', '/other|/other|std_msgs/msg/Float64|gz.msgs.Double|'

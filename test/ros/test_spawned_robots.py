@@ -6,6 +6,7 @@ its own cmd_vel, they collide, robot2's lidar sees robot1, DeleteEntity takes ei
 robot and its topics away (the world runs on), a later robot's pose may be relative to
 another entity, a plugin's <controller_manager_name> names the robot's manager, a taken
 name is refused, and a robot that cannot be simulated is refused while robot1 runs on.
+In a bridged world a later robot waits for its own bridge, unless entries name its topics.
 """
 
 from __future__ import annotations
@@ -502,21 +503,34 @@ def test_a_second_robot_asked_for_while_the_first_waits_for_its_bridge_follows_i
         assert sorted(node.spawned_robots) == ['robot2']
 
 
+def hand_over(node, bridge: str, entries: list) -> bool:
+    """Set sim_node's gz_bridge parameter as the bridge stand-in named ``bridge`` does."""
+    from rclpy.parameter import Parameter
+
+    from pan_tilt_sim.model.gz_bridge import encode
+    from pan_tilt_sim.ros import bridged_topics
+
+    value = encode(bridge, entries)
+    return node.set_parameters([Parameter(bridged_topics.PARAMETER, value=value)])[0].successful
+
+
+def cmd_vel_entry(robot: str):
+    """The entry of a bridge giving gz DiffDrive's ``/model/<robot>/cmd_vel`` its ROS name."""
+    from pan_tilt_sim.model.gz_bridge import ROS_TO_GZ, BridgeEntry
+
+    return BridgeEntry(f'/{robot}/cmd_vel', f'/model/{robot}/cmd_vel',
+                       'geometry_msgs/msg/Twist', 'gz.msgs.Twist', ROS_TO_GZ)
+
+
 def test_a_later_robot_in_a_bridged_world_waits_for_its_own_bridge_to_appear():
     # Nav2's multi-robot launch starts each robot's bridge with its create: a later robot's
     # request can come before its bridge is in the graph, and is built after it hands over.
-    from rclpy.parameter import Parameter
     from std_msgs.msg import Empty
 
-    from pan_tilt_sim.model.gz_bridge import ROS_TO_GZ, BridgeEntry, encode
     from pan_tilt_sim.ros import bridged_topics
 
-    def hand_over(bridge: str, entries: list[BridgeEntry]) -> bool:
-        value = encode(bridge, entries)
-        return node.set_parameters([Parameter(bridged_topics.PARAMETER, value=value)])[0].successful
-
     with world_only() as (harness, node):
-        assert hand_over('/robot1/parameter_bridge', [])
+        assert hand_over(node, '/robot1/parameter_bridge', [])
         first = spawn(harness, name='robot1', resource_string=rover(GZ_DIFF_DRIVE))
         assert first.result.result == 1, first
         client = harness.probe.create_client(srv().SpawnEntity, '/sim_node/spawn_entity')
@@ -528,10 +542,81 @@ def test_a_later_robot_in_a_bridged_world_waits_for_its_own_bridge_to_appear():
         announce = harness.probe.create_publisher(Empty, bridged_topics.ANNOUNCE_TOPIC, 1)
         assert harness.spin_until(lambda: node.bridged_topics.pending())
         assert not future.done(), 'robot2 was built before its bridge handed over'
-        assert hand_over('/probe', [BridgeEntry('/robot2/cmd_vel', '/model/robot2/cmd_vel',
-                                                'geometry_msgs/msg/Twist', 'gz.msgs.Twist',
-                                                ROS_TO_GZ)])
+        assert hand_over(node, '/probe', [cmd_vel_entry('robot2')])
         harness.probe.destroy_publisher(announce)
         assert harness.spin_until(future.done)
         assert future.result().result.result == 1, future.result().result.error_message
         assert harness.spin_until(lambda: node.count_subscribers('/robot2/cmd_vel') > 0)
+
+
+def test_a_later_robot_whose_bridge_handed_over_first_is_built_at_once():
+    # Each robot's bridge started with its create and handed over before either robot
+    # was spawned: robot2's entries name its gz topics, so nothing is left to wait for.
+    from pan_tilt_sim.ros.robot_spawn import NEW_BRIDGE_WAIT_S
+
+    with world_only(real_time_factor=1.0) as (harness, node):
+        assert hand_over(node, '/robot1/parameter_bridge', [cmd_vel_entry('robot1')])
+        assert hand_over(node, '/robot2/parameter_bridge', [cmd_vel_entry('robot2')])
+        first = spawn(harness, name='robot1', resource_string=rover(GZ_DIFF_DRIVE))
+        assert first.result.result == 1, first
+        client = harness.probe.create_client(srv().SpawnEntity, '/sim_node/spawn_entity')
+        assert harness.spin_until(client.service_is_ready)
+        assert harness.spin_until(lambda: node.simulation.time > 0.0)
+        asked_at = node.simulation.time
+        future = client.call_async(srv().SpawnEntity.Request(
+            name='robot2', resource_string=rover(GZ_DIFF_DRIVE)))
+        assert harness.spin_until(future.done)
+        waited = node.simulation.time - asked_at
+        assert future.result().result.result == 1, future.result().result.error_message
+        assert waited < NEW_BRIDGE_WAIT_S / 3, f'robot2 waited {waited:.2f} s of sim time'
+        assert harness.spin_until(lambda: node.count_subscribers('/robot2/cmd_vel') > 0)
+        assert not node.bridged_topics.relays  # renamed as it was created
+
+
+def test_a_topic_the_robots_share_does_not_pass_for_a_later_robots_bridge():
+    # robot1's bridge names /scan, which robot2 (no namespace) has too: that entry is
+    # robot1's bridge's, so robot2 still waits for a bridge of its own to appear.
+    from pan_tilt_sim.model.gz_bridge import GZ_TO_ROS, BridgeEntry
+
+    scan = BridgeEntry('/robot1/scan', '/scan', 'sensor_msgs/msg/LaserScan', 'gz.msgs.LaserScan',
+                       GZ_TO_ROS)
+    with world_only() as (harness, node):
+        assert hand_over(node, '/robot1/parameter_bridge', [scan])
+        first = spawn(harness, name='robot1', resource_string=rover(GZ_DIFF_DRIVE))
+        assert first.result.result == 1, first
+        client = harness.probe.create_client(srv().SpawnEntity, '/sim_node/spawn_entity')
+        assert harness.spin_until(client.service_is_ready)
+        future = client.call_async(srv().SpawnEntity.Request(
+            name='robot2', resource_string=rover(GZ_DIFF_DRIVE)))
+        assert harness.spin_until(lambda: node._robot_spawn.awaiting_bridge or future.done())
+        assert not future.done(), "robot2 took robot1's /scan entry for its own bridge's"
+        assert hand_over(node, '/robot2/parameter_bridge', [cmd_vel_entry('robot2')])
+        assert harness.spin_until(future.done)
+        assert future.result().result.result == 1, future.result().result.error_message
+
+
+def test_a_later_robots_own_topics_are_the_topics_its_plugins_and_sensors_create():
+    # What a later robot's bridge entries are matched against, before the robot is built.
+    from pan_tilt_sim.model import naming
+    from pan_tilt_sim.model.description import description_from_text
+    from pan_tilt_sim.ros.robot_spawn import renamed
+    from pan_tilt_sim.ros.spawned_robots import own_topics
+
+    with world_only() as (harness, node):
+        assert spawn(harness, name='robot1', resource_string=rover(),
+                     namespace='robot1').result.result == 1
+        sim = SimUnderTest(harness, node)
+
+        def topics() -> set[str]:
+            published, subscribed = sim.own_topics()
+            return set(published) | set(subscribed)
+
+        for name, drive, namespace in (('robot2', ROS2_DIFF_DRIVE, 'robot2'),
+                                       ('robot3', GZ_DIFF_DRIVE, '')):
+            before = topics()
+            assert spawn(harness, name=name, resource_string=rover(drive), y=1.0,
+                         namespace=namespace).result.result == 1
+            created = topics() - before
+            predicted = own_topics(renamed(description_from_text(rover(drive), 'test'), name),
+                                   naming.normalize(namespace))
+            assert created <= predicted <= topics(), (name, created, predicted)

@@ -11,6 +11,8 @@ import signal
 
 import pytest
 from mobile_fixtures import GZ_DIFF_DRIVE, plugin_rover_urdf
+from nav_msgs.msg import Odometry
+from node_harness import PROBE_QUEUE
 from stand_in_fixtures import finish, spawn, start, world_only
 
 pytestmark = pytest.mark.skipif(
@@ -94,14 +96,22 @@ def test_lazy_is_taken_without_a_warning_and_a_subscriber_gets_the_messages(tmp_
         assert output.count('(Lazy 1)') == 2 and 'not honoured' not in output, output
 
 
-def test_a_rename_after_the_robot_is_in_is_refused_naming_the_topic():
+def test_a_bridge_started_after_the_robot_is_in_has_its_topic_copied_to_the_ros_name():
     with world_only() as (harness, node):
         assert spawn(harness, resource_string=plugin_rover_urdf(GZ_DIFF_DRIVE)).result.result == 1
-        code, output = finish(harness, run(
-            'model/rover/odometry@nav_msgs/msg/Odometry[gz.msgs.Odometry',
-            '--ros-args', '-r', '__ns:=/robot1'))
-        assert code == 2
-        assert "'/model/rover/odometry' exists already" in output, output
+        process = run('model/rover/odometry@nav_msgs/msg/Odometry[gz.msgs.Odometry',
+                      '--ros-args', '-r', '__ns:=/robot1')
+        odometry: list[Odometry] = []
+        harness.probe.create_subscription(Odometry, '/robot1/model/rover/odometry',
+                                          odometry.append, PROBE_QUEUE)
+        try:
+            assert harness.spin_until(lambda: odometry, BUDGET_S), (
+                harness.probe.get_topic_names_and_types())
+            assert process.poll() is None  # not refused: it runs until stopped
+        finally:
+            process.send_signal(signal.SIGINT)
+            code, output = finish(harness, process)
+        assert code == 0, output
 
 
 def test_image_bridge_hands_its_image_topics_over_and_without_topics_prints_its_usage():
