@@ -30,6 +30,7 @@ PARAMETER = 'gz_bridge'
 # Each bridge stand-in publishes on this hidden topic from its start, so that sim_node
 # knows a bridge is coming and builds a spawned robot only once it has handed over.
 ANNOUNCE_TOPIC = '/_pan_tilt_sim/gz_bridge'
+UNKNOWN_NODE_NAME = '_NODE_NAME_UNKNOWN_'  # rmw's name for a node not discovered yet
 TWIST, TWIST_STAMPED = 'geometry_msgs/msg/Twist', 'geometry_msgs/msg/TwistStamped'
 
 
@@ -110,9 +111,14 @@ class BridgedTopics:
         return self._node.resolve_topic_name(topic)
 
     def _in_graph(self) -> set[str]:
-        """Return the bridge stand-ins announcing themselves now, by full node name."""
+        """Return the bridge stand-ins announcing themselves now, by full node name.
+
+        An endpoint whose node DDS has not named yet (rmw's placeholder name, right
+        after discovery) is left out: it would count one bridge twice, under two names.
+        """
         return {f"{info.node_namespace.rstrip('/')}/{info.node_name}"
-                for info in self._node.get_publishers_info_by_topic(ANNOUNCE_TOPIC)}
+                for info in self._node.get_publishers_info_by_topic(ANNOUNCE_TOPIC)
+                if info.node_name != UNKNOWN_NODE_NAME}
 
     def known(self) -> int:
         """Return how many bridge stand-ins have been seen: handed over, or in the graph now."""

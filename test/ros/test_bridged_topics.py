@@ -7,6 +7,7 @@ The bridge stand-ins announce themselves on a hidden topic and then set sim_node
 from __future__ import annotations
 
 import importlib.util
+from types import SimpleNamespace
 
 import pytest
 from geometry_msgs.msg import TwistStamped
@@ -18,7 +19,7 @@ from rclpy.parameter_client import AsyncParameterClient
 from stand_in_fixtures import BUILD_BUDGET_S, SERVICE, spawn, srv, world_only
 from std_msgs.msg import Empty
 
-from pan_tilt_sim.ros.bridged_topics import ANNOUNCE_TOPIC, PARAMETER
+from pan_tilt_sim.ros.bridged_topics import ANNOUNCE_TOPIC, PARAMETER, BridgedTopics
 
 pytestmark = pytest.mark.skipif(
     importlib.util.find_spec('simulation_interfaces') is None,
@@ -98,3 +99,32 @@ def test_an_entry_that_would_retype_an_existing_topic_on_its_name_is_refused_oth
             'BIDIRECTIONAL']).successful
         bad = set_bridge(harness, ['/probe', '/x|/x|std_msgs/msg/Bool|gz.msgs.Double|GZ_TO_ROS'])
         assert not bad.successful and 'pairs with gz.msgs.Boolean' in bad.reason
+
+
+class _Graph:
+    """The node calls BridgedTopics makes, with the announcing endpoints given."""
+
+    def __init__(self, announcers: list[tuple[str, str]]) -> None:
+        self._announcers = announcers
+
+    def declare_parameter(self, *_args) -> None:
+        pass
+
+    def add_on_set_parameters_callback(self, _callback) -> None:
+        pass
+
+    add_post_set_parameters_callback = add_on_set_parameters_callback
+
+    def get_publishers_info_by_topic(self, topic: str) -> list:
+        assert topic == ANNOUNCE_TOPIC
+        return [SimpleNamespace(node_namespace=namespace, node_name=name)
+                for namespace, name in self._announcers]
+
+
+def test_a_bridge_not_yet_named_by_discovery_is_not_counted_as_another_bridge():
+    # Right after discovery rmw names an endpoint's node '_NODE_NAME_UNKNOWN_'; the same
+    # bridge then shows up twice, once by its name and once by the placeholder.
+    bridges = BridgedTopics(_Graph([('/robot1', 'parameter_bridge'),
+                                    ('_NODE_NAMESPACE_UNKNOWN_', '_NODE_NAME_UNKNOWN_')]))
+    assert bridges.pending() == ['/robot1/parameter_bridge']
+    assert bridges.known() == 1
