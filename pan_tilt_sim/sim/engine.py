@@ -212,6 +212,11 @@ class Simulation:
         # Waiting for spawners, a joint no controller has driven yet is held where it is, as
         # gz_ros2_control's hold_joints holds it; once driven, it is passive when undriven.
         self._hold_undriven = not autostart_controllers
+        # Only the joints its <ros2_control> block gives a command interface (gz_ros2_control's
+        # is_actuated); without a block, every joint.
+        declared = [handle for handle in self._handle_list if handle.declared_commands is not None]
+        self._holdable = ({handle.name for handle in declared if handle.declared_commands}
+                          if declared else set(self.handles))
         self._driven: set[str] = set()
         # Per step member (by id), [step at which it next updates, every so many steps,
         # period s, its update]: the controllers' clocks, kept across switches.
@@ -245,6 +250,7 @@ class Simulation:
             actuator = actuators.get(handle.name)
             if actuator is None:
                 actuator = idle_actuator(handle.spec, hold=self._hold_undriven
+                                         and handle.name in self._holdable
                                          and handle.name not in self._driven)
                 handle.velocity_target = 0.0
             handle.actuator = actuator

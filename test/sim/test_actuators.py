@@ -277,6 +277,25 @@ def test_waiting_for_spawners_undriven_joints_hold_and_once_driven_are_passive(t
         assert sim.joint_positions()['joint1'] == pytest.approx(0.0, abs=0.002)
 
 
+def test_waiting_for_spawners_only_joints_with_command_interfaces_are_held(tmp_path):
+    # gz_ros2_control holds only the joints its <ros2_control> block gives a command
+    # interface (is_actuated); a joint outside the block (an unlisted wheel) stays free.
+    block = ('<ros2_control name="arm" type="system"><hardware>'
+             '<plugin>gz_ros2_control/GazeboSimSystem</plugin></hardware>'
+             '<joint name="joint1"><command_interface name="position"/>'
+             '<state_interface name="position"/></joint></ros2_control>\n</robot>')
+    urdf = two_link_arm_urdf().replace('</robot>', block)
+    one_joint = ('position_controllers/JointGroupPositionController', {'joints': ['joint1']})
+    with simulation(tmp_path, urdf, ros2_control_yaml({'arm': one_joint}),
+                    autostart_controllers=False) as sim:
+        assert sim.handles['joint1'].actuator.kind is ActuatorKind.HOLD
+        assert sim.handles['joint2'].actuator.kind is ActuatorKind.PASSIVE
+        sim.advance(500)
+        positions = sim.joint_positions()
+        assert positions['joint1'] == pytest.approx(0.0, abs=0.002)
+        assert positions['joint2'] > 0.3  # gravity swings it down
+
+
 def test_started_the_pan_tilt_examples_way_an_undriven_joint_is_passive_and_falls(tmp_path):
     with simulation(tmp_path, two_link_arm_urdf(), ros2_control_yaml({'arm': POSITION_GROUP}),
                     active_controllers=[]) as sim:
