@@ -64,3 +64,34 @@ def test_options_not_honoured_are_named_once_each_with_their_value():
 def test_a_gui_only_gz_sim_starts_nothing():
     started = server('-g -v 4', environ={})
     assert not started.run and "'-g'" in started.warnings[-1]
+
+
+def test_levels_takes_no_value_so_the_world_after_it_is_still_the_world(tmp_path):
+    world = tmp_path / 'sandbox.sdf'
+    world.write_text('<sdf version="1.8"><world name="w"/></sdf>')
+    started = server(f'-r --levels {world}', environ={})
+    assert started.parameters['world'] == str(world)
+    assert started.warnings == ["gz_args: '--levels' is not honoured by sim_node"]
+
+
+def test_an_option_value_is_optional_and_never_the_next_option():
+    # gz sim's OptionParser: `[arg]` values are optional, a following `-...` is an option.
+    started = server('--iterations -r empty.sdf', environ={})
+    assert started.parameters['paused'] is False
+    assert started.warnings == ["gz_args: '--iterations' is not honoured by sim_node"]
+
+
+@pytest.mark.parametrize(('word', 'ros'), [('-v4', 'info'), ('-v1', 'error'),
+                                           ('--verbose=2', 'warn')])
+def test_a_verbosity_attached_to_its_flag_is_read(word, ros):
+    started = server(f'-r {word} empty.sdf', environ={})
+    assert started.ros_arguments == ['--log-level', ros] and started.warnings == []
+
+
+def test_of_two_worlds_the_last_is_loaded_as_gz_sim_does_and_the_other_named(tmp_path):
+    world = tmp_path / 'sandbox.sdf'
+    world.write_text('<sdf version="1.8"><world name="w"/></sdf>')
+    started = server(f'shapes.sdf {world}', environ={}, cwd=tmp_path)
+    assert started.parameters['world'] == str(world)
+    assert started.warnings == ["gz_args: 'shapes.sdf' is not honoured by sim_node (gz sim "
+                                'loads the last world given)']
