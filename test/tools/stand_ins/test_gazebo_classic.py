@@ -75,3 +75,26 @@ def test_the_launch_file_gives_sim_node_a_shutdown_on_exit_when_server_is_requir
     (sim_node,) = launch.nodes()
     on_exit = sim_node.kwargs['on_exit']
     assert isinstance(on_exit, launch_stand_in.Shutdown) is shutdown
+
+
+def _launch(monkeypatch, tmp_path, name: str, **arguments: str):
+    launch_file = pathlib.Path(__file__).parents[3] / 'launch' / name
+    return launch_stand_in.StandInLaunch(launch_stand_in.load(launch_file, monkeypatch),
+                                         tmp_path, arguments)
+
+
+def test_gzserver_launch_py_alone_starts_sim_node_as_gazebo_launch_py_does(monkeypatch,
+                                                                            tmp_path):
+    # turtlebot3_gazebo's shape: gzserver.launch.py and gzclient.launch.py included apart.
+    launch = _launch(monkeypatch, tmp_path, 'gzserver.launch.py', pause='true',
+                     server_required='true')
+    (sim_node,) = launch.nodes()
+    assert sim_node.kwargs['name'] == 'gazebo'
+    (parameters,) = sim_node.kwargs['parameters']
+    assert parameters['world'] == 'ground' and parameters['paused'] is True
+    assert isinstance(sim_node.kwargs['on_exit'], launch_stand_in.Shutdown)
+
+
+def test_gzclient_launch_py_starts_nothing(monkeypatch, tmp_path):
+    launch = _launch(monkeypatch, tmp_path, 'gzclient.launch.py', verbose='true')
+    assert list(launch.nodes()) == []
