@@ -6,7 +6,7 @@ gui, server, ...); then ``spawn_entity.py`` (pan_tilt_sim's) brings the robot.
 docs/launch-files.md says which arguments are honoured.
 """
 
-from launch.actions import DeclareLaunchArgument, OpaqueFunction
+from launch.actions import DeclareLaunchArgument, OpaqueFunction, Shutdown
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
@@ -29,7 +29,8 @@ def launch_gazebo(context, *args, **kwargs):
         return []
     return [Node(package='pan_tilt_sim', executable='sim_node', name=gazebo_classic.NODE_NAME,
                  output='screen', parameters=[server.parameters],
-                 ros_arguments=server.ros_arguments)]
+                 ros_arguments=server.ros_arguments,
+                 on_exit=Shutdown() if server.shutdown_on_exit else None)]
 
 
 def generate_launch_description():

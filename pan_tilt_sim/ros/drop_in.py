@@ -48,6 +48,8 @@ SHARED_WITH_CONTROLLERS = (UPDATE_RATE_FIELD, 'use_sim_time')
 # `parameters=[{...}]` (a `/**` wildcard) and `-p` give them to every node.
 DECLARED_AFTER_CONTROLLERS = ('world', 'camera', 'publish_tf', 'sensors',
                               'simulation_interfaces', 'defaults')
+# ros2_control_node's own settings of its real-time thread: sim_node has none to set.
+REAL_TIME_SETTINGS = ('thread_priority', 'cpu_affinity', 'lock_memory')
 DESCRIPTION_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
@@ -73,6 +75,10 @@ def declare_manager_parameters(node: Node, arguments: RosArguments,
     names = set(_flat(node_parameters(arguments.params_files, node.get_name())))
     names.update(arguments.parameters_for(node.get_name()))
     names.update(parameter.name for parameter in overrides)
+    for name in sorted(names & set(REAL_TIME_SETTINGS)):
+        node.get_logger().warning(
+            f"parameter '{name}' is not honoured: sim_node steps controllers and physics in "
+            "sim time on its executor, with no real-time thread to set up")
     rate = None  # declared with the simulation then, from a plugin's file or 100 Hz
     if UPDATE_RATE_FIELD in names:
         rate = parameters.declare(

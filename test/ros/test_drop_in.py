@@ -280,6 +280,15 @@ def test_an_unknown_hardware_component_in_its_initial_state_is_warned_about(tmp_
         err)
 
 
+def test_ros2_control_node_s_real_time_settings_are_taken_with_one_warning_each(capfd):
+    with drop_in_node('-p', 'thread_priority:=90', '-p', 'cpu_affinity:=1',
+                      lock_memory=False):
+        pass
+    err = capfd.readouterr().err
+    for name in ('thread_priority', 'cpu_affinity', 'lock_memory'):
+        assert err.count(f"parameter '{name}' is not honoured") == 1, err
+
+
 def test_named_sim_node_an_empty_description_file_also_means_the_topic(tmp_path):
     controllers = write_yaml(tmp_path, 'c.yaml', MANAGER_YAML)
     harness = NodeHarness()

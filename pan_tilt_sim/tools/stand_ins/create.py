@@ -1,8 +1,9 @@
 """ros_gz_sim's ``create``: hand a robot to the running simulation; exit 0 once it is in.
 
 Arguments as ros_gz_sim's (jazzy): the flags ``-world -file -param -string -topic
--name -allow_renaming -x -y -z -R -P -Y`` and the same names as ROS parameters
-(which win, as there).  The description goes to sim_node's SpawnEntity service
+-name -allow_renaming -x -y -z -R -P -Y``, gflags' own (``--flagfile``, ``--undefok``,
+``--help``, ...), and the same names as ROS parameters (which win, as there).  The
+description goes to sim_node's SpawnEntity service
 (:mod:`pan_tilt_sim.tools.stand_ins.spawning`); exit codes as create's: 0 in, 1
 refused, 255 no description.  ``-world`` is not honoured (one world per sim_node):
 a warning names it.  ``-R -P -Y`` are the pose's fixed-axis angles, as gz's.
@@ -13,7 +14,7 @@ from __future__ import annotations
 import math
 import sys
 
-from pan_tilt_sim.tools.stand_ins.flags import FlagError, parse_flags
+from pan_tilt_sim.tools.stand_ins.flags import FlagError, FlagExitError, parse_flags
 from pan_tilt_sim.tools.stand_ins.launcher import exit_with, run_node
 from pan_tilt_sim.tools.stand_ins.spawning import call_spawn, description_from_topic
 
@@ -26,6 +27,9 @@ PARAMETERS = ('world', 'file', 'string', 'topic', 'name', 'allow_renaming',
 POSE = ('x', 'y', 'z', 'R', 'P', 'Y')
 EXIT_REFUSED = 1
 EXIT_NO_DESCRIPTION = 255  # create's return -1
+USAGE = ('create: Usage: create -world [arg] [-file FILE] [-param PARAM] [-topic TOPIC]\n'
+         '                       [-string STRING] [-name NAME] [-allow_renaming RENAMING] '
+         '[-x X] [-y Y] [-z Z]\n                       [-R ROLL] [-P PITCH] [-Y YAW]\n')
 
 
 def quaternion(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
@@ -56,6 +60,9 @@ def _create(node, words: list[str]) -> int:
     except FlagError as err:
         sys.stderr.write(f'{err}\n')
         return EXIT_REFUSED
+    except FlagExitError as ended:  # gflags' --help* print the usage, --version the name
+        sys.stdout.write(USAGE if ended.flag != 'version' else 'create\n')
+        return ended.code
     values = {name: node.declare_parameter(name, FLAGS[name]).value for name in PARAMETERS}
     world = values['world'] or flags['world']
     if world:

@@ -2,10 +2,12 @@
 
 ``world`` (a path, else found in ``GAZEBO_RESOURCE_PATH``; ``worlds/empty.world``,
 gzserver's default, is the ground), ``pause``, ``verbose``, ``server`` (false: nothing
-to start), ``gui`` (sim_node is headless) and ``extra_gazebo_args`` (``-u``/``--pause``
-and ``--verbose`` honoured).  ``init``, ``factory`` and ``force_system`` need nothing:
-sim_node serves its spawn service anyway.  Any other argument given a value is named
-in one warning.  sim_node starts with no robot: ``spawn_entity.py`` brings it.
+to start), ``server_required`` (the launch ends with sim_node), ``gui`` (sim_node is
+headless) and ``extra_gazebo_args`` (``-u``/``--pause`` and ``--verbose`` honoured; any
+other gzserver option is named with its value in one warning).  ``init``, ``factory``
+and ``force_system`` need nothing: sim_node serves its spawn service anyway.  Any other
+argument given a value is named in one warning.  sim_node starts with no robot:
+``spawn_entity.py`` brings it.
 """
 
 from __future__ import annotations
@@ -30,6 +32,10 @@ ARGUMENTS = {
     'force_system': 'true', 'server_required': 'false', 'gdbserver': 'false',
     'gdbserver_port': '', 'gui_required': 'false',
 }
+# gzserver's options that take a value (the next word), as gazebo 11's --help lists them.
+WITH_VALUE = ('-e', '--physics', '-p', '--play', '-s', '--server-plugin', '-o', '--profile',
+              '--record_encoding', '--record_path', '--record_period', '--record_filter',
+              '--seed', '--iters', '--initial_sim_time')
 HONOURED = ('world', 'gui', 'server', 'verbose', 'pause', 'extra_gazebo_args', 'init',
             'factory', 'force_system', 'server_required', 'gui_required')
 
@@ -43,12 +49,18 @@ def server(arguments: dict[str, str], environ: dict[str, str] | None = None,
                 if name in ARGUMENTS and name not in HONOURED and value != ARGUMENTS[name]]
     paused = truth(arguments.get('pause', 'false'))
     verbose = truth(arguments.get('verbose', 'false'))
-    for word in shlex.split(arguments.get('extra_gazebo_args', '')):
+    words = shlex.split(arguments.get('extra_gazebo_args', ''))
+    index = 0
+    while index < len(words):
+        word = words[index]
+        index += 1
         if word in ('-u', '--pause'):
             paused = True
         elif word == '--verbose':
             verbose = True
         else:
+            if word in WITH_VALUE and index < len(words):
+                word, index = f'{word} {words[index]}', index + 1
             warnings.append(f"extra_gazebo_args: '{word}' is not honoured by sim_node")
     if not truth(arguments.get('server', 'true')):
         return Server({}, [], warnings, run=False)
@@ -57,7 +69,8 @@ def server(arguments: dict[str, str], environ: dict[str, str] | None = None,
                   'robot_from_spawn': True, 'paused': paused,
                   'autostart_controllers': False, 'publish_tf': False}
     # gzserver says little unless --verbose, as sim_node at 'warn'.
-    return Server(parameters, [] if verbose else ['--log-level', 'warn'], warnings)
+    return Server(parameters, [] if verbose else ['--log-level', 'warn'], warnings,
+                  shutdown_on_exit=truth(arguments.get('server_required', 'false')))
 
 
 def truth(text: str) -> bool:

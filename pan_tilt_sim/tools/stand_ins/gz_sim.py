@@ -4,10 +4,11 @@
 file, found as gz-sim finds it: the path, then ``GZ_SIM_RESOURCE_PATH``; ``empty.sdf``
 built in, as the ground; a path not there yet is read when sim_node starts), ``-r``
 (run; without it the simulation starts paused, as gz-sim's does), ``-v N`` (sim_node's
-log level), ``-s`` and ``--headless-rendering`` (sim_node is always a headless server).
-sim_node starts with no robot
-(``robot_from_spawn``): ``create`` brings it.  Any other option is named in one
-warning; a world that cannot be found is a :class:`GzArgsError`.
+log level; ``-v4`` too), ``-s`` and ``--headless-rendering`` (sim_node is always a
+headless server).  sim_node starts with no robot (``robot_from_spawn``): ``create``
+brings it.  Any other option is named in one warning (an option's value is optional
+and never a word starting with ``-``, as gz sim's OptionParser reads it); of several
+worlds the last is loaded, as by gz sim.  A world not found is a :class:`GzArgsError`.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ BUILT_IN_WORLDS = {'empty.sdf': 'ground', 'empty': 'ground'}
 WORLD_SUFFIXES = ('.sdf', '.world', '.sdf.xacro')
 RESOURCE_PATHS = ('GZ_SIM_RESOURCE_PATH', 'IGN_GAZEBO_RESOURCE_PATH')
 # gz sim's options that take a value (the next word), and those that take none.
-WITH_VALUE = ('--iterations', '-z', '--levels', '--network-role', '--network-secondaries',
+WITH_VALUE = ('--iterations', '-z', '--network-role', '--network-secondaries',
               '--record-path', '--record-topic', '--playback', '--physics-engine',
               '--render-engine', '--render-engine-gui', '--render-engine-server',
               '--render-engine-api-backend', '--render-engine-gui-api-backend',
@@ -47,6 +48,7 @@ class Server:
     ros_arguments: list[str]
     warnings: list[str]
     run: bool = True  # False: a GUI-only gz sim, nothing to start
+    shutdown_on_exit: bool = False  # the launch ends when sim_node ends
 
 
 def server(gz_args: str, environ: dict[str, str] | None = None,
@@ -63,6 +65,8 @@ def server(gz_args: str, environ: dict[str, str] | None = None,
         word = words[index]
         index += 1
         option, has_value, value = word.partition('=')
+        if word.startswith('-v') and word[2:].isdigit():  # `-v4`, as OptionParser reads it
+            option, has_value, value = '-v', '=', word[2:]
         if word == '-r':
             running = True
         elif word in ('-s', '--headless-rendering'):
@@ -74,15 +78,17 @@ def server(gz_args: str, environ: dict[str, str] | None = None,
                 value, index = words[index], index + 1
             verbosity = int(value) if value.isdigit() else DEFAULT_VERBOSITY_FLAG
         elif option in WITH_VALUE:
-            if not has_value and index < len(words):
+            if not has_value and index < len(words) and not words[index].startswith('-'):
                 value, index = words[index], index + 1
-            warnings.append(f"gz_args: '{option} {value}' is not honoured by sim_node")
+            named = f'{option} {value}' if value else option
+            warnings.append(f"gz_args: '{named}' is not honoured by sim_node")
         elif word.startswith('-'):
             warnings.append(f"gz_args: '{word}' is not honoured by sim_node")
-        elif world is None:
-            world = word
         else:
-            raise GzArgsError(f"gz_args '{gz_args}': two worlds, '{world}' and '{word}'")
+            if world is not None:
+                warnings.append(f"gz_args: '{world}' is not honoured by sim_node (gz sim "
+                                'loads the last world given)')
+            world = word
     if gui_only:
         return Server({}, [], warnings + [
             "gz_args: '-g' starts only Gazebo's GUI: nothing to start (sim_node is headless; "

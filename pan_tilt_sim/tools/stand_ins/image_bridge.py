@@ -2,7 +2,8 @@
 
 ``image_bridge TOPIC [TOPIC ...]`` (node ``ros_gz_image``, parameter ``qos``): each
 gz image topic appears on ROS under the same name (:mod:`.bridging`); the stand-in
-stays until stopped.  image_transport's compressed topics are not made (a warning).
+stays until stopped.  image_transport's compressed topics are not made, nor is a
+``qos`` other than ``default`` applied (a warning each).
 """
 
 from __future__ import annotations
@@ -41,6 +42,10 @@ def _bridge(node, topics: list[str]) -> int:
     if qos not in QOS_CHOICES:
         node.get_logger().error(
             f'Invalid QoS profile {qos} specified. Using default profile.')
+    elif qos != 'default':
+        node.get_logger().warning(
+            f"qos '{qos}' is not honoured: sim_node publishes the images reliable, which "
+            'reliable and best-effort subscribers both receive')
     node.get_logger().warning(
         "image_transport's compressed and theora topics are not made: raw images only")
     entries = [absolute(node, BridgeEntry(topic, topic, 'sensor_msgs/msg/Image',

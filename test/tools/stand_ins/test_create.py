@@ -36,6 +36,11 @@ def test_a_flag_gflags_does_not_know_exits_1_with_its_line():
     assert (code, output.strip()) == (1, "ERROR: unknown command line flag 'colour'")
 
 
+def test_help_prints_the_usage_and_exits_1_as_gflags_does():
+    code, output = finish(None, run('--help'))
+    assert code == 1 and 'Usage: create -world [arg]' in output and '-allow_renaming' in output
+
+
 def test_it_exits_0_once_the_robot_is_in_and_a_taken_name_fails_unless_renaming(tmp_path):
     urdf = tmp_path / 'rover.urdf'
     urdf.write_text(plugin_rover_urdf())

@@ -129,6 +129,20 @@ def test_image_bridge_hands_its_image_topics_over_and_without_topics_prints_its_
         assert code == 0, output
 
 
+def test_image_bridge_names_a_qos_it_does_not_apply_in_one_warning():
+    with world_only() as (harness, node):
+        process = start('image_bridge', '/camera/image_raw', '--ros-args', '-p',
+                        'qos:=sensor_data')
+        try:
+            assert harness.spin_until(lambda: '/ros_gz_image' in node.bridged_topics._sources,
+                                      BUDGET_S), 'image_bridge never handed over'
+        finally:
+            process.send_signal(signal.SIGINT)
+            code, output = finish(harness, process)
+        assert code == 0, output
+        assert output.count("qos 'sensor_data' is not honoured") == 1, output
+
+
 def test_ros_names_are_the_bridge_nodes_and_gz_names_absolute_unless_expanded():
     from node_harness import NodeHarness
     from rclpy.node import Node
