@@ -596,10 +596,11 @@ class SimNode(Node):
             logger.warning(warning)
         manager = self.simulation.manager
         if not self.settings.autostart_controllers and self.topic_hardware is None:
-            logger.info(
-                f'no controller loaded: waiting for spawners at '
-                f"{self.controller_manager.get_fully_qualified_name()} (declared in "
-                f"{controllers.label}: {', '.join(manager.declared) or 'none'})")
+            if self.controller_manager is not None:  # None: its Gazebo plugins run it
+                logger.info(
+                    f'no controller loaded: waiting for spawners at '
+                    f"{self.controller_manager.get_fully_qualified_name()} (declared in "
+                    f"{controllers.label}: {', '.join(manager.declared) or 'none'})")
             return
         for skipped in manager.skipped:
             logger.info(f"controller '{skipped.name}' (type '{skipped.type}') skipped: "

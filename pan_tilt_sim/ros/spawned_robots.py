@@ -115,7 +115,7 @@ class SpawnedRobot:
         try:
             require_ground(self.simulation, world)
             # Its controllers' gains are parameters of its own controller manager node.
-            manager_node = self._manager_node(description)
+            manager_node = self._manager_node(description, controllers)
             self.bindings = startup.bind_controllers(
                 node, self.simulation, None,
                 GainParameters(manager_node if manager_node is not None else node), reader,
@@ -137,9 +137,11 @@ class SpawnedRobot:
         """Absolute name of a topic of this robot."""
         return naming.join(self.namespace, *names)
 
-    def _manager_node(self, description: RobotDescription) -> Node | None:
-        if not description.model.ros2_control or not optional_interfaces.available(
-                'controller_manager_msgs'):
+    def _manager_node(self, description: RobotDescription,
+                      controllers: ControllersConfig) -> Node | None:
+        if not startup.has_controller_manager(
+                description.model, controllers, is_controller_manager=False) or (
+                not optional_interfaces.available('controller_manager_msgs')):
             return None
         from pan_tilt_sim.ros.controller_manager import ControllerManagerNode
 

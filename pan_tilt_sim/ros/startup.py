@@ -18,12 +18,14 @@ from pan_tilt_sim.errors import ParameterError
 from pan_tilt_sim.model import naming
 from pan_tilt_sim.model.controller_config import (
     CONTROLLERS_ARGS,
+    NO_CONTROLLERS_FILE,
     ControllersConfig,
     controllers_files_for,
     load_controllers_config,
     parse_controllers_args,
 )
 from pan_tilt_sim.model.description import RobotDescription
+from pan_tilt_sim.model.robot import RobotModel
 from pan_tilt_sim.model.ros_arguments import RosArguments
 from pan_tilt_sim.plugins.registry import runs_by_plugins
 from pan_tilt_sim.ros import command_reader, drop_in, optional_interfaces, topic_hardware
@@ -166,6 +168,21 @@ def make_features(node: Node, simulation: Simulation, namespace: str, settings: 
         publish_tf_default=not is_controller_manager)
 
 
+def has_controller_manager(model: RobotModel, controllers: ControllersConfig, *,
+                           is_controller_manager: bool) -> bool:
+    """Return whether the robot has a controller manager, as upstream would make one.
+
+    sim_node in ros2_control_node's place is one; a gz_ros2_control /
+    gazebo_ros2_control plugin beside a ``<ros2_control>`` block makes one; so
+    do controllers read from a file (the user's ``controllers_file``, the
+    plugin's ``<parameters>``, the pan/tilt example's).  A robot that only its
+    Gazebo plugins run (diff drive, joint state publisher; no controllers
+    file) has none, as in Gazebo: no ``controller_manager`` node for it.
+    """
+    return (is_controller_manager or controllers.source != NO_CONTROLLERS_FILE
+            or bool(model.ros2_control and model.control_plugins))
+
+
 def serve_controller_manager(node: Node, bindings: ControllerBindings, simulation: Simulation,
                              controllers: ControllersConfig, settings: SimParameters,
                              arguments: RosArguments, namespace: str, *, topic_mode: bool,
@@ -177,7 +194,8 @@ def serve_controller_manager(node: Node, bindings: ControllerBindings, simulatio
     caller spins and destroys with ``node`` (``manager_node``, a
     :class:`ControllerManagerNode` made beforehand, or a new one); None on
     topic-based hardware (the user's own controller_manager runs) or without
-    controller_manager_msgs.
+    controller_manager_msgs, or for a robot that has none
+    (:func:`has_controller_manager`).
     """
     if topic_mode:
         return None
@@ -187,6 +205,9 @@ def serve_controller_manager(node: Node, bindings: ControllerBindings, simulatio
                 "parameter 'autostart_controllers' is false, but controller_manager_msgs "
                 'is not installed: no spawner could load a controller '
                 '(scripts/build_interfaces.sh builds it)')
+        return None
+    if not has_controller_manager(simulation.description.model, controllers,
+                                  is_controller_manager=is_controller_manager):
         return None
     from pan_tilt_sim.ros.controller_manager import (
         ControllerManagerNode,

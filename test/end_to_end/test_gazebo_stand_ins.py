@@ -160,6 +160,13 @@ def test_a_bridge_config_gives_the_robots_gz_topics_their_ros_names_and_types(
         'existed before its bridge handed over' in outputs['sim_node']), outputs['sim_node']
 
 
+def services_of(harness: NodeHarness, node: str) -> set[str]:
+    """The services the graph shows for node ``/<node>`` (none while it is not seen yet)."""
+    if (node, '/') not in harness.probe.get_node_names_and_namespaces():
+        return set()
+    return {name for name, _types in harness.probe.get_service_names_and_types_by_node(node, '/')}
+
+
 def test_a_top_level_file_in_nav2_bringups_shape_brings_its_xacro_world_and_the_spawn_file(
         monkeypatch, tmp_path):
     # The world is written by `xacro -o` while gz_sim.launch.py starts; the robot comes
@@ -181,12 +188,17 @@ def test_a_top_level_file_in_nav2_bringups_shape_brings_its_xacro_world_and_the_
         assert launch.wait_for_exit('create', EXIT_BUDGET_S) == 0, launch.output('create')
         assert harness.spin_until(lambda: odometry), 'no /odom'
         entities = harness.call(GetEntities, '/gzserver/get_entities', GetEntities.Request())
+        # Its gz systems alone run it: no controller manager, as in Gazebo (only
+        # gz_ros2_control's plugin makes one).  /reset_simulation is made after it would be.
+        assert harness.spin_until(lambda: '/reset_simulation' in services_of(harness, 'gzserver'))
+        nodes = harness.probe.get_node_names_and_namespaces()
     finally:
         harness.close()
         outputs = launch.close()
     assert {'crate', 'rover'} <= set(entities.entities), (entities.entities,
                                                           outputs['sim_node'])
     assert not world.exists()  # its OnShutdown removed it, as nav2_bringup's does
+    assert [node for node in nodes if node[0] == 'controller_manager'] == [], nodes
 
 
 def namespaced_rover_xacro() -> str:

@@ -205,6 +205,31 @@ def test_delete_entity_takes_the_first_robot_away_and_the_world_runs_on():
         assert abs(x_of(robot2)) < 0.01 and abs(x_of(robot3)) < 0.01
 
 
+def managers(node) -> list[tuple[str, str]]:
+    """The controller manager nodes of the ROS graph, as ``ros2 node list`` shows them."""
+    return [(name, namespace) for name, namespace in node.get_node_names_and_namespaces()
+            if name == 'controller_manager']
+
+
+def test_robots_their_gazebo_plugins_run_have_no_controller_manager_first_or_later():
+    # As in Gazebo, where only gz_ros2_control's plugin makes one; the second rover has a
+    # <ros2_control> block but no such plugin, which makes none either.
+    if importlib.util.find_spec('controller_manager_msgs') is None:
+        pytest.skip('controller_manager_msgs is not installed')
+    with world_only() as (harness, node):
+        first = spawn(harness, name='robot1', resource_string=rover(), namespace='robot1')
+        with_block = rover_urdf('rover', extra=f'<gazebo>{ROS2_DIFF_DRIVE}</gazebo>')
+        second = spawn(harness, name='robot2', resource_string=with_block, namespace='robot2',
+                       y=1.0)
+        assert first.result.result == 1 and second.result.result == 1, second
+        assert node.controller_manager is None
+        assert node.spawned_robots['robot2'].controller_manager is None
+        assert managers(node) == []
+        drivers = Drivers(harness)  # and they run as before
+        assert spin_driving(harness, drivers, {'/robot2/cmd_vel': SPEED},
+                            lambda: x_of(node.spawned_robots['robot2'].simulation) > 0.3)
+
+
 def test_deleting_a_first_robot_with_ros2_control_takes_its_controller_manager(tmp_path):
     from drop_in_fixtures import MANAGER_YAML
     from ros2_control_fixtures import write_arm
@@ -332,10 +357,9 @@ def test_a_second_robot_with_ros2_control_gets_a_controller_manager_of_its_own(t
             positions = arm2.joint_positions()
             return abs(positions['joint1'] - 0.5) < 0.02 and abs(positions['joint2'] + 0.5) < 0.02
         assert harness.spin_until(commanded_and_there, BUDGET_S)
-        # The first robot's controller manager is another one: arm2's controllers are not there.
-        assert Spawner(sim, manager='/robot1/controller_manager').controllers() == {}
+        # The only one: the first robot (its plugins run it) has none, as in Gazebo.
+        assert managers(node) == [('controller_manager', '/arm2')]
         # DeleteEntity takes its controller manager away with it.
-        assert ('controller_manager', '/arm2') in node.get_node_names_and_namespaces()
         response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
                                 srv().DeleteEntity.Request(entity='arm2'))
         assert response.result.result == 1, response.result.error_message

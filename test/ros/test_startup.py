@@ -156,3 +156,38 @@ def test_a_step_failing_before_the_threads_start_leaves_no_thread_and_no_publish
         assert probe.get_node_names() == ['probe']
     finally:
         probe.destroy_node()
+
+
+GZ_ROS2_CONTROL = ('<gazebo><plugin filename="gz_ros2_control-system" '
+                   'name="gz_ros2_control::GazeboSimROS2ControlPlugin"/></gazebo>')
+
+
+@pytest.mark.parametrize(('block', 'plugin', 'controllers_file', 'in_its_place', 'expected'), [
+    (False, '', False, False, False),  # its Gazebo plugins run it: none, as in Gazebo
+    (True, '', False, False, False),  # <ros2_control> alone makes none either
+    (True, GZ_ROS2_CONTROL, False, False, True),  # gz_ros2_control's manager
+    (False, '', True, False, True),  # the controllers file the user gave
+    (False, '', False, True, True),  # sim_node in ros2_control_node's place
+])
+def test_a_controller_manager_exists_where_upstream_makes_one(
+        tmp_path, block, plugin, controllers_file, in_its_place, expected):
+    from mobile_fixtures import ROS2_DIFF_DRIVE, rover_urdf
+
+    from pan_tilt_sim.model.controller_config import load_controllers_config
+
+    urdf = tmp_path / 'rover.urdf'
+    urdf.write_text(rover_urdf(ros2_control=block, extra=f'<gazebo>{ROS2_DIFF_DRIVE}</gazebo>'
+                                                          f'{plugin}'))
+    controllers = load_controllers_config([PAN_TILT_YAML] if controllers_file else [])
+    assert startup.has_controller_manager(load_description(urdf).model, controllers,
+                                          is_controller_manager=in_its_place) is expected
+
+
+def test_the_pan_tilt_example_keeps_its_controller_manager(context, pan_tilt):
+    node = Node('sim_node', context=context)
+    try:
+        controllers = choose(node, pan_tilt).config
+    finally:
+        node.destroy_node()
+    assert startup.has_controller_manager(pan_tilt.model, controllers,
+                                          is_controller_manager=False)
