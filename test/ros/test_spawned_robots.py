@@ -143,6 +143,19 @@ def test_robot2s_lidar_sees_robot1():
         assert ahead == pytest.approx(0.98, abs=0.03)
 
 
+def delete(harness, name: str) -> None:
+    """DeleteEntity ``name`` through sim_node's service; it must succeed."""
+    response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
+                            srv().DeleteEntity.Request(entity=name))
+    assert response.result.result == 1, response.result.error_message
+
+
+def topics_under(sim: SimUnderTest, name: str) -> list[str]:
+    """sim_node's own topics (published or subscribed) under ``/name/``."""
+    published, subscribed = sim.own_topics()
+    return [topic for topic in [*published, *subscribed] if topic.startswith(f'/{name}/')]
+
+
 def test_delete_entity_takes_robot2_and_its_topics_away():
     with world_only() as (harness, node):
         two_rovers(harness)
@@ -150,12 +163,8 @@ def test_delete_entity_takes_robot2_and_its_topics_away():
         published, subscribed = sim.own_topics()
         assert {'/robot2/scan', '/robot2/ground_truth', '/robot2/odom'} <= set(published)
         assert '/robot2/cmd_vel' in subscribed
-        response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
-                                srv().DeleteEntity.Request(entity='robot2'))
-        assert response.result.result == 1, response.result.error_message
-        published, subscribed = sim.own_topics()
-        assert not [topic for topic in [*published, *subscribed]
-                    if topic.startswith('/robot2/')]
+        delete(harness, 'robot2')
+        assert not topics_under(sim, 'robot2')
         assert 'robot2' not in node.spawned_robots and not node.simulation.guests
         entities = harness.call(srv().GetEntities, '/sim_node/get_entities').entities
         assert 'robot2' not in entities and 'robot1' in entities
@@ -176,12 +185,8 @@ def test_delete_entity_takes_the_first_robot_away_and_the_world_runs_on():
         published, subscribed = sim.own_topics()
         assert {'/robot1/scan', '/robot1/odom', '/robot1/camera/image_raw'} <= set(published)
         assert '/robot1/cmd_vel' in subscribed
-        response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
-                                srv().DeleteEntity.Request(entity='robot1'))
-        assert response.result.result == 1, response.result.error_message
-        published, subscribed = sim.own_topics()
-        assert not [topic for topic in [*published, *subscribed]
-                    if topic.startswith('/robot1/')]
+        delete(harness, 'robot1')
+        assert not topics_under(sim, 'robot1')
         assert not node.simulation.has_robot
         entities = harness.call(srv().GetEntities, '/sim_node/get_entities').entities
         assert 'robot1' not in entities and 'robot2' in entities
@@ -246,9 +251,7 @@ def test_deleting_a_first_robot_with_ros2_control_takes_its_controller_manager(t
                        y=1.0)
         assert first.result.result == 1 and second.result.result == 1, first
         assert ('controller_manager', '/arm1') in node.get_node_names_and_namespaces()
-        response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
-                                srv().DeleteEntity.Request(entity='arm1'))
-        assert response.result.result == 1, response.result.error_message
+        delete(harness, 'arm1')
         assert harness.spin_until(lambda: ('controller_manager', '/arm1') not in
                                   node.get_node_names_and_namespaces())
         drivers = Drivers(harness)
@@ -360,9 +363,7 @@ def test_a_second_robot_with_ros2_control_gets_a_controller_manager_of_its_own(t
         # The only one: the first robot (its plugins run it) has none, as in Gazebo.
         assert managers(node) == [('controller_manager', '/arm2')]
         # DeleteEntity takes its controller manager away with it.
-        response = harness.call(srv().DeleteEntity, '/sim_node/delete_entity',
-                                srv().DeleteEntity.Request(entity='arm2'))
-        assert response.result.result == 1, response.result.error_message
+        delete(harness, 'arm2')
         assert harness.spin_until(lambda: ('controller_manager', '/arm2') not in
                                   node.get_node_names_and_namespaces())
 
